@@ -1,0 +1,111 @@
+#pragma once
+/// @file contact.hpp
+/// The per-step frictional contact problem as a value, and the solvers that
+/// take it. A test can build a ContactProblem by hand; every solver has the same
+/// signature and returns a SolveResult (converged, iterations, residual).
+///
+/// The problem (paper section 3, its sign convention: conventions.hpp):
+///   s = W p + q                      relative surface positions (eq. 6 and 7)
+///   p_n <= 0, s_n <= 0, p_n s_n = 0  unilateral normal (eq. 8); bilateral at clamps and bonds: s_n = 0
+///   |p_t| <= mu tau;  s_t = 0 if |p_t| < mu tau;  s_t = -beta p_t, beta > 0, if |p_t| = mu tau  (eq. 8)
+///   tau = |p_n| (coulomb pair) or max(0, F_c - p_n) (clamp pair); bonded pairs: s = 0.
+/// The error vector v (eq. 9) is zero exactly at a solution (eq. 10); ||v||_2 [m]
+/// is the solver-independent residual every solver reports.
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "stackbeam/model.hpp"
+
+namespace stackbeam {
+
+/// One contact pair of the problem: its law and which rows of W/q/p are its
+/// normal and tangential components (-1: the component is absent, e.g. fixed by a support).
+struct ContactPair {
+    PairKind kind = PairKind::coulomb;
+    double friction_coefficient = 0.0;  ///< mu [-]
+    double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
+    int row_n = -1;                     ///< row of the normal component, or -1
+    int row_t = -1;                     ///< row of the tangential component, or -1
+};
+
+/// How tau in the friction limit mu*tau is taken (paper, after eq. 17).
+enum class TauRule {
+    current,        ///< tau from the current normal force p_n^j: Coulomb exactly
+    previous_step,  ///< tau from the converged previous step (the paper's fallback)
+};
+
+/// The per-step contact problem: s = W p + q with the pair laws.
+struct ContactProblem {
+    Eigen::MatrixXd W;                 ///< compliance [m/N], symmetric positive definite
+    Eigen::VectorXd q;                 ///< free term [m]: s when p = 0
+    std::vector<ContactPair> pairs;    ///< the pairs and their rows
+    TauRule tau_rule = TauRule::current;
+    Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (used with TauRule::previous_step)
+
+    int size() const { return static_cast<int>(q.size()); }
+    /// Throws InputError if the sizes, rows or laws are inconsistent.
+    void validate() const;
+};
+
+/// State of a pair at a solution.
+enum class PairState { stick, slip, open };
+const char* to_string(PairState state);
+
+/// tau [N] of pair `k` for the force vector p, by the problem's tau rule.
+double friction_normal_force(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+
+/// The paper's error vector v (eq. 9) for forces p and relative positions s = W p + q.
+Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+
+/// State of pair k at (p, s). A pair whose normal force is zero and may open is
+/// open; a tangential force at the friction limit (relative 1e-9) is slip; bonded pairs stick.
+PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+
+/// The available solvers.
+enum class SolverKind {
+    paper,        ///< eq. 17 with E = I and constant alpha (the faithful reference; slow)
+    accelerated,  ///< eq. 17 with E = per-pair 2x2 block inverse of W, Gauss-Seidel sweeps (Lee 1989 style)
+    exact,        ///< active-set direct solver, factorisation reused while the modes stay (default)
+};
+const char* to_string(SolverKind kind);
+/// Parses "paper" | "accelerated" | "exact"; throws InputError naming `field`.
+SolverKind parse_solver_kind(const std::string& text, const std::string& field);
+
+struct SolverOptions {
+    SolverKind kind = SolverKind::exact;
+    double tolerance_m = 2e-6;        ///< stop when ||v||_2 < tolerance_m [m] (paper: 2e-6)
+    int max_iterations = 200000;      ///< iteration limit of the iterative solvers
+    double alpha = 0.0;               ///< paper solver: alpha [N/m]; 0 = alpha_fraction * 2 / lambda_max(W)
+    double alpha_fraction = 0.9;      ///< paper solver: alpha as a fraction of the stability bound 2/lambda_max(W)
+    int max_active_set_iterations = 200;  ///< exact solver: mode switches before it falls back
+};
+
+/// What a solve reports. A solve that does not converge says so; it never passes silently.
+struct SolveResult {
+    bool converged = false;
+    int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact)
+    double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
+    int factorizations = 0;    ///< dense factorisations done in this solve (exact solver)
+    bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
+    std::string message;       ///< why it did not converge, when it did not
+};
+
+/// A contact solver. It may keep data derived from W between calls (factorisations,
+/// eigenvalues): it notices when W changes.
+class ContactSolver {
+public:
+    virtual ~ContactSolver() = default;
+    /// Solves `problem`; p is the warm start on entry and the forces [N] on exit.
+    virtual SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) = 0;
+    virtual SolverKind kind() const = 0;
+};
+
+/// Creates the solver named in `options`. Throws InputError for bad options.
+std::unique_ptr<ContactSolver> make_solver(const SolverOptions& options);
+
+/// Largest eigenvalue of a symmetric matrix [same units as W].
+double largest_eigenvalue(const Eigen::MatrixXd& W);
+
+}  // namespace stackbeam

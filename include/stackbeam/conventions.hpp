@@ -1,0 +1,36 @@
+#pragma once
+/// @file conventions.hpp
+/// Units and sign conventions of stackbeam, stated once and used everywhere.
+///
+/// Units: SI throughout (m, s, kg, N, Pa, J). Names carry the unit where it
+/// could be ambiguous (`length_m`, `mass_kg`, `preload_n`).
+///
+/// Axes:
+///  - x runs along the leaves [m]; every leaf lies on x_start_m <= x <= x_start_m + length_m.
+///  - y is the stack's normal direction, positive UP. Leaves are listed from the
+///    TOP of the stack to the bottom: leaf 0 is the top leaf.
+///  - Beam degrees of freedom per node: axial displacement u (+x) [m],
+///    transverse displacement v (+y) [m], rotation theta = dv/dx (counter-clockwise) [rad].
+///  - A point at height y above a leaf's centroid moves axially by u - y*theta
+///    (plane sections, Bernoulli-Euler); so the top surface moves u - (h/2) theta
+///    and the bottom surface u + (h/2) theta (paper eq. 1).
+///
+/// Rigid body R: its displacement w [m] is along +y (up); its initial velocity
+/// sets the direction of the motion. Output "w positive in the direction of the
+/// initial velocity" is met by giving the paper example an initial velocity of
+/// +2 m/s (the example is mirror-symmetric in y, so the sign is immaterial).
+///
+/// Contact (the paper's convention, eqs. 7-10, kept so the equations read as printed):
+///  - Interface i lies between leaf i (upper, body "A") and leaf i+1 (lower, body "B").
+///  - The pair normal n points from A into B, i.e. DOWN (-y); the tangent t is +x.
+///  - Relative position s = u^A - u^B - d (eq. 7), with u the surface
+///    displacements along n and t. s_n > 0 is interpenetration, s_n < 0 an open gap.
+///    d_n is the initial gap [m] (>= 0), d_t the tangential anchor [m].
+///  - The contact force p acts on A along (n, t) and its reaction -p on B.
+///    p_n < 0 is COMPRESSION; p_n = 0 open. p_t > 0 pushes the upper leaf in +x.
+///  - Coulomb: |p_t| <= mu * tau, tau = |p_n| (unilateral pair) or
+///    max(0, F_c - p_n) at a clamp with preload F_c (compression adds to the preload).
+///  - Slip opposes the force: s_t = -beta p_t, beta > 0 (eq. 8).
+///
+/// Energies are whole-spring values also on the half model (doubled there).
+namespace stackbeam {}

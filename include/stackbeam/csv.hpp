@@ -1,0 +1,16 @@
+#pragma once
+/// @file csv.hpp
+/// CSV output of step records, to a stream the caller provides.
+#include <ostream>
+#include <vector>
+
+#include "stackbeam/simulation.hpp"
+
+namespace stackbeam {
+
+/// Writes a header line (step_record_columns()) and one line per record, full precision.
+void write_csv(std::ostream& out, const std::vector<StepRecord>& records);
+void write_csv_header(std::ostream& out);
+void write_csv_row(std::ostream& out, const StepRecord& record);
+
+}  // namespace stackbeam

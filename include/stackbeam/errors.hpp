@@ -1,0 +1,42 @@
+#pragma once
+/// @file errors.hpp
+/// Exceptions thrown by stackbeam. Every message names the parameter, the value
+/// and what is allowed (InputError), or carries the diagnostics of a numerical
+/// failure (SolverError).
+#include <stdexcept>
+#include <string>
+
+namespace stackbeam {
+
+/// Bad input: a field of a model or option out of range, inconsistent geometry.
+/// `field()` is the path of the offending field, e.g. "leaves[2].height_m".
+class InputError : public std::invalid_argument {
+public:
+    InputError(std::string field, const std::string& message)
+        : std::invalid_argument(field + ": " + message), field_(std::move(field)) {}
+    const std::string& field() const noexcept { return field_; }
+
+private:
+    std::string field_;
+};
+
+/// A numerical procedure that did not reach its goal: a contact iteration that
+/// hit its iteration limit, a time integrator failure. Carries where it happened.
+class SolverError : public std::runtime_error {
+public:
+    SolverError(const std::string& message, long step, double time_s, double residual)
+        : std::runtime_error(message), step_(step), time_s_(time_s), residual_(residual) {}
+    long step() const noexcept { return step_; }         ///< step index (1-based) at failure
+    double time_s() const noexcept { return time_s_; }   ///< time at failure [s]
+    double residual() const noexcept { return residual_; } ///< residual reached (solver units)
+
+private:
+    long step_;
+    double time_s_;
+    double residual_;
+};
+
+/// Formats "value" for messages with full precision.
+std::string format_value(double value);
+
+}  // namespace stackbeam

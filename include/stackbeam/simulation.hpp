@@ -1,0 +1,108 @@
+#pragma once
+/// @file simulation.hpp
+/// Time stepping of the rigid body on the massless stack, and the per-step results.
+///
+/// Mode "closed-form" is the paper's reference scheme (section 4): the contact
+/// forces vary linearly over a step (eq. 14), so the motion of R has the exact
+/// solution (eq. 16)
+///     w(t') = k1 sin(omega t') + k2 cos(omega t') + [F(t) + (F(t+dt) - F(t)) (t'-t)/dt] / k,
+/// with omega = sqrt(k/m), F = c^T p the force of the contact forces on R. Hence
+///     w(t+dt) = w_free + (gamma/k) c^T p(t+dt),   gamma = 1 - sin(omega dt)/(omega dt),
+/// and the contact problem at t+dt is s = W p + q with
+///     W = C' + (gamma/k) c c^T  (constant for a fixed dt),  q = c w_free - d,
+/// which the chosen solver resolves (the paper's 8-step algorithm with the
+/// paper solver: steps 3-8 are its iteration on this problem).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "stackbeam/contact.hpp"
+#include "stackbeam/system.hpp"
+
+namespace stackbeam {
+
+/// Whole-spring values at the end of a step (also on the half model). SI units.
+struct StepRecord {
+    double t_s = 0.0;                   ///< time [s]
+    double w_m = 0.0;                   ///< displacement of R [m] (+y; the initial velocity's direction in the example)
+    double w_dot_m_per_s = 0.0;         ///< velocity of R [m/s]
+    double force_on_mass_n = 0.0;       ///< m * d2w/dt2 = -(force of R on the stack) [N]
+    double probe_friction_force_n = 0.0;///< tangential contact force p_t at the probe pair [N] (NaN: no probe)
+    int contact_iterations = 0;         ///< solver iterations of this step
+    int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
+    double kinetic_energy_j = 0.0;      ///< m w_dot^2 / 2 [J]
+    double strain_energy_j = 0.0;       ///< elastic energy of the leaves [J]
+    double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
+    double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
+    double contact_residual_m = 0.0;    ///< ||v||_2 (eq. 9) at the converged forces [m]
+    int factorizations = 0;             ///< dense factorisations of the step (exact solver)
+};
+
+/// Column names of StepRecord in CSV order.
+std::vector<std::string> step_record_columns();
+/// Values of a record in the order of step_record_columns().
+std::vector<double> step_record_values(const StepRecord& r);
+
+enum class Mode { closed_form };
+const char* to_string(Mode m);
+Mode parse_mode(const std::string& text, const std::string& field);
+
+struct SimulationOptions {
+    Mode mode = Mode::closed_form;
+    double dt_s = 1e-3;        ///< time step [s] (paper: 1e-3)
+    double t_end_s = 0.6;      ///< end time [s]
+    SolverOptions solver;      ///< contact solver and its tolerance (paper: ||v|| < 2e-6 m)
+    TauRule tau_rule = TauRule::current;
+    /// Throw SolverError when a step's contact solve does not converge (default);
+    /// if false the step is kept and flagged by its residual.
+    bool stop_on_nonconvergence = true;
+    /// Throws InputError naming the option when a value is out of range.
+    void validate() const;
+};
+
+/// The paper's closed-form stepping (mode "closed-form").
+class ClosedFormStepper {
+public:
+    ClosedFormStepper(const System& system, const SimulationOptions& options);
+
+    /// Advances one step of dt. Throws SolverError (step, time, residual) if the
+    /// contact solve fails and options.stop_on_nonconvergence.
+    const StepRecord& step();
+    const StepRecord& current() const noexcept { return record_; }
+    long step_index() const noexcept { return step_; }
+
+    /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
+    const Eigen::VectorXd& contact_forces() const noexcept { return p_; }
+    /// Relative surface positions s + d [m] per row (normal: approach, tangential: slip position).
+    const Eigen::VectorXd& relative_positions() const noexcept { return rel_; }
+    /// Tangential anchors d_t and normal gaps d_n [m] per row.
+    const Eigen::VectorXd& anchors() const noexcept { return d_; }
+    /// State of each pair of system().pairs().
+    std::vector<PairState> pair_states() const;
+    /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
+    const ContactProblem& last_problem() const noexcept { return problem_; }
+    const SolveResult& last_solve() const noexcept { return solve_; }
+    const System& system() const noexcept { return system_; }
+    double omega_rad_per_s() const noexcept { return omega_; }
+
+private:
+    const System& system_;
+    SimulationOptions options_;
+    std::unique_ptr<ContactSolver> solver_;
+    ContactProblem problem_;
+    SolveResult solve_;
+    Eigen::VectorXd p_, d_, rel_;
+    double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
+    double omega_ = 0.0, cos_ = 1.0, sin_ = 0.0, gamma_ = 0.0;
+    double e0_ = 0.0, dissipated_ = 0.0;
+    long step_ = 0;
+    StepRecord record_;
+    void fill_record(int iterations, int factorizations);
+};
+
+/// Runs from t = 0 to options.t_end_s; the first record is the initial state.
+/// `on_step` (optional) sees every record as it is made.
+std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
+                                 const std::function<void(const StepRecord&)>& on_step = {});
+
+}  // namespace stackbeam

@@ -1,0 +1,136 @@
+// The contact problem: validation, the paper's error vector (eq. 9), pair
+// states, the friction limit, and the solver factory.
+#include "stackbeam/contact.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+
+#include "contact_solvers.hpp"
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+const char* to_string(PairState state) {
+    switch (state) {
+        case PairState::stick: return "stick";
+        case PairState::slip: return "slip";
+        case PairState::open: return "open";
+    }
+    return "?";
+}
+
+const char* to_string(SolverKind kind) {
+    switch (kind) {
+        case SolverKind::paper: return "paper";
+        case SolverKind::accelerated: return "accelerated";
+        case SolverKind::exact: return "exact";
+    }
+    return "?";
+}
+
+SolverKind parse_solver_kind(const std::string& text, const std::string& field) {
+    if (text == "paper") return SolverKind::paper;
+    if (text == "accelerated") return SolverKind::accelerated;
+    if (text == "exact") return SolverKind::exact;
+    throw InputError(field, "value '" + text + "' is not a solver: allowed paper, accelerated, exact");
+}
+
+void ContactProblem::validate() const {
+    const int n = size();
+    if (W.rows() != n || W.cols() != n)
+        throw InputError("problem.W", "is " + std::to_string(W.rows()) + "x" + std::to_string(W.cols()) +
+                                          ": must be square of the size of q (" + std::to_string(n) + ")");
+    if (!W.allFinite()) throw InputError("problem.W", "has a non-finite entry");
+    if (!q.allFinite()) throw InputError("problem.q", "has a non-finite entry");
+    std::vector<int> used(n, 0);
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+        const auto& c = pairs[k];
+        const std::string f = "problem.pairs[" + std::to_string(k) + "]";
+        for (int r : {c.row_n, c.row_t}) {
+            if (r < -1 || r >= n) throw InputError(f + ".row", "value " + std::to_string(r) + " is outside 0.." + std::to_string(n - 1));
+            if (r >= 0 && used[r]++) throw InputError(f + ".row", "row " + std::to_string(r) + " belongs to two components");
+        }
+        if (!std::isfinite(c.friction_coefficient) || c.friction_coefficient < 0.0)
+            throw InputError(f + ".friction_coefficient", "value " + format_value(c.friction_coefficient) + " must be finite and >= 0");
+        if (!std::isfinite(c.preload_n) || c.preload_n < 0.0)
+            throw InputError(f + ".preload_n", "value " + format_value(c.preload_n) + " must be finite and >= 0");
+    }
+    for (int r = 0; r < n; ++r)
+        if (!used[r]) throw InputError("problem.pairs", "row " + std::to_string(r) + " belongs to no pair");
+    if (tau_rule == TauRule::previous_step && tau_previous_n.size() != static_cast<Eigen::Index>(pairs.size()))
+        throw InputError("problem.tau_previous_n", "needs one entry per pair with TauRule::previous_step");
+}
+
+double friction_normal_force(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
+    const auto& c = problem.pairs[k];
+    const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0;
+    if (c.kind == PairKind::clamp) {
+        if (problem.tau_rule == TauRule::previous_step) return problem.tau_previous_n[k];
+        return std::max(0.0, c.preload_n - pn);
+    }
+    if (c.kind == PairKind::coulomb) {
+        if (pn >= 0.0) return 0.0;  // open: no normal force, no friction
+        return problem.tau_rule == TauRule::previous_step ? problem.tau_previous_n[k] : -pn;
+    }
+    return std::numeric_limits<double>::infinity();  // bonded: no limit
+}
+
+Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(s.size());
+    for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+        const auto& c = problem.pairs[k];
+        if (c.row_n >= 0) {
+            const double pn = p[c.row_n], sn = s[c.row_n];
+            // eq. 9, normal: v_n = s_n if p_n < 0 or s_n > 0, else 0; bilateral pairs: v_n = s_n.
+            if (c.kind != PairKind::coulomb || pn < 0.0 || sn > 0.0) v[c.row_n] = sn;
+        }
+        if (c.row_t >= 0) {
+            const double pt = p[c.row_t], st = s[c.row_t];
+            if (c.kind == PairKind::bonded) {
+                v[c.row_t] = st;
+                continue;
+            }
+            // eq. 9, tangential: v_t = s_t while sticking or while slipping with the force.
+            const double limit = c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p);
+            if (limit <= 0.0) continue;
+            if (std::abs(pt) < limit || pt * st > 0.0) v[c.row_t] = st;
+        }
+    }
+    return v;
+}
+
+PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
+    const auto& c = problem.pairs[k];
+    if (c.kind == PairKind::bonded) return PairState::stick;
+    if (c.kind == PairKind::coulomb && (c.row_n < 0 || p[c.row_n] >= 0.0)) return PairState::open;
+    if (c.row_t < 0) return PairState::stick;
+    const double limit = c.friction_coefficient * friction_normal_force(problem, k, p);
+    if (limit <= 0.0) return PairState::slip;
+    return std::abs(p[c.row_t]) >= limit * (1.0 - 1e-9) ? PairState::slip : PairState::stick;
+}
+
+double largest_eigenvalue(const Eigen::MatrixXd& W) {
+    if (W.rows() == 0) return 0.0;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(W, Eigen::EigenvaluesOnly);
+    return es.eigenvalues().maxCoeff();
+}
+
+std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
+    if (!std::isfinite(o.tolerance_m) || o.tolerance_m <= 0.0)
+        throw InputError("solver.tolerance_m", "value " + format_value(o.tolerance_m) + " must be finite and > 0 [m]");
+    if (o.max_iterations < 1)
+        throw InputError("solver.max_iterations", "value " + std::to_string(o.max_iterations) + " must be >= 1");
+    if (!std::isfinite(o.alpha) || o.alpha < 0.0)
+        throw InputError("solver.alpha", "value " + format_value(o.alpha) + " must be finite and >= 0 (0: automatic) [N/m]");
+    if (!std::isfinite(o.alpha_fraction) || o.alpha_fraction <= 0.0)
+        throw InputError("solver.alpha_fraction", "value " + format_value(o.alpha_fraction) + " must be finite and > 0");
+    switch (o.kind) {
+        case SolverKind::paper: return detail::make_projected_solver(o, false);
+        case SolverKind::accelerated: return detail::make_projected_solver(o, true);
+        case SolverKind::exact: return detail::make_exact_solver(o);
+    }
+    throw InputError("solver.kind", "unknown solver");
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,262 @@
+// The exact (active-set) contact solver.
+//
+// Every pair component is in one mode: a normal component is closed (s_n = 0)
+// or open (p_n = 0); a tangential one sticks (s_t = 0), slips with its force at
+// the limit (p_t = sigma mu tau, sigma = +-1, tau affine in the pair's own p_n)
+// or is free (p_t = 0: open pair, mu = 0, clamp pulled apart past its preload).
+// For a set of modes the problem is linear: the unknowns are the forces of the
+// components held by "s = 0" (set S); the others follow from them. So
+//     (W_SS + W_S,slip * dp_slip/dp_S) p_S = -(q_S + W_S,: e)
+// is solved with a dense LU, and the modes that violate their inequality are
+// switched until none does. W is constant between steps and the modes rarely
+// change, so the LU is kept and reused while the modes stay: most steps cost
+// one triangular solve and one product with W. A mode set seen twice means
+// cycling: the solver then switches one component at a time (the largest
+// violation), and if that fails too it finishes with Gauss-Seidel sweeps and
+// says so (SolveResult::fell_back).
+#include <Eigen/LU>
+#include <cmath>
+#include <set>
+
+#include "contact_solvers.hpp"
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam::detail {
+namespace {
+
+enum : signed char { NONE = 0, CLOSED = 1, OPEN = 2 };
+enum : signed char { STICK = 1, SLIP_POS = 2, SLIP_NEG = 3, FREE = 4 };
+
+class ExactSolver final : public ContactSolver {
+public:
+    explicit ExactSolver(const SolverOptions& o) : options_(o) {}
+    SolverKind kind() const override { return SolverKind::exact; }
+
+    SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
+        const int n = problem.size();
+        const int np = static_cast<int>(problem.pairs.size());
+        if (W_.rows() != n || W_ != problem.W || static_cast<int>(nmode_.size()) != np) {
+            problem.validate();
+            W_ = problem.W;
+            lu_modes_.clear();
+            if (p.size() != n) p = Eigen::VectorXd::Zero(n);
+            init_modes(problem, p);
+        }
+        SolveResult r;
+        std::set<std::vector<signed char>> seen;
+        bool one_at_a_time = false;
+        for (int pass = 1; pass <= options_.max_active_set_iterations; ++pass) {
+            r.iterations = pass;
+            r.factorizations += solve_modes(problem, p);
+            std::vector<signed char> key = modes_key();
+            if (!seen.insert(key).second) one_at_a_time = true;
+            if (!switch_violations(problem, p, one_at_a_time)) {
+                r.converged = true;
+                break;
+            }
+        }
+        Eigen::VectorXd s = problem.W * p + problem.q;
+        r.residual_m = error_vector(problem, p, s).norm();
+        if (!r.converged) {
+            SolveResult gs = gauss_seidel_sweeps(problem, p, options_.tolerance_m, options_.max_iterations);
+            r.fell_back = true;
+            r.converged = gs.converged;
+            r.iterations += gs.iterations;
+            r.residual_m = gs.residual_m;
+            if (!gs.converged)
+                r.message = "exact solver cycled over its modes and the Gauss-Seidel fallback failed: " + gs.message;
+            init_modes(problem, p);
+            return r;
+        }
+        if (!(r.residual_m < options_.tolerance_m)) {
+            r.converged = false;
+            r.message = "exact solver found consistent modes but ||v|| = " + format_value(r.residual_m) +
+                        " m exceeds the tolerance " + format_value(options_.tolerance_m) + " m (ill-conditioned W?)";
+        }
+        return r;
+    }
+
+private:
+    SolverOptions options_;
+    Eigen::MatrixXd W_;
+    std::vector<signed char> nmode_, tmode_;
+    std::vector<signed char> lu_modes_;
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+    std::vector<int> S_;          // rows with s = 0, in order
+    std::vector<int> pos_;        // row -> index in S_ or -1
+    Eigen::VectorXd rhs_, x_, e_;
+
+    std::vector<signed char> modes_key() const {
+        std::vector<signed char> k(nmode_);
+        k.insert(k.end(), tmode_.begin(), tmode_.end());
+        return k;
+    }
+
+    static bool unilateral(const ContactPair& c) { return c.kind == PairKind::coulomb; }
+
+    void make_consistent(const ContactProblem& pr, int k) {
+        const auto& c = pr.pairs[k];
+        if (c.row_t < 0 || c.kind == PairKind::bonded) return;
+        const bool closed = c.row_n >= 0 ? nmode_[k] == CLOSED : !unilateral(c);
+        if (c.friction_coefficient == 0.0) {
+            tmode_[k] = FREE;
+        } else if (unilateral(c)) {
+            if (!closed) tmode_[k] = FREE;
+            else if (tmode_[k] == FREE) tmode_[k] = STICK;
+        }
+    }
+
+    void init_modes(const ContactProblem& pr, const Eigen::VectorXd& p) {
+        const int np = static_cast<int>(pr.pairs.size());
+        nmode_.assign(np, NONE);
+        tmode_.assign(np, NONE);
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0)
+                nmode_[k] = (!unilateral(c) || p[c.row_n] < 0.0 || pr.q[c.row_n] >= 0.0) ? CLOSED : OPEN;
+            if (c.row_t >= 0) {
+                if (c.kind == PairKind::bonded) {
+                    tmode_[k] = STICK;
+                } else {
+                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+                    const double pt = p[c.row_t];
+                    tmode_[k] = (limit > 0.0 && std::abs(pt) >= limit * (1.0 - 1e-9)) ? (pt > 0 ? SLIP_POS : SLIP_NEG) : STICK;
+                }
+                make_consistent(pr, k);
+            }
+        }
+    }
+
+    /// Solves the linear problem of the current modes; returns 1 if it factorised.
+    int solve_modes(const ContactProblem& pr, Eigen::VectorXd& p) {
+        const int n = pr.size();
+        const int np = static_cast<int>(pr.pairs.size());
+        const bool prev = pr.tau_rule == TauRule::previous_step;
+        // e: forces fixed by the modes; coupling of slip rows to their normal unknown.
+        e_.setZero(n);
+        std::vector<std::pair<int, int>> coupled;   // (tangential row, normal row)
+        std::vector<double> coef;                   // dp_t/dp_n
+        S_.clear();
+        pos_.assign(n, -1);
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && nmode_[k] == CLOSED) S_.push_back(c.row_n);
+            if (c.row_t >= 0 && tmode_[k] == STICK) S_.push_back(c.row_t);
+        }
+        for (std::size_t i = 0; i < S_.size(); ++i) pos_[S_[i]] = static_cast<int>(i);
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t < 0 || (tmode_[k] != SLIP_POS && tmode_[k] != SLIP_NEG)) continue;
+            const double sigma = tmode_[k] == SLIP_POS ? 1.0 : -1.0;
+            const double mu = c.friction_coefficient;
+            if (prev) {
+                e_[c.row_t] = sigma * mu * pr.tau_previous_n[k];
+            } else if (c.kind == PairKind::clamp) {  // p_t = sigma mu (F_c - p_n)
+                e_[c.row_t] = sigma * mu * c.preload_n;
+                if (c.row_n >= 0) {
+                    coupled.emplace_back(c.row_t, c.row_n);
+                    coef.push_back(-sigma * mu);
+                }
+            } else {  // coulomb: p_t = sigma mu (-p_n)
+                coupled.emplace_back(c.row_t, c.row_n);
+                coef.push_back(-sigma * mu);
+            }
+        }
+        const int m = static_cast<int>(S_.size());
+        int factorised = 0;
+        std::vector<signed char> key = modes_key();
+        if (m > 0 && key != lu_modes_) {
+            Eigen::MatrixXd M(m, m);
+            for (int j = 0; j < m; ++j)
+                for (int i = 0; i < m; ++i) M(i, j) = pr.W(S_[i], S_[j]);
+            for (std::size_t a = 0; a < coupled.size(); ++a) {
+                const int col = pos_[coupled[a].second];
+                for (int i = 0; i < m; ++i) M(i, col) += coef[a] * pr.W(S_[i], coupled[a].first);
+            }
+            lu_.compute(M);
+            lu_modes_ = std::move(key);
+            factorised = 1;
+        }
+        // rhs = -(q_S + (W e)_S)
+        rhs_.resize(m);
+        for (int i = 0; i < m; ++i) rhs_[i] = -pr.q[S_[i]];
+        for (int r = 0; r < n; ++r)
+            if (e_[r] != 0.0)
+                for (int i = 0; i < m; ++i) rhs_[i] -= pr.W(S_[i], r) * e_[r];
+        if (m > 0) x_ = lu_.solve(rhs_);
+        p = e_;
+        for (int i = 0; i < m; ++i) p[S_[i]] = x_[i];
+        for (std::size_t a = 0; a < coupled.size(); ++a) p[coupled[a].first] += coef[a] * p[coupled[a].second];
+        return factorised;
+    }
+
+    /// Switches the modes whose inequality fails at p; returns false when none fails.
+    bool switch_violations(const ContactProblem& pr, const Eigen::VectorXd& p, bool one_at_a_time) {
+        const Eigen::VectorXd s = pr.W * p + pr.q;
+        const double pscale = std::max(p.lpNorm<Eigen::Infinity>(), 1e-300);
+        const double sscale = std::max(pr.q.lpNorm<Eigen::Infinity>() + pr.W.lpNorm<Eigen::Infinity>() * pscale, 1e-300);
+        const double tp = 1e-10 * pscale, ts = 1e-10 * sscale;
+        const int np = static_cast<int>(pr.pairs.size());
+        struct Switch { int k; bool normal; signed char to; double size; };
+        std::vector<Switch> sw;
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && unilateral(c)) {
+                const double pn = p[c.row_n], sn = s[c.row_n];
+                if (nmode_[k] == CLOSED && pn > tp) sw.push_back({k, true, OPEN, pn / pscale});
+                if (nmode_[k] == OPEN && sn > ts) sw.push_back({k, true, CLOSED, sn / sscale});
+            }
+            if (c.row_t < 0 || c.kind == PairKind::bonded || c.friction_coefficient == 0.0) continue;
+            if (unilateral(c) && tmode_[k] == FREE) continue;  // follows the normal mode
+            const double pt = p[c.row_t], st = s[c.row_t];
+            const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0;
+            const bool clamp_released = c.kind == PairKind::clamp && pr.tau_rule == TauRule::current &&
+                                        c.preload_n - pn < -tp;
+            const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+            switch (tmode_[k]) {
+                case STICK:
+                    if (clamp_released) sw.push_back({k, false, FREE, (pn - c.preload_n) / pscale});
+                    else if (std::abs(pt) > limit + tp)
+                        sw.push_back({k, false, pt > 0 ? SLIP_POS : SLIP_NEG, (std::abs(pt) - limit) / pscale});
+                    break;
+                case SLIP_POS:
+                case SLIP_NEG: {
+                    const double sigma = tmode_[k] == SLIP_POS ? 1.0 : -1.0;
+                    if (clamp_released) sw.push_back({k, false, FREE, (pn - c.preload_n) / pscale});
+                    else if (sigma * st > ts) sw.push_back({k, false, STICK, sigma * st / sscale});
+                    break;
+                }
+                case FREE:  // a clamp that carried no friction
+                    if (c.kind == PairKind::clamp && c.preload_n - pn > tp)
+                        sw.push_back({k, false, STICK, (c.preload_n - pn) / pscale});
+                    break;
+                default: break;
+            }
+        }
+        if (sw.empty()) return false;
+        if (one_at_a_time) {
+            std::size_t best = 0;
+            for (std::size_t i = 1; i < sw.size(); ++i)
+                if (sw[i].size > sw[best].size) best = i;
+            sw = {sw[best]};
+        }
+        for (const auto& x : sw) {
+            if (x.normal) nmode_[x.k] = x.to;
+            else tmode_[x.k] = x.to;
+            if (x.normal && x.to == CLOSED && pr.pairs[x.k].row_t >= 0) tmode_[x.k] = STICK;
+            make_consistent(pr, x.k);
+        }
+        return true;
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& o) {
+    if (o.max_active_set_iterations < 1)
+        throw InputError("solver.max_active_set_iterations",
+                         "value " + std::to_string(o.max_active_set_iterations) + " must be >= 1");
+    return std::make_unique<ExactSolver>(o);
+}
+
+}  // namespace stackbeam::detail

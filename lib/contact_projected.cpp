@@ -1,0 +1,211 @@
+// The paper's projected iteration (eq. 17) with E = I, and its Gauss-Seidel
+// accelerated form (E = per-pair block inverse of W, applied pair by pair).
+#include <cmath>
+
+#include "contact_solvers.hpp"
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam::detail {
+namespace {
+
+double sign(double x) { return (x > 0.0) - (x < 0.0); }
+
+/// eq. 17 with E = I:
+///   p_bar = p - alpha s;  p_n = min(0, p_bar_n);
+///   p_t = sign(p_bar_t) min(|p_bar_t|, mu tau)  if v_t = s_t at the previous iterate,
+///       = sign(p_bar_t) mu tau                  if v_t = 0 != s_t (slipping with the right sign),
+/// iterated until ||v||_2 < tolerance (step 8 of the paper's algorithm).
+class PaperSolver final : public ContactSolver {
+public:
+    explicit PaperSolver(const SolverOptions& o) : options_(o) {}
+    SolverKind kind() const override { return SolverKind::paper; }
+
+    SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
+        const int n = problem.size();
+        if (p.size() != n) p = Eigen::VectorXd::Zero(n);
+        if (W_.rows() != n || W_ != problem.W) {
+            problem.validate();
+            W_ = problem.W;
+            lambda_max_ = largest_eigenvalue(W_);
+        }
+        const double alpha = options_.alpha > 0.0 ? options_.alpha : options_.alpha_fraction * 2.0 / lambda_max_;
+        SolveResult r;
+        Eigen::VectorXd s = problem.W * p + problem.q;
+        Eigen::VectorXd v = error_vector(problem, p, s);
+        r.residual_m = v.norm();
+        Eigen::VectorXd pbar(n);
+        while (r.residual_m >= options_.tolerance_m) {
+            if (r.iterations >= options_.max_iterations || !std::isfinite(r.residual_m)) {
+                r.message = "paper iteration (eq. 17, E = I, alpha = " + format_value(alpha) +
+                            " N/m) did not reach ||v|| < " + format_value(options_.tolerance_m) + " m in " +
+                            std::to_string(r.iterations) + " iterations; residual " + format_value(r.residual_m) +
+                            " m (alpha must be below 2/lambda_max(W) = " + format_value(2.0 / lambda_max_) + " N/m)";
+                return r;
+            }
+            pbar.noalias() = p - alpha * s;
+            for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+                const auto& c = problem.pairs[k];
+                if (c.row_n >= 0)
+                    p[c.row_n] = c.kind == PairKind::coulomb ? std::min(0.0, pbar[c.row_n]) : pbar[c.row_n];
+                if (c.row_t < 0) continue;
+                const int t = c.row_t;
+                if (c.kind == PairKind::bonded) {
+                    p[t] = pbar[t];
+                    continue;
+                }
+                const double limit = c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p);
+                const bool slipping = v[t] == 0.0 && s[t] != 0.0;
+                p[t] = slipping ? sign(pbar[t]) * limit : sign(pbar[t]) * std::min(std::abs(pbar[t]), limit);
+            }
+            s.noalias() = problem.W * p;
+            s += problem.q;
+            v = error_vector(problem, p, s);
+            r.residual_m = v.norm();
+            ++r.iterations;
+        }
+        r.converged = true;
+        return r;
+    }
+
+private:
+    SolverOptions options_;
+    Eigen::MatrixXd W_;
+    double lambda_max_ = 0.0;
+};
+
+class GaussSeidelSolver final : public ContactSolver {
+public:
+    explicit GaussSeidelSolver(const SolverOptions& o) : options_(o) {}
+    SolverKind kind() const override { return SolverKind::accelerated; }
+    SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
+        if (W_.rows() != problem.size() || W_ != problem.W) {
+            problem.validate();
+            W_ = problem.W;
+        }
+        if (p.size() != problem.size()) p = Eigen::VectorXd::Zero(problem.size());
+        return gauss_seidel_sweeps(problem, p, options_.tolerance_m, options_.max_iterations);
+    }
+
+private:
+    SolverOptions options_;
+    Eigen::MatrixXd W_;
+};
+
+}  // namespace
+
+std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& o, bool gauss_seidel) {
+    if (gauss_seidel) return std::make_unique<GaussSeidelSolver>(o);
+    return std::make_unique<PaperSolver>(o);
+}
+
+void solve_pair_locally(const ContactProblem& problem, int k, const Eigen::MatrixXd& W, double bn, double bt,
+                        Eigen::VectorXd& p) {
+    const auto& c = problem.pairs[k];
+    const int rn = c.row_n, rt = c.row_t;
+    const double mu = c.friction_coefficient;
+    const bool prev = problem.tau_rule == TauRule::previous_step;
+    const double tau_prev = prev ? problem.tau_previous_n[k] : 0.0;
+    const double Ann = rn >= 0 ? W(rn, rn) : 1.0, Att = rt >= 0 ? W(rt, rt) : 1.0;
+    const double Ant = (rn >= 0 && rt >= 0) ? W(rn, rt) : 0.0;
+
+    if (rt < 0) {  // normal only
+        const double pn = -bn / Ann;
+        p[rn] = c.kind == PairKind::coulomb ? std::min(0.0, pn) : pn;
+        return;
+    }
+    if (c.kind == PairKind::bonded) {
+        if (rn < 0) {
+            p[rt] = -bt / Att;
+        } else {
+            const double det = Ann * Att - Ant * Ant;
+            p[rn] = (-Att * bn + Ant * bt) / det;
+            p[rt] = (Ant * bn - Ann * bt) / det;
+        }
+        return;
+    }
+    if (rn < 0) {  // tangential only: the limit does not depend on this pair's force
+        const double limit = mu * (c.kind == PairKind::clamp ? (prev ? tau_prev : c.preload_n) : 0.0);
+        p[rt] = std::clamp(-bt / Att, -limit, limit);
+        return;
+    }
+    const double c0 = c.kind == PairKind::clamp ? c.preload_n : 0.0;
+    const bool unilateral = c.kind == PairKind::coulomb;
+    auto tau_of = [&](double pn) {
+        if (unilateral) return pn < 0.0 ? (prev ? tau_prev : -pn) : 0.0;
+        return prev ? tau_prev : std::max(0.0, c0 - pn);
+    };
+    const double tiny = 1e-14;
+    // open (unilateral only): p = 0 is consistent when the free gap is open.
+    if (unilateral && bn <= 0.0) {
+        p[rn] = 0.0;
+        p[rt] = 0.0;
+        return;
+    }
+    // stick
+    {
+        const double det = Ann * Att - Ant * Ant;
+        const double pn = (-Att * bn + Ant * bt) / det;
+        const double pt = (Ant * bn - Ann * bt) / det;
+        const double limit = mu * tau_of(pn);
+        if ((!unilateral || pn <= 0.0) && std::abs(pt) <= limit * (1.0 + tiny)) {
+            p[rn] = pn;
+            p[rt] = pt;
+            return;
+        }
+    }
+    // slip in the direction sigma of the force: p_t = sigma mu tau
+    for (double sigma : {1.0, -1.0}) {
+        double pn, pt;
+        if (prev) {
+            pt = sigma * mu * tau_prev;
+            pn = -(bn + Ant * pt) / Ann;
+        } else {  // p_t = sigma mu (c0 - p_n)
+            pn = (-bn - sigma * mu * Ant * c0) / (Ann - sigma * mu * Ant);
+            pt = sigma * mu * (c0 - pn);
+        }
+        const double st = Ant * pn + Att * pt + bt;
+        const bool normal_ok = unilateral ? pn <= 0.0 : (prev || c0 - pn >= 0.0);
+        if (normal_ok && sigma * st <= tiny * std::abs(bt)) {
+            p[rn] = pn;
+            p[rt] = pt;
+            return;
+        }
+    }
+    // clamp pulled apart beyond its preload: the interface carries no friction
+    const double pn = -bn / Ann;
+    p[rn] = unilateral ? std::min(0.0, pn) : pn;
+    p[rt] = 0.0;
+}
+
+SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& p, double tolerance_m,
+                                int max_sweeps) {
+    SolveResult r;
+    const auto& W = problem.W;
+    Eigen::VectorXd s = W * p + problem.q;
+    r.residual_m = error_vector(problem, p, s).norm();
+    while (r.residual_m >= tolerance_m) {
+        if (r.iterations >= max_sweeps || !std::isfinite(r.residual_m)) {
+            r.message = "Gauss-Seidel sweeps did not reach ||v|| < " + format_value(tolerance_m) + " m in " +
+                        std::to_string(r.iterations) + " sweeps; residual " + format_value(r.residual_m) + " m";
+            return r;
+        }
+        for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+            const auto& c = problem.pairs[k];
+            const double pn0 = c.row_n >= 0 ? p[c.row_n] : 0.0, pt0 = c.row_t >= 0 ? p[c.row_t] : 0.0;
+            double bn = 0.0, bt = 0.0;
+            if (c.row_n >= 0) bn = s[c.row_n] - W(c.row_n, c.row_n) * pn0 - (c.row_t >= 0 ? W(c.row_n, c.row_t) * pt0 : 0.0);
+            if (c.row_t >= 0) bt = s[c.row_t] - W(c.row_t, c.row_t) * pt0 - (c.row_n >= 0 ? W(c.row_t, c.row_n) * pn0 : 0.0);
+            solve_pair_locally(problem, static_cast<int>(k), W, bn, bt, p);
+            if (c.row_n >= 0 && p[c.row_n] != pn0) s += W.col(c.row_n) * (p[c.row_n] - pn0);
+            if (c.row_t >= 0 && p[c.row_t] != pt0) s += W.col(c.row_t) * (p[c.row_t] - pt0);
+        }
+        ++r.iterations;
+        s.noalias() = W * p;  // refresh: no drift of the incremental updates
+        s += problem.q;
+        r.residual_m = error_vector(problem, p, s).norm();
+    }
+    r.converged = true;
+    return r;
+}
+
+}  // namespace stackbeam::detail

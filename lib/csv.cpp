@@ -1,0 +1,28 @@
+#include "stackbeam/csv.hpp"
+
+#include <cstdio>
+
+namespace stackbeam {
+
+void write_csv_header(std::ostream& out) {
+    const auto cols = step_record_columns();
+    for (std::size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << cols[i];
+    out << '\n';
+}
+
+void write_csv_row(std::ostream& out, const StepRecord& record) {
+    const auto vals = step_record_values(record);
+    char buf[40];
+    for (std::size_t i = 0; i < vals.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "%.12g", vals[i]);
+        out << (i ? "," : "") << buf;
+    }
+    out << '\n';
+}
+
+void write_csv(std::ostream& out, const std::vector<StepRecord>& records) {
+    write_csv_header(out);
+    for (const auto& r : records) write_csv_row(out, r);
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,190 @@
+// The paper's closed-form step (eqs. 14-16) and its 8-step algorithm.
+#include "stackbeam/simulation.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+std::vector<std::string> step_record_columns() {
+    return {"t",           "w",              "w_dot",          "force_on_mass",     "probe_friction_force",
+            "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
+            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations"};
+}
+
+std::vector<double> step_record_values(const StepRecord& r) {
+    return {r.t_s,
+            r.w_m,
+            r.w_dot_m_per_s,
+            r.force_on_mass_n,
+            r.probe_friction_force_n,
+            static_cast<double>(r.contact_iterations),
+            static_cast<double>(r.n_stick),
+            static_cast<double>(r.n_slip),
+            static_cast<double>(r.n_open),
+            r.kinetic_energy_j,
+            r.strain_energy_j,
+            r.dissipated_energy_j,
+            r.energy_balance_error_j,
+            r.contact_residual_m,
+            static_cast<double>(r.factorizations)};
+}
+
+const char* to_string(Mode m) {
+    switch (m) {
+        case Mode::closed_form: return "closed-form";
+    }
+    return "?";
+}
+
+Mode parse_mode(const std::string& text, const std::string& field) {
+    if (text == "closed-form") return Mode::closed_form;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form");
+}
+
+void SimulationOptions::validate() const {
+    if (!std::isfinite(dt_s) || dt_s <= 0.0)
+        throw InputError("dt", "value " + format_value(dt_s) + " is not allowed: the time step must be finite and > 0 [s]");
+    if (!std::isfinite(t_end_s) || t_end_s <= 0.0)
+        throw InputError("t_end", "value " + format_value(t_end_s) + " is not allowed: the end time must be finite and > 0 [s]");
+    if (t_end_s / dt_s > 1e9)
+        throw InputError("dt", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end = " + format_value(t_end_s) + " s");
+    make_solver(solver);  // validates the solver options
+}
+
+ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
+    : system_(system), options_(options) {
+    options_.validate();
+    solver_ = make_solver(options_.solver);
+    const int n = system_.num_components();
+    const double k = system_.stiffness_n_per_m();
+    const double m = system_.mass_kg();
+    omega_ = std::sqrt(k / m);
+    const double x = omega_ * options_.dt_s;
+    cos_ = std::cos(x);
+    sin_ = std::sin(x);
+    // gamma = 1 - sin(x)/x, by its series where the subtraction would cancel
+    gamma_ = x < 1e-3 ? x * x / 6.0 - x * x * x * x / 120.0 : 1.0 - sin_ / x;
+
+    problem_.pairs = system_.pairs();
+    problem_.tau_rule = options_.tau_rule;
+    problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
+    const auto& c = system_.coupling();
+    d_ = system_.initial_offsets_m();
+    p_ = Eigen::VectorXd::Zero(n);
+    w_ = system_.model().spec().rigid_body.initial_displacement_m;
+    wd_ = system_.model().spec().rigid_body.initial_velocity_m_per_s;
+
+    if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0)
+        problem_.W = system_.compliance_held();
+        problem_.q = c * w_ - d_;
+        solve_ = solver_->solve(problem_, p_);
+        if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+    }
+    problem_.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
+    problem_.q = Eigen::VectorXd::Zero(n);
+    rel_ = system_.compliance_held() * p_ + c * w_;
+    fill_record(0, 0);
+    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
+    record_.energy_balance_error_j = 0.0;
+}
+
+void ClosedFormStepper::fill_record(int iterations, int factorizations) {
+    const double f = system_.model().whole_spring_factor();
+    const double k = system_.stiffness_n_per_m();
+    const auto& c = system_.coupling();
+    StepRecord& r = record_;
+    r.t_s = t_;
+    r.w_m = w_;
+    r.w_dot_m_per_s = wd_;
+    r.force_on_mass_n = f * (c.dot(p_) - k * w_);
+    const int probe = system_.probe_pair();
+    r.probe_friction_force_n = (probe >= 0 && system_.pairs()[probe].row_t >= 0)
+                                   ? p_[system_.pairs()[probe].row_t]
+                                   : std::numeric_limits<double>::quiet_NaN();
+    r.contact_iterations = iterations;
+    r.factorizations = factorizations;
+    r.n_stick = r.n_slip = r.n_open = 0;
+    for (PairState s : pair_states()) {
+        if (s == PairState::stick) ++r.n_stick;
+        else if (s == PairState::slip) ++r.n_slip;
+        else ++r.n_open;
+    }
+    r.kinetic_energy_j = 0.5 * system_.model().spec().rigid_body.mass_kg * wd_ * wd_;
+    // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp)
+    r.strain_energy_j = 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
+    r.dissipated_energy_j = dissipated_;
+    r.energy_balance_error_j = e0_ - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
+    r.contact_residual_m = solve_.residual_m;
+}
+
+std::vector<PairState> ClosedFormStepper::pair_states() const {
+    std::vector<PairState> s(problem_.pairs.size());
+    for (std::size_t k = 0; k < s.size(); ++k) s[k] = pair_state(problem_, static_cast<int>(k), p_);
+    return s;
+}
+
+const StepRecord& ClosedFormStepper::step() {
+    const double k = system_.stiffness_n_per_m();
+    const double dt = options_.dt_s;
+    const auto& c = system_.coupling();
+    // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
+    const double F0 = c.dot(p_);
+    const double w_free = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k;
+    // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
+    problem_.q = c * w_free - d_;
+    if (problem_.tau_rule == TauRule::previous_step)
+        for (int j = 0; j < static_cast<int>(problem_.pairs.size()); ++j) {
+            const auto& pr = problem_.pairs[j];
+            const double pn = pr.row_n >= 0 ? p_[pr.row_n] : 0.0;
+            problem_.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
+        }
+    const Eigen::VectorXd p0 = p_;
+    solve_ = solver_->solve(problem_, p_);
+    ++step_;
+    if (!solve_.converged && options_.stop_on_nonconvergence)
+        throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
+                              format_value(step_ * dt) + " s: " + solve_.message,
+                          step_, step_ * dt, solve_.residual_m);
+    const double F1 = c.dot(p_);
+    const double w1 = w_free + gamma_ * F1 / k;
+    const double wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
+    // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
+    const Eigen::VectorXd rel1 = problem_.W * p_ + problem_.q + d_;
+    double work = 0.0;
+    for (const auto& pr : problem_.pairs)
+        if (pr.row_t >= 0 && pr.kind != PairKind::bonded)
+            work += 0.5 * (p0[pr.row_t] + p_[pr.row_t]) * (rel1[pr.row_t] - rel_[pr.row_t]);
+    dissipated_ -= system_.model().whole_spring_factor() * work;
+    rel_ = rel1;
+    w_ = w1;
+    wd_ = wd1;
+    t_ = step_ * dt;
+    // Anchors (paper, section 5): a pair that sticks keeps its d_t; any other is re-anchored where it is.
+    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
+        const auto& pr = problem_.pairs[j];
+        if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
+        if (pair_state(problem_, static_cast<int>(j), p_) != PairState::stick) d_[pr.row_t] = rel_[pr.row_t];
+    }
+    fill_record(solve_.iterations, solve_.factorizations);
+    return record_;
+}
+
+std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
+                                 const std::function<void(const StepRecord&)>& on_step) {
+    ClosedFormStepper stepper(system, options);
+    const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
+    std::vector<StepRecord> out;
+    out.reserve(static_cast<std::size_t>(n) + 1);
+    out.push_back(stepper.current());
+    if (on_step) on_step(out.back());
+    for (long i = 0; i < n; ++i) {
+        out.push_back(stepper.step());
+        if (on_step) on_step(out.back());
+    }
+    return out;
+}
+
+}  // namespace stackbeam
