@@ -16,7 +16,10 @@
 // says so (SolveResult::fell_back).
 #include <Eigen/LU>
 #include <cmath>
+#include <algorithm>
 #include <set>
+#include <cstdio>
+#include <cstdlib>
 
 #include "contact_solvers.hpp"
 #include "stackbeam/errors.hpp"
@@ -43,17 +46,16 @@ public:
             init_modes(problem, p);
         }
         SolveResult r;
-        std::set<std::vector<signed char>> seen;
-        bool one_at_a_time = false;
-        for (int pass = 1; pass <= options_.max_active_set_iterations; ++pass) {
-            r.iterations = pass;
-            r.factorizations += solve_modes(problem, p);
-            std::vector<signed char> key = modes_key();
-            if (!seen.insert(key).second) one_at_a_time = true;
-            if (!switch_violations(problem, p, one_at_a_time)) {
-                r.converged = true;
-                break;
-            }
+        // 1. From the previous step's modes (warm start): most steps end here in one pass.
+        r.converged = active_set_passes(problem, p, kWarmPasses, r);
+        if (!r.converged) {
+            // 2. A transition the warm start does not resolve quickly: Gauss-Seidel sweeps
+            //    to a loose tolerance give nearly right modes, then the active set again.
+            const SolveResult gs = gauss_seidel_sweeps(problem, p, kGuessTolerance * options_.tolerance_m,
+                                                       options_.max_iterations);
+            r.iterations += gs.iterations;
+            init_modes(problem, p);
+            r.converged = active_set_passes(problem, p, options_.max_active_set_iterations, r);
         }
         Eigen::VectorXd s = problem.W * p + problem.q;
         r.residual_m = error_vector(problem, p, s).norm();
@@ -86,6 +88,23 @@ private:
     std::vector<int> pos_;        // row -> index in S_ or -1
     Eigen::VectorXd rhs_, x_, e_;
 
+    static constexpr int kWarmPasses = 4;
+    static constexpr double kGuessTolerance = 1e-2;
+
+    /// Active-set passes from the current modes; true when no mode is violated.
+    /// A mode set seen twice means cycling: from then on one switch per pass.
+    bool active_set_passes(const ContactProblem& problem, Eigen::VectorXd& p, int max_passes, SolveResult& r) {
+        std::set<std::vector<signed char>> seen;
+        bool one_at_a_time = false;
+        for (int pass = 1; pass <= max_passes; ++pass) {
+            ++r.iterations;
+            r.factorizations += solve_modes(problem, p);
+            if (!seen.insert(modes_key()).second) one_at_a_time = true;
+            if (!switch_violations(problem, p, one_at_a_time)) return true;
+        }
+        return false;
+    }
+
     std::vector<signed char> modes_key() const {
         std::vector<signed char> k(nmode_);
         k.insert(k.end(), tmode_.begin(), tmode_.end());
@@ -108,12 +127,13 @@ private:
 
     void init_modes(const ContactProblem& pr, const Eigen::VectorXd& p) {
         const int np = static_cast<int>(pr.pairs.size());
+        const Eigen::VectorXd s0 = pr.W * p + pr.q;
         nmode_.assign(np, NONE);
         tmode_.assign(np, NONE);
         for (int k = 0; k < np; ++k) {
             const auto& c = pr.pairs[k];
             if (c.row_n >= 0)
-                nmode_[k] = (!unilateral(c) || p[c.row_n] < 0.0 || pr.q[c.row_n] >= 0.0) ? CLOSED : OPEN;
+                nmode_[k] = (!unilateral(c) || p[c.row_n] < 0.0 || s0[c.row_n] >= 0.0) ? CLOSED : OPEN;
             if (c.row_t >= 0) {
                 if (c.kind == PairKind::bonded) {
                     tmode_[k] = STICK;
@@ -186,7 +206,12 @@ private:
         if (m > 0) x_ = lu_.solve(rhs_);
         p = e_;
         for (int i = 0; i < m; ++i) p[S_[i]] = x_[i];
-        for (std::size_t a = 0; a < coupled.size(); ++a) p[coupled[a].first] += coef[a] * p[coupled[a].second];
+        // slip rows: p_t = sigma mu tau(p_n), written with the same formula as the friction limit
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t >= 0 && (tmode_[k] == SLIP_POS || tmode_[k] == SLIP_NEG))
+                p[c.row_t] = (tmode_[k] == SLIP_POS ? 1.0 : -1.0) * c.friction_coefficient * friction_normal_force(pr, k, p);
+        }
         return factorised;
     }
 
@@ -234,12 +259,13 @@ private:
             }
         }
         if (sw.empty()) return false;
-        if (one_at_a_time) {
-            std::size_t best = 0;
-            for (std::size_t i = 1; i < sw.size(); ++i)
-                if (sw[i].size > sw[best].size) best = i;
-            sw = {sw[best]};
-        }
+        // Contact status first, friction second: while a normal mode is wrong, the
+        // tangential verdicts rest on wrong normal forces.
+        if (std::any_of(sw.begin(), sw.end(), [](const Switch& x) { return x.normal; }))
+            sw.erase(std::remove_if(sw.begin(), sw.end(), [](const Switch& x) { return !x.normal; }), sw.end());
+        // Murty's least-index rule (finite for P-matrix LCPs): the first violated pair, normal first.
+        if (one_at_a_time) sw.resize(1);
+        if (std::getenv("SB_DEBUG")) for (const auto& x : sw) fprintf(stderr, "switch pair %d %s -> %d size %g\n", x.k, x.normal ? "n" : "t", int(x.to), x.size);
         for (const auto& x : sw) {
             if (x.normal) nmode_[x.k] = x.to;
             else tmode_[x.k] = x.to;

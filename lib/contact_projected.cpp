@@ -1,6 +1,7 @@
 // The paper's projected iteration (eq. 17) with E = I, and its Gauss-Seidel
 // accelerated form (E = per-pair block inverse of W, applied pair by pair).
 #include <cmath>
+#include <limits>
 
 #include "contact_solvers.hpp"
 #include "stackbeam/errors.hpp"
@@ -182,9 +183,19 @@ SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& 
     SolveResult r;
     const auto& W = problem.W;
     Eigen::VectorXd s = W * p + problem.q;
-    r.residual_m = error_vector(problem, p, s).norm();
+    // eq. 9's v is blind to forces outside the admissible set (p_n > 0 with an open
+    // gap, |p_t| above the limit): a start that may hold such forces gets one sweep first.
+    bool admissible = true;
+    for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+        const auto& c = problem.pairs[k];
+        if (c.row_n >= 0 && c.kind == PairKind::coulomb && p[c.row_n] > 0.0) admissible = false;
+        if (c.row_t >= 0 && c.kind != PairKind::bonded &&
+            std::abs(p[c.row_t]) > c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p) * (1.0 + 1e-12))
+            admissible = false;
+    }
+    r.residual_m = admissible ? error_vector(problem, p, s).norm() : std::numeric_limits<double>::infinity();
     while (r.residual_m >= tolerance_m) {
-        if (r.iterations >= max_sweeps || !std::isfinite(r.residual_m)) {
+        if (r.iterations >= max_sweeps || (r.iterations > 0 && !std::isfinite(r.residual_m))) {
             r.message = "Gauss-Seidel sweeps did not reach ||v|| < " + format_value(tolerance_m) + " m in " +
                         std::to_string(r.iterations) + " sweeps; residual " + format_value(r.residual_m) + " m";
             return r;

@@ -1,0 +1,52 @@
+#pragma once
+// Helpers shared by the physics tests: runs of the paper example and
+// measurements on time series (period from zero crossings, peaks).
+#include <cmath>
+#include <vector>
+
+#include "stackbeam/paper_example.hpp"
+#include "stackbeam/simulation.hpp"
+
+namespace stackbeam::testing {
+
+inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_s,
+                                         Symmetry sym = Symmetry::half, double tol_m = 1e-10,
+                                         SolverKind solver = SolverKind::exact) {
+    PaperExampleOptions o;
+    o.symmetry = sym;
+    const System s(Model::build(paper_example(c, o)));
+    SimulationOptions so;
+    so.dt_s = dt_s;
+    so.t_end_s = t_end_s;
+    so.solver.kind = solver;
+    so.solver.tolerance_m = tol_m;
+    return simulate(s, so);
+}
+
+/// Times [s] where w crosses zero upwards, by linear interpolation between steps.
+inline std::vector<double> upward_zero_crossings(const std::vector<StepRecord>& r) {
+    std::vector<double> t;
+    for (std::size_t i = 1; i < r.size(); ++i)
+        if (r[i - 1].w_m < 0.0 && r[i].w_m >= 0.0)
+            t.push_back(r[i - 1].t_s + (r[i].t_s - r[i - 1].t_s) * (-r[i - 1].w_m) / (r[i].w_m - r[i - 1].w_m));
+    return t;
+}
+
+/// Mean period [s] from the first to the last upward zero crossing (t = 0 counts: w(0) = 0, w' > 0).
+inline double mean_period(const std::vector<StepRecord>& r) {
+    std::vector<double> t = upward_zero_crossings(r);
+    t.insert(t.begin(), 0.0);
+    return (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+}
+
+/// Largest |w| [m], refined by a parabola through the sampled maximum and its neighbours.
+inline double peak_abs_w(const std::vector<StepRecord>& r) {
+    std::size_t k = 1;
+    for (std::size_t i = 1; i + 1 < r.size(); ++i)
+        if (std::abs(r[i].w_m) > std::abs(r[k].w_m)) k = i;
+    const double a = std::abs(r[k - 1].w_m), b = std::abs(r[k].w_m), c = std::abs(r[k + 1].w_m);
+    const double den = a - 2 * b + c;
+    return den == 0.0 ? b : b - 0.125 * (a - c) * (a - c) / den;
+}
+
+}  // namespace stackbeam::testing
