@@ -7,20 +7,28 @@
 // For a set of modes the problem is linear: the unknowns are the forces of the
 // components held by "s = 0" (set S); the others follow from them. So
 //     (W_SS + W_S,slip * dp_slip/dp_S) p_S = -(q_S + W_S,: e)
-// is solved with a dense LU, and the modes that violate their inequality are
-// switched until none does. W is constant between steps and the modes rarely
+// is solved with a dense LU. W is constant between steps and the modes rarely
 // change, so the LU is kept and reused while the modes stay: most steps cost
-// one triangular solve and one product with W. A mode set seen twice means
-// cycling: the solver then switches one component at a time (the largest
-// violation), and if that fails too it finishes with Gauss-Seidel sweeps and
-// says so (SolveResult::fell_back).
+// one triangular solve and one product with W (stage 1).
+//
+// When the previous step's modes are wrong (a stick-slip or open-close
+// transition), switching the violated modes (primal-dual active set) is not
+// safe: W is not an M-matrix and the modes can cycle. Stage 2 therefore freezes
+// the friction limits (Tresca), which makes the problem a box-constrained convex
+// QP, solved by a monotone primal active-set method that cannot cycle; the
+// limits are updated from its normal forces until they settle (fixed point on
+// tau), and its final working set gives the modes from which stage 1 solves the
+// coupled Coulomb problem exactly. If that polish fails, the settled fixed point
+// (Coulomb to within 1e-3 of the tolerance) is returned, flagged fell_back;
+// if even that fails, Gauss-Seidel sweeps finish the job and say so.
 #include <Eigen/LU>
 #include <cmath>
 #include <algorithm>
-#include <set>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 
+#include "box_qp.hpp"
 #include "contact_solvers.hpp"
 #include "stackbeam/errors.hpp"
 
@@ -49,13 +57,19 @@ public:
         // 1. From the previous step's modes (warm start): most steps end here in one pass.
         r.converged = active_set_passes(problem, p, kWarmPasses, r);
         if (!r.converged) {
-            // 2. A transition the warm start does not resolve quickly: Gauss-Seidel sweeps
-            //    to a loose tolerance give nearly right modes, then the active set again.
-            const SolveResult gs = gauss_seidel_sweeps(problem, p, kGuessTolerance * options_.tolerance_m,
-                                                       options_.max_iterations);
-            r.iterations += gs.iterations;
-            init_modes(problem, p);
-            r.converged = active_set_passes(problem, p, options_.max_active_set_iterations, r);
+            // 2. A transition: solve the problem with the friction limits frozen (Tresca), a
+            //    box-constrained QP, by a monotone active-set method that cannot cycle; update
+            //    the limits from its normal forces until they settle (fixed point on tau); then
+            //    take its modes and solve the coupled Coulomb problem exactly from them.
+            const bool settled = tresca_fixed_point(problem, p, r);
+            if (!settled) init_modes(problem, p);
+            const Eigen::VectorXd p_tresca = p;
+            r.converged = active_set_passes(problem, p, kWarmPasses, r);
+            if (!r.converged && settled) {  // the fixed point itself is within kAccept x tolerance
+                p = p_tresca;
+                r.converged = true;
+                r.fell_back = true;
+            }
         }
         Eigen::VectorXd s = problem.W * p + problem.q;
         r.residual_m = error_vector(problem, p, s).norm();
@@ -66,7 +80,8 @@ public:
             r.iterations += gs.iterations;
             r.residual_m = gs.residual_m;
             if (!gs.converged)
-                r.message = "exact solver cycled over its modes and the Gauss-Seidel fallback failed: " + gs.message;
+                r.message = "exact solver: neither the active set nor the Tresca fixed point converged, and the "
+                            "Gauss-Seidel fallback failed: " + gs.message;
             init_modes(problem, p);
             return r;
         }
@@ -88,19 +103,98 @@ private:
     std::vector<int> pos_;        // row -> index in S_ or -1
     Eigen::VectorXd rhs_, x_, e_;
 
-    static constexpr int kWarmPasses = 4;
-    static constexpr double kGuessTolerance = 1e-2;
+    static constexpr int kWarmPasses = 3;
+    static constexpr int kTrescaIterations = 100;
+    static constexpr int kBudget = 3;
+    static constexpr double kAccept = 1e-3;
 
     /// Active-set passes from the current modes; true when no mode is violated.
-    /// A mode set seen twice means cycling: from then on one switch per pass.
+    /// Block principal pivoting (Judice & Pires): switch every violated mode while the
+    /// number of violations falls; when it has not fallen for kBudget passes, switch
+    /// only the first violated one (Murty's least-index rule, finite for P-matrices).
     bool active_set_passes(const ContactProblem& problem, Eigen::VectorXd& p, int max_passes, SolveResult& r) {
-        std::set<std::vector<signed char>> seen;
-        bool one_at_a_time = false;
+        int best = std::numeric_limits<int>::max(), budget = kBudget;
+        bool single = false;
         for (int pass = 1; pass <= max_passes; ++pass) {
             ++r.iterations;
             r.factorizations += solve_modes(problem, p);
-            if (!seen.insert(modes_key()).second) one_at_a_time = true;
-            if (!switch_violations(problem, p, one_at_a_time)) return true;
+            const int violations = count_violations(problem, p);
+            if (violations == 0) return true;
+            if (violations < best) {
+                best = violations;
+                budget = kBudget;
+                single = false;
+            } else if (budget > 0) {
+                --budget;
+            } else {
+                single = true;
+            }
+            apply_switches(problem, single);
+        }
+        return false;
+    }
+
+
+    /// Fixed point on the friction limits: each pass a box-constrained QP (limits frozen).
+    /// Returns true when the limits settle to kAccept x tolerance (measured in metres).
+    bool tresca_fixed_point(const ContactProblem& pr, Eigen::VectorXd& p, SolveResult& r) {
+        const int n = pr.size();
+        const int np = static_cast<int>(pr.pairs.size());
+        const double inf = std::numeric_limits<double>::infinity();
+        Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
+        std::vector<signed char> at_bound(n, 0);
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && unilateral(c)) {
+                upper[c.row_n] = 0.0;
+                if (nmode_[k] == OPEN) at_bound[c.row_n] = +1;
+            }
+            if (c.row_t >= 0 && (tmode_[k] == SLIP_POS || tmode_[k] == SLIP_NEG))
+                at_bound[c.row_t] = tmode_[k] == SLIP_POS ? +1 : -1;
+        }
+        Eigen::VectorXd tau(np);
+        for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
+        const double accept = kAccept * options_.tolerance_m;
+        for (int it = 0; it < kTrescaIterations; ++it) {
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double limit = c.friction_coefficient * (std::isfinite(tau[k]) ? tau[k] : 0.0);
+                lower[c.row_t] = -limit;
+                upper[c.row_t] = limit;
+            }
+            const BoxQpResult b = solve_box_qp(pr.W, pr.q, lower, upper, p, at_bound, accept, 50 * (n + 1));
+            r.iterations += b.iterations;
+            r.factorizations += b.factorizations;
+            if (!b.converged) return false;
+            double change_m = 0.0;
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double t = friction_normal_force(pr, k, p);
+                change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * pr.W(c.row_t, c.row_t));
+                tau[k] = t;
+            }
+            if (change_m <= accept) {
+                // modes from the working set; slip forces put at the limit of the final tau
+                for (int k = 0; k < np; ++k) {
+                    const auto& c = pr.pairs[k];
+                    if (c.row_n >= 0 && unilateral(c)) nmode_[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
+                    if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+                    if (limit <= 0.0) {
+                        tmode_[k] = FREE;
+                        p[c.row_t] = 0.0;
+                    } else if (at_bound[c.row_t] != 0) {
+                        tmode_[k] = at_bound[c.row_t] > 0 ? SLIP_POS : SLIP_NEG;
+                        p[c.row_t] = at_bound[c.row_t] * limit;
+                    } else {
+                        tmode_[k] = STICK;
+                    }
+                    make_consistent(pr, k);
+                }
+                return true;
+            }
         }
         return false;
     }
@@ -215,64 +309,79 @@ private:
         return factorised;
     }
 
-    /// Switches the modes whose inequality fails at p; returns false when none fails.
-    bool switch_violations(const ContactProblem& pr, const Eigen::VectorXd& p, bool one_at_a_time) {
+    struct Switch { int k; bool normal; signed char to; double size; };
+    std::vector<Switch> sw_;
+
+    /// Finds the modes whose inequality fails at p (kept in sw_); returns their number.
+    int count_violations(const ContactProblem& pr, const Eigen::VectorXd& p) {
+        // Every violation is measured in metres: a gap error directly, a force error by
+        // the motion it would cause, force x W_kk. A mode is wrong when its violation
+        // exceeds kAccept x tolerance (or round-off of the products): the answer is then
+        // exact to far below what the caller asked, and near-degenerate components (p and
+        // s both ~0, common where identical leaves just touch) cannot ping-pong forever.
         const Eigen::VectorXd s = pr.W * p + pr.q;
-        const double pscale = std::max(p.lpNorm<Eigen::Infinity>(), 1e-300);
-        const double sscale = std::max(pr.q.lpNorm<Eigen::Infinity>() + pr.W.lpNorm<Eigen::Infinity>() * pscale, 1e-300);
-        const double tp = 1e-10 * pscale, ts = 1e-10 * sscale;
+        const double pscale = p.lpNorm<Eigen::Infinity>();
+        const double roundoff = 1e-13 * (pr.q.lpNorm<Eigen::Infinity>() + pr.W.lpNorm<Eigen::Infinity>() * pscale);
+        const double ts = std::max(kAccept * options_.tolerance_m, roundoff);
         const int np = static_cast<int>(pr.pairs.size());
-        struct Switch { int k; bool normal; signed char to; double size; };
-        std::vector<Switch> sw;
+        auto& sw = sw_;
+        sw.clear();
+        auto add = [&](int k, bool normal, signed char to, double size_m) {
+            if (size_m > ts) sw.push_back({k, normal, to, size_m});
+        };
         for (int k = 0; k < np; ++k) {
             const auto& c = pr.pairs[k];
+            const double Wn = c.row_n >= 0 ? pr.W(c.row_n, c.row_n) : 0.0;
+            const double Wt = c.row_t >= 0 ? pr.W(c.row_t, c.row_t) : 0.0;
             if (c.row_n >= 0 && unilateral(c)) {
                 const double pn = p[c.row_n], sn = s[c.row_n];
-                if (nmode_[k] == CLOSED && pn > tp) sw.push_back({k, true, OPEN, pn / pscale});
-                if (nmode_[k] == OPEN && sn > ts) sw.push_back({k, true, CLOSED, sn / sscale});
+                if (nmode_[k] == CLOSED) add(k, true, OPEN, pn * Wn);
+                if (nmode_[k] == OPEN) add(k, true, CLOSED, sn);
             }
             if (c.row_t < 0 || c.kind == PairKind::bonded || c.friction_coefficient == 0.0) continue;
             if (unilateral(c) && tmode_[k] == FREE) continue;  // follows the normal mode
+            const double mu = c.friction_coefficient;
             const double pt = p[c.row_t], st = s[c.row_t];
             const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0;
-            const bool clamp_released = c.kind == PairKind::clamp && pr.tau_rule == TauRule::current &&
-                                        c.preload_n - pn < -tp;
-            const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+            const double release_m = (c.kind == PairKind::clamp && pr.tau_rule == TauRule::current)
+                                         ? mu * (pn - c.preload_n) * Wt  // friction lost past the preload
+                                         : -1.0;
+            const double limit = mu * friction_normal_force(pr, k, p);
             switch (tmode_[k]) {
                 case STICK:
-                    if (clamp_released) sw.push_back({k, false, FREE, (pn - c.preload_n) / pscale});
-                    else if (std::abs(pt) > limit + tp)
-                        sw.push_back({k, false, pt > 0 ? SLIP_POS : SLIP_NEG, (std::abs(pt) - limit) / pscale});
+                    if (release_m > ts) add(k, false, FREE, release_m);
+                    else add(k, false, pt > 0 ? SLIP_POS : SLIP_NEG, (std::abs(pt) - limit) * Wt);
                     break;
                 case SLIP_POS:
                 case SLIP_NEG: {
                     const double sigma = tmode_[k] == SLIP_POS ? 1.0 : -1.0;
-                    if (clamp_released) sw.push_back({k, false, FREE, (pn - c.preload_n) / pscale});
-                    else if (sigma * st > ts) sw.push_back({k, false, STICK, sigma * st / sscale});
+                    if (release_m > ts) add(k, false, FREE, release_m);
+                    else add(k, false, STICK, sigma * st);
                     break;
                 }
                 case FREE:  // a clamp that carried no friction
-                    if (c.kind == PairKind::clamp && c.preload_n - pn > tp)
-                        sw.push_back({k, false, STICK, (c.preload_n - pn) / pscale});
+                    if (c.kind == PairKind::clamp) add(k, false, STICK, -release_m);
                     break;
                 default: break;
             }
         }
-        if (sw.empty()) return false;
+        return static_cast<int>(sw.size());
+    }
+
+    /// Switches the violated modes found by count_violations: all, or only the first.
+    void apply_switches(const ContactProblem& pr, bool single) {
+        auto& sw = sw_;
         // Contact status first, friction second: while a normal mode is wrong, the
         // tangential verdicts rest on wrong normal forces.
         if (std::any_of(sw.begin(), sw.end(), [](const Switch& x) { return x.normal; }))
             sw.erase(std::remove_if(sw.begin(), sw.end(), [](const Switch& x) { return !x.normal; }), sw.end());
-        // Murty's least-index rule (finite for P-matrix LCPs): the first violated pair, normal first.
-        if (one_at_a_time) sw.resize(1);
-        if (std::getenv("SB_DEBUG")) for (const auto& x : sw) fprintf(stderr, "switch pair %d %s -> %d size %g\n", x.k, x.normal ? "n" : "t", int(x.to), x.size);
+        if (single) sw.resize(1);
         for (const auto& x : sw) {
             if (x.normal) nmode_[x.k] = x.to;
             else tmode_[x.k] = x.to;
             if (x.normal && x.to == CLOSED && pr.pairs[x.k].row_t >= 0) tmode_[x.k] = STICK;
             make_consistent(pr, x.k);
         }
-        return true;
     }
 };
 
