@@ -3,6 +3,7 @@
 #include "stackbeam/contact.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -25,6 +26,7 @@ const char* to_string(SolverKind kind) {
         case SolverKind::paper: return "paper";
         case SolverKind::accelerated: return "accelerated";
         case SolverKind::exact: return "exact";
+        case SolverKind::block_jacobi: return "block-jacobi";
     }
     return "?";
 }
@@ -33,7 +35,8 @@ SolverKind parse_solver_kind(const std::string& text, const std::string& field) 
     if (text == "paper") return SolverKind::paper;
     if (text == "accelerated") return SolverKind::accelerated;
     if (text == "exact") return SolverKind::exact;
-    throw InputError(field, "value '" + text + "' is not a solver: allowed paper, accelerated, exact");
+    if (text == "block-jacobi") return SolverKind::block_jacobi;
+    throw InputError(field, "value '" + text + "' is not a solver: allowed paper, accelerated, block-jacobi, exact");
 }
 
 void ContactProblem::validate() const {
@@ -102,6 +105,23 @@ Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorX
     return v;
 }
 
+Eigen::VectorXd natural_map(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
+    Eigen::VectorXd r = s;  // bilateral and bonded components: s itself
+    for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+        const auto& c = problem.pairs[k];
+        if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
+            const double w = problem.W(c.row_n, c.row_n), pn = p[c.row_n];
+            r[c.row_n] = w * (pn - std::min(0.0, pn - s[c.row_n] / w));
+        }
+        if (c.row_t >= 0 && c.kind != PairKind::bonded) {
+            const double w = problem.W(c.row_t, c.row_t), pt = p[c.row_t];
+            const double limit = c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p);
+            r[c.row_t] = w * (pt - std::clamp(pt - s[c.row_t] / w, -limit, limit));
+        }
+    }
+    return r;
+}
+
 PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
     const auto& c = problem.pairs[k];
     if (c.kind == PairKind::bonded) return PairState::stick;
@@ -118,6 +138,23 @@ double largest_eigenvalue(const Eigen::MatrixXd& W) {
     return es.eigenvalues().maxCoeff();
 }
 
+namespace {
+/// Adds the solver-independent natural-map residual to every solver's result.
+class ResidualReporting final : public ContactSolver {
+public:
+    explicit ResidualReporting(std::unique_ptr<ContactSolver> inner) : inner_(std::move(inner)) {}
+    SolverKind kind() const override { return inner_->kind(); }
+    SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
+        SolveResult r = inner_->solve(problem, p);
+        r.natural_residual_m = natural_map(problem, p, problem.W * p + problem.q).norm();
+        return r;
+    }
+
+private:
+    std::unique_ptr<ContactSolver> inner_;
+};
+}  // namespace
+
 std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
     if (!std::isfinite(o.tolerance_m) || o.tolerance_m <= 0.0)
         throw InputError("solver.tolerance_m", "value " + format_value(o.tolerance_m) + " must be finite and > 0 [m]");
@@ -127,11 +164,14 @@ std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
         throw InputError("solver.alpha", "value " + format_value(o.alpha) + " must be finite and >= 0 (0: automatic) [N/m]");
     if (!std::isfinite(o.alpha_fraction) || o.alpha_fraction <= 0.0)
         throw InputError("solver.alpha_fraction", "value " + format_value(o.alpha_fraction) + " must be finite and > 0");
+    std::unique_ptr<ContactSolver> inner;
     switch (o.kind) {
-        case SolverKind::paper: return detail::make_projected_solver(o, false);
-        case SolverKind::accelerated: return detail::make_projected_solver(o, true);
-        case SolverKind::exact: return detail::make_exact_solver(o);
+        case SolverKind::paper:
+        case SolverKind::block_jacobi:
+        case SolverKind::accelerated: inner = detail::make_projected_solver(o); break;
+        case SolverKind::exact: inner = detail::make_exact_solver(o); break;
     }
+    if (inner) return std::make_unique<ResidualReporting>(std::move(inner));
     throw InputError("solver.kind", "unknown solver");
 }
 

@@ -1,5 +1,6 @@
 // The paper's projected iteration (eq. 17) with E = I, and its Gauss-Seidel
 // accelerated form (E = per-pair block inverse of W, applied pair by pair).
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 
@@ -11,15 +12,16 @@ namespace {
 
 double sign(double x) { return (x > 0.0) - (x < 0.0); }
 
-/// eq. 17 with E = I:
-///   p_bar = p - alpha s;  p_n = min(0, p_bar_n);
+/// eq. 17:
+///   p_bar = p - alpha E s;  p_n = min(0, p_bar_n);
 ///   p_t = sign(p_bar_t) min(|p_bar_t|, mu tau)  if v_t = s_t at the previous iterate,
 ///       = sign(p_bar_t) mu tau                  if v_t = 0 != s_t (slipping with the right sign),
 /// iterated until ||v||_2 < tolerance (step 8 of the paper's algorithm).
+/// with E = I (the paper). alpha defaults to a fraction of the bound 2 / lambda_max(W).
 class PaperSolver final : public ContactSolver {
 public:
     explicit PaperSolver(const SolverOptions& o) : options_(o) {}
-    SolverKind kind() const override { return SolverKind::paper; }
+    SolverKind kind() const override { return options_.kind; }
 
     SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
         const int n = problem.size();
@@ -37,10 +39,11 @@ public:
         Eigen::VectorXd pbar(n);
         while (r.residual_m >= options_.tolerance_m) {
             if (r.iterations >= options_.max_iterations || !std::isfinite(r.residual_m)) {
-                r.message = "paper iteration (eq. 17, E = I, alpha = " + format_value(alpha) +
-                            " N/m) did not reach ||v|| < " + format_value(options_.tolerance_m) + " m in " +
-                            std::to_string(r.iterations) + " iterations; residual " + format_value(r.residual_m) +
-                            " m (alpha must be below 2/lambda_max(W) = " + format_value(2.0 / lambda_max_) + " N/m)";
+                r.message = "paper iteration (eq. 17, E = I, alpha = " +
+                            format_value(alpha) + ") did not reach ||v|| < " + format_value(options_.tolerance_m) +
+                            " m in " + std::to_string(r.iterations) + " iterations; residual " +
+                            format_value(r.residual_m) + " m (alpha must be below 2/lambda_max(W) = " +
+                            format_value(2.0 / lambda_max_) + ")";
                 return r;
             }
             pbar.noalias() = p - alpha * s;
@@ -74,6 +77,70 @@ private:
     double lambda_max_ = 0.0;
 };
 
+/// eq. 17 with E = the inverse of W's per-pair 2x2 diagonal blocks, the projection
+/// taken in each block's own metric (so that the fixed point is the solution): every
+/// pair's local problem is solved exactly with the other pairs' forces of the
+/// previous iterate, and all pairs move together by the relaxation alpha_fraction.
+/// (With a non-diagonal E, the paper's component-wise projection would have a fixed
+/// point off the solution: a slipping pair would keep s_n = -E_nt s_t / E_nn != 0.)
+class BlockJacobiSolver final : public ContactSolver {
+public:
+    explicit BlockJacobiSolver(const SolverOptions& o) : options_(o) {}
+    SolverKind kind() const override { return SolverKind::block_jacobi; }
+    SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
+        const int n = problem.size();
+        if (p.size() != n) p = Eigen::VectorXd::Zero(n);
+        if (W_.rows() != n || W_ != problem.W) {
+            problem.validate();
+            W_ = problem.W;
+            Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);  // per-pair diagonal blocks of W
+            for (const auto& c : problem.pairs)
+                for (int a : {c.row_n, c.row_t})
+                    for (int b : {c.row_n, c.row_t})
+                        if (a >= 0 && b >= 0) D(a, b) = W_(a, b);
+            Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(W_, D, Eigen::EigenvaluesOnly);
+            lambda_max_ = es.eigenvalues().maxCoeff();
+        }
+        // relaxation: a fraction of the stability bound 2 / lambda_max(E W) of the linear part
+        const double relax = options_.alpha > 0.0 ? options_.alpha : options_.alpha_fraction * 2.0 / lambda_max_;
+        SolveResult r;
+        Eigen::VectorXd s = problem.W * p + problem.q;
+        r.residual_m = error_vector(problem, p, s).norm();
+        Eigen::VectorXd local(n);
+        bool first = true;
+        while (first || r.residual_m >= options_.tolerance_m) {
+            first = false;
+            if (r.iterations >= options_.max_iterations || !std::isfinite(r.residual_m)) {
+                r.message = "block-Jacobi iteration (relaxation " + format_value(relax) + ") did not reach ||v|| < " +
+                            format_value(options_.tolerance_m) + " m in " + std::to_string(r.iterations) +
+                            " iterations; residual " + format_value(r.residual_m) + " m";
+                return r;
+            }
+            local = p;
+            for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+                const auto& c = problem.pairs[k];
+                const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0, pt = c.row_t >= 0 ? p[c.row_t] : 0.0;
+                double bn = 0.0, bt = 0.0;
+                if (c.row_n >= 0) bn = s[c.row_n] - W_(c.row_n, c.row_n) * pn - (c.row_t >= 0 ? W_(c.row_n, c.row_t) * pt : 0.0);
+                if (c.row_t >= 0) bt = s[c.row_t] - W_(c.row_t, c.row_t) * pt - (c.row_n >= 0 ? W_(c.row_t, c.row_n) * pn : 0.0);
+                solve_pair_locally(problem, static_cast<int>(k), W_, bn, bt, local);
+            }
+            p += relax * (local - p);
+            s.noalias() = problem.W * p;
+            s += problem.q;
+            r.residual_m = error_vector(problem, p, s).norm();
+            ++r.iterations;
+        }
+        r.converged = true;
+        return r;
+    }
+
+private:
+    SolverOptions options_;
+    Eigen::MatrixXd W_;
+    double lambda_max_ = 1.0;
+};
+
 class GaussSeidelSolver final : public ContactSolver {
 public:
     explicit GaussSeidelSolver(const SolverOptions& o) : options_(o) {}
@@ -94,8 +161,9 @@ private:
 
 }  // namespace
 
-std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& o, bool gauss_seidel) {
-    if (gauss_seidel) return std::make_unique<GaussSeidelSolver>(o);
+std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& o) {
+    if (o.kind == SolverKind::accelerated) return std::make_unique<GaussSeidelSolver>(o);
+    if (o.kind == SolverKind::block_jacobi) return std::make_unique<BlockJacobiSolver>(o);
     return std::make_unique<PaperSolver>(o);
 }
 

@@ -7,7 +7,7 @@
 
 namespace stackbeam::detail {
 
-std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& options, bool gauss_seidel);
+std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& options);
 std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& options);
 
 /// Exact solution of pair k's own problem s_k = W_kk p_k + b_k (b_k the free

@@ -59,6 +59,15 @@ double friction_normal_force(const ContactProblem& problem, int k, const Eigen::
 /// The paper's error vector v (eq. 9) for forces p and relative positions s = W p + q.
 Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
 
+/// Solver-independent residual [m]: the natural map of the contact laws, scaled to
+/// metres by the diagonal of W. Per component, with w = W_kk:
+///   unilateral normal  w (p_n - min(0, p_n - s_n / w))
+///   tangential         w (p_t - clamp(p_t - s_t / w, -mu tau, mu tau))
+///   bilateral / bonded s
+/// It is zero exactly at a solution and, unlike eq. 9's v, also sees forces outside
+/// the admissible set (tension in an open pair, friction above the limit).
+Eigen::VectorXd natural_map(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+
 /// State of pair k at (p, s). A pair whose normal force is zero and may open is
 /// open; a tangential force at the friction limit (relative 1e-9) is slip; bonded pairs stick.
 PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
@@ -68,17 +77,18 @@ enum class SolverKind {
     paper,        ///< eq. 17 with E = I and constant alpha (the faithful reference; slow)
     accelerated,  ///< eq. 17 with E = per-pair 2x2 block inverse of W, Gauss-Seidel sweeps (Lee 1989 style)
     exact,        ///< active-set direct solver, factorisation reused while the modes stay (default)
+    block_jacobi, ///< eq. 17 with E = per-pair 2x2 block inverse of W, applied to all pairs at once
 };
 const char* to_string(SolverKind kind);
-/// Parses "paper" | "accelerated" | "exact"; throws InputError naming `field`.
+/// Parses "paper" | "accelerated" | "block-jacobi" | "exact"; throws InputError naming `field`.
 SolverKind parse_solver_kind(const std::string& text, const std::string& field);
 
 struct SolverOptions {
     SolverKind kind = SolverKind::exact;
     double tolerance_m = 2e-6;        ///< stop when ||v||_2 < tolerance_m [m] (paper: 2e-6)
     int max_iterations = 200000;      ///< iteration limit of the iterative solvers
-    double alpha = 0.0;               ///< paper solver: alpha [N/m]; 0 = alpha_fraction * 2 / lambda_max(W)
-    double alpha_fraction = 0.9;      ///< paper solver: alpha as a fraction of the stability bound 2/lambda_max(W)
+    double alpha = 0.0;               ///< paper / block_jacobi: alpha; 0 = alpha_fraction * 2 / lambda_max(E W)
+    double alpha_fraction = 0.9;      ///< paper / block_jacobi: alpha as a fraction of the stability bound 2/lambda_max(E W)
     int max_active_set_iterations = 200;  ///< exact solver: mode switches before it falls back
 };
 
@@ -87,6 +97,7 @@ struct SolveResult {
     bool converged = false;
     int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact)
     double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
+    double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
     int factorizations = 0;    ///< dense factorisations done in this solve (exact solver)
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not

@@ -1,0 +1,124 @@
+# CTest registrations of the command line `stackbeam` (target stackbeam_cli).
+#
+# Included from tests/CMakeLists.txt:
+#   if(TARGET stackbeam_cli)
+#     include(${CMAKE_CURRENT_SOURCE_DIR}/cli_tests.cmake)
+#   endif()
+#
+# This file is also the checker the tests run (`cmake -P cli_tests.cmake`, script
+# mode below): it runs the CLI and checks its exit status, that a message names
+# the option, and the output file. PASS_REGULAR_EXPRESSION alone would not do:
+# it ignores the exit status.
+
+if(CMAKE_SCRIPT_MODE_FILE)
+  # ---- script mode: one check ----------------------------------------------------------
+  # -DCLI=<exe> -DARGS=<args separated by |> -DEXPECT_RC=<n> [-DEXPECT_TEXT=<substring of stdout+stderr>]
+  # [-DOUT=<file that must exist after the run, or must not when EXPECT_RC != 0>]
+  # [-DHEADER_PREFIX=<prefix of OUT's first line>] [-DMIN_LINES=<n>]
+  string(REPLACE "|" ";" args "${ARGS}")
+  if(DEFINED OUT)
+    file(REMOVE "${OUT}" "${OUT}.partial")
+  endif()
+  execute_process(COMMAND "${CLI}" ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  list(JOIN args " " args_text)
+  message(STATUS "stackbeam ${args_text}\n-- exit status ${rc}\n-- stdout:\n${out}\n-- stderr:\n${err}")
+  if(NOT rc STREQUAL "${EXPECT_RC}")
+    message(FATAL_ERROR "exit status ${rc}, expected ${EXPECT_RC}")
+  endif()
+  if(DEFINED EXPECT_TEXT)
+    string(FIND "${out}${err}" "${EXPECT_TEXT}" pos)
+    if(pos EQUAL -1)
+      message(FATAL_ERROR "the output does not contain '${EXPECT_TEXT}'")
+    endif()
+  endif()
+  if(DEFINED OUT)
+    if(EXPECT_RC EQUAL 0)
+      if(NOT EXISTS "${OUT}")
+        message(FATAL_ERROR "${OUT} was not written")
+      endif()
+      if(EXISTS "${OUT}.partial")
+        message(FATAL_ERROR "${OUT}.partial was left behind by a successful run")
+      endif()
+      file(STRINGS "${OUT}" lines)
+      list(LENGTH lines n)
+      list(GET lines 0 header)
+      if(DEFINED HEADER_PREFIX)
+        string(FIND "${header}" "${HEADER_PREFIX}" pos)
+        if(NOT pos EQUAL 0)
+          message(FATAL_ERROR "header '${header}' does not start with '${HEADER_PREFIX}'")
+        endif()
+      endif()
+      if(DEFINED MIN_LINES AND n LESS MIN_LINES)
+        message(FATAL_ERROR "${OUT} has ${n} lines, expected at least ${MIN_LINES}")
+      endif()
+    elseif(EXISTS "${OUT}")
+      message(FATAL_ERROR "${OUT} exists after a failed run")
+    endif()
+  endif()
+  return()
+endif()
+
+# ---- configure mode: the registrations -------------------------------------------------
+
+# stackbeam_cli_test(NAME <name> ARGS <arg>... EXPECT_RC <n> [EXPECT_TEXT <text>] [OUT <file>]
+#                    [HEADER_PREFIX <prefix>] [MIN_LINES <n>])
+function(stackbeam_cli_test)
+  cmake_parse_arguments(T "" "NAME;EXPECT_RC;EXPECT_TEXT;OUT;HEADER_PREFIX;MIN_LINES" "ARGS" ${ARGN})
+  string(REPLACE ";" "|" args "${T_ARGS}")
+  set(defs -DCLI=$<TARGET_FILE:stackbeam_cli> "-DARGS=${args}" -DEXPECT_RC=${T_EXPECT_RC})
+  foreach(opt EXPECT_TEXT OUT HEADER_PREFIX MIN_LINES)
+    if(DEFINED T_${opt})
+      list(APPEND defs "-D${opt}=${T_${opt}}")
+    endif()
+  endforeach()
+  add_test(NAME ${T_NAME} COMMAND ${CMAKE_COMMAND} ${defs} -P ${CMAKE_CURRENT_LIST_FILE})
+  set_tests_properties(${T_NAME} PROPERTIES LABELS cli TIMEOUT 60)
+endfunction()
+
+set(_cli_out_dir ${CMAKE_CURRENT_BINARY_DIR})
+
+# Bad arguments: exit status 2, a message naming the option, no output file.
+# name            option value       text the message must contain
+set(_cli_bad_cases
+  "case_unknown|--case|foo|--case: value 'foo'"
+  "elements_zero|--elements|0|--elements: value '0'"
+  "elements_negative|--elements|-3|--elements: value '-3'"
+  "dt_zero|--dt|0|--dt: value '0'"
+  "dt_negative|--dt|-1e-3|--dt: value '-1e-3'"
+  "dt_nan|--dt|nan|--dt: value 'nan' is not allowed: must be a finite number > 0 [s]"
+  "dt_trailing|--dt|1e-3x|--dt: value '1e-3x'"
+  "t_end_inf|--t-end|inf|--t-end: value 'inf'"
+  "tol_zero|--tol|0|--tol: value '0'"
+  "solver_unknown|--solver|magic|--solver: value 'magic'"
+  "mode_unknown|--mode|cvode|--mode: value 'cvode'"
+)
+foreach(entry IN LISTS _cli_bad_cases)
+  string(REPLACE "|" ";" fields "${entry}")
+  list(GET fields 0 name)
+  list(GET fields 1 option)
+  list(GET fields 2 value)
+  list(GET fields 3 text)
+  set(out ${_cli_out_dir}/cli_bad_${name}.csv)
+  # a short, otherwise good run with the one bad value
+  set(args simulate --out ${out})
+  if(NOT option STREQUAL "--case")
+    list(APPEND args --case frictionless)
+  endif()
+  if(NOT option STREQUAL "--t-end")
+    list(APPEND args --t-end 0.01)
+  endif()
+  list(APPEND args ${option} ${value})
+  stackbeam_cli_test(NAME cli_bad_${name} ARGS ${args} EXPECT_RC 2 EXPECT_TEXT "${text}" OUT ${out})
+endforeach()
+
+stackbeam_cli_test(NAME cli_missing_out ARGS simulate --case frictionless --t-end 0.01
+                   EXPECT_RC 2 EXPECT_TEXT "--out")
+stackbeam_cli_test(NAME cli_missing_subcommand ARGS --case frictionless EXPECT_RC 2 EXPECT_TEXT "stackbeam: error:")
+stackbeam_cli_test(NAME cli_help ARGS --help EXPECT_RC 0 EXPECT_TEXT "simulate")
+stackbeam_cli_test(NAME cli_simulate_help ARGS simulate --help EXPECT_RC 0 EXPECT_TEXT "--alpha-fraction")
+
+# A good run: exit status 0, a complete CSV (header + 11 records for 10 steps), no .partial.
+stackbeam_cli_test(NAME cli_ok_frictionless
+                   ARGS simulate --case frictionless --t-end 0.01 --out ${CMAKE_BINARY_DIR}/cli_ok.csv
+                   EXPECT_RC 0 EXPECT_TEXT "steps" OUT ${CMAKE_BINARY_DIR}/cli_ok.csv
+                   HEADER_PREFIX "t,w,w_dot,force_on_mass,probe_friction_force" MIN_LINES 12)
