@@ -87,8 +87,10 @@ public:
         }
         if (!(r.residual_m < options_.tolerance_m)) {
             r.converged = false;
-            r.message = "exact solver found consistent modes but ||v|| = " + format_value(r.residual_m) +
-                        " m exceeds the tolerance " + format_value(options_.tolerance_m) + " m (ill-conditioned W?)";
+            r.message = std::string("exact solver (") + (r.fell_back ? "Tresca fixed point" : "active set") +
+                        ") ended with ||v|| = " + format_value(r.residual_m) + " m above the tolerance " +
+                        format_value(options_.tolerance_m) + " m (natural-map residual " +
+                        format_value(natural_map(problem, p, s).norm()) + " m)";
         }
         return r;
     }
@@ -186,8 +188,12 @@ private:
                         tmode_[k] = FREE;
                         p[c.row_t] = 0.0;
                     } else if (at_bound[c.row_t] != 0) {
-                        tmode_[k] = at_bound[c.row_t] > 0 ? SLIP_POS : SLIP_NEG;
-                        p[c.row_t] = at_bound[c.row_t] * limit;
+                        // slip against the motion; a box that had zero width (tau was 0 in the
+                        // last QP) held the force without a sign: take it from s_t.
+                        const double st = (pr.W.row(c.row_t) * p)(0) + pr.q[c.row_t];
+                        const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t] : (st > 0.0 ? -1 : +1);
+                        tmode_[k] = sigma > 0 ? SLIP_POS : SLIP_NEG;
+                        p[c.row_t] = sigma * limit;
                     } else {
                         tmode_[k] = STICK;
                     }

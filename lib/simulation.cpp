@@ -100,10 +100,13 @@ void ClosedFormStepper::fill_record(int iterations, int factorizations) {
     r.w_m = w_;
     r.w_dot_m_per_s = wd_;
     r.force_on_mass_n = f * (c.dot(p_) - k * w_);
+    // The probe pair may carry no tangential component (mu = 0, or fixed by a support):
+    // its friction force is then zero. NaN only when the model has no probe at all.
     const int probe = system_.probe_pair();
-    r.probe_friction_force_n = (probe >= 0 && system_.pairs()[probe].row_t >= 0)
-                                   ? p_[system_.pairs()[probe].row_t]
-                                   : std::numeric_limits<double>::quiet_NaN();
+    const bool has_probe = system_.model().probe_pair() >= 0;
+    r.probe_friction_force_n = !has_probe ? std::numeric_limits<double>::quiet_NaN()
+                               : (probe >= 0 && system_.pairs()[probe].row_t >= 0) ? p_[system_.pairs()[probe].row_t]
+                                                                                    : 0.0;
     r.contact_iterations = iterations;
     r.factorizations = factorizations;
     r.n_stick = r.n_slip = r.n_open = 0;

@@ -27,7 +27,7 @@ struct StepRecord {
     double w_m = 0.0;                   ///< displacement of R [m] (+y; the initial velocity's direction in the example)
     double w_dot_m_per_s = 0.0;         ///< velocity of R [m/s]
     double force_on_mass_n = 0.0;       ///< m * d2w/dt2 = -(force of R on the stack) [N]
-    double probe_friction_force_n = 0.0;///< tangential contact force p_t at the probe pair [N] (NaN: no probe)
+    double probe_friction_force_n = 0.0;///< tangential contact force p_t at the probe pair [N] (0 if it has none; NaN: no probe)
     int contact_iterations = 0;         ///< solver iterations of this step
     int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
     double kinetic_energy_j = 0.0;      ///< m w_dot^2 / 2 [J]

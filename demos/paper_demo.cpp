@@ -1,0 +1,483 @@
+/// @file paper_demo.cpp
+/// The main job of stackbeam: the example of Lee & Lim (1992), section 5.
+///
+/// The physical problem: a leaf spring of three identical steel-like leaves
+/// (0.5 m long, 0.05 m wide, 0.005 m high, E = 2e10 Pa, massless), stacked and
+/// pinned at both ends, held together by four narrow clamps at x = 0.1, 0.2,
+/// 0.3, 0.4 m (clamp force 1000 N). A rigid body of 20 kg is attached at
+/// midspan and starts at w = 0 with a velocity of 2 m/s normal to the stack.
+/// Three cases of the interface law between the leaves:
+///   bonded        leaves tied together: one beam 0.015 m high (analytic sinusoid)
+///   friction      Coulomb friction mu = 0.5: hysteresis, decaying vibration
+///   frictionless  mu = 0: three beams side by side (analytic sinusoid)
+/// Geometry as read in ../shared/reference-example.md; signs: include/stackbeam/conventions.hpp.
+///
+/// For each case and time-stepping mode (so far only "closed-form", the paper's
+/// exact step with linearly interpolated contact forces) the demo runs the paper's
+/// settings (dt = 1e-3 s; t_end 0.6 s, 2.0 s for friction), prints a table
+/// (steps, contact iterations, wall time, energy balance, deviation from a
+/// reference), writes the time series as CSV to --out-dir and, if gnuplot is on
+/// PATH, PNG figures. References: bonded/frictionless, the sinusoid of the
+/// discretised stiffness (and the one-beam analytic values for comparison);
+/// friction, a closed-form run at dt = 1e-4 s.
+///
+///   paper_demo [--out-dir DIR]      (default out/)
+///
+/// Exit status: 0 success, 1 a run or a figure failed, 2 bad arguments.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stackbeam/csv.hpp"
+#include "stackbeam/errors.hpp"
+#include "stackbeam/model.hpp"
+#include "stackbeam/paper_example.hpp"
+#include "stackbeam/simulation.hpp"
+#include "stackbeam/system.hpp"
+
+namespace fs = std::filesystem;
+using stackbeam::Mode;
+using stackbeam::PaperCase;
+using stackbeam::StepRecord;
+
+namespace {
+
+const stackbeam::PaperExampleOptions kExample{};  // the paper's settings
+const double kMass = kExample.mass_kg;               // m [kg], 20
+const double kVelocity = kExample.initial_velocity_m_per_s;  // v0 [m/s], 2
+constexpr double kDtPaper = 1e-3;   // [s]
+constexpr double kDtFine = 1e-4;    // friction reference [s]
+constexpr double kDtCheck = 2e-4;   // checks that the reference has converged [s]
+
+/// The time-stepping modes run for every case. A CVODE mode is planned: add it
+/// here (and to stackbeam::Mode) and the table gets a row per case for it.
+const std::vector<Mode> kModes = {Mode::closed_form};
+const std::vector<PaperCase> kCases = {PaperCase::bonded, PaperCase::friction, PaperCase::frictionless};
+
+double t_end_of(PaperCase c) { return c == PaperCase::friction ? 2.0 : 0.6; }
+
+/// One simulation and what the table reports about it.
+struct Run {
+    PaperCase pcase{};
+    Mode mode{};
+    double dt_s = 0.0;
+    bool ok = false;
+    std::string error;
+    std::vector<StepRecord> records;
+    long total_iterations = 0;
+    int max_iterations = 0;
+    double wall_s = 0.0;
+    double k_discretised = 0.0;  ///< tied (bonded) or free (frictionless) stiffness of the mesh [N/m]
+    std::string csv_file;        ///< name inside the output directory ("" if none)
+    long steps() const { return records.empty() ? 0 : static_cast<long>(records.size()) - 1; }
+};
+
+Run run_case(PaperCase c, Mode mode, double dt_s, double t_end_s) {
+    Run run;
+    run.pcase = c;
+    run.mode = mode;
+    run.dt_s = dt_s;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+        const stackbeam::Model model = stackbeam::Model::build(stackbeam::paper_example(c));
+        const stackbeam::System system(model);
+        run.k_discretised = c == PaperCase::bonded ? system.tied_stiffness_n_per_m() : system.free_stiffness_n_per_m();
+        stackbeam::SimulationOptions options;
+        options.mode = mode;
+        options.dt_s = dt_s;
+        options.t_end_s = t_end_s;
+        // Collected as they are made, so a failed run still has its records up to the failure.
+        stackbeam::simulate(system, options, [&run](const StepRecord& r) { run.records.push_back(r); });
+        for (std::size_t i = 1; i < run.records.size(); ++i) {
+            run.total_iterations += run.records[i].contact_iterations;
+            run.max_iterations = std::max(run.max_iterations, run.records[i].contact_iterations);
+        }
+        run.ok = true;
+    } catch (const stackbeam::SolverError& e) {
+        std::ostringstream s;
+        s << "solver failure at step " << e.step() << " (t = " << e.time_s() << " s, residual " << e.residual()
+          << "): " << e.what();
+        run.error = s.str();
+    } catch (const std::exception& e) {
+        run.error = e.what();
+    }
+    run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return run;
+}
+
+/// Max over the records of |w(t) - v0/omega sin(omega t)|, omega = sqrt(k/m) [m].
+double max_deviation_from_sinusoid(const std::vector<StepRecord>& records, double k) {
+    const double omega = std::sqrt(k / kMass);
+    double dev = 0.0;
+    for (const auto& r : records) dev = std::max(dev, std::abs(r.w_m - kVelocity / omega * std::sin(omega * r.t_s)));
+    return dev;
+}
+
+/// w of `fine` at time t, linear interpolation between its records.
+double interpolate_w(const std::vector<StepRecord>& fine, double t) {
+    auto it = std::lower_bound(fine.begin(), fine.end(), t, [](const StepRecord& r, double x) { return r.t_s < x; });
+    if (it == fine.begin()) return it->w_m;
+    if (it == fine.end()) return fine.back().w_m;
+    const auto& b = *it;
+    const auto& a = *(it - 1);
+    const double s = (t - a.t_s) / (b.t_s - a.t_s);
+    return a.w_m + s * (b.w_m - a.w_m);
+}
+
+/// Max over the records of `coarse` (up to the end of `fine`) of |w - w_fine| [m].
+double max_deviation_from_run(const std::vector<StepRecord>& coarse, const std::vector<StepRecord>& fine) {
+    double dev = 0.0;
+    for (const auto& r : coarse)
+        if (r.t_s <= fine.back().t_s + 1e-12) dev = std::max(dev, std::abs(r.w_m - interpolate_w(fine, r.t_s)));
+    return dev;
+}
+
+double max_abs_w(const std::vector<StepRecord>& records) {
+    double m = 0.0;
+    for (const auto& r : records) m = std::max(m, std::abs(r.w_m));
+    return m;
+}
+
+/// Writes `records` to dir/name via dir/name.partial (renamed when complete).
+void write_csv_file(const fs::path& dir, const std::string& name, const std::vector<StepRecord>& records) {
+    const fs::path final_path = dir / name;
+    const fs::path partial = dir / (name + ".partial");
+    {
+        std::ofstream out(partial, std::ios::out | std::ios::trunc);
+        if (!out) throw std::runtime_error("cannot open '" + partial.string() + "' for writing");
+        stackbeam::write_csv(out, records);
+        out.close();
+        if (out.fail()) throw std::runtime_error("writing '" + partial.string() + "' failed");
+    }
+    fs::rename(partial, final_path);
+}
+
+std::string csv_name(PaperCase c, Mode m, const std::string& suffix = "") {
+    return std::string(stackbeam::to_string(c)) + "_" + stackbeam::to_string(m) + suffix + ".csv";
+}
+
+// --- gnuplot -----------------------------------------------------------------------
+
+/// Single-quoted for /bin/sh.
+std::string shell_quote(const std::string& s) {
+    std::string q = "'";
+    for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+}
+
+bool gnuplot_on_path() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+/// "pngcairo" or "png", whichever this gnuplot has; nullopt if neither.
+std::optional<std::string> png_terminal() {
+    FILE* pipe = popen("gnuplot -e 'set terminal' 2>&1", "r");
+    if (!pipe) return std::nullopt;
+    std::string text;
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, pipe)) text += buf;
+    pclose(pipe);
+    auto has = [&](const std::string& name) {
+        std::istringstream lines(text);
+        std::string line;
+        while (std::getline(lines, line)) {
+            std::istringstream words(line);
+            std::string first;
+            if (words >> first && first == name) return true;
+        }
+        return false;
+    };
+    if (has("pngcairo")) return std::string("pngcairo");
+    if (has("png")) return std::string("png");
+    return std::nullopt;
+}
+
+/// A gnuplot script drawing the figures from the CSV files in the same directory.
+/// Columns (1-based): 1 t, 2 w, 3 w_dot, 4 force_on_mass, 5 probe_friction_force.
+/// `figures` receives the names of the PNG files the script writes.
+std::string figure_script(const std::string& terminal, const std::map<PaperCase, const Run*>& runs,
+                          const std::string& friction_reference_csv, std::vector<std::string>& figures) {
+    std::ostringstream g;
+    const auto output = [&](const std::string& png) {
+        figures.push_back(png);
+        return "\nset output '" + png + "'\n";
+    };
+    g << "# generated by paper_demo: figures of the paper's section 5 example\n"
+      << "set datafile separator ','\n"
+      << "set terminal " << terminal << (terminal == "pngcairo" ? " enhanced font 'Sans,11'" : " enhanced")
+      << " size 1000,620\n"
+      << "set grid\nset key inside top right box opaque\n"
+      << "# head room above the curves for the key\n"
+      << "set offsets 0, 0, graph 0.25, 0\n";
+    const auto sinusoid_curve = [&](const Run& run, const char* label) {
+        const double k = run.k_discretised;
+        const double omega = std::sqrt(k / kMass);
+        const auto analytic = stackbeam::paper_analytic(run.pcase);
+        std::ostringstream s;
+        s << ", 1000*" << kVelocity / omega << "*sin(" << omega << "*x) with lines lw 1.5 dt 2 lc rgb '#d62728' title "
+          << "sprintf('" << label << " (k = %.0f N/m, omega = %.3f rad/s)', " << k << ", " << omega << ")"
+          << ", 1000*" << analytic.amplitude_m << "*sin(" << analytic.omega_rad_per_s
+          << "*x) with lines lw 1 dt 3 lc rgb '#2ca02c' title "
+          << "sprintf('one-beam analytic (k = %.0f N/m)', " << analytic.stiffness_n_per_m << ")";
+        return s.str();
+    };
+    for (PaperCase c : {PaperCase::bonded, PaperCase::frictionless}) {
+        const auto it = runs.find(c);
+        if (it == runs.end()) continue;
+        const Run& run = *it->second;
+        const std::string name = stackbeam::to_string(c);
+        g << output("fig_displacement_" + name + ".png")
+          << "set title \"Displacement of the 20 kg body, " << name
+          << " case (three leaves, closed-form step, dt = 1 ms)\"\n"
+          << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\nset samples 2000\n"
+          << "plot '" << run.csv_file << "' using 1:($2*1000) every ::1 with lines lw 2 lc rgb '#1f77b4' title "
+          << "'stackbeam, " << stackbeam::to_string(run.mode) << "'" << sinusoid_curve(run, "analytic, mesh stiffness")
+          << "\n";
+    }
+    const auto fr = runs.find(PaperCase::friction);
+    if (fr != runs.end()) {
+        const Run& run = *fr->second;
+        g << output("fig_displacement_friction.png")
+          << "set title \"Displacement of the 20 kg body, friction case (mu = 0.5, clamp force 1000 N)\"\n"
+          << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\n"
+          << "plot '" << run.csv_file << "' using 1:($2*1000) with lines lw 2 lc rgb '#1f77b4' title "
+          << "'stackbeam, " << stackbeam::to_string(run.mode) << ", dt = 1 ms'";
+        if (!friction_reference_csv.empty())
+            g << ", '" << friction_reference_csv
+              << "' using 1:($2*1000) with lines lw 1 dt 2 lc rgb '#d62728' title 'reference, dt = 0.1 ms'";
+        g << "\n";
+        g << output("fig_friction_force_friction.png")
+          << "set title \"Friction force on the upper interface at the left clamp (x = 0.1 m), friction case\"\n"
+          << "set xlabel 'time t [s]'\nset ylabel 'tangential contact force p_t [N]'\n"
+          << "plot '" << run.csv_file << "' using 1:5 with lines lw 1.5 lc rgb '#1f77b4' title "
+          << "'p_t at the probe pair, top/middle leaf (> 0 pushes the upper leaf in +x)'\n";
+        g << output("fig_hysteresis_friction.png")
+          << "set title \"Force on the body vs its displacement, friction case (hysteresis loop)\"\n"
+          << "set xlabel 'displacement w [mm]'\nset ylabel 'force on the body m d^2w/dt^2 [N]'\n"
+          << "set key inside top right\n"
+          << "plot '" << run.csv_file << "' using ($2*1000):4 with lines lw 1.5 lc rgb '#1f77b4' title "
+          << "'friction case, 0 - 2 s'";
+        // The frictionless stack's line -k w for comparison (the bonded line is 9x steeper and
+        // would squash the loop).
+        const auto fl = runs.find(PaperCase::frictionless);
+        if (fl != runs.end())
+            g << ", '" << fl->second->csv_file << "' using ($2*1000):4 with lines lw 1 lc rgb '#7f7f7f' title "
+              << "'frictionless stack (k = 12,000 N/m), for comparison'";
+        g << "\nset key inside top right\n";
+    }
+    if (!runs.empty()) {
+        g << output("fig_displacement_all.png")
+          << "set title 'Displacement of the 20 kg body, the three cases'\n"
+          << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\nset xrange [0:0.6]\nplot ";
+        bool first = true;
+        for (const auto& [c, run] : runs) {
+            g << (first ? "" : ", ") << "'" << run->csv_file << "' using 1:($2*1000) with lines lw 2 title '"
+              << stackbeam::to_string(c) << "'";
+            first = false;
+        }
+        g << "\nset xrange [*:*]\n";
+    }
+    g << "unset output\n";
+    return g.str();
+}
+
+void print_usage(std::ostream& os) {
+    os << "usage: paper_demo [--out-dir DIR]\n"
+          "Runs the paper's section 5 example (three leaves, four clamps, 20 kg body at 2 m/s) in the\n"
+          "bonded, friction and frictionless cases; prints a table, writes CSV time series and, if gnuplot\n"
+          "is on PATH, PNG figures to DIR (default out/).\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    fs::path out_dir = "out";
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "-h" || arg == "--help") {
+            print_usage(std::cout);
+            return 0;
+        } else if (arg == "--out-dir" && i + 1 < argc) {
+            out_dir = argv[++i];
+        } else if (arg.rfind("--out-dir=", 0) == 0) {
+            out_dir = arg.substr(10);
+        } else {
+            std::cerr << "paper_demo: error: unknown or incomplete argument '" << arg << "'\n";
+            print_usage(std::cerr);
+            return 2;
+        }
+    }
+    if (out_dir.empty()) {
+        std::cerr << "paper_demo: error: --out-dir: an empty directory name is not allowed\n";
+        return 2;
+    }
+    try {
+        fs::create_directories(out_dir);
+        // Remove what an earlier run of the demo wrote here (only those names), so that no
+        // stale CSV or figure is taken for a result of this run.
+        for (const auto& entry : fs::directory_iterator(out_dir)) {
+            const std::string name = entry.path().filename().string();
+            bool ours = name == "figures.gp" || name == "fig_displacement_all.png" ||
+                        name == "fig_friction_force_friction.png" || name == "fig_hysteresis_friction.png";
+            for (PaperCase c : kCases) {
+                const std::string cs = stackbeam::to_string(c);
+                ours = ours || name == "fig_displacement_" + cs + ".png";
+                for (Mode m : kModes)
+                    for (const char* suffix : {".csv", ".csv.partial", "_dt1e-4.csv", "_dt1e-4.csv.partial"})
+                        ours = ours || name == cs + "_" + stackbeam::to_string(m) + suffix;
+            }
+            if (ours && entry.is_regular_file()) fs::remove(entry.path());
+        }
+    } catch (const std::exception& e) {
+        std::cerr << "paper_demo: error: --out-dir: cannot create '" << out_dir.string() << "': " << e.what() << "\n";
+        return 2;
+    }
+
+    std::printf("stackbeam paper demo: Lee & Lim (1992) section 5, three leaves 0.5 x 0.05 x 0.005 m, E = 2e10 Pa,\n"
+                "pinned ends, four clamps (1000 N), 20 kg body at midspan starting at 2 m/s; half model,\n"
+                "20 elements per half leaf, contact tolerance 2e-6 m, exact contact solver.\n\n");
+
+    bool all_ok = true;
+    std::vector<Run> runs;
+    for (PaperCase c : kCases)
+        for (Mode m : kModes) {
+            runs.push_back(run_case(c, m, kDtPaper, t_end_of(c)));
+            Run& run = runs.back();
+            if (!run.ok) {
+                all_ok = false;
+                std::fprintf(stderr, "paper_demo: error: case %s, mode %s: %s\n", stackbeam::to_string(c),
+                             stackbeam::to_string(m), run.error.c_str());
+            }
+        }
+
+    // Friction reference: closed form at dt = 1e-4 s, and at 2e-4 s to show it has converged.
+    Run fine = run_case(PaperCase::friction, Mode::closed_form, kDtFine, t_end_of(PaperCase::friction));
+    Run check = run_case(PaperCase::friction, Mode::closed_form, kDtCheck, t_end_of(PaperCase::friction));
+    for (const Run* r : {&fine, &check})
+        if (!r->ok) {
+            all_ok = false;
+            std::fprintf(stderr, "paper_demo: error: friction reference at dt = %g s: %s\n", r->dt_s, r->error.c_str());
+        }
+
+    // --- table 1: every run -------------------------------------------------------------
+    const double e0 = 0.5 * kMass * kVelocity * kVelocity;
+    std::printf("%-13s %-12s %7s %6s %11s %9s %9s %12s %12s %13s  %s\n", "case", "mode", "dt [s]", "steps", "iterations",
+                "max/step", "wall [s]", "E err end", "max|E err|", "max dev [m]", "reference of the deviation");
+    const auto print_row = [&](const Run& run, double dev, const std::string& reference) {
+        if (!run.ok) {
+            std::printf("%-13s %-12s FAILED: %s\n", stackbeam::to_string(run.pcase), stackbeam::to_string(run.mode),
+                        run.error.c_str());
+            return;
+        }
+        double max_energy_error = 0.0;
+        for (const auto& r : run.records) max_energy_error = std::max(max_energy_error, std::abs(r.energy_balance_error_j));
+        std::printf("%-13s %-12s %7.0e %6ld %11ld %9d %9.3f %12.3e %12.3e %13.3e  %s\n", stackbeam::to_string(run.pcase),
+                    stackbeam::to_string(run.mode), run.dt_s, run.steps(), run.total_iterations, run.max_iterations,
+                    run.wall_s, run.records.back().energy_balance_error_j, max_energy_error, dev, reference.c_str());
+    };
+    for (const Run& run : runs) {
+        double dev = NAN;
+        std::string reference;
+        if (run.ok && run.pcase != PaperCase::friction) {
+            dev = max_deviation_from_sinusoid(run.records, run.k_discretised);
+            reference = "sinusoid of the mesh stiffness";
+        } else if (run.ok && fine.ok) {
+            dev = max_deviation_from_run(run.records, fine.records);
+            reference = "closed-form run at dt = 1e-4 s";
+        }
+        print_row(run, dev, reference);
+    }
+    if (fine.ok && check.ok)
+        print_row(check, max_deviation_from_run(check.records, fine.records), "closed-form run at dt = 1e-4 s");
+    if (fine.ok) print_row(fine, 0.0, "(the friction reference itself)");
+    std::printf("(E err: initial energy %.0f J - kinetic - strain - dissipated [J], at the end and its max over the "
+                "run; max dev: max over t of |w - w_ref| [m])\n\n",
+                e0);
+
+    // --- table 2: the linear cases against the analytic figures -------------------------------
+    std::printf("%-13s %-12s %13s %13s %11s %11s %11s %11s %13s %13s\n", "case", "mode", "k mesh [N/m]",
+                "k 1-beam", "omega mesh", "omega 1-b", "ampl mesh", "ampl 1-b", "max |w| [m]", "dev 1-beam");
+    for (const Run& run : runs) {
+        if (!run.ok || run.pcase == PaperCase::friction) continue;
+        const auto a = stackbeam::paper_analytic(run.pcase);
+        const double omega = std::sqrt(run.k_discretised / kMass);
+        std::printf("%-13s %-12s %13.1f %13.1f %11.4f %11.4f %11.5f %11.5f %13.5f %13.3e\n",
+                    stackbeam::to_string(run.pcase), stackbeam::to_string(run.mode), run.k_discretised,
+                    a.stiffness_n_per_m, omega, a.omega_rad_per_s, kVelocity / omega, a.amplitude_m,
+                    max_abs_w(run.records), max_deviation_from_sinusoid(run.records, a.stiffness_n_per_m));
+    }
+    std::printf("(mesh: the discretised stack, bonded = all contact components tied; 1-beam: paper_analytic(), "
+                "48EI/L^3 of the equivalent beam; omega [rad/s], amplitude v0/omega [m];\n dev 1-beam: max |w - "
+                "v0/omega sin(omega t)| with the one-beam omega [m])\n\n");
+
+    // --- CSV files ----------------------------------------------------------------------------
+    std::map<PaperCase, const Run*> plotted;
+    std::string fine_csv;
+    try {
+        for (Run& run : runs) {
+            if (run.records.empty()) continue;
+            if (!run.ok) {  // the records up to the failure, never under the name of a complete run
+                const std::string partial = csv_name(run.pcase, run.mode) + ".partial";
+                std::ofstream out(out_dir / partial);
+                stackbeam::write_csv(out, run.records);
+                std::printf("wrote %s (the failed run up to its failure)\n", (out_dir / partial).string().c_str());
+                continue;
+            }
+            run.csv_file = csv_name(run.pcase, run.mode);
+            write_csv_file(out_dir, run.csv_file, run.records);
+            std::printf("wrote %s\n", (out_dir / run.csv_file).string().c_str());
+            if (run.ok && run.mode == Mode::closed_form) plotted[run.pcase] = &run;
+        }
+        if (fine.ok) {
+            fine.csv_file = csv_name(PaperCase::friction, Mode::closed_form, "_dt1e-4");
+            write_csv_file(out_dir, fine.csv_file, fine.records);
+            fine_csv = fine.csv_file;
+            std::printf("wrote %s\n", (out_dir / fine.csv_file).string().c_str());
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "paper_demo: error: %s\n", e.what());
+        return 1;
+    }
+
+    // --- figures --------------------------------------------------------------------------------
+    if (!gnuplot_on_path()) {
+        std::printf("gnuplot is not on PATH: no figures (install gnuplot-nox to get them)\n");
+    } else if (const auto terminal = png_terminal(); !terminal) {
+        std::printf("gnuplot has neither the pngcairo nor the png terminal: no figures\n");
+    } else if (!plotted.empty()) {
+        const fs::path script = out_dir / "figures.gp";
+        std::vector<std::string> figures;
+        {
+            std::ofstream gp(script);
+            gp << figure_script(*terminal, plotted, fine_csv, figures);
+            if (!gp) {
+                std::fprintf(stderr, "paper_demo: error: cannot write %s\n", script.string().c_str());
+                return 1;
+            }
+        }
+        const std::string cmd = "cd " + shell_quote(out_dir.string()) + " && gnuplot figures.gp";
+        if (std::system(cmd.c_str()) != 0) {
+            std::fprintf(stderr, "paper_demo: error: gnuplot failed on %s\n", script.string().c_str());
+            return 1;
+        }
+        std::printf("wrote figures (gnuplot, %s terminal, script figures.gp) to %s:\n", terminal->c_str(),
+                    out_dir.string().c_str());
+        for (const auto& f : figures) std::printf("  %s\n", f.c_str());
+    }
+
+    if (!all_ok) {
+        std::fprintf(stderr, "paper_demo: error: at least one run failed (see above)\n");
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,252 @@
+/// @file stackbeam_cli.cpp
+/// `stackbeam`: the command line of the stackbeam library.
+///
+/// The physical problem: a leaf spring made of elastic leaves (Bernoulli-Euler
+/// beams, massless) stacked on top of each other and held together by narrow
+/// clamps. The leaves can slide on each other against Coulomb friction. A rigid
+/// body R (the axle seat with its mass) is attached at midspan and starts moving
+/// normal to the stack; the friction between the leaves makes the spring
+/// hysteretic, so the vibration of R decays. This program simulates the built-in
+/// example of Lee & Lim (1992), section 5: three leaves 0.5 x 0.05 x 0.005 m,
+/// E = 2e10 Pa, pinned at both ends, four clamps at x = 0.1 ... 0.4 m, a 20 kg
+/// body at midspan moving at 2 m/s, in one of three cases (bonded leaves,
+/// friction mu = 0.5 with clamp force 1000 N, frictionless). Geometry:
+/// ../shared/reference-example.md; signs and units: include/stackbeam/conventions.hpp.
+///
+///   stackbeam simulate --case friction --t-end 2 --out friction.csv
+///
+/// writes one CSV row per time step (columns of stackbeam::step_record_columns()).
+/// The CSV is written to FILE.partial and renamed to FILE only when the whole run
+/// succeeded. Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "stackbeam/csv.hpp"
+#include "stackbeam/errors.hpp"
+#include "stackbeam/model.hpp"
+#include "stackbeam/paper_example.hpp"
+#include "stackbeam/simulation.hpp"
+#include "stackbeam/system.hpp"
+
+namespace {
+
+constexpr int exit_ok = 0;
+constexpr int exit_other = 1;
+constexpr int exit_input = 2;
+constexpr int exit_solver = 3;
+
+/// Bad command-line input; reported like stackbeam::InputError.
+struct ArgumentError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// Parses a finite double > 0 from `text`, all of it, or throws naming `option`.
+double parse_positive(const std::string& option, const std::string& text, const char* unit) {
+    const std::string allowed = std::string("must be a finite number > 0 [") + unit + "]";
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double value = std::strtod(begin, &end);
+    if (text.empty() || end == begin || *end != '\0')
+        throw ArgumentError(option + ": value '" + text + "' is not a number: " + allowed);
+    if (!std::isfinite(value) || value <= 0.0)
+        throw ArgumentError(option + ": value '" + text + "' is not allowed: " + allowed);
+    if (errno == ERANGE)  // underflow to a denormal or zero
+        throw ArgumentError(option + ": value '" + text + "' is out of range: " + allowed);
+    return value;
+}
+
+/// Parses an integer >= 1 from `text`, all of it, or throws naming `option`.
+int parse_count(const std::string& option, const std::string& text) {
+    const std::string allowed = "must be an integer >= 1";
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(begin, &end, 10);
+    if (text.empty() || end == begin || *end != '\0')
+        throw ArgumentError(option + ": value '" + text + "' is not an integer: " + allowed);
+    if (errno == ERANGE || value < 1 || value > std::numeric_limits<int>::max())
+        throw ArgumentError(option + ": value '" + text + "' is not allowed: " + allowed);
+    return static_cast<int>(value);
+}
+
+/// Text of the options of `simulate`, as given (defaults as documented).
+struct SimulateArgs {
+    std::string case_name;
+    std::string mode = "closed-form";
+    std::string t_end = "0.6";
+    std::string dt = "1e-3";
+    std::string elements = "20";
+    bool full_model = false;
+    std::string tol = "2e-6";
+    std::string solver = "exact";
+    std::string alpha_fraction = "0.9";
+    std::string max_iterations = "200000";
+    std::string out;
+};
+
+int run_simulate(const SimulateArgs& a) {
+    // --- validate every argument before any work ---------------------------------
+    const stackbeam::PaperCase pcase = stackbeam::parse_paper_case(a.case_name, "--case");
+    stackbeam::SimulationOptions options;
+    options.mode = stackbeam::parse_mode(a.mode, "--mode");
+    options.dt_s = parse_positive("--dt", a.dt, "s");
+    options.t_end_s = parse_positive("--t-end", a.t_end, "s");
+    options.solver.kind = stackbeam::parse_solver_kind(a.solver, "--solver");
+    options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
+    options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
+    if (options.solver.alpha_fraction >= 1.0)
+        throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
+                            "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
+    options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
+    stackbeam::PaperExampleOptions example;
+    example.elements_per_half_leaf = parse_count("--elements", a.elements);
+    example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
+    if (a.out.empty()) throw ArgumentError("--out: an output file name is required");
+    options.validate();
+
+    // --- build ----------------------------------------------------------------------
+    const auto t0 = std::chrono::steady_clock::now();
+    const stackbeam::Model model = stackbeam::Model::build(stackbeam::paper_example(pcase, example));
+    const stackbeam::System system(model);
+
+    // --- run, streaming rows to FILE.partial ----------------------------------------
+    const std::string partial = a.out + ".partial";
+    std::ofstream csv(partial, std::ios::out | std::ios::trunc);
+    if (!csv) throw ArgumentError("--out: cannot open '" + partial + "' for writing");
+    stackbeam::write_csv_header(csv);
+
+    long steps = -1;  // the first record is the initial state
+    long total_iterations = 0;
+    int max_iterations = 0;
+    stackbeam::StepRecord last;
+    try {
+        stackbeam::simulate(system, options, [&](const stackbeam::StepRecord& r) {
+            stackbeam::write_csv_row(csv, r);
+            ++steps;
+            total_iterations += r.contact_iterations;
+            max_iterations = std::max(max_iterations, r.contact_iterations);
+            last = r;
+        });
+    } catch (...) {
+        csv.flush();
+        std::cerr << "stackbeam: note: " << a.out << " was not written; the rows up to the failure are in "
+                  << partial << "\n";
+        throw;
+    }
+    csv.flush();
+    csv.close();
+    if (csv.fail()) throw std::runtime_error("writing '" + partial + "' failed");
+    if (std::rename(partial.c_str(), a.out.c_str()) != 0)
+        throw std::runtime_error("cannot rename '" + partial + "' to '" + a.out + "'");
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    // --- summary ----------------------------------------------------------------------
+    const double e0 = 0.5 * model.spec().rigid_body.mass_kg * std::pow(model.spec().rigid_body.initial_velocity_m_per_s, 2);
+    std::printf("case %s, mode %s, solver %s, %d elements per half leaf (%s model), dt %g s, t_end %g s\n",
+                stackbeam::to_string(pcase), stackbeam::to_string(options.mode),
+                stackbeam::to_string(options.solver.kind), example.elements_per_half_leaf,
+                a.full_model ? "full" : "half", options.dt_s, options.t_end_s);
+    std::printf("steps                      %ld\n", steps);
+    std::printf("contact iterations         total %ld, max per step %d, mean per step %.2f\n", total_iterations,
+                max_iterations, steps > 0 ? static_cast<double>(total_iterations) / steps : 0.0);
+    std::printf("final state                t %.6g s, w %.6g m, w_dot %.6g m/s\n", last.t_s, last.w_m,
+                last.w_dot_m_per_s);
+    std::printf("energy balance error       %.3e J (initial energy %.6g J, dissipated %.6g J)\n",
+                last.energy_balance_error_j, e0, last.dissipated_energy_j);
+    std::printf("wall time                  %.3f s\n", wall_s);
+    std::printf("output                     %s\n", a.out.c_str());
+    return exit_ok;
+}
+
+/// The command-line option behind a library field, or "" if none.
+std::string option_of_field(const std::string& field) {
+    static const std::pair<const char*, const char*> map[] = {
+        {"dt", "--dt"},
+        {"t_end", "--t-end"},
+        {"solver.tolerance_m", "--tol"},
+        {"solver.alpha_fraction", "--alpha-fraction"},
+        {"solver.max_iterations", "--max-iterations"},
+        {"elements_per_half_leaf", "--elements"},
+    };
+    for (const auto& [f, o] : map)
+        if (field == f) return o;
+    return "";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"stackbeam: vibration of a stacked-beam leaf spring with Coulomb friction between the leaves\n"
+                 "(Lee & Lim 1992, section 5 example: three leaves, four clamps, 20 kg body at 2 m/s)",
+                 "stackbeam"};
+    app.require_subcommand(1);
+    app.footer("Example:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
+               "Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.");
+
+    SimulateArgs a;
+    CLI::App* sim = app.add_subcommand("simulate", "Simulate the paper example and write one CSV row per time step");
+    sim->add_option("--case", a.case_name, "bonded | friction | frictionless")->type_name("CASE")->required();
+    sim->add_option("--mode", a.mode, "time stepping: closed-form (the paper's exact step)")->type_name("MODE")->capture_default_str();
+    sim->add_option("--t-end", a.t_end, "end time [s]")->type_name("S")->capture_default_str();
+    sim->add_option("--dt", a.dt, "time step [s]")->type_name("S")->capture_default_str();
+    sim->add_option("--elements", a.elements, "elements per half leaf")->type_name("N")->capture_default_str();
+    sim->add_flag("--full-model", a.full_model, "mesh the whole spring instead of the symmetric half");
+    sim->add_option("--tol", a.tol, "contact tolerance on ||v||_2 [m]")->type_name("M")->capture_default_str();
+    sim->add_option("--solver", a.solver, "contact solver: exact | accelerated | block-jacobi | paper")->type_name("SOLVER")->capture_default_str();
+    sim->add_option("--alpha-fraction", a.alpha_fraction,
+                    "paper solver: alpha as a fraction (0 < F < 1) of its stability bound 2/lambda_max(W)")
+        ->type_name("F")
+        ->capture_default_str();
+    sim->add_option("--max-iterations", a.max_iterations, "iteration limit per step of the iterative solvers")
+        ->type_name("N")
+        ->capture_default_str();
+    sim->add_option("--out", a.out, "output CSV file (written as FILE.partial, renamed when complete)")
+        ->type_name("FILE.csv")
+        ->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "stackbeam: error: " << e.what() << "\n(run 'stackbeam --help' or 'stackbeam simulate --help')\n";
+        return exit_input;
+    }
+
+    try {
+        if (sim->parsed()) return run_simulate(a);
+        return exit_other;
+    } catch (const ArgumentError& e) {
+        std::cerr << "stackbeam: error: " << e.what() << "\n";
+        return exit_input;
+    } catch (const stackbeam::InputError& e) {
+        // The library names its field ("dt: ..."); say the option instead ("--dt: ...").
+        const std::string option = option_of_field(e.field());
+        std::string message = e.what();
+        const std::string prefix = e.field() + ": ";
+        if (!option.empty() && message.rfind(prefix, 0) == 0) message = option + ": " + message.substr(prefix.size());
+        std::cerr << "stackbeam: error: " << message << "\n";
+        return exit_input;
+    } catch (const stackbeam::SolverError& e) {
+        std::cerr << "stackbeam: error: solver failure at step " << e.step() << " (t = " << e.time_s()
+                  << " s, residual " << e.residual() << "): " << e.what() << "\n";
+        return exit_solver;
+    } catch (const std::exception& e) {
+        std::cerr << "stackbeam: error: " << e.what() << "\n";
+        return exit_other;
+    }
+}

@@ -1,0 +1,41 @@
+# Shared by run-demo.sh and run-tests.sh (sourced, not run): installs the Debian
+# packages the project needs, if missing, and configures and builds it in build/.
+
+# The packages every build needs.
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev)
+
+# install_packages PKG...: apt-get installs the packages that are not installed yet.
+# Skips apt entirely (fast) when all of them are installed already.
+install_packages() {
+  local missing=() pkg
+  if ! command -v dpkg-query >/dev/null 2>&1; then
+    echo "note: dpkg-query not found (not a Debian system?); not installing: $*" >&2
+    return 0
+  fi
+  for pkg in "$@"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed'; then
+      missing+=("$pkg")
+    fi
+  done
+  if [ "${#missing[@]}" -eq 0 ]; then
+    echo "packages: all installed ($*)"
+    return 0
+  fi
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    if ! command -v sudo >/dev/null 2>&1; then
+      echo "error: need root or sudo to install: ${missing[*]}" >&2
+      return 1
+    fi
+    sudo=(sudo)
+  fi
+  echo "packages: installing ${missing[*]}"
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+}
+
+# build: configures and builds the project in build/ (Release).
+build() {
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+  cmake --build build -j"$(nproc)"
+}
