@@ -38,7 +38,7 @@ namespace {
 enum : signed char { NONE = 0, CLOSED = 1, OPEN = 2 };
 enum : signed char { STICK = 1, SLIP_POS = 2, SLIP_NEG = 3, FREE = 4 };
 
-class ExactSolver final : public ContactSolver {
+class ExactSolver final : public WCachingSolver {
 public:
     explicit ExactSolver(const SolverOptions& o) : options_(o) {}
     SolverKind kind() const override { return SolverKind::exact; }
@@ -46,9 +46,7 @@ public:
     SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
         const int n = problem.size();
         const int np = static_cast<int>(problem.pairs.size());
-        if (W_.rows() != n || W_ != problem.W || static_cast<int>(nmode_.size()) != np) {
-            problem.validate();
-            W_ = problem.W;
+        if (refresh(problem) || static_cast<int>(nmode_.size()) != np) {
             lu_modes_.clear();
             if (p.size() != n) p = Eigen::VectorXd::Zero(n);
             init_modes(problem, p);
@@ -97,7 +95,6 @@ public:
 
 private:
     SolverOptions options_;
-    Eigen::MatrixXd W_;
     std::vector<signed char> nmode_, tmode_;
     std::vector<signed char> lu_modes_;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu_;

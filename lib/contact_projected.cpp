@@ -18,7 +18,7 @@ double sign(double x) { return (x > 0.0) - (x < 0.0); }
 ///       = sign(p_bar_t) mu tau                  if v_t = 0 != s_t (slipping with the right sign),
 /// iterated until ||v||_2 < tolerance (step 8 of the paper's algorithm).
 /// with E = I (the paper). alpha defaults to a fraction of the bound 2 / lambda_max(W).
-class PaperSolver final : public ContactSolver {
+class PaperSolver final : public WCachingSolver {
 public:
     explicit PaperSolver(const SolverOptions& o) : options_(o) {}
     SolverKind kind() const override { return options_.kind; }
@@ -26,11 +26,7 @@ public:
     SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
         const int n = problem.size();
         if (p.size() != n) p = Eigen::VectorXd::Zero(n);
-        if (W_.rows() != n || W_ != problem.W) {
-            problem.validate();
-            W_ = problem.W;
-            lambda_max_ = largest_eigenvalue(W_);
-        }
+        if (refresh(problem)) lambda_max_ = largest_eigenvalue(W_);
         const double alpha = options_.alpha > 0.0 ? options_.alpha : options_.alpha_fraction * 2.0 / lambda_max_;
         SolveResult r;
         Eigen::VectorXd s = problem.W * p + problem.q;
@@ -73,7 +69,6 @@ public:
 
 private:
     SolverOptions options_;
-    Eigen::MatrixXd W_;
     double lambda_max_ = 0.0;
 };
 
@@ -83,16 +78,14 @@ private:
 /// previous iterate, and all pairs move together by the relaxation alpha_fraction.
 /// (With a non-diagonal E, the paper's component-wise projection would have a fixed
 /// point off the solution: a slipping pair would keep s_n = -E_nt s_t / E_nn != 0.)
-class BlockJacobiSolver final : public ContactSolver {
+class BlockJacobiSolver final : public WCachingSolver {
 public:
     explicit BlockJacobiSolver(const SolverOptions& o) : options_(o) {}
     SolverKind kind() const override { return SolverKind::block_jacobi; }
     SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
         const int n = problem.size();
         if (p.size() != n) p = Eigen::VectorXd::Zero(n);
-        if (W_.rows() != n || W_ != problem.W) {
-            problem.validate();
-            W_ = problem.W;
+        if (refresh(problem)) {
             Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);  // per-pair diagonal blocks of W
             for (const auto& c : problem.pairs)
                 for (int a : {c.row_n, c.row_t})
@@ -117,13 +110,10 @@ public:
                 return r;
             }
             local = p;
-            for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
-                const auto& c = problem.pairs[k];
-                const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0, pt = c.row_t >= 0 ? p[c.row_t] : 0.0;
-                double bn = 0.0, bt = 0.0;
-                if (c.row_n >= 0) bn = s[c.row_n] - W_(c.row_n, c.row_n) * pn - (c.row_t >= 0 ? W_(c.row_n, c.row_t) * pt : 0.0);
-                if (c.row_t >= 0) bt = s[c.row_t] - W_(c.row_t, c.row_t) * pt - (c.row_n >= 0 ? W_(c.row_t, c.row_n) * pn : 0.0);
-                solve_pair_locally(problem, static_cast<int>(k), W_, bn, bt, local);
+            for (int k = 0; k < static_cast<int>(problem.pairs.size()); ++k) {
+                double bn, bt;
+                pair_free_term(problem, k, p, s, bn, bt);
+                solve_pair_locally(problem, k, W_, bn, bt, local);
             }
             p += relax * (local - p);
             s.noalias() = problem.W * p;
@@ -137,26 +127,21 @@ public:
 
 private:
     SolverOptions options_;
-    Eigen::MatrixXd W_;
     double lambda_max_ = 1.0;
 };
 
-class GaussSeidelSolver final : public ContactSolver {
+class GaussSeidelSolver final : public WCachingSolver {
 public:
     explicit GaussSeidelSolver(const SolverOptions& o) : options_(o) {}
     SolverKind kind() const override { return SolverKind::accelerated; }
     SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) override {
-        if (W_.rows() != problem.size() || W_ != problem.W) {
-            problem.validate();
-            W_ = problem.W;
-        }
+        refresh(problem);
         if (p.size() != problem.size()) p = Eigen::VectorXd::Zero(problem.size());
         return gauss_seidel_sweeps(problem, p, options_.tolerance_m, options_.max_iterations);
     }
 
 private:
     SolverOptions options_;
-    Eigen::MatrixXd W_;
 };
 
 }  // namespace
@@ -165,6 +150,15 @@ std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& o) {
     if (o.kind == SolverKind::accelerated) return std::make_unique<GaussSeidelSolver>(o);
     if (o.kind == SolverKind::block_jacobi) return std::make_unique<BlockJacobiSolver>(o);
     return std::make_unique<PaperSolver>(o);
+}
+
+void pair_free_term(const ContactProblem& problem, int k, const Eigen::VectorXd& p, const Eigen::VectorXd& s,
+                    double& bn, double& bt) {
+    const auto& c = problem.pairs[k];
+    const auto& W = problem.W;
+    const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0, pt = c.row_t >= 0 ? p[c.row_t] : 0.0;
+    bn = c.row_n >= 0 ? s[c.row_n] - W(c.row_n, c.row_n) * pn - (c.row_t >= 0 ? W(c.row_n, c.row_t) * pt : 0.0) : 0.0;
+    bt = c.row_t >= 0 ? s[c.row_t] - W(c.row_t, c.row_t) * pt - (c.row_n >= 0 ? W(c.row_t, c.row_n) * pn : 0.0) : 0.0;
 }
 
 void solve_pair_locally(const ContactProblem& problem, int k, const Eigen::MatrixXd& W, double bn, double bt,
@@ -268,13 +262,12 @@ SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& 
                         std::to_string(r.iterations) + " sweeps; residual " + format_value(r.residual_m) + " m";
             return r;
         }
-        for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+        for (int k = 0; k < static_cast<int>(problem.pairs.size()); ++k) {
             const auto& c = problem.pairs[k];
             const double pn0 = c.row_n >= 0 ? p[c.row_n] : 0.0, pt0 = c.row_t >= 0 ? p[c.row_t] : 0.0;
-            double bn = 0.0, bt = 0.0;
-            if (c.row_n >= 0) bn = s[c.row_n] - W(c.row_n, c.row_n) * pn0 - (c.row_t >= 0 ? W(c.row_n, c.row_t) * pt0 : 0.0);
-            if (c.row_t >= 0) bt = s[c.row_t] - W(c.row_t, c.row_t) * pt0 - (c.row_n >= 0 ? W(c.row_t, c.row_n) * pn0 : 0.0);
-            solve_pair_locally(problem, static_cast<int>(k), W, bn, bt, p);
+            double bn, bt;
+            pair_free_term(problem, k, p, s, bn, bt);
+            solve_pair_locally(problem, k, W, bn, bt, p);
             if (c.row_n >= 0 && p[c.row_n] != pn0) s += W.col(c.row_n) * (p[c.row_n] - pn0);
             if (c.row_t >= 0 && p[c.row_t] != pt0) s += W.col(c.row_t) * (p[c.row_t] - pt0);
         }

@@ -16,6 +16,24 @@ std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& options);
 void solve_pair_locally(const ContactProblem& problem, int k, const Eigen::MatrixXd& W, double bn, double bt,
                         Eigen::VectorXd& p);
 
+/// Pair k's own free term (bn, bt) = s_k - W_kk p_k: its relative position with its
+/// own force removed and every other pair's force kept.
+void pair_free_term(const ContactProblem& problem, int k, const Eigen::VectorXd& p, const Eigen::VectorXd& s,
+                    double& bn, double& bt);
+
+/// Base of the solvers that keep data derived from W: refresh() validates the
+/// problem and reports true when W is new (so the derived data must be rebuilt).
+class WCachingSolver : public ContactSolver {
+protected:
+    bool refresh(const ContactProblem& problem) {
+        if (W_.rows() == problem.size() && W_ == problem.W) return false;
+        problem.validate();
+        W_ = problem.W;
+        return true;
+    }
+    Eigen::MatrixXd W_;
+};
+
 /// Gauss-Seidel sweeps with exact pair solves until ||v||_2 < tolerance_m.
 SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& p, double tolerance_m,
                                 int max_sweeps);
