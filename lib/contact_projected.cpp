@@ -12,6 +12,36 @@ namespace {
 
 double sign(double x) { return (x > 0.0) - (x < 0.0); }
 
+/// The common loop of the iterative solvers: `update(p, s, v)` makes the next iterate
+/// from the current one (s = W p + q and v its error vector, eq. 9); the loop stops at
+/// ||v||_2 < tolerance (the paper's step 8), or at the iteration limit with a message
+/// that starts with `what`. `at_least_once`: iterate even if the start already passes.
+template <class Update>
+SolveResult iterate(const ContactProblem& problem, Eigen::VectorXd& p, const SolverOptions& o,
+                    const std::string& what, bool at_least_once, Update update) {
+    SolveResult r;
+    Eigen::VectorXd s = problem.W * p + problem.q;
+    Eigen::VectorXd v = error_vector(problem, p, s);
+    r.residual_m = v.norm();
+    bool first = at_least_once;
+    while (first || r.residual_m >= o.tolerance_m) {
+        first = false;
+        if (r.iterations >= o.max_iterations || !std::isfinite(r.residual_m)) {
+            r.message = what + " did not reach ||v|| < " + format_value(o.tolerance_m) + " m in " +
+                        std::to_string(r.iterations) + " iterations; residual " + format_value(r.residual_m) + " m";
+            return r;
+        }
+        update(p, s, v);
+        s.noalias() = problem.W * p;
+        s += problem.q;
+        v = error_vector(problem, p, s);
+        r.residual_m = v.norm();
+        ++r.iterations;
+    }
+    r.converged = true;
+    return r;
+}
+
 /// eq. 17:
 ///   p_bar = p - alpha E s;  p_n = min(0, p_bar_n);
 ///   p_t = sign(p_bar_t) min(|p_bar_t|, mu tau)  if v_t = s_t at the previous iterate,
@@ -28,20 +58,11 @@ public:
         if (p.size() != n) p = Eigen::VectorXd::Zero(n);
         if (refresh(problem)) lambda_max_ = largest_eigenvalue(W_);
         const double alpha = options_.alpha > 0.0 ? options_.alpha : options_.alpha_fraction * 2.0 / lambda_max_;
-        SolveResult r;
-        Eigen::VectorXd s = problem.W * p + problem.q;
-        Eigen::VectorXd v = error_vector(problem, p, s);
-        r.residual_m = v.norm();
         Eigen::VectorXd pbar(n);
-        while (r.residual_m >= options_.tolerance_m) {
-            if (r.iterations >= options_.max_iterations || !std::isfinite(r.residual_m)) {
-                r.message = "paper iteration (eq. 17, E = I, alpha = " +
-                            format_value(alpha) + ") did not reach ||v|| < " + format_value(options_.tolerance_m) +
-                            " m in " + std::to_string(r.iterations) + " iterations; residual " +
-                            format_value(r.residual_m) + " m (alpha must be below 2/lambda_max(W) = " +
-                            format_value(2.0 / lambda_max_) + ")";
-                return r;
-            }
+        const std::string what = "paper iteration (eq. 17, E = I, alpha = " + format_value(alpha) +
+                                 "; stable below 2/lambda_max(W) = " + format_value(2.0 / lambda_max_) + ")";
+        return iterate(problem, p, options_, what, false,
+                       [&](Eigen::VectorXd& p, const Eigen::VectorXd& s, const Eigen::VectorXd& v) {
             pbar.noalias() = p - alpha * s;
             for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
                 const auto& c = problem.pairs[k];
@@ -57,14 +78,7 @@ public:
                 const bool slipping = v[t] == 0.0 && s[t] != 0.0;
                 p[t] = slipping ? sign(pbar[t]) * limit : sign(pbar[t]) * std::min(std::abs(pbar[t]), limit);
             }
-            s.noalias() = problem.W * p;
-            s += problem.q;
-            v = error_vector(problem, p, s);
-            r.residual_m = v.norm();
-            ++r.iterations;
-        }
-        r.converged = true;
-        return r;
+        });
     }
 
 private:
@@ -96,19 +110,9 @@ public:
         }
         // relaxation: a fraction of the stability bound 2 / lambda_max(E W) of the linear part
         const double relax = options_.alpha > 0.0 ? options_.alpha : options_.alpha_fraction * 2.0 / lambda_max_;
-        SolveResult r;
-        Eigen::VectorXd s = problem.W * p + problem.q;
-        r.residual_m = error_vector(problem, p, s).norm();
         Eigen::VectorXd local(n);
-        bool first = true;
-        while (first || r.residual_m >= options_.tolerance_m) {
-            first = false;
-            if (r.iterations >= options_.max_iterations || !std::isfinite(r.residual_m)) {
-                r.message = "block-Jacobi iteration (relaxation " + format_value(relax) + ") did not reach ||v|| < " +
-                            format_value(options_.tolerance_m) + " m in " + std::to_string(r.iterations) +
-                            " iterations; residual " + format_value(r.residual_m) + " m";
-                return r;
-            }
+        return iterate(problem, p, options_, "block-Jacobi iteration (relaxation " + format_value(relax) + ")", true,
+                       [&](Eigen::VectorXd& p, const Eigen::VectorXd& s, const Eigen::VectorXd&) {
             local = p;
             for (int k = 0; k < static_cast<int>(problem.pairs.size()); ++k) {
                 double bn, bt;
@@ -116,13 +120,7 @@ public:
                 solve_pair_locally(problem, k, W_, bn, bt, local);
             }
             p += relax * (local - p);
-            s.noalias() = problem.W * p;
-            s += problem.q;
-            r.residual_m = error_vector(problem, p, s).norm();
-            ++r.iterations;
-        }
-        r.converged = true;
-        return r;
+        });
     }
 
 private:
