@@ -25,8 +25,6 @@
 #include <cmath>
 #include <algorithm>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 #include "box_qp.hpp"
 #include "contact_solvers.hpp"
@@ -53,7 +51,7 @@ public:
         }
         SolveResult r;
         // 1. From the previous step's modes (warm start): most steps end here in one pass.
-        r.converged = active_set_passes(problem, p, kWarmPasses, r);
+        r.converged = active_set_passes(problem, p, options_.max_active_set_iterations, r);
         if (!r.converged) {
             // 2. A transition: solve the problem with the friction limits frozen (Tresca), a
             //    box-constrained QP, by a monotone active-set method that cannot cycle; update
@@ -62,7 +60,7 @@ public:
             const bool settled = tresca_fixed_point(problem, p, r);
             if (!settled) init_modes(problem, p);
             const Eigen::VectorXd p_tresca = p;
-            r.converged = active_set_passes(problem, p, kWarmPasses, r);
+            r.converged = active_set_passes(problem, p, options_.max_active_set_iterations, r);
             if (!r.converged && settled) {  // the fixed point itself is within kAccept x tolerance
                 p = p_tresca;
                 r.converged = true;
@@ -102,7 +100,6 @@ private:
     std::vector<int> pos_;        // row -> index in S_ or -1
     Eigen::VectorXd rhs_, x_, e_;
 
-    static constexpr int kWarmPasses = 3;
     static constexpr int kTrescaIterations = 100;
     static constexpr int kBudget = 3;
     static constexpr double kAccept = 1e-3;
@@ -158,7 +155,7 @@ private:
             for (int k = 0; k < np; ++k) {
                 const auto& c = pr.pairs[k];
                 if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                const double limit = c.friction_coefficient * (std::isfinite(tau[k]) ? tau[k] : 0.0);
+                const double limit = c.friction_coefficient * tau[k];
                 lower[c.row_t] = -limit;
                 upper[c.row_t] = limit;
             }

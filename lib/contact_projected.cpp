@@ -240,9 +240,6 @@ void solve_pair_locally(const ContactProblem& problem, int k, const Eigen::Matri
 
 SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& p, double tolerance_m,
                                 int max_sweeps) {
-    SolveResult r;
-    const auto& W = problem.W;
-    Eigen::VectorXd s = W * p + problem.q;
     // eq. 9's v is blind to forces outside the admissible set (p_n > 0 with an open
     // gap, |p_t| above the limit): a start that may hold such forces gets one sweep first.
     bool admissible = true;
@@ -253,29 +250,24 @@ SolveResult gauss_seidel_sweeps(const ContactProblem& problem, Eigen::VectorXd& 
             std::abs(p[c.row_t]) > c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p) * (1.0 + 1e-12))
             admissible = false;
     }
-    r.residual_m = admissible ? error_vector(problem, p, s).norm() : std::numeric_limits<double>::infinity();
-    while (r.residual_m >= tolerance_m) {
-        if (r.iterations >= max_sweeps || (r.iterations > 0 && !std::isfinite(r.residual_m))) {
-            r.message = "Gauss-Seidel sweeps did not reach ||v|| < " + format_value(tolerance_m) + " m in " +
-                        std::to_string(r.iterations) + " sweeps; residual " + format_value(r.residual_m) + " m";
-            return r;
-        }
+    SolverOptions o;
+    o.tolerance_m = tolerance_m;
+    o.max_iterations = max_sweeps;
+    const auto& W = problem.W;
+    Eigen::VectorXd ls;
+    return iterate(problem, p, o, "Gauss-Seidel sweeps", !admissible,
+                   [&](Eigen::VectorXd& p, const Eigen::VectorXd& s, const Eigen::VectorXd&) {
+        ls = s;  // kept current pair by pair; iterate() recomputes s after the sweep (no drift)
         for (int k = 0; k < static_cast<int>(problem.pairs.size()); ++k) {
             const auto& c = problem.pairs[k];
             const double pn0 = c.row_n >= 0 ? p[c.row_n] : 0.0, pt0 = c.row_t >= 0 ? p[c.row_t] : 0.0;
             double bn, bt;
-            pair_free_term(problem, k, p, s, bn, bt);
+            pair_free_term(problem, k, p, ls, bn, bt);
             solve_pair_locally(problem, k, W, bn, bt, p);
-            if (c.row_n >= 0 && p[c.row_n] != pn0) s += W.col(c.row_n) * (p[c.row_n] - pn0);
-            if (c.row_t >= 0 && p[c.row_t] != pt0) s += W.col(c.row_t) * (p[c.row_t] - pt0);
+            if (c.row_n >= 0 && p[c.row_n] != pn0) ls += W.col(c.row_n) * (p[c.row_n] - pn0);
+            if (c.row_t >= 0 && p[c.row_t] != pt0) ls += W.col(c.row_t) * (p[c.row_t] - pt0);
         }
-        ++r.iterations;
-        s.noalias() = W * p;  // refresh: no drift of the incremental updates
-        s += problem.q;
-        r.residual_m = error_vector(problem, p, s).norm();
-    }
-    r.converged = true;
-    return r;
+    });
 }
 
 }  // namespace stackbeam::detail

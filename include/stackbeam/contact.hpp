@@ -89,7 +89,8 @@ struct SolverOptions {
     int max_iterations = 200000;      ///< iteration limit of the iterative solvers
     double alpha = 0.0;               ///< paper / block_jacobi: alpha; 0 = alpha_fraction * 2 / lambda_max(E W)
     double alpha_fraction = 0.9;      ///< paper / block_jacobi: alpha as a fraction of the stability bound 2/lambda_max(E W)
-    int max_active_set_iterations = 200;  ///< exact solver: mode switches before it falls back
+    int max_active_set_iterations = 3;    ///< exact solver: active-set passes from the given modes before it
+                                          ///< turns to the Tresca fixed point (and again after it)
 };
 
 /// What a solve reports. A solve that does not converge says so; it never passes silently.
