@@ -43,13 +43,29 @@ std::vector<std::string> step_record_columns();
 /// Values of a record in the order of step_record_columns().
 std::vector<double> step_record_values(const StepRecord& r);
 
-enum class Mode { closed_form };
+/// The integrators of the massless-leaf model.
+enum class Mode {
+    closed_form,  ///< the paper's closed-form step (eq. 16), fixed dt: the reference
+    cvode,        ///< SUNDIALS CVODE between events, root-finding on every contact transition
+};
 const char* to_string(Mode m);
 Mode parse_mode(const std::string& text, const std::string& field);
 
+/// Options of mode "cvode" (see cvode_stepper.hpp).
+struct CvodeOptions {
+    double rtol = 1e-8;          ///< CVODE relative tolerance [-]
+    double atol_m = 1e-12;       ///< absolute tolerance on w [m]; on w_dot it is atol_m * omega, on the
+                                 ///< dissipated energy atol_m * k * (amplitude scale) (see cvode_stepper.cpp)
+    double max_step_s = 0.0;     ///< largest internal step [s]; 0 = no limit
+    bool root_finding = true;    ///< locate transitions by CVODE root-finding (false: only the per-step
+                                 ///< contact check finds them, by bisection; for testing that safety net)
+    long max_steps = 10000000;   ///< limit on CVODE's internal steps over the whole run
+};
+
 struct SimulationOptions {
     Mode mode = Mode::closed_form;
-    double dt_s = 1e-3;        ///< time step [s] (paper: 1e-3)
+    double dt_s = 1e-3;        ///< time step [s] (paper: 1e-3); in mode cvode the output interval
+    CvodeOptions cvode;        ///< mode cvode only
     double t_end_s = 0.6;      ///< end time [s]
     SolverOptions solver;      ///< contact solver and its tolerance (paper: ||v|| < 2e-6 m)
     TauRule tau_rule = TauRule::current;
