@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -35,13 +36,15 @@ std::vector<double> step_record_values(const StepRecord& r) {
 const char* to_string(Mode m) {
     switch (m) {
         case Mode::closed_form: return "closed-form";
+        case Mode::cvode: return "cvode";
     }
     return "?";
 }
 
 Mode parse_mode(const std::string& text, const std::string& field) {
     if (text == "closed-form") return Mode::closed_form;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form");
+    if (text == "cvode") return Mode::cvode;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode");
 }
 
 void SimulationOptions::validate() const {
@@ -52,6 +55,19 @@ void SimulationOptions::validate() const {
     if (t_end_s / dt_s > 1e9)
         throw InputError("dt", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end = " + format_value(t_end_s) + " s");
     make_solver(solver);  // validates the solver options
+    if (mode == Mode::cvode) {
+        if (!std::isfinite(cvode.rtol) || cvode.rtol < 1e-14 || cvode.rtol > 1e-2)
+            throw InputError("rtol", "value " + format_value(cvode.rtol) +
+                                         " is not allowed: CVODE's relative tolerance must be in [1e-14, 1e-2]");
+        if (!std::isfinite(cvode.atol_m) || cvode.atol_m <= 0.0)
+            throw InputError("atol", "value " + format_value(cvode.atol_m) +
+                                         " is not allowed: the absolute tolerance on w must be finite and > 0 [m]");
+        if (!std::isfinite(cvode.max_step_s) || cvode.max_step_s < 0.0)
+            throw InputError("max_step", "value " + format_value(cvode.max_step_s) +
+                                             " is not allowed: the largest step must be finite and >= 0 (0: no limit) [s]");
+        if (cvode.max_steps < 1)
+            throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
+    }
 }
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
@@ -176,17 +192,37 @@ const StepRecord& ClosedFormStepper::step() {
 }
 
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
-                                 const std::function<void(const StepRecord&)>& on_step) {
-    ClosedFormStepper stepper(system, options);
+                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report) {
+    options.validate();
     const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
     std::vector<StepRecord> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
-    out.push_back(stepper.current());
-    if (on_step) on_step(out.back());
-    for (long i = 0; i < n; ++i) {
-        out.push_back(stepper.step());
+    auto keep = [&](const StepRecord& r) {
+        out.push_back(r);
         if (on_step) on_step(out.back());
+    };
+    RunReport rep;
+    rep.mode = options.mode;
+    if (options.mode == Mode::cvode) {
+        CvodeStepper stepper(system, options);
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) keep(stepper.advance());
+        rep.cvode = stepper.stats();
+        rep.events = stepper.events();
+        rep.steps = rep.cvode.steps;
+        rep.contact_iterations = rep.cvode.contact_iterations;
+        rep.factorizations = rep.cvode.mode_factorizations;
+    } else {
+        ClosedFormStepper stepper(system, options);
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.step());
+            rep.contact_iterations += out.back().contact_iterations;
+            rep.factorizations += out.back().factorizations;
+        }
+        rep.steps = n;
     }
+    if (report) *report = std::move(rep);
     return out;
 }
 

@@ -116,9 +116,14 @@ private:
     void fill_record(int iterations, int factorizations);
 };
 
-/// Runs from t = 0 to options.t_end_s; the first record is the initial state.
-/// `on_step` (optional) sees every record as it is made.
+struct RunReport;  // cvode_stepper.hpp
+
+/// Runs from t = 0 to options.t_end_s in options.mode; the first record is the
+/// initial state, then one per dt_s (a step of the closed-form mode, an output time
+/// of the cvode mode). `on_step` (optional) sees every record as it is made;
+/// `report` (optional) receives the counters and, in mode cvode, the event log.
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
-                                 const std::function<void(const StepRecord&)>& on_step = {});
+                                 const std::function<void(const StepRecord&)>& on_step = {},
+                                 RunReport* report = nullptr);
 
 }  // namespace stackbeam
