@@ -14,9 +14,11 @@
 /// ../shared/reference-example.md; signs and units: include/stackbeam/conventions.hpp.
 ///
 ///   stackbeam simulate --case friction --t-end 2 --out friction.csv
+///   stackbeam simulate --case friction --mode cvode --rtol 1e-8 --events events.csv --out friction.csv
 ///
-/// writes one CSV row per time step (columns of stackbeam::step_record_columns()).
-/// The CSV is written to FILE.partial and renamed to FILE only when the whole run
+/// writes one CSV row per time step (closed-form) or output time (cvode, every --dt),
+/// columns of stackbeam::step_record_columns(); --events writes the cvode event log.
+/// Every file is written to FILE.partial and renamed to FILE only when the whole run
 /// succeeded. Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.
 #include <CLI/CLI.hpp>
 
@@ -33,6 +35,7 @@
 #include <utility>
 
 #include "stackbeam/csv.hpp"
+#include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
@@ -90,7 +93,11 @@ struct SimulateArgs {
     std::string elements = "20";
     bool full_model = false;
     std::string tol = "2e-6";
-    std::string solver = "exact";
+    std::string solver;  // default: exact (closed-form), accelerated (cvode)
+    std::string rtol = "1e-8";
+    std::string atol = "1e-12";
+    std::string max_step = "";
+    std::string events;
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
     std::string out;
@@ -103,7 +110,15 @@ int run_simulate(const SimulateArgs& a) {
     options.mode = stackbeam::parse_mode(a.mode, "--mode");
     options.dt_s = parse_positive("--dt", a.dt, "s");
     options.t_end_s = parse_positive("--t-end", a.t_end, "s");
-    options.solver.kind = stackbeam::parse_solver_kind(a.solver, "--solver");
+    const bool cvode = options.mode == stackbeam::Mode::cvode;
+    // cvode: the paper's projected iteration (eq. 17, E = per-pair block inverse) checks each step
+    options.solver.kind = stackbeam::parse_solver_kind(a.solver.empty() ? (cvode ? "accelerated" : "exact") : a.solver,
+                                                       "--solver");
+    options.cvode.rtol = parse_positive("--rtol", a.rtol, "-");
+    options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
+    if (!a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
+    if (!cvode && !a.events.empty())
+        throw ArgumentError("--events: the event log exists in mode cvode only (given --mode " + a.mode + ")");
     options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
     options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
     if (options.solver.alpha_fraction >= 1.0)
@@ -131,6 +146,7 @@ int run_simulate(const SimulateArgs& a) {
     long total_iterations = 0;
     int max_iterations = 0;
     stackbeam::StepRecord last;
+    stackbeam::RunReport report;
     try {
         stackbeam::simulate(system, options, [&](const stackbeam::StepRecord& r) {
             stackbeam::write_csv_row(csv, r);
@@ -138,7 +154,7 @@ int run_simulate(const SimulateArgs& a) {
             total_iterations += r.contact_iterations;
             max_iterations = std::max(max_iterations, r.contact_iterations);
             last = r;
-        });
+        }, &report);
     } catch (...) {
         csv.flush();
         std::cerr << "stackbeam: note: " << a.out << " was not written; the rows up to the failure are in "
@@ -148,6 +164,16 @@ int run_simulate(const SimulateArgs& a) {
     csv.flush();
     csv.close();
     if (csv.fail()) throw std::runtime_error("writing '" + partial + "' failed");
+    if (!a.events.empty()) {
+        const std::string events_partial = a.events + ".partial";
+        std::ofstream ev(events_partial, std::ios::out | std::ios::trunc);
+        if (!ev) throw ArgumentError("--events: cannot open '" + events_partial + "' for writing");
+        stackbeam::write_events_csv(ev, report.events);
+        ev.close();
+        if (ev.fail()) throw std::runtime_error("writing '" + events_partial + "' failed");
+        if (std::rename(events_partial.c_str(), a.events.c_str()) != 0)
+            throw std::runtime_error("cannot rename '" + events_partial + "' to '" + a.events + "'");
+    }
     if (std::rename(partial.c_str(), a.out.c_str()) != 0)
         throw std::runtime_error("cannot rename '" + partial + "' to '" + a.out + "'");
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -158,7 +184,17 @@ int run_simulate(const SimulateArgs& a) {
                 stackbeam::to_string(pcase), stackbeam::to_string(options.mode),
                 stackbeam::to_string(options.solver.kind), example.elements_per_half_leaf,
                 a.full_model ? "full" : "half", options.dt_s, options.t_end_s);
-    std::printf("steps                      %ld\n", steps);
+    if (cvode) {
+        const auto& cs = report.cvode;
+        std::printf("cvode                      rtol %g, atol %g m; %ld steps, %ld RHS evaluations, %ld root evaluations\n",
+                    options.cvode.rtol, options.cvode.atol_m, cs.steps, cs.rhs_evaluations, cs.root_evaluations);
+        std::printf("events                     %ld event times (%ld found by the per-step check), %zu transitions, "
+                    "%ld restarts, %ld mode factorisations\n",
+                    cs.events, cs.missed_events, report.events.size(), cs.restarts, cs.mode_factorizations);
+        std::printf("outputs                    %ld (every %g s)\n", steps, options.dt_s);
+    } else {
+        std::printf("steps                      %ld\n", steps);
+    }
     std::printf("contact iterations         total %ld, max per step %d, mean per step %.2f\n", total_iterations,
                 max_iterations, steps > 0 ? static_cast<double>(total_iterations) / steps : 0.0);
     std::printf("final state                t %.6g s, w %.6g m, w_dot %.6g m/s\n", last.t_s, last.w_m,
@@ -167,6 +203,7 @@ int run_simulate(const SimulateArgs& a) {
                 last.energy_balance_error_j, e0, last.dissipated_energy_j);
     std::printf("wall time                  %.3f s\n", wall_s);
     std::printf("output                     %s\n", a.out.c_str());
+    if (!a.events.empty()) std::printf("event log                  %s\n", a.events.c_str());
     return exit_ok;
 }
 
@@ -179,6 +216,9 @@ std::string option_of_field(const std::string& field) {
         {"solver.alpha_fraction", "--alpha-fraction"},
         {"solver.max_iterations", "--max-iterations"},
         {"elements_per_half_leaf", "--elements"},
+        {"rtol", "--rtol"},
+        {"atol", "--atol"},
+        {"max_step", "--max-step"},
     };
     for (const auto& [f, o] : map)
         if (field == f) return o;
@@ -198,13 +238,25 @@ int main(int argc, char** argv) {
     SimulateArgs a;
     CLI::App* sim = app.add_subcommand("simulate", "Simulate the paper example and write one CSV row per time step");
     sim->add_option("--case", a.case_name, "bonded | friction | frictionless")->type_name("CASE")->required();
-    sim->add_option("--mode", a.mode, "time stepping: closed-form (the paper's exact step)")->type_name("MODE")->capture_default_str();
+    sim->add_option("--mode", a.mode,
+                    "time stepping: closed-form (the paper's exact step, fixed dt) | cvode (SUNDIALS CVODE, "
+                    "root-finding on every stick-slip and open-close transition)")
+        ->type_name("MODE")
+        ->capture_default_str();
     sim->add_option("--t-end", a.t_end, "end time [s]")->type_name("S")->capture_default_str();
-    sim->add_option("--dt", a.dt, "time step [s]")->type_name("S")->capture_default_str();
+    sim->add_option("--dt", a.dt, "time step [s] (closed-form); output interval [s] (cvode)")->type_name("S")->capture_default_str();
+    sim->add_option("--rtol", a.rtol, "cvode: relative tolerance [-]")->type_name("R")->capture_default_str();
+    sim->add_option("--atol", a.atol, "cvode: absolute tolerance on w [m]")->type_name("A")->capture_default_str();
+    sim->add_option("--max-step", a.max_step, "cvode: largest internal step [s] (default: no limit)")->type_name("S");
+    sim->add_option("--events", a.events, "cvode: write the event log (time, interface, x, pair, transition) to this CSV")
+        ->type_name("FILE.csv");
     sim->add_option("--elements", a.elements, "elements per half leaf")->type_name("N")->capture_default_str();
     sim->add_flag("--full-model", a.full_model, "mesh the whole spring instead of the symmetric half");
     sim->add_option("--tol", a.tol, "contact tolerance on ||v||_2 [m]")->type_name("M")->capture_default_str();
-    sim->add_option("--solver", a.solver, "contact solver: exact | accelerated | block-jacobi | paper")->type_name("SOLVER")->capture_default_str();
+    sim->add_option("--solver", a.solver,
+                    "contact solver: exact | accelerated | block-jacobi | paper (default: exact in closed-form; "
+                    "accelerated, the paper's iteration with a block E, checking each step in cvode)")
+        ->type_name("SOLVER");
     sim->add_option("--alpha-fraction", a.alpha_fraction,
                     "paper solver: alpha as a fraction (0 < F < 1) of its stability bound 2/lambda_max(W)")
         ->type_name("F")

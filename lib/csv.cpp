@@ -20,6 +20,16 @@ void write_csv_row(std::ostream& out, const StepRecord& record) {
     out << '\n';
 }
 
+void write_events_csv(std::ostream& out, const std::vector<ContactEvent>& events) {
+    out << "t,interface,x,pair,from,to,cause,w,w_dot\n";
+    char buf[200];
+    for (const auto& e : events) {
+        std::snprintf(buf, sizeof buf, "%.15g,%d,%.12g,%d,%s,%s,%s,%.12g,%.12g", e.t_s, e.interface_index, e.x_m, e.pair,
+                      e.from.c_str(), e.to.c_str(), e.cause.c_str(), e.w_m, e.w_dot_m_per_s);
+        out << buf << '\n';
+    }
+}
+
 void write_csv(std::ostream& out, const std::vector<StepRecord>& records) {
     write_csv_header(out);
     for (const auto& r : records) write_csv_row(out, r);

@@ -4,6 +4,7 @@
 #include <ostream>
 #include <vector>
 
+#include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/simulation.hpp"
 
 namespace stackbeam {
@@ -12,5 +13,10 @@ namespace stackbeam {
 void write_csv(std::ostream& out, const std::vector<StepRecord>& records);
 void write_csv_header(std::ostream& out);
 void write_csv_row(std::ostream& out, const StepRecord& record);
+
+/// The event log of mode cvode: header
+/// t,interface,x,pair,from,to,cause,w,w_dot  (SI units: s, -, m, -, -, -, -, m, m/s)
+/// and one line per transition.
+void write_events_csv(std::ostream& out, const std::vector<ContactEvent>& events);
 
 }  // namespace stackbeam
