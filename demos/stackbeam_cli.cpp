@@ -97,6 +97,7 @@ struct SimulateArgs {
     std::string rtol = "1e-8";
     std::string atol = "1e-12";
     std::string max_step = "";
+    std::string max_steps = "10000000";
     std::string events;
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
@@ -117,6 +118,7 @@ int run_simulate(const SimulateArgs& a) {
     options.cvode.rtol = parse_positive("--rtol", a.rtol, "-");
     options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
     if (!a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
+    options.cvode.max_steps = parse_count("--max-steps", a.max_steps);
     if (!cvode && !a.events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (given --mode " + a.mode + ")");
     options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
@@ -219,6 +221,7 @@ std::string option_of_field(const std::string& field) {
         {"rtol", "--rtol"},
         {"atol", "--atol"},
         {"max_step", "--max-step"},
+        {"max_steps", "--max-steps"},
     };
     for (const auto& [f, o] : map)
         if (field == f) return o;
@@ -248,6 +251,7 @@ int main(int argc, char** argv) {
     sim->add_option("--rtol", a.rtol, "cvode: relative tolerance [-]")->type_name("R")->capture_default_str();
     sim->add_option("--atol", a.atol, "cvode: absolute tolerance on w [m]")->type_name("A")->capture_default_str();
     sim->add_option("--max-step", a.max_step, "cvode: largest internal step [s] (default: no limit)")->type_name("S");
+    sim->add_option("--max-steps", a.max_steps, "cvode: limit on CVODE's steps over the run")->type_name("N")->capture_default_str();
     sim->add_option("--events", a.events, "cvode: write the event log (time, interface, x, pair, transition) to this CSV")
         ->type_name("FILE.csv");
     sim->add_option("--elements", a.elements, "elements per half leaf")->type_name("N")->capture_default_str();

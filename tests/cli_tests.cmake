@@ -90,7 +90,13 @@ set(_cli_bad_cases
   "t_end_inf|--t-end|inf|--t-end: value 'inf'"
   "tol_zero|--tol|0|--tol: value '0'"
   "solver_unknown|--solver|magic|--solver: value 'magic'"
-  "mode_unknown|--mode|cvode|--mode: value 'cvode'"
+  "mode_unknown|--mode|rk4|--mode: value 'rk4'"
+  "rtol_zero|--rtol|0|--rtol: value '0'"
+  "rtol_nan|--rtol|nan|--rtol: value 'nan'"
+  "rtol_too_large|--rtol|0.5|--rtol: value 0.5 is not allowed"
+  "atol_negative|--atol|-1e-9|--atol: value '-1e-9'"
+  "max_step_zero|--max-step|0|--max-step: value '0'"
+  "events_without_cvode|--events|ev.csv|--events: the event log exists in mode cvode only"
 )
 foreach(entry IN LISTS _cli_bad_cases)
   string(REPLACE "|" ";" fields "${entry}")
@@ -107,6 +113,9 @@ foreach(entry IN LISTS _cli_bad_cases)
   if(NOT option STREQUAL "--t-end")
     list(APPEND args --t-end 0.01)
   endif()
+  if(option MATCHES "^--(rtol|atol|max-step)$")
+    list(APPEND args --mode cvode)
+  endif()
   list(APPEND args ${option} ${value})
   stackbeam_cli_test(NAME cli_bad_${name} ARGS ${args} EXPECT_RC 2 EXPECT_TEXT "${text}" OUT ${out})
 endforeach()
@@ -122,3 +131,21 @@ stackbeam_cli_test(NAME cli_ok_frictionless
                    ARGS simulate --case frictionless --t-end 0.01 --out ${CMAKE_BINARY_DIR}/cli_ok.csv
                    EXPECT_RC 0 EXPECT_TEXT "steps" OUT ${CMAKE_BINARY_DIR}/cli_ok.csv
                    HEADER_PREFIX "t,w,w_dot,force_on_mass,probe_friction_force" MIN_LINES 12)
+
+# Mode cvode: a complete CSV on the output grid and the event log (header + transitions).
+stackbeam_cli_test(NAME cli_ok_cvode_friction
+                   ARGS simulate --case friction --mode cvode --t-end 0.1 --rtol 1e-8
+                        --events ${CMAKE_BINARY_DIR}/cli_cvode_events.csv --out ${CMAKE_BINARY_DIR}/cli_cvode.csv
+                   EXPECT_RC 0 EXPECT_TEXT "event times" OUT ${CMAKE_BINARY_DIR}/cli_cvode.csv
+                   HEADER_PREFIX "t,w,w_dot,force_on_mass,probe_friction_force" MIN_LINES 102)
+stackbeam_cli_test(NAME cli_ok_cvode_events_file
+                   ARGS simulate --case friction --mode cvode --t-end 0.1
+                        --events ${CMAKE_BINARY_DIR}/cli_cvode_events2.csv --out ${CMAKE_BINARY_DIR}/cli_cvode2.csv
+                   EXPECT_RC 0 OUT ${CMAKE_BINARY_DIR}/cli_cvode_events2.csv
+                   HEADER_PREFIX "t,interface,x,pair,from,to,cause,w,w_dot" MIN_LINES 40)
+# A CVODE failure (here: more steps needed than --max-steps allows with --max-step 1e-6 s)
+# exits 3 with the time and leaves no output.
+stackbeam_cli_test(NAME cli_cvode_failure
+                   ARGS simulate --case friction --mode cvode --t-end 0.1 --max-step 1e-6 --max-steps 1000
+                        --out ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv
+                   EXPECT_RC 3 EXPECT_TEXT "cvode mode" OUT ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv)
