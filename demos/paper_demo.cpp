@@ -12,14 +12,17 @@
 ///   frictionless  mu = 0: three beams side by side (analytic sinusoid)
 /// Geometry as read in ../shared/reference-example.md; signs: include/stackbeam/conventions.hpp.
 ///
-/// For each case and time-stepping mode (so far only "closed-form", the paper's
-/// exact step with linearly interpolated contact forces) the demo runs the paper's
-/// settings (dt = 1e-3 s; t_end 0.6 s, 2.0 s for friction), prints a table
-/// (steps, contact iterations, wall time, energy balance, deviation from a
-/// reference), writes the time series as CSV to --out-dir and, if gnuplot is on
-/// PATH, PNG figures. References: bonded/frictionless, the sinusoid of the
-/// discretised stiffness (and the one-beam analytic values for comparison);
-/// friction, a closed-form run at dt = 1e-4 s.
+/// For each case it runs both time-stepping modes with the paper's settings
+/// (t_end 0.6 s, 2.0 s for friction):
+///   closed-form  the paper's exact step with linearly interpolated contact forces, dt = 1e-3 s
+///   cvode        SUNDIALS CVODE between contact events (rtol 1e-8), root-finding on every
+///                stick-slip and open-close transition, output every 1e-3 s
+/// and prints a comparison table per case (max deviation between the modes, deviation
+/// from a reference, steps, right-hand sides, contact iterations, events, wall time,
+/// energy balance), writes the time series (and cvode's event log) as CSV to
+/// --out-dir and, if gnuplot is on PATH, PNG figures with both modes overlaid.
+/// References: bonded/frictionless, the sinusoid of the discretised stiffness (and
+/// the one-beam analytic values for comparison); friction, a closed-form run at dt = 1e-4 s.
 ///
 ///   paper_demo [--out-dir DIR]      (default out/)
 ///
@@ -41,6 +44,7 @@
 #include <vector>
 
 #include "stackbeam/csv.hpp"
+#include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
@@ -60,10 +64,10 @@ const double kVelocity = kExample.initial_velocity_m_per_s;  // v0 [m/s], 2
 constexpr double kDtPaper = 1e-3;   // [s]
 constexpr double kDtFine = 1e-4;    // friction reference [s]
 constexpr double kDtCheck = 2e-4;   // checks that the reference has converged [s]
+constexpr double kRtol = 1e-8;      // cvode's relative tolerance [-]
 
-/// The time-stepping modes run for every case. A CVODE mode is planned: add it
-/// here (and to stackbeam::Mode) and the table gets a row per case for it.
-const std::vector<Mode> kModes = {Mode::closed_form};
+/// The time-stepping modes run for every case.
+const std::vector<Mode> kModes = {Mode::closed_form, Mode::cvode};
 const std::vector<PaperCase> kCases = {PaperCase::bonded, PaperCase::friction, PaperCase::frictionless};
 
 double t_end_of(PaperCase c) { return c == PaperCase::friction ? 2.0 : 0.6; }
@@ -79,6 +83,7 @@ struct Run {
     long total_iterations = 0;
     int max_iterations = 0;
     double wall_s = 0.0;
+    stackbeam::RunReport report;  ///< steps, counters and (cvode) the event log
     double k_discretised = 0.0;  ///< tied (bonded) or free (frictionless) stiffness of the mesh [N/m]
     std::string csv_file;        ///< name inside the output directory ("" if none)
     long steps() const { return records.empty() ? 0 : static_cast<long>(records.size()) - 1; }
@@ -98,8 +103,11 @@ Run run_case(PaperCase c, Mode mode, double dt_s, double t_end_s) {
         options.mode = mode;
         options.dt_s = dt_s;
         options.t_end_s = t_end_s;
+        options.cvode.rtol = kRtol;
+        // cvode: the paper's projected iteration (eq. 17, E = per-pair block inverse) checks each step
+        if (mode == Mode::cvode) options.solver.kind = stackbeam::SolverKind::accelerated;
         // Collected as they are made, so a failed run still has its records up to the failure.
-        stackbeam::simulate(system, options, [&run](const StepRecord& r) { run.records.push_back(r); });
+        stackbeam::simulate(system, options, [&run](const StepRecord& r) { run.records.push_back(r); }, &run.report);
         for (std::size_t i = 1; i < run.records.size(); ++i) {
             run.total_iterations += run.records[i].contact_iterations;
             run.max_iterations = std::max(run.max_iterations, run.records[i].contact_iterations);
@@ -202,88 +210,103 @@ std::optional<std::string> png_terminal() {
     return std::nullopt;
 }
 
-/// A gnuplot script drawing the figures from the CSV files in the same directory.
+/// A gnuplot script drawing the figures from the CSV files in the same directory,
+/// both modes overlaid (closed-form solid, cvode dashed).
 /// Columns (1-based): 1 t, 2 w, 3 w_dot, 4 force_on_mass, 5 probe_friction_force.
 /// `figures` receives the names of the PNG files the script writes.
-std::string figure_script(const std::string& terminal, const std::map<PaperCase, const Run*>& runs,
+std::string figure_script(const std::string& terminal, const std::map<PaperCase, std::vector<const Run*>>& runs,
                           const std::string& friction_reference_csv, std::vector<std::string>& figures) {
     std::ostringstream g;
     const auto output = [&](const std::string& png) {
         figures.push_back(png);
         return "\nset output '" + png + "'\n";
     };
-    g << "# generated by paper_demo: figures of the paper's section 5 example\n"
+    g << "# generated by paper_demo: figures of the paper's section 5 example, both modes\n"
       << "set datafile separator ','\n"
       << "set terminal " << terminal << (terminal == "pngcairo" ? " enhanced font 'Sans,11'" : " enhanced")
       << " size 1000,620\n"
       << "set grid\nset key inside top right box opaque\n"
       << "# head room above the curves for the key\n"
       << "set offsets 0, 0, graph 0.25, 0\n";
+    // one curve per mode: closed-form solid blue, cvode dashed orange
+    const auto mode_curves = [&](const std::vector<const Run*>& rs, const std::string& using_expr,
+                                 const std::string& what) {
+        std::ostringstream s;
+        bool first = true;
+        for (const Run* r : rs) {
+            const bool cv = r->mode == Mode::cvode;
+            s << (first ? "" : ", ") << "'" << r->csv_file << "' using " << using_expr << " with lines lw "
+              << (cv ? "1.5 dt 2 lc rgb '#ff7f0e'" : "2 lc rgb '#1f77b4'") << " title '" << what
+              << (cv ? "cvode (rtol 1e-8)" : "closed-form (dt = 1 ms)") << "'";
+            first = false;
+        }
+        return s.str();
+    };
     const auto sinusoid_curve = [&](const Run& run, const char* label) {
         const double k = run.k_discretised;
         const double omega = std::sqrt(k / kMass);
         const auto analytic = stackbeam::paper_analytic(run.pcase);
         std::ostringstream s;
-        s << ", 1000*" << kVelocity / omega << "*sin(" << omega << "*x) with lines lw 1.5 dt 2 lc rgb '#d62728' title "
+        s << ", 1000*" << kVelocity / omega << "*sin(" << omega << "*x) with lines lw 1 dt 3 lc rgb '#d62728' title "
           << "sprintf('" << label << " (k = %.0f N/m, omega = %.3f rad/s)', " << k << ", " << omega << ")"
           << ", 1000*" << analytic.amplitude_m << "*sin(" << analytic.omega_rad_per_s
-          << "*x) with lines lw 1 dt 3 lc rgb '#2ca02c' title "
+          << "*x) with lines lw 1 dt 4 lc rgb '#2ca02c' title "
           << "sprintf('one-beam analytic (k = %.0f N/m)', " << analytic.stiffness_n_per_m << ")";
         return s.str();
     };
     for (PaperCase c : {PaperCase::bonded, PaperCase::frictionless}) {
         const auto it = runs.find(c);
-        if (it == runs.end()) continue;
-        const Run& run = *it->second;
+        if (it == runs.end() || it->second.empty()) continue;
         const std::string name = stackbeam::to_string(c);
         g << output("fig_displacement_" + name + ".png")
-          << "set title \"Displacement of the 20 kg body, " << name
-          << " case (three leaves, closed-form step, dt = 1 ms)\"\n"
+          << "set title \"Displacement of the 20 kg body, " << name << " case (three leaves)\"\n"
           << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\nset samples 2000\n"
-          << "plot '" << run.csv_file << "' using 1:($2*1000) every ::1 with lines lw 2 lc rgb '#1f77b4' title "
-          << "'stackbeam, " << stackbeam::to_string(run.mode) << "'" << sinusoid_curve(run, "analytic, mesh stiffness")
-          << "\n";
+          << "plot " << mode_curves(it->second, "1:($2*1000)", "stackbeam, ")
+          << sinusoid_curve(*it->second.front(), "analytic, mesh stiffness") << "\n";
     }
     const auto fr = runs.find(PaperCase::friction);
-    if (fr != runs.end()) {
-        const Run& run = *fr->second;
+    if (fr != runs.end() && !fr->second.empty()) {
+        const auto& rs = fr->second;
         g << output("fig_displacement_friction.png")
           << "set title \"Displacement of the 20 kg body, friction case (mu = 0.5, clamp force 1000 N)\"\n"
           << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\n"
-          << "plot '" << run.csv_file << "' using 1:($2*1000) with lines lw 2 lc rgb '#1f77b4' title "
-          << "'stackbeam, " << stackbeam::to_string(run.mode) << ", dt = 1 ms'";
+          << "plot " << mode_curves(rs, "1:($2*1000)", "stackbeam, ");
         if (!friction_reference_csv.empty())
             g << ", '" << friction_reference_csv
-              << "' using 1:($2*1000) with lines lw 1 dt 2 lc rgb '#d62728' title 'reference, dt = 0.1 ms'";
+              << "' using 1:($2*1000) with lines lw 1 dt 3 lc rgb '#d62728' title 'reference, closed-form dt = 0.1 ms'";
         g << "\n";
         g << output("fig_friction_force_friction.png")
           << "set title \"Friction force on the upper interface at the left clamp (x = 0.1 m), friction case\"\n"
-          << "set xlabel 'time t [s]'\nset ylabel 'tangential contact force p_t [N]'\n"
-          << "plot '" << run.csv_file << "' using 1:5 with lines lw 1.5 lc rgb '#1f77b4' title "
-          << "'p_t at the probe pair, top/middle leaf (> 0 pushes the upper leaf in +x)'\n";
+          << "set xlabel 'time t [s]'\nset ylabel 'tangential contact force p_t [N] (> 0 pushes the upper leaf in +x)'\n"
+          << "plot " << mode_curves(rs, "1:5", "p_t at the probe pair, ") << "\n";
         g << output("fig_hysteresis_friction.png")
-          << "set title \"Force on the body vs its displacement, friction case (hysteresis loop)\"\n"
+          << "set title \"Force on the body vs its displacement, friction case (hysteresis loop, 0 - 2 s)\"\n"
           << "set xlabel 'displacement w [mm]'\nset ylabel 'force on the body m d^2w/dt^2 [N]'\n"
-          << "set key inside top right\n"
-          << "plot '" << run.csv_file << "' using ($2*1000):4 with lines lw 1.5 lc rgb '#1f77b4' title "
-          << "'friction case, 0 - 2 s'";
+          << "plot " << mode_curves(rs, "($2*1000):4", "");
         // The frictionless stack's line -k w for comparison (the bonded line is 9x steeper and
         // would squash the loop).
         const auto fl = runs.find(PaperCase::frictionless);
-        if (fl != runs.end())
-            g << ", '" << fl->second->csv_file << "' using ($2*1000):4 with lines lw 1 lc rgb '#7f7f7f' title "
+        if (fl != runs.end() && !fl->second.empty())
+            g << ", '" << fl->second.front()->csv_file << "' using ($2*1000):4 with lines lw 1 lc rgb '#7f7f7f' title "
               << "'frictionless stack (k = 12,000 N/m), for comparison'";
-        g << "\nset key inside top right\n";
+        g << "\n";
     }
     if (!runs.empty()) {
         g << output("fig_displacement_all.png")
-          << "set title 'Displacement of the 20 kg body, the three cases'\n"
+          << "set title 'Displacement of the 20 kg body, the three cases (solid: closed-form, dashed: cvode)'\n"
           << "set xlabel 'time t [s]'\nset ylabel 'displacement w [mm]'\nset xrange [0:0.6]\nplot ";
+        const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c"};
+        int i = 0;
         bool first = true;
-        for (const auto& [c, run] : runs) {
-            g << (first ? "" : ", ") << "'" << run->csv_file << "' using 1:($2*1000) with lines lw 2 title '"
-              << stackbeam::to_string(c) << "'";
-            first = false;
+        for (const auto& [c, rs] : runs) {
+            for (const Run* r : rs) {
+                const bool cv = r->mode == Mode::cvode;
+                g << (first ? "" : ", ") << "'" << r->csv_file << "' using 1:($2*1000) with lines lw "
+                  << (cv ? "1.5 dt 2" : "2") << " lc rgb '" << colours[i % 3] << "' title '" << stackbeam::to_string(c)
+                  << ", " << stackbeam::to_string(r->mode) << "'";
+                first = false;
+            }
+            ++i;
         }
         g << "\nset xrange [*:*]\n";
     }
@@ -333,7 +356,8 @@ int main(int argc, char** argv) {
                 const std::string cs = stackbeam::to_string(c);
                 ours = ours || name == "fig_displacement_" + cs + ".png";
                 for (Mode m : kModes)
-                    for (const char* suffix : {".csv", ".csv.partial", "_dt1e-4.csv", "_dt1e-4.csv.partial"})
+                    for (const char* suffix : {".csv", ".csv.partial", "_dt1e-4.csv", "_dt1e-4.csv.partial",
+                                               "_events.csv", "_events.csv.partial"})
                         ours = ours || name == cs + "_" + stackbeam::to_string(m) + suffix;
             }
             if (ours && entry.is_regular_file()) fs::remove(entry.path());
@@ -345,7 +369,9 @@ int main(int argc, char** argv) {
 
     std::printf("stackbeam paper demo: Lee & Lim (1992) section 5, three leaves 0.5 x 0.05 x 0.005 m, E = 2e10 Pa,\n"
                 "pinned ends, four clamps (1000 N), 20 kg body at midspan starting at 2 m/s; half model,\n"
-                "20 elements per half leaf, contact tolerance 2e-6 m, exact contact solver.\n\n");
+                "20 elements per half leaf, contact tolerance 2e-6 m. Modes: closed-form (the paper's step, dt = 1 ms,\n"
+                "exact contact solver) and cvode (CVODE Adams, rtol 1e-8, root-finding on every contact transition,\n"
+                "the paper's projected iteration checking each step; output every 1 ms).\n\n");
 
     bool all_ok = true;
     std::vector<Run> runs;
@@ -369,39 +395,67 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "paper_demo: error: friction reference at dt = %g s: %s\n", r->dt_s, r->error.c_str());
         }
 
-    // --- table 1: every run -------------------------------------------------------------
+    // --- table 1: per case, the two modes compared ----------------------------------------
     const double e0 = 0.5 * kMass * kVelocity * kVelocity;
-    std::printf("%-13s %-12s %7s %6s %11s %9s %9s %12s %12s %13s  %s\n", "case", "mode", "dt [s]", "steps", "iterations",
-                "max/step", "wall [s]", "E err end", "max|E err|", "max dev [m]", "reference of the deviation");
-    const auto print_row = [&](const Run& run, double dev, const std::string& reference) {
+    const auto reference_deviation = [&](const Run& run, std::string& reference) {
+        if (!run.ok) return std::nan("");
+        if (run.pcase != PaperCase::friction) {
+            reference = "sinusoid of the mesh stiffness";
+            return max_deviation_from_sinusoid(run.records, run.k_discretised);
+        }
+        if (!fine.ok) return std::nan("");
+        reference = "closed-form run at dt = 1e-4 s";
+        return max_deviation_from_run(run.records, fine.records);
+    };
+    const auto print_header = [] {
+        std::printf("  %-12s %7s %9s %11s %7s %8s %12s %12s %12s\n", "mode", "steps", "RHS evals", "contact it.",
+                    "events", "wall [s]", "E err end", "max|E err|", "dev ref [m]");
+    };
+    const auto print_row = [&](const Run& run, double dev) {
         if (!run.ok) {
-            std::printf("%-13s %-12s FAILED: %s\n", stackbeam::to_string(run.pcase), stackbeam::to_string(run.mode),
-                        run.error.c_str());
+            std::printf("  %-12s FAILED: %s\n", stackbeam::to_string(run.mode), run.error.c_str());
             return;
         }
         double max_energy_error = 0.0;
         for (const auto& r : run.records) max_energy_error = std::max(max_energy_error, std::abs(r.energy_balance_error_j));
-        std::printf("%-13s %-12s %7.0e %6ld %11ld %9d %9.3f %12.3e %12.3e %13.3e  %s\n", stackbeam::to_string(run.pcase),
-                    stackbeam::to_string(run.mode), run.dt_s, run.steps(), run.total_iterations, run.max_iterations,
-                    run.wall_s, run.records.back().energy_balance_error_j, max_energy_error, dev, reference.c_str());
+        const bool cv = run.mode == Mode::cvode;
+        std::printf("  %-12s %7ld %9s %11ld %7s %8.3f %12.3e %12.3e %12.3e\n", stackbeam::to_string(run.mode),
+                    run.report.steps, cv ? std::to_string(run.report.cvode.rhs_evaluations).c_str() : "-",
+                    run.report.contact_iterations, cv ? std::to_string(run.report.cvode.events).c_str() : "-",
+                    run.wall_s, run.records.back().energy_balance_error_j, max_energy_error, dev);
     };
-    for (const Run& run : runs) {
-        double dev = NAN;
+    for (PaperCase c : kCases) {
+        std::printf("%s case, 0 - %g s\n", stackbeam::to_string(c), t_end_of(c));
+        print_header();
+        std::vector<const Run*> of_case;
         std::string reference;
-        if (run.ok && run.pcase != PaperCase::friction) {
-            dev = max_deviation_from_sinusoid(run.records, run.k_discretised);
-            reference = "sinusoid of the mesh stiffness";
-        } else if (run.ok && fine.ok) {
-            dev = max_deviation_from_run(run.records, fine.records);
-            reference = "closed-form run at dt = 1e-4 s";
+        for (const Run& run : runs)
+            if (run.pcase == c) {
+                print_row(run, reference_deviation(run, reference));
+                of_case.push_back(&run);
+            }
+        if (c == PaperCase::friction && fine.ok && check.ok)
+            std::printf("  (reference check: closed-form at dt = %g s deviates %.3e m from the one at dt = %g s)\n",
+                        kDtCheck, max_deviation_from_run(check.records, fine.records), kDtFine);
+        if (of_case.size() == 2 && of_case[0]->ok && of_case[1]->ok) {
+            const Run& cvr = of_case[0]->mode == Mode::cvode ? *of_case[0] : *of_case[1];
+            std::printf("  max |w_closed-form - w_cvode| = %.3e m (max |w| %.4f m); reference of dev ref: %s\n",
+                        max_deviation_from_run(of_case[0]->records, of_case[1]->records), max_abs_w(cvr.records),
+                        reference.c_str());
+            const auto& cs = cvr.report.cvode;
+            long stick_slip = 0;
+            for (const auto& e : cvr.report.events) stick_slip += e.is_stick_slip();
+            std::printf("  cvode: %ld event times (%zu transitions, %ld stick-slip), %ld restarts, %ld mode "
+                        "factorisations, %ld missed events found by the per-step check, max force jump at an "
+                        "event %.2e N\n",
+                        cs.events, cvr.report.events.size(), stick_slip, cs.restarts, cs.mode_factorizations,
+                        cs.missed_events, cs.max_force_jump_n);
         }
-        print_row(run, dev, reference);
+        std::printf("\n");
     }
-    if (fine.ok && check.ok)
-        print_row(check, max_deviation_from_run(check.records, fine.records), "closed-form run at dt = 1e-4 s");
-    if (fine.ok) print_row(fine, 0.0, "(the friction reference itself)");
-    std::printf("(E err: initial energy %.0f J - kinetic - strain - dissipated [J], at the end and its max over the "
-                "run; max dev: max over t of |w - w_ref| [m])\n\n",
+    std::printf("(steps: closed-form steps or CVODE steps; RHS evals: CVODE right-hand sides (closed-form evaluates its "
+                "exact solution); contact it.: contact solver iterations;\n events: event times of cvode; E err: initial "
+                "energy %.0f J - kinetic - strain - dissipated [J]; dev ref: max over t of |w - w_ref| [m])\n\n",
                 e0);
 
     // --- table 2: the linear cases against the analytic figures -------------------------------
@@ -421,7 +475,7 @@ int main(int argc, char** argv) {
                 "v0/omega sin(omega t)| with the one-beam omega [m])\n\n");
 
     // --- CSV files ----------------------------------------------------------------------------
-    std::map<PaperCase, const Run*> plotted;
+    std::map<PaperCase, std::vector<const Run*>> plotted;
     std::string fine_csv;
     try {
         for (Run& run : runs) {
@@ -436,7 +490,19 @@ int main(int argc, char** argv) {
             run.csv_file = csv_name(run.pcase, run.mode);
             write_csv_file(out_dir, run.csv_file, run.records);
             std::printf("wrote %s\n", (out_dir / run.csv_file).string().c_str());
-            if (run.ok && run.mode == Mode::closed_form) plotted[run.pcase] = &run;
+            plotted[run.pcase].push_back(&run);
+            if (run.mode == Mode::cvode && !run.report.events.empty()) {
+                const std::string name = csv_name(run.pcase, run.mode, "_events");
+                const fs::path partial = out_dir / (name + ".partial");
+                {
+                    std::ofstream out(partial);
+                    stackbeam::write_events_csv(out, run.report.events);
+                    out.close();
+                    if (out.fail()) throw std::runtime_error("writing '" + partial.string() + "' failed");
+                }
+                fs::rename(partial, out_dir / name);
+                std::printf("wrote %s (the event log)\n", (out_dir / name).string().c_str());
+            }
         }
         if (fine.ok) {
             fine.csv_file = csv_name(PaperCase::friction, Mode::closed_form, "_dt1e-4");
