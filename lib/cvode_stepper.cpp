@@ -277,7 +277,8 @@ struct CvodeStepper::Impl {
     /// The contact iteration decides the modes at (t_e, w, w'), with the forces p_cur
     /// there in the old modes (cvode_stepper.hpp). Logs the transitions; refactorises.
     void decide_modes(double w, double wd, const Eigen::VectorXd& p_cur, const std::string& cause) {
-        const Eigen::VectorXd rel = C * p_cur + c * w;  // s + d
+        // s + d; in a built mode affine in w (O(n)), else (t = 0) from the forces
+        const Eigen::VectorXd rel = P.size() == n ? Eigen::VectorXd(hs * w + bs + d) : Eigen::VectorXd(C * p_cur + c * w);
         const double wdd = (c.dot(p_cur) - k * w) / m;
         const double target = kLookahead * L_ref;
         double delta = std::numeric_limits<double>::infinity();
@@ -493,7 +494,8 @@ struct CvodeStepper::Impl {
             else ++rec.n_open;
         }
         rec.kinetic_energy_j = 0.5 * mass_whole * wd * wd;
-        rec.strain_energy_j = 0.5 * f * ((n > 0 ? p.dot(C * p) : 0.0) + k * w * w);
+        // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
+        rec.strain_energy_j = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + d - c * w) : 0.0) + k * w * w);
         rec.dissipated_energy_j = f * D;
         rec.energy_balance_error_j = e0 - (rec.kinetic_energy_j + rec.strain_energy_j + rec.dissipated_energy_j);
         rec.contact_residual_m = last_check_residual;
