@@ -2,12 +2,23 @@
 // paper's eqs. (1)-(6) and (A3). See system.hpp for the formulation.
 #include "stackbeam/system.hpp"
 
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseQR>
 #include <cmath>
+#include <atomic>
+#include <mutex>
 #include <string>
 
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
+
+struct System::LazyCompliance {
+    std::once_flag once;
+    std::atomic<bool> built{false};
+    Eigen::MatrixXd C;
+};
+
 namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
@@ -189,37 +200,58 @@ System::System(const Model& model) : model_(model) {
         throw InputError("leaves", "the stack is not restrained with the rigid body held: some leaf (or the seat) can move "
                                    "as a rigid body; give it supports or tie it to the rigid body (rigid_body.tied_leaves)");
     Gr_ = G.leftCols(nr);
+    G_ = G;
     const Eigen::VectorXd gw = Eigen::VectorXd(G.col(nr));
-    const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
-    C_held_ = Gr_ * X;
-    C_held_ = 0.5 * (C_held_ + C_held_.transpose()).eval();
+    C_held_ = std::make_shared<LazyCompliance>();
     const Eigen::VectorXd y = Krr_llt_.solve(Eigen::VectorXd(Krw_col_));
     c_ = gw - Gr_ * y;
     k_ = Kww - Eigen::VectorXd(Krw_col_).dot(y);
     if (!(k_ > 0.0))
         throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
                                                " N/m): the rigid body must be carried by supported leaves");
+    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD):
+    // checked on the sparse G_r (a sparse QR of G_r^T, cost near-linear in the rows, which
+    // are local) rather than by factorising the dense C', which is built only on demand.
     if (row > 0) {
-        Eigen::LLT<Eigen::MatrixXd> llt(C_held_);
-        if (llt.info() != Eigen::Success)
+        const Eigen::SparseMatrix<double> GrT = Gr_.transpose();
+        Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr(GrT);
+        if (qr.info() != Eigen::Success || qr.rank() < row)
             throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
     }
     mass_ = spec.rigid_body.mass_kg / model_.whole_spring_factor();
 }
 
+const Eigen::MatrixXd& System::compliance_held() const {
+    std::call_once(C_held_->once, [this] {
+        const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
+        Eigen::MatrixXd C = Gr_ * X;
+        C_held_->C = 0.5 * (C + C.transpose());
+        C_held_->built = true;
+    });
+    return C_held_->C;
+}
+
+bool System::compliance_held_built() const noexcept {
+    return C_held_->built;
+}
+
 double System::tied_stiffness_n_per_m() const {
     if (c_.size() == 0) return free_stiffness_n_per_m();
-    const Eigen::VectorXd x = C_held_.llt().solve(c_);
+    const Eigen::VectorXd x = compliance_held().llt().solve(c_);
     return model_.whole_spring_factor() * (k_ + c_.dot(x));
 }
 
-Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
+Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w) const {
     const int nr = static_cast<int>(K_red_.rows()) - 1;
     Eigen::VectorXd rhs = Gr_.transpose() * p - Eigen::VectorXd(Krw_col_) * w;
     Eigen::VectorXd z(nr + 1);
     z.head(nr) = Krr_llt_.solve(rhs);
     z[nr] = w;
-    return P_ * z;
+    return z;
+}
+
+Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
+    return P_ * reduced_displacements(p, w);
 }
 
 }  // namespace stackbeam
