@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "active_set.hpp"
 #include "contact_solvers.hpp"
@@ -90,10 +91,8 @@ bool same_matrix(const SpMat& a, const SpMat& b) {
            std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), (a.outerSize() + 1) * sizeof(int)) == 0;
 }
 
-// Passes after the first max_active_set_iterations before the dense fallback; each
-// pass may factorise. Block principal pivoting with Murty's rule as the safeguard
-// settles in a few passes on the transitions seen in the leaf-spring runs.
-constexpr int kMaxPasses = 60;
+constexpr int kTrescaIterations = 100;  // as in the dense solver
+constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
 constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
 
@@ -124,6 +123,10 @@ struct SparseContactSolver::Impl {
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> lu;
     bool lu_ok = false;
     std::vector<int> pos;                // row -> index in lin.S, or -1
+    Eigen::VectorXd dz;                  // column scaling of z: diag(K)^-1/2
+    SpMat Gt_scaled;                     // Dz G^T: column r is contact row r, scaled
+    Eigen::VectorXd row_scale;           // scaling of the held rows (1/||G_i Dz||)
+    SpMat A;                             // the scaled saddle-point matrix of the current modes
     // cached back-solves of the current factorisation
     int unit_dof = -1;                   // x_unit solves [e_unit_dof; 0]
     Eigen::VectorXd x_unit;
@@ -156,6 +159,9 @@ struct SparseContactSolver::Impl {
         const SpMat absG = G.cwiseAbs();
         const Eigen::VectorXd rows = absG * Eigen::VectorXd::Ones(G.cols());
         if (m > 0) g_norm_inf = rows.maxCoeff();
+        dz = K.diagonal().cwiseSqrt().cwiseInverse();
+        Gt_scaled = dz.asDiagonal() * SpMat(G.transpose());
+        Gt_scaled.makeCompressed();
         laws.W.resize(0, 0);
         laws.q = Eigen::VectorXd::Zero(m);
         laws.pairs = pr.pairs;
@@ -172,36 +178,51 @@ struct SparseContactSolver::Impl {
         return G * z - pr.d;
     }
 
-    /// Solves the linear problem of the current modes into p and z; returns 1 if it factorised.
-    int solve_modes(const SparseContactProblem& pr, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-        const int n = static_cast<int>(K.rows()), m = pr.size();
+    /// Solves the linear problem of the current modes for load b and offsets d into p and
+    /// z; returns 1 if it factorised. The saddle-point system is scaled symmetrically
+    /// (z = Dz y with Dz = diag(K)^-1/2, held row i by 1/||G_i Dz||): K mixes axial
+    /// (EA/L ~ 1e8), bending (EI/L^3 ~ 1e7) and rotational (EI/L ~ 1e3) entries and G is
+    /// O(1), and unscaled the LU's pivoting would lose digits. Each cached solve gets one
+    /// step of iterative refinement, so held rows come out at s = 0 to round-off.
+    int solve_modes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
         modes.linearize(laws, lin);
+        std::vector<signed char> key = modes.key();
+        const int f = solve_held(lin, key, b, d, p, z);
+        modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
+        return f;
+    }
+
+    /// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
+    /// factorised unless `key` names the current factorisation.
+    int solve_held(const detail::ModeLinearization& lin, std::vector<signed char>& key, const Eigen::VectorXd& b,
+                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        const int n = static_cast<int>(K.rows()), m = static_cast<int>(d.size());
         const auto& S = lin.S;
         const int ms = static_cast<int>(S.size());
         pos.assign(m, -1);
         for (int i = 0; i < ms; ++i) pos[S[i]] = i;
         int factorised = 0;
-        std::vector<signed char> key = modes.key();
         if (key != lu_key) {
-            // [K, -G_S^T - G_slip^T D; G_S, 0]
+            row_scale.resize(ms);
+            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
+            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
             std::vector<Eigen::Triplet<double>> t;
             t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
             for (int j = 0; j < n; ++j)
-                for (SpMat::InnerIterator it(K, j); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
-            const SpMat Gt = G.transpose();  // column r = contact row r
-            for (int i = 0; i < ms; ++i) {
-                for (SpMat::InnerIterator it(Gt, S[i]); it; ++it) {
-                    t.emplace_back(it.row(), n + i, -it.value());
-                    t.emplace_back(n + i, it.row(), it.value());
+                for (SpMat::InnerIterator it(K, j); it; ++it)
+                    t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+            for (int i = 0; i < ms; ++i)
+                for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
+                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
                 }
-            }
             for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
                 const int col = pos[lin.coupled[a].second];
                 if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
-                for (SpMat::InnerIterator it(Gt, lin.coupled[a].first); it; ++it)
-                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value());
+                for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
+                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
             }
-            SpMat A(n + ms, n + ms);
+            A.resize(n + ms, n + ms);
             A.setFromTriplets(t.begin(), t.end());
             A.makeCompressed();
             lu.compute(A);
@@ -212,14 +233,14 @@ struct SparseContactSolver::Impl {
             factorised = 1;
         }
         if (!lu_ok) throw SingularModes{};
-        // right-hand side [b + G^T e; d_S] = b-part + constant part
+        // right-hand side [Dz (b + G^T e); R d_S] = b-part + constant part
         Eigen::VectorXd dS(ms);
-        for (int i = 0; i < ms; ++i) dS[i] = pr.d[S[i]];
+        for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
         if (!const_ok || const_e != lin.e || const_dS != dS) {
-            rhs.setZero(n + ms);
-            rhs.head(n) = G.transpose() * lin.e;
-            rhs.tail(ms) = dS;
-            x_const = lu.solve(rhs);
+            rhs.resize(n + ms);
+            rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
+            rhs.tail(ms) = row_scale.cwiseProduct(dS);
+            x_const = refined_solve(rhs);
             const_e = lin.e;
             const_dS = dS;
             const_ok = true;
@@ -228,7 +249,7 @@ struct SparseContactSolver::Impl {
         // multiple of a cached unit solve; anything else is solved directly.
         int nz = -1, count = 0;
         for (int i = 0; i < n; ++i)
-            if (pr.b[i] != 0.0) {
+            if (b[i] != 0.0) {
                 nz = i;
                 ++count;
             }
@@ -237,28 +258,183 @@ struct SparseContactSolver::Impl {
         } else if (count == 1) {
             if (unit_dof != nz) {
                 rhs.setZero(n + ms);
-                rhs[nz] = 1.0;
-                x_unit = lu.solve(rhs);
+                rhs[nz] = dz[nz];
+                x_unit = refined_solve(rhs);
                 unit_dof = nz;
             }
-            x = x_const + pr.b[nz] * x_unit;
+            x = x_const + b[nz] * x_unit;
         } else {
             rhs.setZero(n + ms);
-            rhs.head(n) = pr.b;
-            x = x_const + lu.solve(rhs);
+            rhs.head(n) = dz.cwiseProduct(b);
+            x = x_const + refined_solve(rhs);
         }
-        z = x.head(n);
+        z = dz.cwiseProduct(x.head(n));
         p = lin.e;
-        for (int i = 0; i < ms; ++i) p[S[i]] = x[n + i];
-        modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
+        for (int i = 0; i < ms; ++i) p[S[i]] = row_scale[i] * x[n + i];
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
         return factorised;
     }
 
-    int count_violations(const SparseContactProblem& pr, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
-        s = G * z - pr.d;
-        const double roundoff = 1e-13 * (pr.d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
+    /// The box-constrained QP min 1/2 x^T W x + q^T x, lower <= x <= upper, by the monotone
+    /// primal active-set method of box_qp.hpp (the dense solver's), each equality-constrained
+    /// step one sparse solve of the held (free) rows with the bound ones fixed: the
+    /// objective falls at every iteration, so it cannot cycle. x = p, and z follows it.
+    bool box_qp(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& lower,
+                const Eigen::VectorXd& upper, Eigen::VectorXd& x, Eigen::VectorXd& z,
+                std::vector<signed char>& at_bound, double tolerance, int max_iterations, SolveResult& r) {
+        const int m = static_cast<int>(x.size());
+        at_bound.resize(m, 0);
+        for (int i = 0; i < m; ++i) {  // feasible start; components with an empty interior are held
+            if (x[i] <= lower[i]) { x[i] = lower[i]; if (std::isfinite(lower[i])) at_bound[i] = -1; }
+            if (x[i] >= upper[i]) { x[i] = upper[i]; if (std::isfinite(upper[i])) at_bound[i] = +1; }
+            if (at_bound[i] == -1 && !std::isfinite(lower[i])) at_bound[i] = 0;
+            if (at_bound[i] == +1 && !std::isfinite(upper[i])) at_bound[i] = 0;
+            if (at_bound[i] != 0) x[i] = at_bound[i] < 0 ? lower[i] : upper[i];
+            if (lower[i] == upper[i]) at_bound[i] = +1;
+        }
+        z = k_llt.solve(b + G.transpose() * x);
+        detail::ModeLinearization qp;
+        Eigen::VectorXd y, zy;
+        for (int iter = 0; iter < max_iterations; ++iter) {
+            ++r.iterations;
+            qp.S.clear();
+            qp.e = x;
+            for (int i = 0; i < m; ++i)
+                if (at_bound[i] == 0) {
+                    qp.S.push_back(i);
+                    qp.e[i] = 0.0;
+                }
+            std::vector<signed char> key(at_bound);
+            key.push_back(100);  // a box-QP working set, not a set of modes
+            r.factorizations += solve_held(qp, key, b, d, y, zy);
+            double alpha = 1.0;
+            int blocking = -1;
+            signed char side = 0;
+            for (int i : qp.S) {
+                const double dd = y[i] - x[i];
+                if (dd < 0.0 && y[i] < lower[i]) {
+                    const double t = (lower[i] - x[i]) / dd;
+                    if (t < alpha) { alpha = t; blocking = i; side = -1; }
+                } else if (dd > 0.0 && y[i] > upper[i]) {
+                    const double t = (upper[i] - x[i]) / dd;
+                    if (t < alpha) { alpha = t; blocking = i; side = +1; }
+                }
+            }
+            alpha = std::max(alpha, 0.0);
+            x += alpha * (y - x);
+            z += alpha * (zy - z);
+            if (blocking >= 0) {
+                at_bound[blocking] = side;
+                x[blocking] = side < 0 ? lower[blocking] : upper[blocking];
+                continue;
+            }
+            const Eigen::VectorXd sx = G * z - d;
+            int worst = -1;
+            double worst_size = tolerance;
+            for (int i = 0; i < m; ++i) {
+                if (at_bound[i] == 0 || lower[i] == upper[i]) continue;
+                const double wrong = at_bound[i] < 0 ? -sx[i] : sx[i];
+                if (wrong > worst_size) { worst_size = wrong; worst = i; }
+            }
+            if (worst < 0) return true;
+            at_bound[worst] = 0;
+        }
+        return false;
+    }
+
+    Eigen::VectorXd refined_solve(const Eigen::VectorXd& r) {
+        Eigen::VectorXd y = lu.solve(r);
+        const Eigen::VectorXd res = r - A * y;
+        y += lu.solve(res);
+        return y;
+    }
+
+    int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
+        s = G * z - d;
+        const double roundoff = 1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
         return modes.count_violations(laws, p, s, diag, std::max(kAccept * options.tolerance_m, roundoff));
     }
+
+    /// Active-set passes at load b and offsets d from the current modes.
+    bool passes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                int max_passes, SolveResult& r) {
+        return detail::active_set_passes(
+            modes, laws, p, max_passes, kBudget, r, [&](Eigen::VectorXd& x) { return solve_modes(b, d, x, z); },
+            [&](const Eigen::VectorXd& x) { return count_violations(d, x, z); });
+    }
+
+    /// Fixed point on the friction limits, as in the dense solver (contact_exact.cpp): each
+    /// pass solves the problem with the limits frozen (Tresca), a box-constrained convex QP
+    /// (box_qp, which cannot cycle); the limits are updated from its normal forces until they
+    /// settle to kAccept x tolerance (in metres); its final working set gives the modes.
+    bool tresca_fixed_point(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p,
+                            Eigen::VectorXd& z, SolveResult& r) {
+        const ContactProblem& pr = laws;
+        const int n = static_cast<int>(d.size());
+        const int np = static_cast<int>(pr.pairs.size());
+        const double inf = std::numeric_limits<double>::infinity();
+        Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
+        std::vector<signed char> at_bound(n, 0);
+        auto& nmode = modes.nmode;
+        auto& tmode = modes.tmode;
+        using detail::ModeSet;
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && ModeSet::unilateral(c)) {
+                upper[c.row_n] = 0.0;
+                if (nmode[k] == detail::OPEN) at_bound[c.row_n] = +1;
+            }
+            if (c.row_t >= 0 && (tmode[k] == detail::SLIP_POS || tmode[k] == detail::SLIP_NEG))
+                at_bound[c.row_t] = tmode[k] == detail::SLIP_POS ? +1 : -1;
+        }
+        Eigen::VectorXd tau(np);
+        for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
+        const double accept = kAccept * options.tolerance_m;
+        for (int it = 0; it < kTrescaIterations; ++it) {
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double limit = c.friction_coefficient * tau[k];
+                lower[c.row_t] = -limit;
+                upper[c.row_t] = limit;
+            }
+            if (!box_qp(b, d, lower, upper, p, z, at_bound, accept, 50 * (n + 1), r)) return false;
+            double change_m = 0.0;
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double t = friction_normal_force(pr, k, p);
+                change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * diag[c.row_t]);
+                tau[k] = t;
+            }
+            if (change_m <= accept) {
+                // modes from the working set; slip forces put at the limit of the final tau
+                s = G * z - d;
+                for (int k = 0; k < np; ++k) {
+                    const auto& c = pr.pairs[k];
+                    if (c.row_n >= 0 && ModeSet::unilateral(c)) nmode[k] = at_bound[c.row_n] == +1 ? detail::OPEN : detail::CLOSED;
+                    if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+                    if (limit <= 0.0) {
+                        tmode[k] = detail::FREE;
+                        p[c.row_t] = 0.0;
+                    } else if (at_bound[c.row_t] != 0) {
+                        const double st = s[c.row_t];
+                        const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t] : (st > 0.0 ? -1 : +1);
+                        tmode[k] = sigma > 0 ? detail::SLIP_POS : detail::SLIP_NEG;
+                        p[c.row_t] = sigma * limit;
+                    } else {
+                        tmode[k] = detail::STICK;
+                    }
+                    modes.make_consistent(pr, k);
+                }
+                return true;
+            }
+        }
+        return false;
+    }
+
 };
 
 SparseContactSolver::SparseContactSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -289,25 +465,45 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.modes.init(im.laws, p, im.positions_of(problem, p, z));
     }
     SolveResult r;
-    auto solve_modes = [&](Eigen::VectorXd& x) { return im.solve_modes(problem, x, z); };
-    auto violations = [&](const Eigen::VectorXd& x) { return im.count_violations(problem, x, z); };
-    // 1. From the previous step's modes; 2. more passes (each may factorise) if a transition
-    //    needs them: block principal pivoting, Murty's least-index rule when it stalls.
     bool singular = false;
+    const Eigen::VectorXd p_start = p;
     try {
-        r.converged = detail::active_set_passes(im.modes, im.laws, p, im.options.max_active_set_iterations, kBudget, r,
-                                                solve_modes, violations) ||
-                      detail::active_set_passes(im.modes, im.laws, p, kMaxPasses, kBudget, r, solve_modes, violations);
+        // 1. From the previous step's modes: most steps end here in one pass.
+        r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+        // 2. A transition the passes do not settle: the Tresca fixed point, then the coupled
+        //    Coulomb problem from its modes; if that polish fails, the settled fixed point
+        //    (Coulomb to within kAccept x tolerance) is taken and flagged, as in the dense solver.
+        if (!r.converged) {
+            const bool settled = im.tresca_fixed_point(problem.b, problem.d, p, z, r);
+            if (!settled) im.modes.init(im.laws, p, im.positions_of(problem, p, z));
+            const Eigen::VectorXd p_tresca = p;
+            r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+            if (!r.converged && settled) {
+                p = p_tresca;
+                im.s = im.positions_of(problem, p, z);
+                r.converged = true;
+                r.fell_back = true;
+            }
+        }
     } catch (const SingularModes&) {
         singular = true;  // a set of modes with dependent held rows: leave it to the dense solver
         im.lu_key.clear();
     }
     if (!r.converged) {
-        // 3. Last resort: the dense problem and the dense exact solver (Tresca fixed point,
-        //    Gauss-Seidel). O(m^2) memory; reported.
+        // 3. Last resort for problems small enough: the dense problem and the dense exact
+        //    solver (Tresca fixed point, Gauss-Seidel). O(m^2) memory; reported.
+        if (m > kDenseFallbackMaxRows) {
+            p = p_start;
+            r.message = std::string("sparse path: the active-set passes ") +
+                        (singular ? "met a singular set of modes" : "and the Tresca fixed point did not settle") +
+                        "; the dense fallback is not tried for " + std::to_string(m) + " > " +
+                        std::to_string(kDenseFallbackMaxRows) + " contact rows";
+            im.s = im.positions_of(problem, p, z);
+            r.residual_m = error_vector(im.laws, p, im.s).norm();
+            return r;
+        }
         const ContactProblem dense = problem.to_dense();
-        SolverOptions o = im.options;
-        SolveResult d = make_solver(o)->solve(dense, p);
+        SolveResult d = make_solver(im.options)->solve(dense, p);
         r.iterations += d.iterations;
         r.factorizations += d.factorizations;
         r.fell_back = true;
