@@ -2,8 +2,6 @@
 // paper's eqs. (1)-(6) and (A3). See system.hpp for the formulation.
 #include "stackbeam/system.hpp"
 
-#include <Eigen/OrderingMethods>
-#include <Eigen/SparseQR>
 #include <cmath>
 #include <atomic>
 #include <mutex>
@@ -143,6 +141,7 @@ System::System(const Model& model) : model_(model) {
 
     // --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
     const auto& cand = model_.candidate_pairs();
+    const Eigen::SparseMatrix<double> Pt = P_.transpose();
     Triplets gt;
     std::vector<double> gaps;
     int row = 0;
@@ -159,8 +158,8 @@ System::System(const Model& model) : model_(model) {
         gtan.insert(da + 2) = 0.5 * ha;
         gtan.insert(db) = -1.0;
         gtan.insert(db + 2) = 0.5 * hb;
-        const Eigen::SparseVector<double> rn = (P_.transpose() * gn).pruned(1.0, 1e-12);
-        const Eigen::SparseVector<double> rt = (P_.transpose() * gtan).pruned(1.0, 1e-12);
+        const Eigen::SparseVector<double> rn = (Pt * gn).pruned(1.0, 1e-12);
+        const Eigen::SparseVector<double> rt = (Pt * gtan).pruned(1.0, 1e-12);
         const bool has_n = rn.nonZeros() > 0;
         bool has_t = rt.nonZeros() > 0;
         // A friction pair whose normal motion a support or the seat fixes has no normal
@@ -209,13 +208,16 @@ System::System(const Model& model) : model_(model) {
     if (!(k_ > 0.0))
         throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
                                                " N/m): the rigid body must be carried by supported leaves");
-    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD):
-    // checked on the sparse G_r (a sparse QR of G_r^T, cost near-linear in the rows, which
-    // are local) rather than by factorising the dense C', which is built only on demand.
+    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD), i.e.
+    // when G_r G_r^T is: checked by a sparse LDL^T of G_r G_r^T (the rows are local, so it is
+    // sparse and cheap) rather than by factorising the dense C', which is built only on demand.
+    // A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
+    // are 1 and h/2, so an independent set of rows stays far above that).
     if (row > 0) {
-        const Eigen::SparseMatrix<double> GrT = Gr_.transpose();
-        Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr(GrT);
-        if (qr.info() != Eigen::Success || qr.rank() < row)
+        const Eigen::SparseMatrix<double> GGt = Gr_ * Gr_.transpose();
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
+        const double scale = GGt.diagonal().maxCoeff();
+        if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
             throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
     }
     mass_ = spec.rigid_body.mass_kg / model_.whole_spring_factor();
