@@ -46,6 +46,11 @@ void ContactProblem::validate() const {
                                           ": must be square of the size of q (" + std::to_string(n) + ")");
     if (!W.allFinite()) throw InputError("problem.W", "has a non-finite entry");
     if (!q.allFinite()) throw InputError("problem.q", "has a non-finite entry");
+    detail::validate_laws(pairs, n, tau_rule, tau_previous_n);
+}
+
+void detail::validate_laws(const std::vector<ContactPair>& pairs, int n, TauRule tau_rule,
+                           const Eigen::VectorXd& tau_previous_n) {
     std::vector<int> used(n, 0);
     for (std::size_t k = 0; k < pairs.size(); ++k) {
         const auto& c = pairs[k];

@@ -57,14 +57,8 @@ void SparseContactProblem::validate() const {
         throw InputError("problem.G", "has " + std::to_string(G.rows()) + " rows: must match d (" + std::to_string(d.size()) + ")");
     if (b.size() != n) throw InputError("problem.b", "must have one entry per row of K");
     if (!b.allFinite()) throw InputError("problem.b", "has a non-finite entry");
-    // the pair laws: checked by ContactProblem::validate on a problem of the same size
-    ContactProblem laws;
-    laws.W = Eigen::MatrixXd::Zero(size(), size());
-    laws.q = d;
-    laws.pairs = pairs;
-    laws.tau_rule = tau_rule;
-    laws.tau_previous_n = tau_previous_n;
-    laws.validate();
+    if (!d.allFinite()) throw InputError("problem.d", "has a non-finite entry");
+    detail::validate_laws(pairs, size(), tau_rule, tau_previous_n);
 }
 
 ContactProblem SparseContactProblem::to_dense() const {

@@ -3,6 +3,7 @@
 #include "stackbeam/system.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <string>
@@ -141,7 +142,7 @@ System::System(const Model& model) : model_(model) {
 
     // --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
     const auto& cand = model_.candidate_pairs();
-    const Eigen::SparseMatrix<double> Pt = P_.transpose();
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P_;
     Triplets gt;
     std::vector<double> gaps;
     int row = 0;
@@ -151,17 +152,24 @@ System::System(const Model& model) : model_(model) {
         const int da = 3 * node_dof(a, cp.node), db = 3 * node_dof(b, cp.node);
         const double ha = spec.leaves[a].height_m, hb = spec.leaves[b].height_m;
         // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
-        Eigen::SparseVector<double> gn(num_full_), gtan(num_full_);
-        gn.insert(da + 1) = -1.0;
-        gn.insert(db + 1) = 1.0;
-        gtan.insert(da) = 1.0;
-        gtan.insert(da + 2) = 0.5 * ha;
-        gtan.insert(db) = -1.0;
-        gtan.insert(db + 2) = 0.5 * hb;
-        const Eigen::SparseVector<double> rn = (Pt * gn).pruned(1.0, 1e-12);
-        const Eigen::SparseVector<double> rt = (Pt * gtan).pruned(1.0, 1e-12);
-        const bool has_n = rn.nonZeros() > 0;
-        bool has_t = rt.nonZeros() > 0;
+        // On the reduced DOFs: each full DOF is at most one master times a coefficient (a row
+        // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
+        auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
+            std::vector<std::pair<int, double>> out;
+            for (const auto& [dof, g] : full)
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Prow, dof); it; ++it) {
+                    auto f = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == it.col(); });
+                    if (f == out.end()) out.emplace_back(static_cast<int>(it.col()), g * it.value());
+                    else f->second += g * it.value();
+                }
+            out.erase(std::remove_if(out.begin(), out.end(), [](const auto& e) { return std::abs(e.second) < 1e-12; }), out.end());
+            std::sort(out.begin(), out.end());
+            return out;
+        };
+        const auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
+        const auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        const bool has_n = !rn.empty();
+        bool has_t = !rt.empty();
         // A friction pair whose normal motion a support or the seat fixes has no normal
         // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
         if (!has_n && cp.kind == PairKind::coulomb) has_t = false;
@@ -173,12 +181,12 @@ System::System(const Model& model) : model_(model) {
         p.preload_n = cp.preload_n;
         if (has_n) {
             p.row_n = row++;
-            for (Eigen::SparseVector<double>::InnerIterator it(rn); it; ++it) gt.emplace_back(p.row_n, it.index(), it.value());
+            for (const auto& [col, v] : rn) gt.emplace_back(p.row_n, col, v);
             gaps.push_back(cp.initial_gap_m);
         }
         if (has_t) {
             p.row_t = row++;
-            for (Eigen::SparseVector<double>::InnerIterator it(rt); it; ++it) gt.emplace_back(p.row_t, it.index(), it.value());
+            for (const auto& [col, v] : rt) gt.emplace_back(p.row_t, col, v);
             gaps.push_back(0.0);
         }
         if (ci == model_.probe_pair()) probe_ = static_cast<int>(pairs_.size());
