@@ -180,7 +180,7 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
     BOOST_TEST(small.num_components() < kSparsePathMinComponents);
     BOOST_TEST(choose_contact_path(small, so) == ContactPath::dense);
     PaperExampleOptions o;
-    o.elements_per_half_leaf = 120;  // 3 leaves: 2 interfaces x ~121 nodes x 2 rows > 400
+    o.elements_per_half_leaf = 300;  // 3 leaves: 2 interfaces x ~300 nodes x 2 rows > 1000
     const System large(Model::build(paper_example(PaperCase::friction, o)));
     BOOST_TEST(large.num_components() >= kSparsePathMinComponents);
     BOOST_TEST(choose_contact_path(large, so) == ContactPath::sparse);

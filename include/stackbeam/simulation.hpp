@@ -62,10 +62,12 @@ const char* to_string(ContactPath path);
 ContactPath parse_contact_path(const std::string& text, const std::string& field);
 
 /// ContactPath::automatic takes the sparse path from this many contact components
-/// (rows of the contact problem) on, with the exact solver. Measured (BENCHMARKS.md):
-/// below it the dense path is as fast or faster per simulated second, and its O(m^2)
-/// memory is small.
-constexpr int kSparsePathMinComponents = 400;
+/// (rows of the contact problem) on, with the exact solver. Measured (BENCHMARKS.md,
+/// friction case, the costliest): at 636 rows both paths take the same time per step,
+/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
+/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
+/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
+constexpr int kSparsePathMinComponents = 1000;
 
 /// Options of mode "cvode" (see cvode_stepper.hpp).
 struct CvodeOptions {
