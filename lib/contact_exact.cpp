@@ -21,6 +21,9 @@
 // coupled Coulomb problem exactly. If that polish fails, the settled fixed point
 // (Coulomb to within 1e-3 of the tolerance) is returned, flagged fell_back;
 // if even that fails, Gauss-Seidel sweeps finish the job and say so.
+//
+// The modes, their linear problem and the switching rules are shared with the
+// sparse path (active_set.hpp, contact_sparse.cpp).
 #include <Eigen/LU>
 #include <cmath>
 #include <algorithm>

@@ -24,13 +24,21 @@
 //    solver (so both take the same decisions). It is computed once per (K, G) from a
 //    sparse Cholesky factor K = P^T L L^T P as W_ii = ||L^-1 P g_i||^2, in blocks of
 //    columns. This is the one part whose cost is not linear (about m times the
-//    factor's fill); it is done once per run.
+//    factor's fill); it is done once per run (0.35 s at 10 leaves x 400 elements).
 //  - Mode switching (violations, block principal pivoting, Murty's rule) is the code
-//    of the dense solver (active_set.hpp). The dense solver turns to a Tresca fixed
-//    point on a dense box QP after max_active_set_iterations passes; here the passes
-//    simply continue (up to kMaxPasses, each one a sparse factorisation), and if they
-//    still do not settle, the dense problem is built (to_dense()) and the dense exact
-//    solver finishes the step: correct, but O(m^2) memory; reported as fell_back.
+//    of the dense solver (active_set.hpp), and so is the handling of transitions: after
+//    max_active_set_iterations passes, a Tresca fixed point (friction limits frozen: a
+//    box-constrained convex QP) whose working set gives the modes of a final Coulomb
+//    solve. The box QP is solved by block principal pivoting (a few factorisations)
+//    and, if that stalls, by the dense solver's monotone primal active-set method (one
+//    factorisation per working-set change, cannot cycle), each step a sparse solve.
+//    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
+//    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
+//    with a message.
+//  - Cost: a step whose modes stay is O(n); a transition costs a sparse factorisation
+//    per pass (0.27 s at 10 leaves x 400 elements, Eigen's SparseLU), and a friction
+//    step on many identical leaves needs 100-300 of them. That, not the formulation,
+//    is what keeps large friction runs slow (BENCHMARKS.md).
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>

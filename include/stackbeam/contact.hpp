@@ -148,10 +148,12 @@ struct SparseContactProblem {
 ///     [ K                       -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
 ///     [ G_S                      0                  ] [p_S] = [d_S      ]
 /// (S: rows held by s = 0; slip rows carry p_t = e_t + D p_n), factorised by a sparse
-/// LU once per set of modes and reused while the modes stay. The mode switching is
-/// that of the exact solver (the same code, lib/active_set.hpp). If the passes do not
-/// settle, the solver builds the dense problem (to_dense()) and finishes with the
-/// dense exact solver, and says so (SolveResult::fell_back).
+/// LU once per set of modes and reused while the modes stay. The mode switching and the
+/// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
+/// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
+/// both paths reach the same solution. If that fails, a problem of at most 4000 rows is
+/// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
+/// one returns converged = false with a message.
 class SparseContactSolver {
 public:
     /// options.kind must be SolverKind::exact; throws InputError otherwise.
