@@ -97,7 +97,7 @@ constexpr int kTrescaIterations = 100;  // as in the dense solver
 constexpr int kBoxPasses = 50;          // block principal pivoting passes per box QP
 // passes without fewer violations before the box QP turns to Murty's single switches:
 // 8 halves the factorisations of friction steps on 10 leaves against 3 (measured:
-// 18 -> 8 per step at 342 rows, 290 -> ~130 at 1,782); the primal method still backs it up
+// 18 -> 8 per step at 342 rows, 290 -> 150 at 1,782); the primal method still backs it up
 constexpr int kBoxBudget = 8;
 constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
@@ -194,6 +194,7 @@ struct SparseContactSolver::Impl {
     int solve_modes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
         modes.linearize(laws, lin);
         std::vector<signed char> key = modes.key();
+        key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
         const int f = solve_held(lin, key, b, d, p, z);
         modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
         return f;
