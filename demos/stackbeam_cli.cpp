@@ -101,6 +101,7 @@ struct SimulateArgs {
     std::string events;
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
+    std::string contact_path = "auto";
     std::string out;
 };
 
@@ -127,6 +128,7 @@ int run_simulate(const SimulateArgs& a) {
         throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
                             "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
     options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
+    options.contact_path = stackbeam::parse_contact_path(a.contact_path, "--contact-path");
     stackbeam::PaperExampleOptions example;
     example.elements_per_half_leaf = parse_count("--elements", a.elements);
     example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
@@ -137,6 +139,7 @@ int run_simulate(const SimulateArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const stackbeam::Model model = stackbeam::Model::build(stackbeam::paper_example(pcase, example));
     const stackbeam::System system(model);
+    const stackbeam::ContactPath path = stackbeam::choose_contact_path(system, options);
 
     // --- run, streaming rows to FILE.partial ----------------------------------------
     const std::string partial = a.out + ".partial";
@@ -186,6 +189,9 @@ int run_simulate(const SimulateArgs& a) {
                 stackbeam::to_string(pcase), stackbeam::to_string(options.mode),
                 stackbeam::to_string(options.solver.kind), example.elements_per_half_leaf,
                 a.full_model ? "full" : "half", options.dt_s, options.t_end_s);
+    if (!cvode)
+        std::printf("contact path               %s (%d contact components)\n", stackbeam::to_string(path),
+                    system.num_components());
     if (cvode) {
         const auto& cs = report.cvode;
         std::printf("cvode                      rtol %g, atol %g m; %ld steps, %ld RHS evaluations, %ld root evaluations\n",
@@ -222,6 +228,7 @@ std::string option_of_field(const std::string& field) {
         {"atol", "--atol"},
         {"max_step", "--max-step"},
         {"max_steps", "--max-steps"},
+        {"contact_path", "--contact-path"},
     };
     for (const auto& [f, o] : map)
         if (field == f) return o;
@@ -267,6 +274,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     sim->add_option("--max-iterations", a.max_iterations, "iteration limit per step of the iterative solvers")
         ->type_name("N")
+        ->capture_default_str();
+    sim->add_option("--contact-path", a.contact_path,
+                    "contact problem: auto (dense below " + std::to_string(stackbeam::kSparsePathMinComponents) +
+                        " contact components, else sparse) | dense | sparse (exact solver only)")
+        ->type_name("PATH")
         ->capture_default_str();
     sim->add_option("--out", a.out, "output CSV file (written as FILE.partial, renamed when complete)")
         ->type_name("FILE.csv")

@@ -46,6 +46,11 @@ void ContactProblem::validate() const {
                                           ": must be square of the size of q (" + std::to_string(n) + ")");
     if (!W.allFinite()) throw InputError("problem.W", "has a non-finite entry");
     if (!q.allFinite()) throw InputError("problem.q", "has a non-finite entry");
+    detail::validate_laws(pairs, n, tau_rule, tau_previous_n);
+}
+
+void detail::validate_laws(const std::vector<ContactPair>& pairs, int n, TauRule tau_rule,
+                           const Eigen::VectorXd& tau_previous_n) {
     std::vector<int> used(n, 0);
     for (std::size_t k = 0; k < pairs.size(); ++k) {
         const auto& c = pairs[k];
@@ -106,15 +111,20 @@ Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorX
 }
 
 Eigen::VectorXd natural_map(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
+    return detail::natural_map_diag(problem, problem.W.diagonal(), p, s);
+}
+
+Eigen::VectorXd detail::natural_map_diag(const ContactProblem& problem, const Eigen::VectorXd& diag,
+                                         const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
     Eigen::VectorXd r = s;  // bilateral and bonded components: s itself
     for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
         const auto& c = problem.pairs[k];
         if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
-            const double w = problem.W(c.row_n, c.row_n), pn = p[c.row_n];
+            const double w = diag[c.row_n], pn = p[c.row_n];
             r[c.row_n] = w * (pn - std::min(0.0, pn - s[c.row_n] / w));
         }
         if (c.row_t >= 0 && c.kind != PairKind::bonded) {
-            const double w = problem.W(c.row_t, c.row_t), pt = p[c.row_t];
+            const double w = diag[c.row_t], pt = p[c.row_t];
             const double limit = c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p);
             r[c.row_t] = w * (pt - std::clamp(pt - s[c.row_t] / w, -limit, limit));
         }

@@ -10,6 +10,13 @@ namespace stackbeam::detail {
 std::unique_ptr<ContactSolver> make_projected_solver(const SolverOptions& options);
 std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& options);
 
+/// The checks of ContactProblem::validate on the pairs and the tau rule, for n rows.
+void validate_laws(const std::vector<ContactPair>& pairs, int n, TauRule tau_rule, const Eigen::VectorXd& tau_previous_n);
+
+/// natural_map() with the diagonal of W given (the sparse path has no dense W).
+Eigen::VectorXd natural_map_diag(const ContactProblem& problem, const Eigen::VectorXd& diag,
+                                 const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+
 /// Exact solution of pair k's own problem s_k = W_kk p_k + b_k (b_k the free
 /// term with every other pair's force fixed): open, stick or slip, whichever is
 /// consistent. Writes the pair's components of p.

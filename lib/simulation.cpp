@@ -47,6 +47,36 @@ Mode parse_mode(const std::string& text, const std::string& field) {
     throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode");
 }
 
+const char* to_string(ContactPath path) {
+    switch (path) {
+        case ContactPath::automatic: return "auto";
+        case ContactPath::dense: return "dense";
+        case ContactPath::sparse: return "sparse";
+    }
+    return "?";
+}
+
+ContactPath parse_contact_path(const std::string& text, const std::string& field) {
+    if (text == "auto") return ContactPath::automatic;
+    if (text == "dense") return ContactPath::dense;
+    if (text == "sparse") return ContactPath::sparse;
+    throw InputError(field, "value '" + text + "' is not a contact path: allowed auto, dense, sparse");
+}
+
+ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {
+    const bool exact = options.solver.kind == SolverKind::exact;
+    switch (options.contact_path) {
+        case ContactPath::dense: return ContactPath::dense;
+        case ContactPath::sparse:
+            if (!exact)
+                throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
+                                                     to_string(options.solver.kind) + "')");
+            return ContactPath::sparse;
+        case ContactPath::automatic: break;
+    }
+    return exact && system.num_components() >= kSparsePathMinComponents ? ContactPath::sparse : ContactPath::dense;
+}
+
 void SimulationOptions::validate() const {
     if (!std::isfinite(dt_s) || dt_s <= 0.0)
         throw InputError("dt", "value " + format_value(dt_s) + " is not allowed: the time step must be finite and > 0 [s]");
@@ -68,12 +98,18 @@ void SimulationOptions::validate() const {
         if (cvode.max_steps < 1)
             throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
     }
+    if (mode == Mode::cvode && contact_path == ContactPath::sparse)
+        throw InputError("contact_path", "value 'sparse' is not available in mode cvode: its mode sets are factorised "
+                                         "on the dense compliance C' (use auto or dense)");
+    if (contact_path == ContactPath::sparse && solver.kind != SolverKind::exact)
+        throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
+                                             to_string(solver.kind) + "')");
 }
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
     : system_(system), options_(options) {
     options_.validate();
-    solver_ = make_solver(options_.solver);
+    path_ = choose_contact_path(system_, options_);
     const int n = system_.num_components();
     const double k = system_.stiffness_n_per_m();
     const double m = system_.mass_kg();
@@ -93,15 +129,57 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     w_ = system_.model().spec().rigid_body.initial_displacement_m;
     wd_ = system_.model().spec().rigid_body.initial_velocity_m_per_s;
 
-    if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0)
-        problem_.W = system_.compliance_held();
-        problem_.q = c * w_ - d_;
-        solve_ = solver_->solve(problem_, p_);
-        if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+    if (path_ == ContactPath::dense) {
+        solver_ = make_solver(options_.solver);
+        if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0)
+            problem_.W = system_.compliance_held();
+            problem_.q = c * w_ - d_;
+            solve_ = solver_->solve(problem_, p_);
+            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+        }
+        problem_.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
+        problem_.q = Eigen::VectorXd::Zero(n);
+        rel_ = system_.compliance_held() * p_ + c * w_;
+    } else {
+        // Sparse path (see simulation.hpp): K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma,
+        // with 1 - gamma = sin(x)/x taken directly (no cancellation for small x).
+        if (!(sin_ > 0.0))
+            throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
+                                       " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
+        const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
+        const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
+        const int nz = static_cast<int>(K.rows());
+        w_dof_ = nz - 1;
+        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver);
+        z_ = system_.reduced_displacements(p_, w_);
+        if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0): the problem on z_r
+            const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+            SparseContactProblem held;
+            held.K = K.topLeftCorner(w_dof_, w_dof_);
+            held.G = G.leftCols(w_dof_);
+            held.b = -Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1)) * w_;
+            held.d = d_ - Eigen::VectorXd(G.col(w_dof_)) * w_;
+            held.pairs = problem_.pairs;
+            held.tau_rule = problem_.tau_rule;
+            held.tau_previous_n = problem_.tau_previous_n;
+            SparseContactSolver initial(options_.solver);
+            Eigen::VectorXd zr;
+            solve_ = initial.solve(held, p_, zr);
+            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+            z_.head(w_dof_) = zr;
+        }
+        Eigen::SparseMatrix<double> Kaug = K;
+        Kaug.coeffRef(w_dof_, w_dof_) += k * one_minus_gamma / gamma_;
+        Kaug.makeCompressed();
+        sparse_problem_.K = std::move(Kaug);
+        sparse_problem_.G = system_.contact_rows();
+        sparse_problem_.b = Eigen::VectorXd::Zero(nz);
+        sparse_problem_.d = d_;
+        sparse_problem_.pairs = problem_.pairs;
+        sparse_problem_.tau_rule = problem_.tau_rule;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        rel_ = system_.contact_rows() * z_;
     }
-    problem_.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
-    problem_.q = Eigen::VectorXd::Zero(n);
-    rel_ = system_.compliance_held() * p_ + c * w_;
     fill_record(0, 0);
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
@@ -132,8 +210,12 @@ void ClosedFormStepper::fill_record(int iterations, int factorizations) {
         else ++r.n_open;
     }
     r.kinetic_energy_j = 0.5 * system_.model().spec().rigid_body.mass_kg * wd_ * wd_;
-    // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp)
-    r.strain_energy_j = 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
+    // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp); the
+    // sparse path has z itself and never builds C'.
+    if (path_ == ContactPath::dense)
+        r.strain_energy_j = 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
+    else
+        r.strain_energy_j = 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
     r.dissipated_energy_j = dissipated_;
     r.energy_balance_error_j = e0_ - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
     r.contact_residual_m = solve_.residual_m;
@@ -153,7 +235,7 @@ const StepRecord& ClosedFormStepper::step() {
     const double F0 = c.dot(p_);
     const double w_free = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k;
     // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
-    problem_.q = c * w_free - d_;
+    if (path_ == ContactPath::dense) problem_.q = c * w_free - d_;
     if (problem_.tau_rule == TauRule::previous_step)
         for (int j = 0; j < static_cast<int>(problem_.pairs.size()); ++j) {
             const auto& pr = problem_.pairs[j];
@@ -161,7 +243,14 @@ const StepRecord& ClosedFormStepper::step() {
             problem_.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
         }
     const Eigen::VectorXd p0 = p_;
-    solve_ = solver_->solve(problem_, p_);
+    if (path_ == ContactPath::dense) {
+        solve_ = solver_->solve(problem_, p_);
+    } else {
+        sparse_problem_.b[w_dof_] = k / gamma_ * w_free;
+        sparse_problem_.d = d_;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, z_);
+    }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence)
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
@@ -171,7 +260,8 @@ const StepRecord& ClosedFormStepper::step() {
     const double w1 = w_free + gamma_ * F1 / k;
     const double wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
     // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
-    const Eigen::VectorXd rel1 = problem_.W * p_ + problem_.q + d_;
+    const Eigen::VectorXd rel1 = path_ == ContactPath::dense ? Eigen::VectorXd(problem_.W * p_ + problem_.q + d_)
+                                                             : Eigen::VectorXd(sparse_problem_.G * z_);
     double work = 0.0;
     for (const auto& pr : problem_.pairs)
         if (pr.row_t >= 0 && pr.kind != PairKind::bonded)

@@ -3,11 +3,21 @@
 #include "stackbeam/system.hpp"
 
 #include <cmath>
+#include <algorithm>
+#include <atomic>
+#include <mutex>
 #include <string>
 
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
+
+struct System::LazyCompliance {
+    std::once_flag once;
+    std::atomic<bool> built{false};
+    Eigen::MatrixXd C;
+};
+
 namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
@@ -132,6 +142,7 @@ System::System(const Model& model) : model_(model) {
 
     // --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
     const auto& cand = model_.candidate_pairs();
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P_;
     Triplets gt;
     std::vector<double> gaps;
     int row = 0;
@@ -141,17 +152,24 @@ System::System(const Model& model) : model_(model) {
         const int da = 3 * node_dof(a, cp.node), db = 3 * node_dof(b, cp.node);
         const double ha = spec.leaves[a].height_m, hb = spec.leaves[b].height_m;
         // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
-        Eigen::SparseVector<double> gn(num_full_), gtan(num_full_);
-        gn.insert(da + 1) = -1.0;
-        gn.insert(db + 1) = 1.0;
-        gtan.insert(da) = 1.0;
-        gtan.insert(da + 2) = 0.5 * ha;
-        gtan.insert(db) = -1.0;
-        gtan.insert(db + 2) = 0.5 * hb;
-        const Eigen::SparseVector<double> rn = (P_.transpose() * gn).pruned(1.0, 1e-12);
-        const Eigen::SparseVector<double> rt = (P_.transpose() * gtan).pruned(1.0, 1e-12);
-        const bool has_n = rn.nonZeros() > 0;
-        bool has_t = rt.nonZeros() > 0;
+        // On the reduced DOFs: each full DOF is at most one master times a coefficient (a row
+        // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
+        auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
+            std::vector<std::pair<int, double>> out;
+            for (const auto& [dof, g] : full)
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Prow, dof); it; ++it) {
+                    auto f = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == it.col(); });
+                    if (f == out.end()) out.emplace_back(static_cast<int>(it.col()), g * it.value());
+                    else f->second += g * it.value();
+                }
+            out.erase(std::remove_if(out.begin(), out.end(), [](const auto& e) { return std::abs(e.second) < 1e-12; }), out.end());
+            std::sort(out.begin(), out.end());
+            return out;
+        };
+        const auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
+        const auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        const bool has_n = !rn.empty();
+        bool has_t = !rt.empty();
         // A friction pair whose normal motion a support or the seat fixes has no normal
         // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
         if (!has_n && cp.kind == PairKind::coulomb) has_t = false;
@@ -163,12 +181,12 @@ System::System(const Model& model) : model_(model) {
         p.preload_n = cp.preload_n;
         if (has_n) {
             p.row_n = row++;
-            for (Eigen::SparseVector<double>::InnerIterator it(rn); it; ++it) gt.emplace_back(p.row_n, it.index(), it.value());
+            for (const auto& [col, v] : rn) gt.emplace_back(p.row_n, col, v);
             gaps.push_back(cp.initial_gap_m);
         }
         if (has_t) {
             p.row_t = row++;
-            for (Eigen::SparseVector<double>::InnerIterator it(rt); it; ++it) gt.emplace_back(p.row_t, it.index(), it.value());
+            for (const auto& [col, v] : rt) gt.emplace_back(p.row_t, col, v);
             gaps.push_back(0.0);
         }
         if (ci == model_.probe_pair()) probe_ = static_cast<int>(pairs_.size());
@@ -189,37 +207,61 @@ System::System(const Model& model) : model_(model) {
         throw InputError("leaves", "the stack is not restrained with the rigid body held: some leaf (or the seat) can move "
                                    "as a rigid body; give it supports or tie it to the rigid body (rigid_body.tied_leaves)");
     Gr_ = G.leftCols(nr);
+    G_ = G;
     const Eigen::VectorXd gw = Eigen::VectorXd(G.col(nr));
-    const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
-    C_held_ = Gr_ * X;
-    C_held_ = 0.5 * (C_held_ + C_held_.transpose()).eval();
+    C_held_ = std::make_shared<LazyCompliance>();
     const Eigen::VectorXd y = Krr_llt_.solve(Eigen::VectorXd(Krw_col_));
     c_ = gw - Gr_ * y;
     k_ = Kww - Eigen::VectorXd(Krw_col_).dot(y);
     if (!(k_ > 0.0))
         throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
                                                " N/m): the rigid body must be carried by supported leaves");
+    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD), i.e.
+    // when G_r G_r^T is: checked by a sparse LDL^T of G_r G_r^T (the rows are local, so it is
+    // sparse and cheap) rather than by factorising the dense C', which is built only on demand.
+    // A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
+    // are 1 and h/2, so an independent set of rows stays far above that).
     if (row > 0) {
-        Eigen::LLT<Eigen::MatrixXd> llt(C_held_);
-        if (llt.info() != Eigen::Success)
+        const Eigen::SparseMatrix<double> GGt = Gr_ * Gr_.transpose();
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
+        const double scale = GGt.diagonal().maxCoeff();
+        if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
             throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
     }
     mass_ = spec.rigid_body.mass_kg / model_.whole_spring_factor();
 }
 
+const Eigen::MatrixXd& System::compliance_held() const {
+    std::call_once(C_held_->once, [this] {
+        const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
+        Eigen::MatrixXd C = Gr_ * X;
+        C_held_->C = 0.5 * (C + C.transpose());
+        C_held_->built = true;
+    });
+    return C_held_->C;
+}
+
+bool System::compliance_held_built() const noexcept {
+    return C_held_->built;
+}
+
 double System::tied_stiffness_n_per_m() const {
     if (c_.size() == 0) return free_stiffness_n_per_m();
-    const Eigen::VectorXd x = C_held_.llt().solve(c_);
+    const Eigen::VectorXd x = compliance_held().llt().solve(c_);
     return model_.whole_spring_factor() * (k_ + c_.dot(x));
 }
 
-Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
+Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w) const {
     const int nr = static_cast<int>(K_red_.rows()) - 1;
     Eigen::VectorXd rhs = Gr_.transpose() * p - Eigen::VectorXd(Krw_col_) * w;
     Eigen::VectorXd z(nr + 1);
     z.head(nr) = Krr_llt_.solve(rhs);
     z[nr] = w;
-    return P_ * z;
+    return z;
+}
+
+Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
+    return P_ * reduced_displacements(p, w);
 }
 
 }  // namespace stackbeam

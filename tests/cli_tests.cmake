@@ -97,6 +97,7 @@ set(_cli_bad_cases
   "atol_negative|--atol|-1e-9|--atol: value '-1e-9'"
   "max_step_zero|--max-step|0|--max-step: value '0'"
   "events_without_cvode|--events|ev.csv|--events: the event log exists in mode cvode only"
+  "contact_path_unknown|--contact-path|banded|--contact-path: value 'banded' is not a contact path: allowed auto, dense, sparse"
 )
 foreach(entry IN LISTS _cli_bad_cases)
   string(REPLACE "|" ";" fields "${entry}")
@@ -125,6 +126,18 @@ stackbeam_cli_test(NAME cli_missing_out ARGS simulate --case frictionless --t-en
 stackbeam_cli_test(NAME cli_missing_subcommand ARGS --case frictionless EXPECT_RC 2 EXPECT_TEXT "stackbeam: error:")
 stackbeam_cli_test(NAME cli_help ARGS --help EXPECT_RC 0 EXPECT_TEXT "simulate")
 stackbeam_cli_test(NAME cli_simulate_help ARGS simulate --help EXPECT_RC 0 EXPECT_TEXT "--alpha-fraction")
+
+# The sparse contact path needs the exact solver: a clear error naming the option.
+stackbeam_cli_test(NAME cli_bad_contact_path_solver
+                   ARGS simulate --case friction --t-end 0.01 --contact-path sparse --solver accelerated
+                        --out ${_cli_out_dir}/cli_bad_contact_path_solver.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--contact-path: value 'sparse' needs the exact solver"
+                   OUT ${_cli_out_dir}/cli_bad_contact_path_solver.csv)
+# A good run on the sparse path.
+stackbeam_cli_test(NAME cli_ok_sparse
+                   ARGS simulate --case friction --t-end 0.01 --contact-path sparse --out ${CMAKE_BINARY_DIR}/cli_sparse.csv
+                   EXPECT_RC 0 EXPECT_TEXT "contact path               sparse" OUT ${CMAKE_BINARY_DIR}/cli_sparse.csv
+                   HEADER_PREFIX "t,w,w_dot" MIN_LINES 12)
 
 # A good run: exit status 0, a complete CSV (header + 11 records for 10 steps), no .partial.
 stackbeam_cli_test(NAME cli_ok_frictionless

@@ -12,6 +12,7 @@
 /// The error vector v (eq. 9) is zero exactly at a solution (eq. 10); ||v||_2 [m]
 /// is the solver-independent residual every solver reports.
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 #include <memory>
 #include <string>
 #include <vector>
@@ -116,6 +117,64 @@ public:
 
 /// Creates the solver named in `options`. Throws InputError for bad options.
 std::unique_ptr<ContactSolver> make_solver(const SolverOptions& options);
+
+/// The per-step contact problem on the sparse stiffness (the "sparse path"):
+///     K z = b + G^T p,    s = G z - d,
+/// with the pair laws of ContactProblem (the same pairs, rows and tau rule). z are
+/// displacements, K a sparse symmetric positive definite stiffness, G the contact
+/// rows. Eliminating z gives the dense problem s = W p + q of ContactProblem with
+///     W = G K^-1 G^T,  q = G K^-1 b - d     (to_dense()),
+/// so both have the same solution; this form never builds the dense W (its cost
+/// grows with the number of elements, not with its square or cube).
+struct SparseContactProblem {
+    Eigen::SparseMatrix<double> K;     ///< stiffness, n x n, symmetric positive definite (both triangles stored)
+    Eigen::SparseMatrix<double> G;     ///< contact rows [-], m x n
+    Eigen::VectorXd b;                 ///< load with p = 0, n entries
+    Eigen::VectorXd d;                 ///< offsets [m], m entries (normal gaps, tangential anchors)
+    std::vector<ContactPair> pairs;    ///< the pairs and their rows (rows of G)
+    TauRule tau_rule = TauRule::current;
+    Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (TauRule::previous_step)
+
+    int size() const { return static_cast<int>(d.size()); }
+    /// Throws InputError if the sizes, rows or laws are inconsistent.
+    void validate() const;
+    /// The equivalent dense problem (W = G K^-1 G^T, q = G K^-1 b - d): m solves and
+    /// m^2 doubles; for tests and for the sparse solver's last-resort fallback.
+    ContactProblem to_dense() const;
+};
+
+/// The active-set method of SolverKind::exact on a SparseContactProblem. Per set of
+/// modes the conditions are linear, so the solve is one sparse saddle-point system
+///     [ K                       -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
+///     [ G_S                      0                  ] [p_S] = [d_S      ]
+/// (S: rows held by s = 0; slip rows carry p_t = e_t + D p_n), factorised by a sparse
+/// LU once per set of modes and reused while the modes stay. The mode switching and the
+/// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
+/// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
+/// both paths reach the same solution. If that fails, a problem of at most 4000 rows is
+/// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
+/// one returns converged = false with a message.
+class SparseContactSolver {
+public:
+    /// options.kind must be SolverKind::exact; throws InputError otherwise.
+    explicit SparseContactSolver(const SolverOptions& options);
+    ~SparseContactSolver();
+    SparseContactSolver(const SparseContactSolver&) = delete;
+    SparseContactSolver& operator=(const SparseContactSolver&) = delete;
+
+    /// Solves `problem`; p is the warm start on entry and the forces [N] on exit; z the
+    /// displacements on exit. It keeps its factorisations while K and G stay the same.
+    SolveResult solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// s = G z - d at the last solution [m].
+    const Eigen::VectorXd& relative_positions() const;
+    /// Diagonal of W = G K^-1 G^T [m/N] (computed once per K, G: it scales the force
+    /// violations to metres as in the dense solver).
+    const Eigen::VectorXd& compliance_diagonal() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 /// Largest eigenvalue of a symmetric matrix [same units as W].
 double largest_eigenvalue(const Eigen::MatrixXd& W);

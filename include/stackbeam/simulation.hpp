@@ -51,6 +51,24 @@ enum class Mode {
 const char* to_string(Mode m);
 Mode parse_mode(const std::string& text, const std::string& field);
 
+/// How the closed-form stepper poses the per-step contact problem.
+enum class ContactPath {
+    automatic,  ///< dense for small problems, sparse for large ones (see choose_contact_path)
+    dense,      ///< ContactProblem: the dense W = C' + (gamma/k) c c^T (O(m^2) memory, O(m^3) set-up); every solver
+    sparse,     ///< SparseContactProblem on the banded stiffness, near-linear in the elements; exact solver only
+};
+const char* to_string(ContactPath path);
+/// Parses "auto" | "dense" | "sparse"; throws InputError naming `field`.
+ContactPath parse_contact_path(const std::string& text, const std::string& field);
+
+/// ContactPath::automatic takes the sparse path from this many contact components
+/// (rows of the contact problem) on, with the exact solver. Measured (BENCHMARKS.md,
+/// friction case, the costliest): at 636 rows both paths take the same time per step,
+/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
+/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
+/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
+constexpr int kSparsePathMinComponents = 1000;
+
 /// Options of mode "cvode" (see cvode_stepper.hpp).
 struct CvodeOptions {
     double rtol = 1e-8;          ///< CVODE relative tolerance [-]
@@ -69,6 +87,8 @@ struct SimulationOptions {
     double t_end_s = 0.6;      ///< end time [s]
     SolverOptions solver;      ///< contact solver and its tolerance (paper: ||v|| < 2e-6 m)
     TauRule tau_rule = TauRule::current;
+    /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
+    ContactPath contact_path = ContactPath::automatic;
     /// Throw SolverError when a step's contact solve does not converge (default);
     /// if false the step is kept and flagged by its residual.
     bool stop_on_nonconvergence = true;
@@ -76,7 +96,20 @@ struct SimulationOptions {
     void validate() const;
 };
 
+/// The contact path `options.contact_path` resolves to on `system`: automatic gives
+/// sparse when the solver is exact and system.num_components() >= kSparsePathMinComponents,
+/// dense otherwise. Throws InputError for the sparse path with a solver other than exact.
+ContactPath choose_contact_path(const System& system, const SimulationOptions& options);
+
 /// The paper's closed-form stepping (mode "closed-form").
+///
+/// On the sparse path (ContactPath) the same step is posed on the reduced stiffness
+/// instead of on W (SparseContactProblem, K z = b + G^T p, s = G z - d): eq. 16's
+/// w(t+dt) = w_free + (gamma/k) c^T p makes the rigid body a spring on w,
+///     K_aug = K + k_R e_w e_w^T,  k_R = k (1 - gamma) / gamma,   b = (k/gamma) w_free e_w,
+/// which is exact: eliminating z gives W = G K_aug^-1 G^T = C' + (gamma/k) c c^T and
+/// q = c w_free - d (the w row reads (k + k_R) w = (k/gamma) w_free + c^T p, and
+/// k + k_R = k/gamma). So both paths solve the same problem, to round-off.
 class ClosedFormStepper {
 public:
     ClosedFormStepper(const System& system, const SimulationOptions& options);
@@ -96,7 +129,14 @@ public:
     /// State of each pair of system().pairs().
     std::vector<PairState> pair_states() const;
     /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
+    /// On the sparse path W and q are empty (the pairs and tau rule are set): see last_sparse_problem().
     const ContactProblem& last_problem() const noexcept { return problem_; }
+    /// The sparse contact problem of the last step (sparse path; empty on the dense path).
+    const SparseContactProblem& last_sparse_problem() const noexcept { return sparse_problem_; }
+    /// The path this stepper uses (never automatic).
+    ContactPath contact_path() const noexcept { return path_; }
+    /// Reduced displacements z of the leaves [m, rad] at the current step (sparse path; empty on the dense path).
+    const Eigen::VectorXd& reduced_displacements() const noexcept { return z_; }
     const SolveResult& last_solve() const noexcept { return solve_; }
     const System& system() const noexcept { return system_; }
     double omega_rad_per_s() const noexcept { return omega_; }
@@ -104,8 +144,13 @@ public:
 private:
     const System& system_;
     SimulationOptions options_;
+    ContactPath path_ = ContactPath::dense;
     std::unique_ptr<ContactSolver> solver_;
+    std::unique_ptr<SparseContactSolver> sparse_solver_;
     ContactProblem problem_;
+    SparseContactProblem sparse_problem_;
+    Eigen::VectorXd z_;
+    int w_dof_ = -1;
     SolveResult solve_;
     Eigen::VectorXd p_, d_, rel_;
     double w_ = 0.0, wd_ = 0.0, t_ = 0.0;

@@ -13,6 +13,7 @@
 /// per unit w. All of it on the meshed part (half the spring on the half model).
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
+#include <memory>
 #include <vector>
 
 #include "stackbeam/contact.hpp"
@@ -38,8 +39,16 @@ public:
     int num_components() const noexcept { return static_cast<int>(gaps_.size()); }
     /// d_n per row for normal rows (the initial gap) and 0 for tangential rows [m].
     const Eigen::VectorXd& initial_offsets_m() const noexcept { return gaps_; }
-    /// Compliance of the contact points with R held, C' [m/N] (eq. A3).
-    const Eigen::MatrixXd& compliance_held() const noexcept { return C_held_; }
+    /// Compliance of the contact points with R held, C' [m/N] (eq. A3). Dense,
+    /// num_components()^2 doubles: built on the first call (one sparse solve per
+    /// contact row), not by the constructor, so that a large model run on the sparse
+    /// contact path (simulation.hpp, ContactPath) never pays for it. Thread-safe.
+    const Eigen::MatrixXd& compliance_held() const;
+    /// Whether compliance_held() has been built (for tests of the sparse path).
+    bool compliance_held_built() const noexcept;
+    /// Contact rows on the reduced DOFs, G [-] (num_components() x num_reduced_dofs(),
+    /// w last): s = G z - d for reduced displacements z (paper eq. 1 and 7).
+    const Eigen::SparseMatrix<double>& contact_rows() const noexcept { return G_; }
     /// c = A/a: relative surface displacement per unit w with p = 0 [-].
     const Eigen::VectorXd& coupling() const noexcept { return c_; }
     /// k = 1/a: stiffness at R of the meshed part with p = 0 [N/m].
@@ -58,6 +67,9 @@ public:
     int num_reduced_dofs() const noexcept { return static_cast<int>(K_red_.rows()); }
     /// Reduced stiffness P^T K P [N/m, N, N m per unit DOF], w last.
     const Eigen::SparseMatrix<double>& stiffness_reduced() const noexcept { return K_red_; }
+    /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
+    /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
+    Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;
     /// Displacements (u, v, theta) of every leaf node [m, m, rad] for contact forces p
     /// and rigid-body displacement w: index 3*node_dof(leaf, node) + {0,1,2}.
     Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
@@ -69,7 +81,9 @@ private:
     std::vector<ContactPair> pairs_;
     std::vector<int> pair_candidate_;
     Eigen::VectorXd gaps_;
-    Eigen::MatrixXd C_held_;
+    struct LazyCompliance;                          // C', built once on demand
+    std::shared_ptr<LazyCompliance> C_held_;        // shared by copies (same model, same C')
+    Eigen::SparseMatrix<double> G_;                 // contact rows x reduced DOFs (w last)
     Eigen::VectorXd c_;
     double k_ = 0.0;
     double mass_ = 0.0;

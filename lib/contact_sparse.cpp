@@ -1,0 +1,602 @@
+// The sparse contact path: the exact solver's active-set method on
+//     K z = b + G^T p,  s = G z - d       (SparseContactProblem, contact.hpp)
+// without ever forming the dense W = G K^-1 G^T.
+//
+// Design (why a saddle-point system per set of modes):
+//  - For a set of modes the contact conditions are linear: held rows (closed normal,
+//    stuck tangential, bonded) impose G_S z = d_S; slipping rows carry a force affine in
+//    their pair's normal force, p_t = e_t + D p_n; open / free rows carry p = e = 0.
+//    With z and p_S as unknowns this is one sparse system
+//        [ K     -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
+//        [ G_S    0                  ] [p_S] = [d_S      ]
+//    whose size and fill grow linearly with the number of elements (the contact rows
+//    are local: each touches the DOFs of two leaves at one node). It is not symmetric
+//    when a slip row is coupled to its normal force, and it is indefinite, so it is
+//    factorised by a sparse LU (Eigen::SparseLU, COLAMD ordering: no extra package).
+//  - The factorisation depends only on the modes; it is kept and reused while they
+//    stay, like the dense solver's LU. Within one set of modes the solution is affine in
+//    the right-hand side; on the closed-form stepper only b (the rigid body's load,
+//    one entry) changes from step to step, and e, d_S only when the modes or anchors
+//    do. So two back-solves per set of modes ({unit b entry} and {e, d_S}) are cached
+//    and a step whose modes stay costs O(n) (a linear combination, one product with G),
+//    not a back-solve.
+//  - The diagonal of W scales force violations to metres, exactly as in the dense
+//    solver (so both take the same decisions). It is computed once per (K, G) from a
+//    sparse Cholesky factor K = P^T L L^T P as W_ii = ||L^-1 P g_i||^2, in blocks of
+//    columns. This is the one part whose cost is not linear (about m times the
+//    factor's fill); it is done once per run (0.35 s at 10 leaves x 400 elements).
+//  - Mode switching (violations, block principal pivoting, Murty's rule) is the code
+//    of the dense solver (active_set.hpp), and so is the handling of transitions: after
+//    max_active_set_iterations passes, a Tresca fixed point (friction limits frozen: a
+//    box-constrained convex QP) whose working set gives the modes of a final Coulomb
+//    solve. The box QP is solved by block principal pivoting (a few factorisations)
+//    and, if that stalls, by the dense solver's monotone primal active-set method (one
+//    factorisation per working-set change, cannot cycle), each step a sparse solve.
+//    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
+//    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
+//    with a message.
+//  - Cost: a step whose modes stay is O(n); a transition costs a sparse factorisation
+//    per pass (0.27 s at 10 leaves x 400 elements, Eigen's SparseLU), and a friction
+//    step on many identical leaves needs 100-300 of them. That, not the formulation,
+//    is what keeps large friction runs slow (BENCHMARKS.md).
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "active_set.hpp"
+#include "contact_solvers.hpp"
+#include "stackbeam/contact.hpp"
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+void SparseContactProblem::validate() const {
+    const int n = static_cast<int>(K.rows());
+    if (K.cols() != n) throw InputError("problem.K", "must be square");
+    if (G.cols() != n)
+        throw InputError("problem.G", "has " + std::to_string(G.cols()) + " columns: must match K (" + std::to_string(n) + ")");
+    if (G.rows() != d.size())
+        throw InputError("problem.G", "has " + std::to_string(G.rows()) + " rows: must match d (" + std::to_string(d.size()) + ")");
+    if (b.size() != n) throw InputError("problem.b", "must have one entry per row of K");
+    if (!b.allFinite()) throw InputError("problem.b", "has a non-finite entry");
+    if (!d.allFinite()) throw InputError("problem.d", "has a non-finite entry");
+    detail::validate_laws(pairs, size(), tau_rule, tau_previous_n);
+}
+
+ContactProblem SparseContactProblem::to_dense() const {
+    Eigen::SimplicialLLT<SpMat> llt(K);
+    if (llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
+    ContactProblem pr;
+    const Eigen::MatrixXd X = llt.solve(Eigen::MatrixXd(G.transpose()));
+    pr.W = G * X;
+    pr.W = 0.5 * (pr.W + pr.W.transpose()).eval();
+    pr.q = G * llt.solve(b) - d;
+    pr.pairs = pairs;
+    pr.tau_rule = tau_rule;
+    pr.tau_previous_n = tau_previous_n;
+    return pr;
+}
+
+namespace {
+bool same_matrix(const SpMat& a, const SpMat& b) {
+    if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+    if (!a.isCompressed() || !b.isCompressed()) return false;
+    const auto nnz = static_cast<std::size_t>(a.nonZeros());
+    return std::memcmp(a.valuePtr(), b.valuePtr(), nnz * sizeof(double)) == 0 &&
+           std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), nnz * sizeof(int)) == 0 &&
+           std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), (a.outerSize() + 1) * sizeof(int)) == 0;
+}
+
+constexpr int kTrescaIterations = 100;  // as in the dense solver
+constexpr int kBoxPasses = 50;          // block principal pivoting passes per box QP
+// passes without fewer violations before the box QP turns to Murty's single switches:
+// 8 halves the factorisations of friction steps on 10 leaves against 3 (measured:
+// 18 -> 8 per step at 342 rows, 290 -> 150 at 1,782); the primal method still backs it up
+constexpr int kBoxBudget = 8;
+constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
+constexpr int kBudget = 3;          // as in the dense solver
+constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
+
+struct SingularModes {};            // a set of modes whose saddle-point system is singular
+
+bool same_laws(const std::vector<ContactPair>& a, const std::vector<ContactPair>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t k = 0; k < a.size(); ++k)
+        if (a[k].kind != b[k].kind || a[k].friction_coefficient != b[k].friction_coefficient ||
+            a[k].preload_n != b[k].preload_n || a[k].row_n != b[k].row_n || a[k].row_t != b[k].row_t)
+            return false;
+    return true;
+}
+}  // namespace
+
+struct SparseContactSolver::Impl {
+    SolverOptions options;
+    // structure of the last problem
+    SpMat K, G;
+    Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> k_llt;
+    Eigen::VectorXd diag;                // diagonal of W
+    double g_norm_inf = 0.0;             // max row sum of |G|
+    ContactProblem laws;                 // pairs and tau rule; W empty, q zero (sizes only)
+    detail::ModeSet modes;
+    detail::ModeLinearization lin;
+    // factorisation of the current modes
+    std::vector<signed char> lu_key;
+    Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> lu;
+    bool lu_ok = false;
+    std::vector<int> pos;                // row -> index in lin.S, or -1
+    Eigen::VectorXd dz;                  // column scaling of z: diag(K)^-1/2
+    SpMat Gt_scaled;                     // Dz G^T: column r is contact row r, scaled
+    Eigen::VectorXd row_scale;           // scaling of the held rows (1/||G_i Dz||)
+    SpMat A;                             // the scaled saddle-point matrix of the current modes
+    // cached back-solves of the current factorisation
+    int unit_dof = -1;                   // x_unit solves [e_unit_dof; 0]
+    Eigen::VectorXd x_unit;
+    Eigen::VectorXd const_e, const_dS;   // x_const solves [G^T e; d_S] for these e, d_S
+    Eigen::VectorXd x_const;
+    bool const_ok = false;
+    Eigen::VectorXd s, x, rhs;
+
+    void reset_structure(const SparseContactProblem& pr) {
+        pr.validate();
+        K = pr.K;
+        G = pr.G;
+        K.makeCompressed();
+        G.makeCompressed();
+        k_llt.compute(K);
+        if (k_llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
+        // diag(G K^-1 G^T) = column norms of L^-1 P G^T, in blocks of columns
+        const int m = pr.size();
+        diag.resize(m);
+        const SpMat PGt = k_llt.permutationP() * SpMat(G.transpose());
+        constexpr int kBlock = 64;
+        Eigen::MatrixXd Y;
+        for (int j0 = 0; j0 < m; j0 += kBlock) {
+            const int nb = std::min(kBlock, m - j0);
+            Y = Eigen::MatrixXd(PGt.middleCols(j0, nb));
+            k_llt.matrixL().solveInPlace(Y);
+            diag.segment(j0, nb) = Y.colwise().squaredNorm().transpose();
+        }
+        g_norm_inf = 0.0;
+        const SpMat absG = G.cwiseAbs();
+        const Eigen::VectorXd rows = absG * Eigen::VectorXd::Ones(G.cols());
+        if (m > 0) g_norm_inf = rows.maxCoeff();
+        dz = K.diagonal().cwiseSqrt().cwiseInverse();
+        Gt_scaled = dz.asDiagonal() * SpMat(G.transpose());
+        Gt_scaled.makeCompressed();
+        laws.W.resize(0, 0);
+        laws.q = Eigen::VectorXd::Zero(m);
+        laws.pairs = pr.pairs;
+        lu_key.clear();
+        lu_ok = false;
+        const_ok = false;
+        unit_dof = -1;
+        modes.nmode.clear();
+    }
+
+    /// s = G z - d for z = K^-1 (b + G^T p).
+    Eigen::VectorXd positions_of(const SparseContactProblem& pr, const Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        z = k_llt.solve(pr.b + G.transpose() * p);
+        return G * z - pr.d;
+    }
+
+    /// Solves the linear problem of the current modes for load b and offsets d into p and
+    /// z; returns 1 if it factorised. The saddle-point system is scaled symmetrically
+    /// (z = Dz y with Dz = diag(K)^-1/2, held row i by 1/||G_i Dz||): K mixes axial
+    /// (EA/L ~ 1e8), bending (EI/L^3 ~ 1e7) and rotational (EI/L ~ 1e3) entries and G is
+    /// O(1), and unscaled the LU's pivoting would lose digits. Each cached solve gets one
+    /// step of iterative refinement, so held rows come out at s = 0 to round-off.
+    int solve_modes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        modes.linearize(laws, lin);
+        std::vector<signed char> key = modes.key();
+        key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
+        const int f = solve_held(lin, key, b, d, p, z);
+        modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
+        return f;
+    }
+
+    /// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
+    /// factorised unless `key` names the current factorisation.
+    int solve_held(const detail::ModeLinearization& lin, std::vector<signed char>& key, const Eigen::VectorXd& b,
+                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        const int n = static_cast<int>(K.rows()), m = static_cast<int>(d.size());
+        const auto& S = lin.S;
+        const int ms = static_cast<int>(S.size());
+        pos.assign(m, -1);
+        for (int i = 0; i < ms; ++i) pos[S[i]] = i;
+        int factorised = 0;
+        if (key != lu_key) {
+            row_scale.resize(ms);
+            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
+            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+            std::vector<Eigen::Triplet<double>> t;
+            t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
+            for (int j = 0; j < n; ++j)
+                for (SpMat::InnerIterator it(K, j); it; ++it)
+                    t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+            for (int i = 0; i < ms; ++i)
+                for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
+                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+                }
+            for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+                const int col = pos[lin.coupled[a].second];
+                if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+                for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
+                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+            }
+            A.resize(n + ms, n + ms);
+            A.setFromTriplets(t.begin(), t.end());
+            A.makeCompressed();
+            lu.compute(A);
+            lu_ok = lu.info() == Eigen::Success;
+            lu_key = std::move(key);
+            const_ok = false;
+            unit_dof = -1;
+            factorised = 1;
+        }
+        if (!lu_ok) throw SingularModes{};
+        // right-hand side [Dz (b + G^T e); R d_S] = b-part + constant part
+        Eigen::VectorXd dS(ms);
+        for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
+        if (!const_ok || const_e != lin.e || const_dS != dS) {
+            rhs.resize(n + ms);
+            rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
+            rhs.tail(ms) = row_scale.cwiseProduct(dS);
+            x_const = refined_solve(rhs);
+            const_e = lin.e;
+            const_dS = dS;
+            const_ok = true;
+        }
+        // b: one nonzero entry (the closed-form stepper's load on the rigid body) is a
+        // multiple of a cached unit solve; anything else is solved directly.
+        int nz = -1, count = 0;
+        for (int i = 0; i < n; ++i)
+            if (b[i] != 0.0) {
+                nz = i;
+                ++count;
+            }
+        if (count == 0) {
+            x = x_const;
+        } else if (count == 1) {
+            if (unit_dof != nz) {
+                rhs.setZero(n + ms);
+                rhs[nz] = dz[nz];
+                x_unit = refined_solve(rhs);
+                unit_dof = nz;
+            }
+            x = x_const + b[nz] * x_unit;
+        } else {
+            rhs.setZero(n + ms);
+            rhs.head(n) = dz.cwiseProduct(b);
+            x = x_const + refined_solve(rhs);
+        }
+        z = dz.cwiseProduct(x.head(n));
+        p = lin.e;
+        for (int i = 0; i < ms; ++i) p[S[i]] = row_scale[i] * x[n + i];
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+        return factorised;
+    }
+
+    /// The box-constrained QP min 1/2 x^T W x + q^T x, lower <= x <= upper, by the monotone
+    /// primal active-set method of box_qp.hpp (the dense solver's), each equality-constrained
+    /// step one sparse solve of the held (free) rows with the bound ones fixed: the
+    /// objective falls at every iteration, so it cannot cycle. x = p, and z follows it.
+    bool box_qp(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& lower,
+                const Eigen::VectorXd& upper, Eigen::VectorXd& x, Eigen::VectorXd& z,
+                std::vector<signed char>& at_bound, double tolerance, int max_iterations, SolveResult& r) {
+        const int m = static_cast<int>(x.size());
+        at_bound.resize(m, 0);
+        for (int i = 0; i < m; ++i) {  // feasible start; components with an empty interior are held
+            if (x[i] <= lower[i]) { x[i] = lower[i]; if (std::isfinite(lower[i])) at_bound[i] = -1; }
+            if (x[i] >= upper[i]) { x[i] = upper[i]; if (std::isfinite(upper[i])) at_bound[i] = +1; }
+            if (at_bound[i] == -1 && !std::isfinite(lower[i])) at_bound[i] = 0;
+            if (at_bound[i] == +1 && !std::isfinite(upper[i])) at_bound[i] = 0;
+            if (at_bound[i] != 0) x[i] = at_bound[i] < 0 ? lower[i] : upper[i];
+            if (lower[i] == upper[i]) at_bound[i] = +1;
+        }
+        z = k_llt.solve(b + G.transpose() * x);
+        detail::ModeLinearization qp;
+        Eigen::VectorXd y, zy;
+        for (int iter = 0; iter < max_iterations; ++iter) {
+            ++r.iterations;
+            qp.S.clear();
+            qp.e = x;
+            for (int i = 0; i < m; ++i)
+                if (at_bound[i] == 0) {
+                    qp.S.push_back(i);
+                    qp.e[i] = 0.0;
+                }
+            std::vector<signed char> key(at_bound);
+            key.push_back(100);  // a box-QP working set, not a set of modes
+            r.factorizations += solve_held(qp, key, b, d, y, zy);
+            double alpha = 1.0;
+            int blocking = -1;
+            signed char side = 0;
+            for (int i : qp.S) {
+                const double dd = y[i] - x[i];
+                if (dd < 0.0 && y[i] < lower[i]) {
+                    const double t = (lower[i] - x[i]) / dd;
+                    if (t < alpha) { alpha = t; blocking = i; side = -1; }
+                } else if (dd > 0.0 && y[i] > upper[i]) {
+                    const double t = (upper[i] - x[i]) / dd;
+                    if (t < alpha) { alpha = t; blocking = i; side = +1; }
+                }
+            }
+            alpha = std::max(alpha, 0.0);
+            x += alpha * (y - x);
+            z += alpha * (zy - z);
+            if (blocking >= 0) {
+                at_bound[blocking] = side;
+                x[blocking] = side < 0 ? lower[blocking] : upper[blocking];
+                continue;
+            }
+            const Eigen::VectorXd sx = G * z - d;
+            int worst = -1;
+            double worst_size = tolerance;
+            for (int i = 0; i < m; ++i) {
+                if (at_bound[i] == 0 || lower[i] == upper[i]) continue;
+                const double wrong = at_bound[i] < 0 ? -sx[i] : sx[i];
+                if (wrong > worst_size) { worst_size = wrong; worst = i; }
+            }
+            if (worst < 0) return true;
+            at_bound[worst] = 0;
+        }
+        return false;
+    }
+
+    Eigen::VectorXd refined_solve(const Eigen::VectorXd& r) {
+        Eigen::VectorXd y = lu.solve(r);
+        const Eigen::VectorXd res = r - A * y;
+        y += lu.solve(res);
+        return y;
+    }
+
+    int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
+        s = G * z - d;
+        const double roundoff = 1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
+        return modes.count_violations(laws, p, s, diag, std::max(kAccept * options.tolerance_m, roundoff));
+    }
+
+    /// Active-set passes at load b and offsets d from the current modes.
+    bool passes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                int max_passes, SolveResult& r) {
+        return detail::active_set_passes(
+            modes, laws, p, max_passes, kBudget, r, [&](Eigen::VectorXd& x) { return solve_modes(b, d, x, z); },
+            [&](const Eigen::VectorXd& x) { return count_violations(d, x, z); });
+    }
+
+    /// The same box-constrained QP by block principal pivoting (Judice & Pires): every
+    /// violated bound or multiplier switches at once while their number falls, then
+    /// Murty's least-index rule (finite: the QP's matrix W is symmetric positive definite).
+    /// A few factorisations where the primal method needs one per working-set change
+    /// (hundreds per step on a 10-leaf stack). Returns false after max_passes.
+    bool box_qp_bpp(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& lower,
+                    const Eigen::VectorXd& upper, Eigen::VectorXd& x, Eigen::VectorXd& z,
+                    std::vector<signed char>& at_bound, double tolerance, int max_passes, SolveResult& r) {
+        const int m = static_cast<int>(x.size());
+        at_bound.resize(m, 0);
+        for (int i = 0; i < m; ++i) {
+            if (lower[i] == upper[i]) at_bound[i] = +1;
+            if (at_bound[i] == -1 && !std::isfinite(lower[i])) at_bound[i] = 0;
+            if (at_bound[i] == +1 && !std::isfinite(upper[i])) at_bound[i] = 0;
+        }
+        detail::ModeLinearization qp;
+        std::vector<int> viol;
+        int best = std::numeric_limits<int>::max(), budget = kBoxBudget;
+        for (int pass = 0; pass < max_passes; ++pass) {
+            ++r.iterations;
+            qp.S.clear();
+            qp.e.setZero(m);
+            for (int i = 0; i < m; ++i) {
+                if (at_bound[i] == 0) qp.S.push_back(i);
+                else qp.e[i] = at_bound[i] < 0 ? lower[i] : upper[i];
+            }
+            std::vector<signed char> key(at_bound);
+            key.push_back(100);  // a box-QP working set, not a set of modes
+            r.factorizations += solve_held(qp, key, b, d, x, z);
+            const Eigen::VectorXd sx = G * z - d;
+            viol.clear();
+            for (int i = 0; i < m; ++i) {
+                double v = 0.0;
+                if (at_bound[i] == 0) v = std::max(lower[i] - x[i], x[i] - upper[i]) * diag[i];
+                else if (lower[i] < upper[i]) v = at_bound[i] < 0 ? -sx[i] : sx[i];
+                if (v > tolerance) viol.push_back(i);
+            }
+            const int nv = static_cast<int>(viol.size());
+            if (nv == 0) return true;
+            bool single = false;
+            if (nv < best) {
+                best = nv;
+                budget = kBoxBudget;
+            } else if (budget > 0) {
+                --budget;
+            } else {
+                single = true;
+            }
+            if (single) viol.resize(1);
+            for (int i : viol) {
+                if (at_bound[i] != 0) at_bound[i] = 0;
+                else at_bound[i] = x[i] < lower[i] ? -1 : +1;
+            }
+        }
+        return false;
+    }
+
+    /// Fixed point on the friction limits, as in the dense solver (contact_exact.cpp): each
+    /// pass solves the problem with the limits frozen (Tresca), a box-constrained convex QP
+    /// (box_qp, which cannot cycle); the limits are updated from its normal forces until they
+    /// settle to kAccept x tolerance (in metres); its final working set gives the modes.
+    bool tresca_fixed_point(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p,
+                            Eigen::VectorXd& z, SolveResult& r) {
+        const ContactProblem& pr = laws;
+        const int n = static_cast<int>(d.size());
+        const int np = static_cast<int>(pr.pairs.size());
+        const double inf = std::numeric_limits<double>::infinity();
+        Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
+        std::vector<signed char> at_bound(n, 0);
+        auto& nmode = modes.nmode;
+        auto& tmode = modes.tmode;
+        using detail::ModeSet;
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && ModeSet::unilateral(c)) {
+                upper[c.row_n] = 0.0;
+                if (nmode[k] == detail::OPEN) at_bound[c.row_n] = +1;
+            }
+            if (c.row_t >= 0 && (tmode[k] == detail::SLIP_POS || tmode[k] == detail::SLIP_NEG))
+                at_bound[c.row_t] = tmode[k] == detail::SLIP_POS ? +1 : -1;
+        }
+        Eigen::VectorXd tau(np);
+        for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
+        const double accept = kAccept * options.tolerance_m;
+        for (int it = 0; it < kTrescaIterations; ++it) {
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double limit = c.friction_coefficient * tau[k];
+                lower[c.row_t] = -limit;
+                upper[c.row_t] = limit;
+            }
+            // block principal pivoting first (few factorisations); the monotone primal method
+            // (one factorisation per working-set change, cannot cycle) if it does not settle
+            const std::vector<signed char> start = at_bound;
+            const Eigen::VectorXd p_start = p;
+            if (!box_qp_bpp(b, d, lower, upper, p, z, at_bound, accept, kBoxPasses, r)) {
+                at_bound = start;
+                p = p_start;
+                if (!box_qp(b, d, lower, upper, p, z, at_bound, accept, 50 * (n + 1), r)) return false;
+            }
+            double change_m = 0.0;
+            for (int k = 0; k < np; ++k) {
+                const auto& c = pr.pairs[k];
+                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                const double t = friction_normal_force(pr, k, p);
+                change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * diag[c.row_t]);
+                tau[k] = t;
+            }
+            if (change_m <= accept) {
+                // modes from the working set; slip forces put at the limit of the final tau
+                s = G * z - d;
+                for (int k = 0; k < np; ++k) {
+                    const auto& c = pr.pairs[k];
+                    if (c.row_n >= 0 && ModeSet::unilateral(c)) nmode[k] = at_bound[c.row_n] == +1 ? detail::OPEN : detail::CLOSED;
+                    if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+                    if (limit <= 0.0) {
+                        tmode[k] = detail::FREE;
+                        p[c.row_t] = 0.0;
+                    } else if (at_bound[c.row_t] != 0) {
+                        const double st = s[c.row_t];
+                        const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t] : (st > 0.0 ? -1 : +1);
+                        tmode[k] = sigma > 0 ? detail::SLIP_POS : detail::SLIP_NEG;
+                        p[c.row_t] = sigma * limit;
+                    } else {
+                        tmode[k] = detail::STICK;
+                    }
+                    modes.make_consistent(pr, k);
+                }
+                return true;
+            }
+        }
+        return false;
+    }
+
+};
+
+SparseContactSolver::SparseContactSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
+    make_solver(options);  // validates the options
+    if (options.kind != SolverKind::exact)
+        throw InputError("solver.kind", std::string("value '") + to_string(options.kind) +
+                                            "' is not available on the sparse contact path: it has the exact "
+                                            "(active-set) solver only");
+    impl_->options = options;
+}
+
+SparseContactSolver::~SparseContactSolver() = default;
+
+const Eigen::VectorXd& SparseContactSolver::relative_positions() const { return impl_->s; }
+const Eigen::VectorXd& SparseContactSolver::compliance_diagonal() const { return impl_->diag; }
+
+SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    Impl& im = *impl_;
+    const int m = problem.size();
+    const int np = static_cast<int>(problem.pairs.size());
+    if (!same_matrix(problem.K, im.K) || !same_matrix(problem.G, im.G) || !same_laws(im.laws.pairs, problem.pairs) ||
+        im.laws.q.size() != m)
+        im.reset_structure(problem);
+    im.laws.tau_rule = problem.tau_rule;
+    im.laws.tau_previous_n = problem.tau_previous_n;
+    if (static_cast<int>(im.modes.nmode.size()) != np) {
+        if (p.size() != m) p = Eigen::VectorXd::Zero(m);
+        im.modes.init(im.laws, p, im.positions_of(problem, p, z));
+    }
+    SolveResult r;
+    bool singular = false;
+    const Eigen::VectorXd p_start = p;
+    try {
+        // 1. From the previous step's modes: most steps end here in one pass.
+        r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+        // 2. A transition the passes do not settle: the Tresca fixed point, then the coupled
+        //    Coulomb problem from its modes; if that polish fails, the settled fixed point
+        //    (Coulomb to within kAccept x tolerance) is taken and flagged, as in the dense solver.
+        if (!r.converged) {
+            const bool settled = im.tresca_fixed_point(problem.b, problem.d, p, z, r);
+            if (!settled) im.modes.init(im.laws, p, im.positions_of(problem, p, z));
+            const Eigen::VectorXd p_tresca = p;
+            r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+            if (!r.converged && settled) {
+                p = p_tresca;
+                im.s = im.positions_of(problem, p, z);
+                r.converged = true;
+                r.fell_back = true;
+            }
+        }
+    } catch (const SingularModes&) {
+        singular = true;  // a set of modes with dependent held rows: leave it to the dense solver
+        im.lu_key.clear();
+    }
+    if (!r.converged) {
+        // 3. Last resort for problems small enough: the dense problem and the dense exact
+        //    solver (Tresca fixed point, Gauss-Seidel). O(m^2) memory; reported.
+        if (m > kDenseFallbackMaxRows) {
+            p = p_start;
+            r.message = std::string("sparse path: the active-set passes ") +
+                        (singular ? "met a singular set of modes" : "and the Tresca fixed point did not settle") +
+                        "; the dense fallback is not tried for " + std::to_string(m) + " > " +
+                        std::to_string(kDenseFallbackMaxRows) + " contact rows";
+            im.s = im.positions_of(problem, p, z);
+            r.residual_m = error_vector(im.laws, p, im.s).norm();
+            return r;
+        }
+        const ContactProblem dense = problem.to_dense();
+        SolveResult d = make_solver(im.options)->solve(dense, p);
+        r.iterations += d.iterations;
+        r.factorizations += d.factorizations;
+        r.fell_back = true;
+        r.converged = d.converged;
+        if (!d.converged)
+            r.message = std::string("sparse path: the active-set passes ") +
+                        (singular ? "met a singular set of modes" : "did not settle") +
+                        " and the dense fallback failed: " + d.message;
+        im.s = im.positions_of(problem, p, z);
+        im.modes.init(im.laws, p, im.s);
+    }
+    r.residual_m = error_vector(im.laws, p, im.s).norm();
+    r.natural_residual_m = detail::natural_map_diag(im.laws, im.diag, p, im.s).norm();
+    if (r.converged && !(r.residual_m < im.options.tolerance_m)) {
+        r.converged = false;
+        r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +
+                    " m above the tolerance " + format_value(im.options.tolerance_m) + " m (natural-map residual " +
+                    format_value(r.natural_residual_m) + " m)";
+    }
+    return r;
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,213 @@
+// The sparse contact path (SparseContactProblem on the reduced stiffness) against
+// the dense one (W = C' + (gamma/k) c c^T): both pose the same problem (simulation.hpp
+// derives the rigid body's spring k_R = k (1 - gamma)/gamma), so runs must agree to
+// round-off, step by step, on the paper example's three cases and on a graduated stack.
+#define BOOST_TEST_MODULE sparse_path
+#include <boost/test/unit_test.hpp>
+#include <cmath>
+#include <ostream>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/paper_example.hpp"
+#include "stackbeam/simulation.hpp"
+#include "stackbeam/system.hpp"
+
+namespace tt = boost::test_tools;
+using namespace stackbeam;
+
+namespace stackbeam {
+std::ostream& operator<<(std::ostream& os, ContactPath p) { return os << to_string(p); }
+}  // namespace stackbeam
+
+namespace {
+
+// Agreement tolerance. Both paths solve the same linear system per set of modes, one
+// by a dense LU of W_SS (cond(W) ~ 1e5 on the paper example), the other by a scaled,
+// refined sparse LU of the saddle-point system, and they reach the same modes at every
+// step, so the forces and w differ only by the round-off of the two solves, amplified
+// by cond(W): about 1e-16 x 1e5 = 1e-11 relative per step; the recursion
+// w -> w_free -> p is a (damped) oscillator, so it does not grow over the run. Observed:
+// at most 6e-11 (forces, friction case) relative to the largest value over the run.
+// 1e-9 keeps a margin of about 15 and still catches any real discrepancy (a wrong
+// rigid-body spring k_R, or a different mode at one step, gives >= 1e-6).
+constexpr double kRel = 1e-9;
+
+struct Run {
+    std::vector<StepRecord> records;
+    std::vector<Eigen::VectorXd> forces;
+    bool c_built = false;
+};
+
+Run run(const System& sys, ContactPath path, double dt, int steps, double tol, TauRule rule) {
+    SimulationOptions so;
+    so.tau_rule = rule;
+    so.dt_s = dt;
+    so.t_end_s = dt * steps;
+    so.solver.tolerance_m = tol;
+    so.contact_path = path;
+    ClosedFormStepper st(sys, so);
+    BOOST_TEST(st.contact_path() == path);
+    Run r;
+    r.records.push_back(st.current());
+    r.forces.push_back(st.contact_forces());
+    for (int i = 0; i < steps; ++i) {
+        r.records.push_back(st.step());
+        r.forces.push_back(st.contact_forces());
+    }
+    return r;
+}
+
+double max_abs(const std::vector<StepRecord>& r, double StepRecord::*field) {
+    double m = 0.0;
+    for (const auto& x : r) m = std::max(m, std::abs(x.*field));
+    return m;
+}
+
+/// Runs both paths on `spec` (a fresh System each, so that the sparse one provably
+/// never builds the dense C') and compares them step by step.
+void compare_paths(const ModelSpec& spec, double dt, int steps, double tol, bool compare_states = true,
+                   TauRule rule = TauRule::current) {
+    const System dense_sys(Model::build(spec));
+    const System sparse_sys(Model::build(spec));
+    const Run d = run(dense_sys, ContactPath::dense, dt, steps, tol, rule);
+    const Run s = run(sparse_sys, ContactPath::sparse, dt, steps, tol, rule);
+    BOOST_TEST(!sparse_sys.compliance_held_built());  // the sparse path never forms C'
+    BOOST_TEST_REQUIRE(d.records.size() == s.records.size());
+    const double w_scale = max_abs(d.records, &StepRecord::w_m);
+    const double v_scale = max_abs(d.records, &StepRecord::w_dot_m_per_s);
+    const double e_scale = d.records.front().kinetic_energy_j + d.records.front().strain_energy_j;
+    // force scale: the largest contact force, or the force on the body where the contact
+    // forces are all ~0 (frictionless identical leaves bend alike and press on nothing)
+    double p_scale = max_abs(d.records, &StepRecord::force_on_mass_n);
+    for (const auto& p : d.forces) p_scale = std::max(p_scale, p.lpNorm<Eigen::Infinity>());
+    double dw = 0.0, dv = 0.0, dp = 0.0, du = 0.0, dd = 0.0;
+    int mode_mismatch = 0;
+    for (std::size_t i = 0; i < d.records.size(); ++i) {
+        const StepRecord &a = d.records[i], &b = s.records[i];
+        dw = std::max(dw, std::abs(a.w_m - b.w_m));
+        dv = std::max(dv, std::abs(a.w_dot_m_per_s - b.w_dot_m_per_s));
+        dp = std::max(dp, (d.forces[i] - s.forces[i]).lpNorm<Eigen::Infinity>());
+        du = std::max(du, std::abs(a.strain_energy_j - b.strain_energy_j));
+        dd = std::max(dd, std::abs(a.dissipated_energy_j - b.dissipated_energy_j));
+        if (a.n_stick != b.n_stick || a.n_slip != b.n_slip || a.n_open != b.n_open) ++mode_mismatch;
+    }
+    BOOST_TEST_MESSAGE("max differences: w " << dw / w_scale << ", w_dot " << dv / v_scale << ", p "
+                                             << dp / p_scale << ", strain energy " << du / e_scale
+                                             << ", dissipated " << dd / e_scale << " (relative)");
+    BOOST_CHECK_SMALL(dw / w_scale, kRel);
+    BOOST_CHECK_SMALL(dv / v_scale, kRel);
+    BOOST_CHECK_SMALL(dp / p_scale, kRel);
+    BOOST_CHECK_SMALL(du / e_scale, kRel);
+    BOOST_CHECK_SMALL(dd / e_scale, kRel);
+    if (compare_states) BOOST_TEST(mode_mismatch == 0);  // the same pairs stick, slip and open at every step
+    // the dissipation of the friction runs is not zero, so its comparison has teeth there
+    BOOST_TEST_MESSAGE("dissipated at the end: " << d.records.back().dissipated_energy_j << " J");
+}
+
+// tolerance 1e-10 m: far below the physics (amplitudes ~ 2e-2 m), so the modes are
+// settled well inside their thresholds and both paths see the same transitions.
+constexpr double kTol = 1e-10;
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_the_paper_example_bonded) {
+    compare_paths(paper_example(PaperCase::bonded), 1e-3, 300, kTol);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_the_paper_example_friction) {
+    // 300 steps = 0.3 s: more than one period with stick-slip transitions at the clamps
+    compare_paths(paper_example(PaperCase::friction), 1e-3, 300, kTol);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_with_the_previous_step_friction_limit) {
+    // the paper's fallback rule: the slip forces come from the previous step's tau, so the
+    // sparse path's cached constant solve changes every step
+    compare_paths(paper_example(PaperCase::friction), 1e-3, 200, kTol, true, TauRule::previous_step);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_the_paper_example_frictionless) {
+    // The identical frictionless leaves bend alike: every contact force is zero up to
+    // round-off (~1e-12 N), so whether a pair counts as open or closed is the sign of
+    // round-off on either path; the states are not compared, the forces are (to the
+    // force on the body as scale).
+    compare_paths(paper_example(PaperCase::frictionless), 1e-3, 300, kTol, false);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_the_full_model) {
+    // full model: the seat rotates (theta_R) and ties the leaves axially; 200 steps
+    PaperExampleOptions o;
+    o.symmetry = Symmetry::full;
+    compare_paths(paper_example(PaperCase::friction, o), 1e-3, 200, kTol);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_graduated_stack) {
+    // As in test_graduated.cpp: a long pinned leaf over a shorter free one, mu = 0.3,
+    // two clamps with 200 N; plus an initial displacement so that the held initial
+    // contact state (R held at w(0)) is exercised on both paths.
+    constexpr double L = 0.5, b = 0.05, h = 0.005, E = 2e10, short_len = 0.25;
+    ModelSpec s;
+    s.leaves.push_back({L, 0.0, h, b, E, 0.0, SupportKind::pinned, SupportKind::pinned});
+    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, SupportKind::free, SupportKind::free});
+    s.interfaces.push_back({InterfaceLaw::coulomb, 0.3, 0.0});
+    s.clamps = {{0.15, 200.0}, {0.35, 200.0}};
+    s.rigid_body.mass_kg = 20.0;
+    s.rigid_body.x_m = 0.5 * L;
+    s.rigid_body.initial_velocity_m_per_s = 1.0;
+    s.rigid_body.initial_displacement_m = -2e-3;
+    s.mesh.element_length_m = 0.5 * L / 20;
+    s.symmetry = Symmetry::half;
+    compare_paths(s, 5e-4, 400, kTol);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_problem_is_the_dense_problem) {
+    // The stepper's sparse problem, condensed (to_dense), is the dense path's W and q:
+    // the k_R derivation in simulation.hpp, checked on one step. W ~ 1e-5 m/N; the two
+    // are computed by different sequences of solves: 1e-9 relative.
+    const System sys(Model::build(paper_example(PaperCase::friction)));
+    SimulationOptions so;
+    so.solver.tolerance_m = kTol;
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper sp(sys, so);
+    so.contact_path = ContactPath::dense;
+    ClosedFormStepper de(sys, so);
+    for (int i = 0; i < 5; ++i) {
+        sp.step();
+        de.step();
+    }
+    const ContactProblem c = sp.last_sparse_problem().to_dense();
+    const ContactProblem& ref = de.last_problem();
+    BOOST_TEST((c.W - ref.W).norm() / ref.W.norm() < 1e-9);
+    BOOST_TEST((c.q - ref.q).norm() / ref.q.norm() < 1e-9);
+    BOOST_TEST(sp.last_problem().W.size() == 0);  // the sparse stepper holds no dense W
+}
+
+BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
+    const System small(Model::build(paper_example(PaperCase::friction)));
+    SimulationOptions so;
+    BOOST_TEST(so.contact_path == ContactPath::automatic);
+    BOOST_TEST(small.num_components() < kSparsePathMinComponents);
+    BOOST_TEST(choose_contact_path(small, so) == ContactPath::dense);
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 300;  // 3 leaves: 2 interfaces x ~300 nodes x 2 rows > 1000
+    const System large(Model::build(paper_example(PaperCase::friction, o)));
+    BOOST_TEST(large.num_components() >= kSparsePathMinComponents);
+    BOOST_TEST(choose_contact_path(large, so) == ContactPath::sparse);
+    BOOST_TEST(!large.compliance_held_built());  // the constructor no longer builds C'
+    so.solver.kind = SolverKind::accelerated;    // only the exact solver has a sparse form
+    BOOST_TEST(choose_contact_path(large, so) == ContactPath::dense);
+    so.contact_path = ContactPath::sparse;
+    BOOST_CHECK_THROW(so.validate(), InputError);
+    BOOST_CHECK_THROW(SparseContactSolver(so.solver), InputError);
+
+    BOOST_TEST(parse_contact_path("auto", "--contact-path") == ContactPath::automatic);
+    BOOST_TEST(parse_contact_path("sparse", "--contact-path") == ContactPath::sparse);
+    try {
+        parse_contact_path("banded", "--contact-path");
+        BOOST_FAIL("no error for an unknown contact path");
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        BOOST_TEST(e.field() == "--contact-path");
+        BOOST_TEST(msg.find("'banded'") != std::string::npos);
+        BOOST_TEST(msg.find("auto, dense, sparse") != std::string::npos);
+    }
+}
