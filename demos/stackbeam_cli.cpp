@@ -29,6 +29,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -36,6 +37,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
+#include "stackbeam/scenario.hpp"
 #include "stackbeam/simulation.hpp"
 #include "stackbeam/system.hpp"
 
@@ -84,6 +86,7 @@ int parse_count(const std::string& option, const std::string& text) {
 /// Text of the options of `simulate`, as given (defaults as documented).
 struct SimulateArgs {
     std::string case_name;
+    std::string scenario;
     std::string mode = "closed-form";
     std::string t_end = "0.6";
     std::string dt = "1e-3";
@@ -94,35 +97,68 @@ struct SimulateArgs {
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
     std::string out;
+    std::set<std::string> given;  ///< the options given on the command line
 };
+
+/// Sets the integrator options from the command line: all of them (with their
+/// defaults) for --case, only those given explicitly over a scenario's values.
+void apply_simulation_options(const SimulateArgs& a, bool only_given, stackbeam::SimulationOptions& options) {
+    auto use = [&](const char* option) { return !only_given || a.given.count(option) > 0; };
+    if (use("--mode")) options.mode = stackbeam::parse_mode(a.mode, "--mode");
+    if (use("--dt")) options.dt_s = parse_positive("--dt", a.dt, "s");
+    if (use("--t-end")) options.t_end_s = parse_positive("--t-end", a.t_end, "s");
+    if (use("--solver")) options.solver.kind = stackbeam::parse_solver_kind(a.solver, "--solver");
+    if (use("--tol")) options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
+    if (use("--alpha-fraction")) {
+        options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
+        if (options.solver.alpha_fraction >= 1.0)
+            throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
+                                "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
+    }
+    if (use("--max-iterations")) options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
+}
 
 int run_simulate(const SimulateArgs& a) {
     // --- validate every argument before any work ---------------------------------
-    const stackbeam::PaperCase pcase = stackbeam::parse_paper_case(a.case_name, "--case");
     stackbeam::SimulationOptions options;
-    options.mode = stackbeam::parse_mode(a.mode, "--mode");
-    options.dt_s = parse_positive("--dt", a.dt, "s");
-    options.t_end_s = parse_positive("--t-end", a.t_end, "s");
-    options.solver.kind = stackbeam::parse_solver_kind(a.solver, "--solver");
-    options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
-    options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
-    if (options.solver.alpha_fraction >= 1.0)
-        throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
-                            "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
-    options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
-    stackbeam::PaperExampleOptions example;
-    example.elements_per_half_leaf = parse_count("--elements", a.elements);
-    example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
-    if (a.out.empty()) throw ArgumentError("--out: an output file name is required");
+    stackbeam::ModelSpec spec;
+    std::string out = a.out;
+    std::string setup;  // first line of the summary
+    if (!a.scenario.empty()) {
+        // A scenario file; options given on the command line override its values.
+        const stackbeam::Scenario scenario = stackbeam::load_scenario(a.scenario);
+        spec = scenario.model;
+        options = scenario.simulation;
+        apply_simulation_options(a, true, options);
+        if (out.empty()) out = scenario.outputs.csv_path;
+        if (out.empty())
+            throw ArgumentError("--out: an output file name is required (none given, and " + a.scenario +
+                                " has no outputs.csv_path)");
+        if (!scenario.outputs.events_path.empty())
+            throw stackbeam::InputError("outputs.events_path", "is given (" + scenario.outputs.events_path +
+                                                                   ") but this build of stackbeam writes no event log");
+        setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
+    } else {
+        if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
+        const stackbeam::PaperCase pcase = stackbeam::parse_paper_case(a.case_name, "--case");
+        apply_simulation_options(a, false, options);
+        stackbeam::PaperExampleOptions example;
+        example.elements_per_half_leaf = parse_count("--elements", a.elements);
+        example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
+        if (out.empty()) throw ArgumentError("--out: an output file name is required");
+        spec = stackbeam::paper_example(pcase, example);
+        setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
+                " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+    }
     options.validate();
 
     // --- build ----------------------------------------------------------------------
     const auto t0 = std::chrono::steady_clock::now();
-    const stackbeam::Model model = stackbeam::Model::build(stackbeam::paper_example(pcase, example));
+    const stackbeam::Model model = stackbeam::Model::build(spec);
     const stackbeam::System system(model);
 
     // --- run, streaming rows to FILE.partial ----------------------------------------
-    const std::string partial = a.out + ".partial";
+    const std::string partial = out + ".partial";
     std::ofstream csv(partial, std::ios::out | std::ios::trunc);
     if (!csv) throw ArgumentError("--out: cannot open '" + partial + "' for writing");
     stackbeam::write_csv_header(csv);
@@ -141,23 +177,21 @@ int run_simulate(const SimulateArgs& a) {
         });
     } catch (...) {
         csv.flush();
-        std::cerr << "stackbeam: note: " << a.out << " was not written; the rows up to the failure are in "
+        std::cerr << "stackbeam: note: " << out << " was not written; the rows up to the failure are in "
                   << partial << "\n";
         throw;
     }
     csv.flush();
     csv.close();
     if (csv.fail()) throw std::runtime_error("writing '" + partial + "' failed");
-    if (std::rename(partial.c_str(), a.out.c_str()) != 0)
-        throw std::runtime_error("cannot rename '" + partial + "' to '" + a.out + "'");
+    if (std::rename(partial.c_str(), out.c_str()) != 0)
+        throw std::runtime_error("cannot rename '" + partial + "' to '" + out + "'");
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // --- summary ----------------------------------------------------------------------
     const double e0 = 0.5 * model.spec().rigid_body.mass_kg * std::pow(model.spec().rigid_body.initial_velocity_m_per_s, 2);
-    std::printf("case %s, mode %s, solver %s, %d elements per half leaf (%s model), dt %g s, t_end %g s\n",
-                stackbeam::to_string(pcase), stackbeam::to_string(options.mode),
-                stackbeam::to_string(options.solver.kind), example.elements_per_half_leaf,
-                a.full_model ? "full" : "half", options.dt_s, options.t_end_s);
+    std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", setup.c_str(), stackbeam::to_string(options.mode),
+                stackbeam::to_string(options.solver.kind), options.dt_s, options.t_end_s);
     std::printf("steps                      %ld\n", steps);
     std::printf("contact iterations         total %ld, max per step %d, mean per step %.2f\n", total_iterations,
                 max_iterations, steps > 0 ? static_cast<double>(total_iterations) / steps : 0.0);
@@ -166,7 +200,7 @@ int run_simulate(const SimulateArgs& a) {
     std::printf("energy balance error       %.3e J (initial energy %.6g J, dissipated %.6g J)\n",
                 last.energy_balance_error_j, e0, last.dissipated_energy_j);
     std::printf("wall time                  %.3f s\n", wall_s);
-    std::printf("output                     %s\n", a.out.c_str());
+    std::printf("output                     %s\n", out.c_str());
     return exit_ok;
 }
 
@@ -197,12 +231,17 @@ int main(int argc, char** argv) {
 
     SimulateArgs a;
     CLI::App* sim = app.add_subcommand("simulate", "Simulate the paper example and write one CSV row per time step");
-    sim->add_option("--case", a.case_name, "bonded | friction | frictionless")->type_name("CASE")->required();
+    CLI::Option* case_opt = sim->add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
+    CLI::Option* scenario_opt =
+        sim->add_option("--scenario", a.scenario,
+                        "a scenario file (TOML, scenarios/README.md) instead of --case; options given here override its values")
+            ->type_name("FILE.toml")
+            ->excludes(case_opt);
     sim->add_option("--mode", a.mode, "time stepping: closed-form (the paper's exact step)")->type_name("MODE")->capture_default_str();
     sim->add_option("--t-end", a.t_end, "end time [s]")->type_name("S")->capture_default_str();
     sim->add_option("--dt", a.dt, "time step [s]")->type_name("S")->capture_default_str();
-    sim->add_option("--elements", a.elements, "elements per half leaf")->type_name("N")->capture_default_str();
-    sim->add_flag("--full-model", a.full_model, "mesh the whole spring instead of the symmetric half");
+    sim->add_option("--elements", a.elements, "--case: elements per half leaf")->type_name("N")->capture_default_str()->excludes(scenario_opt);
+    sim->add_flag("--full-model", a.full_model, "--case: mesh the whole spring instead of the symmetric half")->excludes(scenario_opt);
     sim->add_option("--tol", a.tol, "contact tolerance on ||v||_2 [m]")->type_name("M")->capture_default_str();
     sim->add_option("--solver", a.solver, "contact solver: exact | accelerated | block-jacobi | paper")->type_name("SOLVER")->capture_default_str();
     sim->add_option("--alpha-fraction", a.alpha_fraction,
@@ -212,9 +251,9 @@ int main(int argc, char** argv) {
     sim->add_option("--max-iterations", a.max_iterations, "iteration limit per step of the iterative solvers")
         ->type_name("N")
         ->capture_default_str();
-    sim->add_option("--out", a.out, "output CSV file (written as FILE.partial, renamed when complete)")
-        ->type_name("FILE.csv")
-        ->required();
+    sim->add_option("--out", a.out,
+                    "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names one")
+        ->type_name("FILE.csv");
 
     try {
         app.parse(argc, argv);
@@ -226,6 +265,9 @@ int main(int argc, char** argv) {
         std::cerr << "stackbeam: error: " << e.what() << "\n(run 'stackbeam --help' or 'stackbeam simulate --help')\n";
         return exit_input;
     }
+
+    for (const CLI::Option* option : sim->get_options())
+        if (option->count() > 0) a.given.insert(option->get_name());
 
     try {
         if (sim->parsed()) return run_simulate(a);

@@ -98,7 +98,7 @@ public:
         for (const auto& k : keys) {
             ctx_.remember(child(path_, k), v.as_table().at(k));
             if (std::find(allowed_.begin(), allowed_.end(), k) == allowed_.end())
-                ctx_.fail(child(path_, k), "unknown key '" + k + "'" + (path_.empty() ? "" : " in [" + path_ + "]") +
+                ctx_.fail(child(path_, k), "unknown key '" + k + "'" + (path_.empty() ? "" : " in " + path_) +
                                                ": allowed keys are " + join(allowed_));
         }
     }
