@@ -14,6 +14,8 @@
 /// ../shared/reference-example.md; signs and units: include/stackbeam/conventions.hpp.
 ///
 ///   stackbeam simulate --case friction --t-end 2 --out friction.csv
+///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: scenarios/README.md;
+///                      integrator options and --out given here override the file's)
 ///
 /// writes one CSV row per time step (columns of stackbeam::step_record_columns()).
 /// The CSV is written to FILE.partial and renamed to FILE only when the whole run
@@ -226,7 +228,8 @@ int main(int argc, char** argv) {
                  "(Lee & Lim 1992, section 5 example: three leaves, four clamps, 20 kg body at 2 m/s)",
                  "stackbeam"};
     app.require_subcommand(1);
-    app.footer("Example:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
+    app.footer("Examples:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
+               "  stackbeam simulate --scenario scenarios/paper_friction.toml\n"
                "Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.");
 
     SimulateArgs a;

@@ -421,10 +421,46 @@ void parse_outputs(const Table& top, ScenarioOutputs& out) {
     out.events_path = path("events_path", "the event log");
 }
 
+/// The TOML parser recurses into nested arrays and inline tables, so a file of
+/// thousands of '[' would overflow the stack: refuse nesting deeper than a scenario
+/// ever needs before parsing. Scans brackets outside strings and comments.
+void check_nesting(const std::string& text, const std::string& source_name) {
+    constexpr int kMaxDepth = 32;
+    int depth = 0, line = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '\n') {
+            ++line;
+        } else if (c == '#') {
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+        } else if (c == '"' || c == '\'') {
+            const bool multi = text.compare(i, 3, std::string(3, c)) == 0;
+            const std::string close = multi ? std::string(3, c) : std::string(1, c);
+            i += close.size();
+            while (i < text.size() && text.compare(i, close.size(), close) != 0) {
+                if (c == '"' && text[i] == '\\') ++i;  // an escape in a basic string
+                else if (text[i] == '\n') {
+                    ++line;
+                    if (!multi) break;  // an unterminated string: the parser reports it
+                }
+                ++i;
+            }
+            i += close.size() - 1;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxDepth)
+                throw InputError(source_name, "TOML syntax error: arrays or tables nested deeper than " +
+                                                  std::to_string(kMaxDepth) + " levels at line " + std::to_string(line));
+        } else if (c == ']' || c == '}') {
+            depth = std::max(0, depth - 1);
+        }
+    }
+}
+
 }  // namespace
 
 Scenario parse_scenario(const std::string& text, const std::string& source_name) {
     Context ctx(source_name);
+    check_nesting(text, source_name);
     toml::value root;
     try {
         std::istringstream in(text);

@@ -256,4 +256,13 @@ BOOST_AUTO_TEST_CASE(malformed_and_unreadable) {
     r = rejection(kGood + "\n[mesh]\nelement_length_m = 0.1\n");  // a table defined twice
     BOOST_TEST(r.first == "test.toml");
     BOOST_CHECK_THROW(load_scenario(scenario_path("no_such_file.toml")), InputError);
+
+    const std::string deep = std::string(40, '[') + std::string(40, ']');
+    r = rejection("a = " + deep + "\n" + kGood);  // refused before the parser recurses
+    BOOST_TEST(r.first == "test.toml");
+    BOOST_TEST(contains(r.second, "nested deeper than 32 levels at line 1"));
+    // brackets in strings and comments do not count
+    const std::string text = "description = \"" + deep + "\"  # " + deep + "\n" + "# '''\"\"\" " + deep + "\n" + kGood;
+    BOOST_TEST(rejection(text).first == "accepted");
+    BOOST_TEST(parse_scenario(text, "t").description == deep);
 }
