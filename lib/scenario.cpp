@@ -112,7 +112,7 @@ public:
         ctx_.fail(child(path_, key), "required key is missing: " + what);
     }
 
-    /// A number (integer or float) in `unit`; required unless a default is given.
+    /// A number (an integer or a float); required unless a default is given.
     double number(const std::string& key, const std::string& what, const double* fallback = nullptr) const {
         if (!has(key)) {
             if (fallback) return *fallback;
@@ -127,7 +127,7 @@ public:
         return number(key, what, &fallback);
     }
 
-    /// An integer that fits an int (or a long with `as_long`).
+    /// An integer in [lo, hi]; required unless a default is given.
     long long integer(const std::string& key, const std::string& what, long long lo, long long hi,
                       const long long* fallback = nullptr) const {
         if (!has(key)) {
@@ -162,7 +162,7 @@ public:
         return v.as_boolean();
     }
 
-    /// A sub-table, or nullptr-like (has() false) when absent and not required.
+    /// A required sub-table (check has() first for an optional one).
     Table table(const std::string& key, std::vector<std::string> allowed) const {
         if (!has(key)) missing(key, "a table [" + child(path_, key) + "] with keys " + join(allowed));
         return Table(ctx_, at(key), child(path_, key), std::move(allowed));
