@@ -15,6 +15,8 @@
 ///
 ///   stackbeam simulate --case friction --t-end 2 --out friction.csv
 ///   stackbeam simulate --case friction --mode cvode --rtol 1e-8 --events events.csv --out friction.csv
+///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: scenarios/README.md;
+///                      integrator options and --out given here override the file's)
 ///
 /// writes one CSV row per time step (closed-form) or output time (cvode, every --dt),
 /// columns of stackbeam::step_record_columns(); --events writes the cvode event log.
@@ -31,6 +33,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -39,6 +42,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
+#include "stackbeam/scenario.hpp"
 #include "stackbeam/simulation.hpp"
 #include "stackbeam/system.hpp"
 
@@ -87,6 +91,7 @@ int parse_count(const std::string& option, const std::string& text) {
 /// Text of the options of `simulate`, as given (defaults as documented).
 struct SimulateArgs {
     std::string case_name;
+    std::string scenario;
     std::string mode = "closed-form";
     std::string t_end = "0.6";
     std::string dt = "1e-3";
@@ -103,46 +108,80 @@ struct SimulateArgs {
     std::string max_iterations = "200000";
     std::string contact_path = "auto";
     std::string out;
+    std::set<std::string> given;  ///< the options given on the command line
 };
+
+/// Sets the integrator options from the command line: all of them (with their
+/// defaults) for --case, only those given explicitly over a scenario's values.
+void apply_simulation_options(const SimulateArgs& a, bool only_given, stackbeam::SimulationOptions& options) {
+    auto use = [&](const char* option) { return !only_given || a.given.count(option) > 0; };
+    if (use("--mode")) options.mode = stackbeam::parse_mode(a.mode, "--mode");
+    if (use("--dt")) options.dt_s = parse_positive("--dt", a.dt, "s");
+    if (use("--t-end")) options.t_end_s = parse_positive("--t-end", a.t_end, "s");
+    // cvode: by default the paper's projected iteration (eq. 17, E = per-pair block inverse) checks each step
+    if (use("--solver"))
+        options.solver.kind = stackbeam::parse_solver_kind(
+            a.solver.empty() ? (options.mode == stackbeam::Mode::cvode ? "accelerated" : "exact") : a.solver, "--solver");
+    if (use("--rtol")) options.cvode.rtol = parse_positive("--rtol", a.rtol, "-");
+    if (use("--atol")) options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
+    if (use("--max-step") && !a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
+    if (use("--max-steps")) options.cvode.max_steps = parse_count("--max-steps", a.max_steps);
+    if (use("--contact-path")) options.contact_path = stackbeam::parse_contact_path(a.contact_path, "--contact-path");
+    if (use("--tol")) options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
+    if (use("--alpha-fraction")) {
+        options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
+        if (options.solver.alpha_fraction >= 1.0)
+            throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
+                                "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
+    }
+    if (use("--max-iterations")) options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
+}
 
 int run_simulate(const SimulateArgs& a) {
     // --- validate every argument before any work ---------------------------------
-    const stackbeam::PaperCase pcase = stackbeam::parse_paper_case(a.case_name, "--case");
     stackbeam::SimulationOptions options;
-    options.mode = stackbeam::parse_mode(a.mode, "--mode");
-    options.dt_s = parse_positive("--dt", a.dt, "s");
-    options.t_end_s = parse_positive("--t-end", a.t_end, "s");
+    stackbeam::ModelSpec spec;
+    std::string out = a.out;
+    std::string events = a.events;
+    std::string setup;  // first line of the summary
+    if (!a.scenario.empty()) {
+        // A scenario file; options given on the command line override its values.
+        const stackbeam::Scenario scenario = stackbeam::load_scenario(a.scenario);
+        spec = scenario.model;
+        options = scenario.simulation;
+        apply_simulation_options(a, true, options);
+        if (out.empty()) out = scenario.outputs.csv_path;
+        if (out.empty())
+            throw ArgumentError("--out: an output file name is required (none given, and " + a.scenario +
+                                " has no outputs.csv_path)");
+        if (events.empty()) events = scenario.outputs.events_path;
+        setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
+    } else {
+        if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
+        const stackbeam::PaperCase pcase = stackbeam::parse_paper_case(a.case_name, "--case");
+        apply_simulation_options(a, false, options);
+        stackbeam::PaperExampleOptions example;
+        example.elements_per_half_leaf = parse_count("--elements", a.elements);
+        example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
+        if (out.empty()) throw ArgumentError("--out: an output file name is required");
+        spec = stackbeam::paper_example(pcase, example);
+        setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
+                " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+    }
     const bool cvode = options.mode == stackbeam::Mode::cvode;
-    // cvode: the paper's projected iteration (eq. 17, E = per-pair block inverse) checks each step
-    options.solver.kind = stackbeam::parse_solver_kind(a.solver.empty() ? (cvode ? "accelerated" : "exact") : a.solver,
-                                                       "--solver");
-    options.cvode.rtol = parse_positive("--rtol", a.rtol, "-");
-    options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
-    if (!a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
-    options.cvode.max_steps = parse_count("--max-steps", a.max_steps);
-    if (!cvode && !a.events.empty())
-        throw ArgumentError("--events: the event log exists in mode cvode only (given --mode " + a.mode + ")");
-    options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
-    options.solver.alpha_fraction = parse_positive("--alpha-fraction", a.alpha_fraction, "-");
-    if (options.solver.alpha_fraction >= 1.0)
-        throw ArgumentError("--alpha-fraction: value '" + a.alpha_fraction +
-                            "' is not allowed: must be a number in (0, 1), a fraction of the stability bound");
-    options.solver.max_iterations = parse_count("--max-iterations", a.max_iterations);
-    options.contact_path = stackbeam::parse_contact_path(a.contact_path, "--contact-path");
-    stackbeam::PaperExampleOptions example;
-    example.elements_per_half_leaf = parse_count("--elements", a.elements);
-    example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
-    if (a.out.empty()) throw ArgumentError("--out: an output file name is required");
+    if (!cvode && !events.empty())
+        throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
+                            std::string(stackbeam::to_string(options.mode)) + ")");
     options.validate();
 
     // --- build ----------------------------------------------------------------------
     const auto t0 = std::chrono::steady_clock::now();
-    const stackbeam::Model model = stackbeam::Model::build(stackbeam::paper_example(pcase, example));
+    const stackbeam::Model model = stackbeam::Model::build(spec);
     const stackbeam::System system(model);
     const stackbeam::ContactPath path = stackbeam::choose_contact_path(system, options);
 
     // --- run, streaming rows to FILE.partial ----------------------------------------
-    const std::string partial = a.out + ".partial";
+    const std::string partial = out + ".partial";
     std::ofstream csv(partial, std::ios::out | std::ios::trunc);
     if (!csv) throw ArgumentError("--out: cannot open '" + partial + "' for writing");
     stackbeam::write_csv_header(csv);
@@ -162,36 +201,31 @@ int run_simulate(const SimulateArgs& a) {
         }, &report);
     } catch (...) {
         csv.flush();
-        std::cerr << "stackbeam: note: " << a.out << " was not written; the rows up to the failure are in "
+        std::cerr << "stackbeam: note: " << out << " was not written; the rows up to the failure are in "
                   << partial << "\n";
         throw;
     }
     csv.flush();
     csv.close();
     if (csv.fail()) throw std::runtime_error("writing '" + partial + "' failed");
-    if (!a.events.empty()) {
-        const std::string events_partial = a.events + ".partial";
+    if (!events.empty()) {
+        const std::string events_partial = events + ".partial";
         std::ofstream ev(events_partial, std::ios::out | std::ios::trunc);
         if (!ev) throw ArgumentError("--events: cannot open '" + events_partial + "' for writing");
         stackbeam::write_events_csv(ev, report.events);
         ev.close();
         if (ev.fail()) throw std::runtime_error("writing '" + events_partial + "' failed");
-        if (std::rename(events_partial.c_str(), a.events.c_str()) != 0)
-            throw std::runtime_error("cannot rename '" + events_partial + "' to '" + a.events + "'");
+        if (std::rename(events_partial.c_str(), events.c_str()) != 0)
+            throw std::runtime_error("cannot rename '" + events_partial + "' to '" + events + "'");
     }
-    if (std::rename(partial.c_str(), a.out.c_str()) != 0)
-        throw std::runtime_error("cannot rename '" + partial + "' to '" + a.out + "'");
+    if (std::rename(partial.c_str(), out.c_str()) != 0)
+        throw std::runtime_error("cannot rename '" + partial + "' to '" + out + "'");
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // --- summary ----------------------------------------------------------------------
     const double e0 = 0.5 * model.spec().rigid_body.mass_kg * std::pow(model.spec().rigid_body.initial_velocity_m_per_s, 2);
-    std::printf("case %s, mode %s, solver %s, %d elements per half leaf (%s model), dt %g s, t_end %g s\n",
-                stackbeam::to_string(pcase), stackbeam::to_string(options.mode),
-                stackbeam::to_string(options.solver.kind), example.elements_per_half_leaf,
-                a.full_model ? "full" : "half", options.dt_s, options.t_end_s);
-    if (!cvode)
-        std::printf("contact path               %s (%d contact components)\n", stackbeam::to_string(path),
-                    system.num_components());
+    std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", setup.c_str(), stackbeam::to_string(options.mode),
+                stackbeam::to_string(options.solver.kind), options.dt_s, options.t_end_s);
     if (cvode) {
         const auto& cs = report.cvode;
         std::printf("cvode                      rtol %g, atol %g m; %ld steps, %ld RHS evaluations, %ld root evaluations\n",
@@ -201,6 +235,8 @@ int run_simulate(const SimulateArgs& a) {
                     cs.events, cs.missed_events, report.events.size(), cs.restarts, cs.mode_factorizations);
         std::printf("outputs                    %ld (every %g s)\n", steps, options.dt_s);
     } else {
+        std::printf("contact path               %s (%d contact components)\n", stackbeam::to_string(path),
+                    system.num_components());
         std::printf("steps                      %ld\n", steps);
     }
     std::printf("contact iterations         total %ld, max per step %d, mean per step %.2f\n", total_iterations,
@@ -210,8 +246,8 @@ int run_simulate(const SimulateArgs& a) {
     std::printf("energy balance error       %.3e J (initial energy %.6g J, dissipated %.6g J)\n",
                 last.energy_balance_error_j, e0, last.dissipated_energy_j);
     std::printf("wall time                  %.3f s\n", wall_s);
-    std::printf("output                     %s\n", a.out.c_str());
-    if (!a.events.empty()) std::printf("event log                  %s\n", a.events.c_str());
+    std::printf("output                     %s\n", out.c_str());
+    if (!events.empty()) std::printf("event log                  %s\n", events.c_str());
     return exit_ok;
 }
 
@@ -242,12 +278,18 @@ int main(int argc, char** argv) {
                  "(Lee & Lim 1992, section 5 example: three leaves, four clamps, 20 kg body at 2 m/s)",
                  "stackbeam"};
     app.require_subcommand(1);
-    app.footer("Example:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
+    app.footer("Examples:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
+               "  stackbeam simulate --scenario scenarios/paper_friction.toml\n"
                "Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.");
 
     SimulateArgs a;
     CLI::App* sim = app.add_subcommand("simulate", "Simulate the paper example and write one CSV row per time step");
-    sim->add_option("--case", a.case_name, "bonded | friction | frictionless")->type_name("CASE")->required();
+    CLI::Option* case_opt = sim->add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
+    CLI::Option* scenario_opt =
+        sim->add_option("--scenario", a.scenario,
+                        "a scenario file (TOML, scenarios/README.md) instead of --case; options given here override its values")
+            ->type_name("FILE.toml")
+            ->excludes(case_opt);
     sim->add_option("--mode", a.mode,
                     "time stepping: closed-form (the paper's exact step, fixed dt) | cvode (SUNDIALS CVODE, "
                     "root-finding on every stick-slip and open-close transition)")
@@ -261,8 +303,8 @@ int main(int argc, char** argv) {
     sim->add_option("--max-steps", a.max_steps, "cvode: limit on CVODE's steps over the run")->type_name("N")->capture_default_str();
     sim->add_option("--events", a.events, "cvode: write the event log (time, interface, x, pair, transition) to this CSV")
         ->type_name("FILE.csv");
-    sim->add_option("--elements", a.elements, "elements per half leaf")->type_name("N")->capture_default_str();
-    sim->add_flag("--full-model", a.full_model, "mesh the whole spring instead of the symmetric half");
+    sim->add_option("--elements", a.elements, "--case: elements per half leaf")->type_name("N")->capture_default_str()->excludes(scenario_opt);
+    sim->add_flag("--full-model", a.full_model, "--case: mesh the whole spring instead of the symmetric half")->excludes(scenario_opt);
     sim->add_option("--tol", a.tol, "contact tolerance on ||v||_2 [m]")->type_name("M")->capture_default_str();
     sim->add_option("--solver", a.solver,
                     "contact solver: exact | accelerated | block-jacobi | paper (default: exact in closed-form; "
@@ -280,9 +322,9 @@ int main(int argc, char** argv) {
                         " contact components, else sparse) | dense | sparse (exact solver only)")
         ->type_name("PATH")
         ->capture_default_str();
-    sim->add_option("--out", a.out, "output CSV file (written as FILE.partial, renamed when complete)")
-        ->type_name("FILE.csv")
-        ->required();
+    sim->add_option("--out", a.out,
+                    "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names one")
+        ->type_name("FILE.csv");
 
     try {
         app.parse(argc, argv);
@@ -294,6 +336,9 @@ int main(int argc, char** argv) {
         std::cerr << "stackbeam: error: " << e.what() << "\n(run 'stackbeam --help' or 'stackbeam simulate --help')\n";
         return exit_input;
     }
+
+    for (const CLI::Option* option : sim->get_options())
+        if (option->count() > 0) a.given.insert(option->get_name());
 
     try {
         if (sim->parsed()) return run_simulate(a);

@@ -2,7 +2,7 @@
 # packages the project needs, if missing, and configures and builds it in build/.
 
 # The packages every build needs.
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev)
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.
@@ -38,4 +38,15 @@ install_packages() {
 build() {
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
   cmake --build build -j"$(nproc)"
+}
+
+# build_sanitized: a second build in build-asan/ with AddressSanitizer and
+# UndefinedBehaviorSanitizer (every UB report fatal), assertions on (Eigen's index
+# checks too), -O1 -g1 (a third of the compile time of -O2 -g with both
+# sanitizers, line numbers in the reports kept), the library shared (the Release
+# build's is static, so the tests cover both kinds of installed package).
+build_sanitized() {
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
+    -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+  cmake --build build-asan -j"$(nproc)"
 }

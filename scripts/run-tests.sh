@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
-# The tests: installs what is missing (Debian), builds, and runs every test with CTest.
+# The tests: installs what is missing (Debian), builds, and runs every test with CTest,
+# twice: the Release build in build/, then a second build in build-asan/ under
+# AddressSanitizer and UndefinedBehaviorSanitizer (any report fails the test that
+# made it). STACKBEAM_SANITIZERS=0 skips the second (for a quick local run; CI runs both).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
@@ -8,3 +11,12 @@ source scripts/common.sh
 install_packages "${STACKBEAM_BUILD_PACKAGES[@]}"
 build
 ctest --test-dir build --output-on-failure
+
+if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
+  start=$(date +%s)
+  build_sanitized
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1 \
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+    ctest --test-dir build-asan --output-on-failure
+  echo "sanitizer build and tests: $(( $(date +%s) - start )) s"
+fi

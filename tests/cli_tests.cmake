@@ -162,3 +162,30 @@ stackbeam_cli_test(NAME cli_cvode_failure
                    ARGS simulate --case friction --mode cvode --t-end 0.1 --max-step 1e-6 --max-steps 1000
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv
                    EXPECT_RC 3 EXPECT_TEXT "cvode mode" OUT ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv)
+# Scenario files: a good run (options given override the file), the file's output path
+# (relative to the working directory, here the test's: build/tests), and the combinations
+# that are rejected. The bad-input suite of scenario files is bad_input_tests.cmake.
+set(_scenarios ${PROJECT_SOURCE_DIR}/scenarios)
+stackbeam_cli_test(NAME cli_scenario_ok
+                   ARGS simulate --scenario ${_scenarios}/paper_friction.toml --t-end 0.01 --out ${_cli_out_dir}/cli_scenario.csv
+                   EXPECT_RC 0 EXPECT_TEXT "t_end 0.01 s" OUT ${_cli_out_dir}/cli_scenario.csv
+                   HEADER_PREFIX "t,w,w_dot,force_on_mass,probe_friction_force" MIN_LINES 12)
+stackbeam_cli_test(NAME cli_scenario_output_from_file
+                   ARGS simulate --scenario ${_scenarios}/paper_frictionless.toml --t-end 0.01
+                   EXPECT_RC 0 EXPECT_TEXT "output                     paper_frictionless.csv"
+                   OUT ${_cli_out_dir}/paper_frictionless.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_scenario_with_case
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --case bonded --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--case excludes --scenario" OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_scenario_with_elements
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --elements 5 --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "excludes --elements" OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_scenario_bad_override
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --dt nan --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--dt: value 'nan' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_scenario_missing_file
+                   ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_neither_case_nor_scenario
+                   ARGS simulate --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--case or --scenario: one of them is required" OUT ${_cli_out_dir}/cli_x.csv)

@@ -1,0 +1,53 @@
+#pragma once
+/// @file scenario.hpp
+/// Scenario files: a whole run (the stack, the loading, the integrator and the
+/// outputs) described in a TOML file, e.g. scenarios/paper_friction.toml. The
+/// format is documented in scenarios/README.md.
+///
+/// Every key is checked: an unknown key, a wrong type, a missing required field
+/// or a value out of range throws InputError whose field() is the key's path in
+/// the file, e.g. "leaves[2].height_m", and whose message gives the value, what is
+/// allowed and where it is (file:line:column). The parser prints nothing, and the
+/// TOML library it uses is not part of this interface.
+#include <string>
+
+#include "stackbeam/model.hpp"
+#include "stackbeam/simulation.hpp"
+
+namespace stackbeam {
+
+/// How the rigid body is set in motion. Today only initial conditions
+/// (`[loading] kind = "initial-conditions"`), stored in ModelSpec::rigid_body.
+enum class LoadingKind {
+    initial_conditions,  ///< w(0) and dw/dt(0) of the rigid body, no external force
+};
+const char* to_string(LoadingKind kind);
+
+/// Where a run writes its results. Empty: not given in the file. Relative paths
+/// are relative to the working directory (like command-line paths), not to the file.
+struct ScenarioOutputs {
+    std::string csv_path;     ///< `[outputs] csv_path`: the per-step records (CSV)
+    std::string events_path;  ///< `[outputs] events_path`: the event log (mode cvode), optional
+};
+
+/// A parsed, validated scenario.
+struct Scenario {
+    std::string source;        ///< the file name (or the name given to parse_scenario)
+    std::string description;   ///< free text (`description`), may be empty
+    ModelSpec model;           ///< the stack; Model::build(model) succeeds (checked by the parser)
+    LoadingKind loading = LoadingKind::initial_conditions;
+    SimulationOptions simulation;  ///< the integrator; validate() succeeds (checked by the parser)
+    ScenarioOutputs outputs;
+};
+
+/// Parses scenario TOML `text`; `source_name` names it in messages. Builds the
+/// model once to validate it (Model::build) and validates the options
+/// (SimulationOptions::validate), translating their field names into the file's
+/// key paths. Throws InputError on any problem.
+Scenario parse_scenario(const std::string& text, const std::string& source_name);
+
+/// Reads and parses the scenario file at `path`. Throws InputError (field: the
+/// path) if it cannot be read, and as parse_scenario otherwise.
+Scenario load_scenario(const std::string& path);
+
+}  // namespace stackbeam

@@ -1,0 +1,27 @@
+# CTest test public_headers_private_deps: no public header (include/stackbeam/)
+# includes a header of a private dependency, SUNDIALS or toml11. The compile of a
+# user's program would not show such a leak here (the headers are in the system
+# include path), a user without them would see it: so the headers are read.
+#   cmake -DINCLUDE_DIR=<include/stackbeam> -P public_headers_test.cmake
+cmake_minimum_required(VERSION 3.16)
+file(GLOB_RECURSE headers "${INCLUDE_DIR}/*")
+set(leaks "")
+foreach(h IN LISTS headers)
+  file(STRINGS "${h}" includes REGEX "^[ \t]*#[ \t]*include")
+  foreach(line IN LISTS includes)
+    # the dependencies' include directories (<cvode/cvode.h>, <sundials/...>, <toml.hpp>);
+    # the project's own "stackbeam/cvode_stepper.hpp" is not one of them
+    if(line MATCHES "[<\"](sundials|cvode|nvector|sunlinsol|sunmatrix|sunnonlinsol|arkode|ida|kinsol)/" OR
+       line MATCHES "[<\"]toml(11)?[/.]")
+      string(APPEND leaks "  ${h}: ${line}\n")
+    endif()
+  endforeach()
+endforeach()
+list(LENGTH headers n)
+if(n EQUAL 0)
+  message(FATAL_ERROR "no header in ${INCLUDE_DIR}")
+endif()
+if(NOT leaks STREQUAL "")
+  message(FATAL_ERROR "public headers include private dependencies (SUNDIALS, toml11):\n${leaks}")
+endif()
+message(STATUS "${n} public headers in ${INCLUDE_DIR}, none includes SUNDIALS or toml11")

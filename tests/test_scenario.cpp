@@ -1,0 +1,268 @@
+// Scenario files: the paper example's files reproduce the built-in example (the
+// same ModelSpec field by field, the same records to round-off), and bad input is
+// rejected with the file's key path and location. (The command line's bad-input
+// suite, tests/bad_input/*.toml, is in bad_input_tests.cmake.)
+#define BOOST_TEST_MODULE scenario
+#include <boost/test/unit_test.hpp>
+#include <cmath>
+#include <string>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/paper_example.hpp"
+#include "stackbeam/scenario.hpp"
+#include "stackbeam/simulation.hpp"
+
+namespace tt = boost::test_tools;
+using namespace stackbeam;
+
+#ifndef STACKBEAM_SOURCE_DIR
+#error "STACKBEAM_SOURCE_DIR must be defined"
+#endif
+
+namespace {
+
+std::string scenario_path(const char* name) { return std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/" + name; }
+
+void check_same_spec(const ModelSpec& a, const ModelSpec& b) {
+    BOOST_TEST_REQUIRE(a.leaves.size() == b.leaves.size());
+    for (std::size_t i = 0; i < a.leaves.size(); ++i) {
+        BOOST_TEST_CONTEXT("leaves[" << i << "]") {
+            const auto &x = a.leaves[i], &y = b.leaves[i];
+            BOOST_TEST(x.length_m == y.length_m);
+            BOOST_TEST(x.x_start_m == y.x_start_m);
+            BOOST_TEST(x.height_m == y.height_m);
+            BOOST_TEST(x.width_m == y.width_m);
+            BOOST_TEST(x.youngs_modulus_pa == y.youngs_modulus_pa);
+            BOOST_TEST(x.density_kg_per_m3 == y.density_kg_per_m3);
+            BOOST_TEST((x.left_support == y.left_support));
+            BOOST_TEST((x.right_support == y.right_support));
+        }
+    }
+    BOOST_TEST_REQUIRE(a.interfaces.size() == b.interfaces.size());
+    for (std::size_t i = 0; i < a.interfaces.size(); ++i) {
+        BOOST_TEST((a.interfaces[i].law == b.interfaces[i].law));
+        BOOST_TEST(a.interfaces[i].friction_coefficient == b.interfaces[i].friction_coefficient);
+        BOOST_TEST(a.interfaces[i].initial_gap_m == b.interfaces[i].initial_gap_m);
+    }
+    BOOST_TEST_REQUIRE(a.clamps.size() == b.clamps.size());
+    for (std::size_t i = 0; i < a.clamps.size(); ++i) {
+        BOOST_TEST(a.clamps[i].x_m == b.clamps[i].x_m);
+        BOOST_TEST(a.clamps[i].preload_n == b.clamps[i].preload_n);
+    }
+    BOOST_TEST(a.rigid_body.mass_kg == b.rigid_body.mass_kg);
+    BOOST_TEST(a.rigid_body.x_m == b.rigid_body.x_m);
+    BOOST_TEST(a.rigid_body.tied_leaves == b.rigid_body.tied_leaves);
+    BOOST_TEST(a.rigid_body.initial_displacement_m == b.rigid_body.initial_displacement_m);
+    BOOST_TEST(a.rigid_body.initial_velocity_m_per_s == b.rigid_body.initial_velocity_m_per_s);
+    BOOST_TEST(a.mesh.element_length_m == b.mesh.element_length_m);
+    BOOST_TEST((a.symmetry == b.symmetry));
+    BOOST_TEST_REQUIRE(a.probe.has_value() == b.probe.has_value());
+    if (a.probe) {
+        BOOST_TEST(a.probe->interface_index == b.probe->interface_index);
+        BOOST_TEST(a.probe->x_m == b.probe->x_m);
+    }
+}
+
+/// The records of `t_end_s` of closed-form steps from the scenario file and from
+/// the built-in example agree to round-off (relative 1e-12 of each column's scale).
+void check_reproduces(const char* file, PaperCase c, double t_end_s) {
+    Scenario s = load_scenario(scenario_path(file));
+    check_same_spec(s.model, paper_example(c));
+    BOOST_TEST((s.simulation.mode == Mode::closed_form));
+    BOOST_TEST(s.simulation.dt_s == 1e-3);
+    BOOST_TEST(s.simulation.solver.tolerance_m == 2e-6);
+
+    s.simulation.t_end_s = t_end_s;
+    const System from_file(Model::build(s.model));
+    const auto a = simulate(from_file, s.simulation);
+
+    SimulationOptions o;  // the built-in example at the paper's settings (the defaults)
+    o.t_end_s = t_end_s;
+    const System builtin(Model::build(paper_example(c)));
+    const auto b = simulate(builtin, o);
+
+    BOOST_TEST_REQUIRE(a.size() == b.size());
+    BOOST_TEST(a.size() >= 301u);
+    const auto columns = step_record_columns();
+    std::vector<double> scale(columns.size(), 0.0);
+    for (const auto& r : b) {
+        const auto v = step_record_values(r);
+        for (std::size_t j = 0; j < v.size(); ++j) scale[j] = std::max(scale[j], std::abs(v[j]));
+    }
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const auto va = step_record_values(a[i]), vb = step_record_values(b[i]);
+        for (std::size_t j = 0; j < va.size(); ++j) {
+            const double d = std::abs(va[j] - vb[j]) / std::max(scale[j], 1e-300);
+            worst = std::max(worst, d);
+            if (d > 1e-12) BOOST_ERROR("step " << i << " column " << columns[j] << ": " << va[j] << " vs " << vb[j]);
+        }
+    }
+    BOOST_TEST_MESSAGE(file << ": " << a.size() << " records, largest relative difference " << worst);
+}
+
+/// The InputError of parsing `text`: its field and message ("accepted" if none).
+std::pair<std::string, std::string> rejection(const std::string& text) {
+    try {
+        parse_scenario(text, "test.toml");
+    } catch (const InputError& e) {
+        return {e.field(), e.what()};
+    }
+    return {"accepted", ""};
+}
+
+/// A small valid scenario: two cantilever leaves (fixed at x = 0), a clamp, the body at the tip of the longer.
+const std::string kGood = R"(
+[[leaves]]
+length_m = 1.0
+height_m = 0.01
+width_m = 0.05
+youngs_modulus_pa = 2.1e11
+left_support = "fixed"
+
+[[leaves]]
+length_m = 0.6
+height_m = 0.01
+width_m = 0.05
+youngs_modulus_pa = 2.1e11
+left_support = "fixed"
+
+[[interfaces]]
+law = "coulomb"
+friction_coefficient = 0.3
+
+[[clamps]]
+x_m = 0.3
+preload_n = 500
+
+[rigid_body]
+mass_kg = 5
+x_m = 1.0
+
+[loading]
+kind = "initial-conditions"
+initial_velocity_m_per_s = 0.5
+
+[mesh]
+element_length_m = 0.05
+
+[integrator]
+mode = "closed-form"
+dt_s = 1e-3
+t_end_s = 0.05
+)";
+
+/// kGood with `from` replaced by `to` (which must occur).
+std::string edit(const std::string& from, const std::string& to) {
+    std::string s = kGood;
+    const auto pos = s.find(from);
+    BOOST_TEST_REQUIRE(pos != std::string::npos);
+    return s.replace(pos, from.size(), to);
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(paper_bonded_file_reproduces_builtin) { check_reproduces("paper_bonded.toml", PaperCase::bonded, 0.3); }
+BOOST_AUTO_TEST_CASE(paper_frictionless_file_reproduces_builtin) {
+    check_reproduces("paper_frictionless.toml", PaperCase::frictionless, 0.3);
+}
+BOOST_AUTO_TEST_CASE(paper_friction_file_reproduces_builtin) {
+    check_reproduces("paper_friction.toml", PaperCase::friction, 0.3);
+}
+
+BOOST_AUTO_TEST_CASE(paper_files_settings) {
+    const Scenario f = load_scenario(scenario_path("paper_friction.toml"));
+    BOOST_TEST(f.simulation.t_end_s == 2.0);
+    BOOST_TEST(f.outputs.csv_path == "paper_friction.csv");
+    BOOST_TEST(f.outputs.events_path.empty());
+    BOOST_TEST((f.loading == LoadingKind::initial_conditions));
+    BOOST_TEST(!f.description.empty());
+}
+
+BOOST_AUTO_TEST_CASE(good_scenario_defaults_and_run) {
+    const Scenario s = parse_scenario(kGood, "good.toml");
+    BOOST_TEST(s.source == "good.toml");
+    BOOST_TEST(s.model.leaves[0].x_start_m == 0.0);
+    BOOST_TEST(s.model.leaves[1].density_kg_per_m3 == 0.0);
+    BOOST_TEST((s.model.leaves[0].right_support == SupportKind::free));
+    BOOST_TEST((s.model.symmetry == Symmetry::full));
+    BOOST_TEST(s.model.clamps[0].preload_n == 500.0);  // an integer is accepted for a number
+    BOOST_TEST(s.model.rigid_body.initial_displacement_m == 0.0);
+    BOOST_TEST((s.simulation.solver.kind == SolverKind::exact));
+    BOOST_TEST(s.outputs.csv_path.empty());
+    const System sys(Model::build(s.model));
+    const auto r = simulate(sys, s.simulation);
+    BOOST_TEST(r.size() == 51u);
+    BOOST_TEST(std::isfinite(r.back().w_m));
+}
+
+BOOST_AUTO_TEST_CASE(unknown_key_lists_allowed_keys) {
+    const auto [field, what] = rejection(edit("width_m = 0.05\nyoungs_modulus_pa = 2.1e11\nleft_support = \"fixed\"\n\n[[leaves]]",
+                                              "width_m = 0.05\nyoungs_modulus_pa = 2.1e11\nleft_support = \"fixed\"\nwidht_m = 1\n\n[[leaves]]"));
+    BOOST_TEST(field == "leaves[0].widht_m");
+    BOOST_TEST(contains(what, "unknown key 'widht_m'"));
+    BOOST_TEST(contains(what, "allowed keys are length_m, x_start_m, height_m, width_m"));
+    BOOST_TEST(contains(what, "test.toml:8:"));  // file:line:column of the key
+}
+
+BOOST_AUTO_TEST_CASE(wrong_type_missing_and_range) {
+    auto r = rejection(edit("height_m = 0.01\nwidth_m = 0.05\nyoungs_modulus_pa = 2.1e11\nleft_support = \"fixed\"\n\n[[interfaces]]",
+                            "height_m = \"thin\"\nwidth_m = 0.05\nyoungs_modulus_pa = 2.1e11\nleft_support = \"fixed\"\n\n[[interfaces]]"));
+    BOOST_TEST(r.first == "leaves[1].height_m");
+    BOOST_TEST(contains(r.second, "wrong type, a string: must be a number"));
+
+    r = rejection(edit("mass_kg = 5\n", ""));
+    BOOST_TEST(r.first == "rigid_body.mass_kg");
+    BOOST_TEST(contains(r.second, "required key is missing"));
+
+    r = rejection(edit("mass_kg = 5", "mass_kg = -5"));  // range: Model::build, path and location of the file
+    BOOST_TEST(r.first == "rigid_body.mass_kg");
+    BOOST_TEST(contains(r.second, "value -5 is not allowed: must be finite and > 0 [kg]"));
+    BOOST_TEST(contains(r.second, "(test.toml:"));
+
+    r = rejection(edit("mass_kg = 5", "mass_kg = nan"));
+    BOOST_TEST(r.first == "rigid_body.mass_kg");
+    BOOST_TEST(contains(r.second, "value nan is not allowed"));
+
+    r = rejection(edit("initial_velocity_m_per_s = 0.5", "initial_velocity_m_per_s = inf"));
+    BOOST_TEST(r.first == "loading.initial_velocity_m_per_s");  // Model names rigid_body.*: translated
+
+    r = rejection(edit("dt_s = 1e-3", "dt_s = -1e-3"));
+    BOOST_TEST(r.first == "integrator.dt_s");  // SimulationOptions names "dt": translated
+    BOOST_TEST(contains(r.second, "value -0.001 is not allowed"));
+
+    r = rejection(edit("mode = \"closed-form\"", "mode = \"euler\""));
+    BOOST_TEST(r.first == "integrator.mode");
+    BOOST_TEST(contains(r.second, "allowed closed-form"));
+}
+
+BOOST_AUTO_TEST_CASE(interface_laws_and_loading_kind) {
+    auto r = rejection(edit("law = \"coulomb\"", "law = \"bonded\""));  // bonded takes no mu
+    BOOST_TEST(r.first == "interfaces[0].friction_coefficient");
+    r = rejection(edit("law = \"coulomb\"", "law = \"sticky\""));
+    BOOST_TEST(r.first == "interfaces[0].law");
+    BOOST_TEST(contains(r.second, "'coulomb', 'frictionless', 'bonded'"));
+    r = rejection(edit("kind = \"initial-conditions\"", "kind = \"harmonic-force\""));
+    BOOST_TEST(r.first == "loading.kind");
+    BOOST_TEST(contains(r.second, "not supported (yet)"));
+}
+
+BOOST_AUTO_TEST_CASE(malformed_and_unreadable) {
+    auto r = rejection(edit("[mesh]", "[mesh"));
+    BOOST_TEST(r.first == "test.toml");
+    BOOST_TEST(contains(r.second, "TOML syntax error"));
+    r = rejection(kGood + "\n[mesh]\nelement_length_m = 0.1\n");  // a table defined twice
+    BOOST_TEST(r.first == "test.toml");
+    BOOST_CHECK_THROW(load_scenario(scenario_path("no_such_file.toml")), InputError);
+
+    const std::string deep = std::string(40, '[') + std::string(40, ']');
+    r = rejection("a = " + deep + "\n" + kGood);  // refused before the parser recurses
+    BOOST_TEST(r.first == "test.toml");
+    BOOST_TEST(contains(r.second, "nested deeper than 32 levels at line 1"));
+    // brackets in strings and comments do not count
+    const std::string text = "description = \"" + deep + "\"  # " + deep + "\n" + "# '''\"\"\" " + deep + "\n" + kGood;
+    BOOST_TEST(rejection(text).first == "accepted");
+    BOOST_TEST(parse_scenario(text, "t").description == deep);
+}
