@@ -67,6 +67,10 @@ public:
     int num_reduced_dofs() const noexcept { return static_cast<int>(K_red_.rows()); }
     /// Reduced stiffness P^T K P [N/m, N, N m per unit DOF], w last.
     const Eigen::SparseMatrix<double>& stiffness_reduced() const noexcept { return K_red_; }
+    /// Reduced mass P^T M P [kg, kg m^2 per unit DOF], w last: the leaves' consistent
+    /// mass matrices (density from the model; 0 = massless, the paper) plus the rigid
+    /// body's mass on w (the meshed part's share: half on the half model).
+    Eigen::SparseMatrix<double> mass_reduced() const;
     /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
     /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
     Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;
