@@ -199,6 +199,11 @@ int run_simulate(const SimulateArgs& a) {
             max_iterations = std::max(max_iterations, r.contact_iterations);
             last = r;
         }, &report);
+    } catch (const stackbeam::InputError&) {
+        // bad input found when the run starts (e.g. an option the mode cannot use): no rows to keep
+        csv.close();
+        std::remove(partial.c_str());
+        throw;
     } catch (...) {
         csv.flush();
         std::cerr << "stackbeam: note: " << out << " was not written; the rows up to the failure are in "

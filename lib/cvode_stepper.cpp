@@ -620,6 +620,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     : impl_(std::make_unique<Impl>(system, options)) {
     Impl& s = *impl_;
     s.opt.validate();
+    require_massless_leaves(system, Mode::cvode);
     if (s.opt.tau_rule != TauRule::current)
         throw InputError("tau_rule", "mode cvode takes the friction limit from the current normal force "
                                      "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");

@@ -106,9 +106,20 @@ void SimulationOptions::validate() const {
                                              to_string(solver.kind) + "')");
 }
 
+void require_massless_leaves(const System& system, Mode mode) {
+    const auto& leaves = system.model().spec().leaves;
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+        if (leaves[i].density_kg_per_m3 != 0.0)
+            throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
+                             "value " + format_value(leaves[i].density_kg_per_m3) + " is not used by mode " +
+                                 to_string(mode) + ", which treats the leaves as massless (the paper): give 0 "
+                                 "(the leaves' inertia is not integrated in time yet; modal_analysis() uses it)");
+}
+
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
     : system_(system), options_(options) {
     options_.validate();
+    require_massless_leaves(system_, Mode::closed_form);
     path_ = choose_contact_path(system_, options_);
     const int n = system_.num_components();
     const double k = system_.stiffness_n_per_m();

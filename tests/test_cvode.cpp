@@ -273,6 +273,21 @@ BOOST_AUTO_TEST_CASE(bad_options_are_rejected_by_name) {
     o.tau_rule = TauRule::previous_step;
     expect_field(o, "tau_rule");
     BOOST_TEST((parse_mode("cvode", "--mode") == Mode::cvode));
+    // a leaf density > 0 would be ignored by the massless modes: refused by name
+    ModelSpec massive = paper_example(PaperCase::friction);
+    massive.leaves[1].density_kg_per_m3 = 7850.0;
+    const System sm(Model::build(massive));
+    for (Mode m : {Mode::closed_form, Mode::cvode}) {
+        SimulationOptions om;
+        om.mode = m;
+        om.t_end_s = 0.01;
+        try {
+            simulate(sm, om);
+            BOOST_ERROR("no error for a massive leaf in mode " << to_string(m));
+        } catch (const InputError& e) {
+            BOOST_TEST(e.field() == "leaves[1].density_kg_per_m3");
+        }
+    }
     BOOST_CHECK_THROW(parse_mode("rk4", "--mode"), InputError);
 }
 

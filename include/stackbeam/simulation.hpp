@@ -161,6 +161,11 @@ private:
     void fill_record(int iterations, int factorizations);
 };
 
+/// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
+/// with a density > 0 would be silently ignored there: this throws InputError naming
+/// it (leaves[i].density_kg_per_m3) instead. modal.hpp uses the density.
+void require_massless_leaves(const System& system, Mode mode);
+
 struct RunReport;  // cvode_stepper.hpp
 
 /// Runs from t = 0 to options.t_end_s in options.mode; the first record is the
