@@ -91,6 +91,7 @@ struct CvodeStepper::Impl {
     Eigen::VectorXd p_out;
 
     ContactProblem chk_problem, ev_problem;
+    double ev_tolerance = 0.0;  // [m] the event decisions' tolerance on ||v|| (see the constructor)
     std::unique_ptr<ContactSolver> chk_solver, ev_solver;
     std::vector<ContactEvent> events;
     CvodeStats stats;
@@ -276,7 +277,12 @@ struct CvodeStepper::Impl {
 
     /// The contact iteration decides the modes at (t_e, w, w'), with the forces p_cur
     /// there in the old modes (cvode_stepper.hpp). Logs the transitions; refactorises.
-    void decide_modes(double w, double wd, const Eigen::VectorXd& p_cur, const std::string& cause) {
+    /// `triggered` (root returns): the witness slots CVODE found; the old modes with
+    /// those transitions applied are tried first, and kept if they hold on the
+    /// look-ahead problem (the contact iteration's stop test accepts them there);
+    /// otherwise, and without `triggered`, the exact contact solver decides.
+    void decide_modes(double w, double wd, const Eigen::VectorXd& p_cur, const std::string& cause,
+                      const std::vector<int>* triggered = nullptr) {
         // s + d; in a built mode affine in w (O(n)), else (t = 0) from the forces
         const Eigen::VectorXd rel = P.size() == n ? Eigen::VectorXd(hs * w + bs + d) : Eigen::VectorXd(C * p_cur + c * w);
         const double wdd = (c.dot(p_cur) - k * w) / m;
@@ -284,7 +290,8 @@ struct CvodeStepper::Impl {
         double delta = std::numeric_limits<double>::infinity();
         if (wd != 0.0) delta = std::min(delta, target / std::abs(wd));
         if (wdd != 0.0) delta = std::min(delta, std::sqrt(2.0 * target / std::abs(wdd)));
-        const double dw = std::isfinite(delta) ? wd * delta + 0.5 * wdd * delta * delta : 0.0;
+        if (!std::isfinite(delta)) delta = 0.0;
+        const double dw = wd * delta + 0.5 * wdd * delta * delta;
 
         // Incremental problem a look-ahead away: stuck pairs keep their anchors, every
         // other pair is anchored where it is (paper, section 5).
@@ -294,24 +301,78 @@ struct CvodeStepper::Impl {
             if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != T_STICK) d_la[cp.row_t] = rel[cp.row_t];
         }
         ev_problem.q = c * (w + dw) - d_la;
-        Eigen::VectorXd p_la = p_cur;
-        const SolveResult res = ev_solver->solve(ev_problem, p_la);
-        stats.contact_iterations += res.iterations;
-        iters_since += res.iterations;
-        if (!res.converged)
-            throw SolverError("cvode mode: the contact iteration deciding the modes at t = " + format_value(t) +
-                                  " s (" + cause + ") did not converge: " + res.message,
-                              stats.steps, t, res.residual_m);
-        std::vector<signed char> nm, tm;
-        modes_from_solution(p_la, nm, tm);
 
-        // Log, re-anchor the pairs that start to stick, refactorise.
+        // Re-anchors the pairs that start to stick; the modes become (nm, tm).
+        auto enter = [&](const std::vector<signed char>& nm, const std::vector<signed char>& tm) {
+            for (int kk = 0; kk < np; ++kk) {
+                const auto& cp = pairs()[kk];
+                if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == T_STICK && tmode[kk] != T_STICK)
+                    d[cp.row_t] = rel[cp.row_t];
+            }
+            nmode = nm;
+            tmode = tm;
+        };
+
+        std::vector<signed char> nm, tm;
+        bool decided = false;
+        if (triggered != nullptr && n > 0) {
+            nm = nmode;
+            tm = tmode;
+            for (std::size_t i = 0; i < slots.size(); ++i) {
+                if ((*triggered)[i] == 0) continue;
+                const int kk = slots[i].pair;
+                const auto& cp = pairs()[kk];
+                const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
+                if (slots[i].normal && cp.kind == PairKind::coulomb) {
+                    if (nm[kk] == N_CLOSED) {
+                        nm[kk] = N_OPEN;
+                        if (cp.row_t >= 0) tm[kk] = T_FREE;
+                    } else {
+                        nm[kk] = N_CLOSED;
+                        if (cp.row_t >= 0) tm[kk] = friction ? T_STICK : T_FREE;
+                    }
+                } else if (slots[i].normal) {  // clamp released or engaged again
+                    tm[kk] = tm[kk] == T_FREE ? T_STICK : T_FREE;
+                } else if (tm[kk] == T_STICK) {
+                    tm[kk] = p_cur[cp.row_t] > 0.0 ? T_SLIP_POS : T_SLIP_NEG;
+                } else if (tm[kk] == T_SLIP_POS || tm[kk] == T_SLIP_NEG) {
+                    tm[kk] = T_STICK;
+                }
+            }
+            const Eigen::VectorXd d_saved = d;
+            const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+            enter(nm, tm);
+            build_mode();
+            // the stop test of the contact iteration at the look-ahead, and every witness
+            const double wl = w + dw, wdl = wd + wdd * delta;
+            const Eigen::VectorXd pl = forces(wl);
+            const double v = error_vector(ev_problem, pl, hs * wl + bs + d - d_la).norm();
+            std::vector<double> g(slots.size());
+            if (!slots.empty()) witnesses(wl, wdl, g.data());
+            decided = v < ev_tolerance && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+            ++stats.contact_iterations;
+            ++iters_since;
+            d = d_saved;  // restored either way: log() below re-anchors from the old modes
+            nmode = nm_saved;
+            tmode = tm_saved;
+        }
+        if (!decided) {
+            Eigen::VectorXd p_la = p_cur;
+            const SolveResult res = ev_solver->solve(ev_problem, p_la);
+            stats.contact_iterations += res.iterations;
+            iters_since += res.iterations;
+            if (!res.converged)
+                throw SolverError("cvode mode: the contact iteration deciding the modes at t = " + format_value(t) +
+                                      " s (" + cause + ") did not converge: " + res.message,
+                                  stats.steps, t, res.residual_m);
+            modes_from_solution(p_la, nm, tm);
+        }
+
+        // Log the transitions, enter the new modes, refactorise (unless the candidate was).
         for (int kk = 0; kk < np; ++kk) {
             const auto& cp = pairs()[kk];
             if (cp.kind == PairKind::bonded) continue;
             if (nm[kk] == nmode[kk] && tm[kk] == tmode[kk] && cause != "start") continue;
-            if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == T_STICK && tmode[kk] != T_STICK)
-                d[cp.row_t] = rel[cp.row_t];
             ContactEvent e;
             e.t_s = t;
             e.pair = kk;
@@ -325,9 +386,8 @@ struct CvodeStepper::Impl {
             e.w_dot_m_per_s = wd;
             events.push_back(std::move(e));
         }
-        nmode = nm;
-        tmode = tm;
-        build_mode();
+        enter(nm, tm);
+        if (!decided) build_mode();
         const Eigen::VectorXd p_new = forces(w);
         if (n > 0) stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
         reset_check_anchors(w);
@@ -557,7 +617,9 @@ struct CvodeStepper::Impl {
             t = tret;
             note_event_time(tret);
             const Eigen::VectorXd p_cur = forces(w);
-            decide_modes(w, wd, p_cur, "root");
+            std::vector<int> found(slots.size(), 0);
+            check(CVodeGetRootInfo(cv, found.data()), "CVodeGetRootInfo");
+            decide_modes(w, wd, p_cur, "root", &found);
             restart(tret, w, wd, D);
             return true;
         }
@@ -673,6 +735,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     // ||v|| of an exact active-set answer is LU round-off, ~cond(C') 1e-16 L_ref ~ 1e-11 L_ref;
     // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
     ev.tolerance_m = 1e-10 * s.L_ref;
+    s.ev_tolerance = ev.tolerance_m;
     ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
     s.ev_solver = make_solver(ev);
 

@@ -26,10 +26,13 @@
 /// round-off, common between identical leaves) do not chatter. F_ref, L_ref, V_ref:
 /// force, displacement and velocity scales of the run (cvode_stepper.cpp).
 ///
-/// At an event (and at t = 0) the contact iteration decides the new modes: the
-/// exact contact solver on the incremental problem a short look-ahead away
-/// (|dw| = 1e-7 L_ref along w' and w''), with the stuck pairs' anchors kept and
-/// every other pair re-anchored where it is (the paper's section 5 rule). The
+/// At an event (and at t = 0) the contact iteration decides the new modes on the
+/// incremental problem a short look-ahead away (|dw| = 1e-7 L_ref along w' and w''),
+/// with the stuck pairs' anchors kept and every other pair re-anchored where it is
+/// (the paper's section 5 rule): the old modes with the transitions CVODE found
+/// applied are tried first and kept when the contact iteration's stop test
+/// (||v|| < tolerance) and every witness accept them there; otherwise the exact
+/// contact solver solves that problem and its answer gives the modes. The
 /// forces at the event in the new modes must equal those of the old ones (the
 /// jump is recorded in CvodeStats::max_force_jump_n); CVODE is then re-initialised.
 ///
