@@ -15,13 +15,21 @@
 #include <deque>
 #include <limits>
 
+#include "active_set.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
 namespace {
 
-enum NMode : signed char { N_NONE = 0, N_CLOSED = 1, N_OPEN = 2 };
-enum TMode : signed char { T_NONE = 0, T_STICK = 1, T_SLIP_POS = 2, T_SLIP_NEG = 3, T_FREE = 4 };
+// Pair modes: those of the active-set solvers (active_set.hpp), T_NONE for an absent
+// tangential component.
+using detail::CLOSED;
+using detail::FREE;
+using detail::OPEN;
+using detail::SLIP_NEG;
+using detail::SLIP_POS;
+using detail::STICK;
+constexpr signed char N_NONE = detail::NONE, T_NONE = detail::NONE;
 
 /// Every witness is positive by a margin (relative to its scale) while its mode
 /// holds, so that pairs that merely touch (p = s = 0 up to round-off) do not chatter.
@@ -63,7 +71,9 @@ struct CvodeStepper::Impl {
     Eigen::VectorXd d_chk;     // anchors of the per-step check: slip rows at the previous accepted step
     double k = 0, m = 0, f = 1, mass_whole = 0;
     double F_ref = 1, L_ref = 1, V_ref = 1, omega_ref = 1;
-    std::vector<signed char> nmode, tmode;
+    detail::ModeSet modes;                               // the current modes
+    std::vector<signed char>& nmode = modes.nmode;       // per pair: CLOSED, OPEN (N_NONE: no normal row)
+    std::vector<signed char>& tmode = modes.tmode;       // per pair: STICK, SLIP_POS, SLIP_NEG, FREE (T_NONE)
 
     // the current mode set: p(w) = P w + r, s(w) = hs w + bs, m w'' = a1 w + a0,
     // D' = -w' (diss_a w + diss_b)
@@ -123,29 +133,20 @@ struct CvodeStepper::Impl {
     ///     (C'_S: T) p_S = d_S - c_S w - C'_S: e,
     /// an |S| x |S| LU (|S| is small when most pairs are open or slipping).
     void build_mode() {
-        std::vector<int> S;
+        detail::ModeLinearization lin;
+        modes.linearize(chk_problem, lin);
+        const std::vector<int>& S = lin.S;
         std::vector<int> pos(n, -1);
-        for (int kk = 0; kk < np; ++kk) {
-            const auto& cp = pairs()[kk];
-            if (cp.row_n >= 0 && nmode[kk] != N_OPEN) S.push_back(cp.row_n);
-            if (cp.row_t >= 0 && tmode[kk] == T_STICK) S.push_back(cp.row_t);
-        }
         const int ms = static_cast<int>(S.size());
         for (int i = 0; i < ms; ++i) pos[S[i]] = i;
         // p = T p_S + e: T as (row, column, coefficient) triplets
         Eigen::MatrixXd CT = Eigen::MatrixXd::Zero(n, ms);  // C' T, all rows
-        Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+        const Eigen::VectorXd& e = lin.e;
         struct Link { int row, col; double coef; };
         std::vector<Link> T;
         for (int i = 0; i < ms; ++i) T.push_back({S[i], i, 1.0});
-        for (int kk = 0; kk < np; ++kk) {
-            const auto& cp = pairs()[kk];
-            if (cp.row_t < 0 || (tmode[kk] != T_SLIP_POS && tmode[kk] != T_SLIP_NEG)) continue;
-            const double sigma = tmode[kk] == T_SLIP_POS ? 1.0 : -1.0;
-            const double mu = cp.friction_coefficient;
-            if (cp.kind == PairKind::clamp) e[cp.row_t] = sigma * mu * cp.preload_n;
-            if (cp.row_n >= 0 && pos[cp.row_n] >= 0) T.push_back({cp.row_t, pos[cp.row_n], -sigma * mu});
-        }
+        for (std::size_t i = 0; i < lin.coupled.size(); ++i)
+            if (pos[lin.coupled[i].second] >= 0) T.push_back({lin.coupled[i].first, pos[lin.coupled[i].second], lin.coef[i]});
         for (const auto& l : T) CT.col(l.col) += l.coef * C.col(l.row);
         const Eigen::VectorXd Ce = C * e;
         Eigen::MatrixXd A(ms, ms);
@@ -178,7 +179,7 @@ struct CvodeStepper::Impl {
         diss_a = diss_b = 0.0;
         for (int kk = 0; kk < np; ++kk) {
             const int rt = pairs()[kk].row_t;
-            if (rt >= 0 && (tmode[kk] == T_SLIP_POS || tmode[kk] == T_SLIP_NEG)) {
+            if (rt >= 0 && (tmode[kk] == SLIP_POS || tmode[kk] == SLIP_NEG)) {
                 diss_a += P[rt] * hs[rt];
                 diss_b += r[rt] * hs[rt];
             }
@@ -207,26 +208,26 @@ struct CvodeStepper::Impl {
             double margin = kForceMargin;
             if (slots[i].normal) {
                 if (cp.kind == PairKind::coulomb) {
-                    if (nmode[kk] == N_CLOSED) {
+                    if (nmode[kk] == CLOSED) {
                         v = -pn() / F_ref;
                     } else {
                         v = -(hs[cp.row_n] * w + bs[cp.row_n]) / L_ref;
                         margin = kMotionMargin;
                     }
                 } else {  // clamp: engaged while p_n < F_c
-                    v = tmode[kk] == T_FREE ? (pn() - cp.preload_n) / F_ref : (cp.preload_n - pn()) / F_ref;
+                    v = tmode[kk] == FREE ? (pn() - cp.preload_n) / F_ref : (cp.preload_n - pn()) / F_ref;
                 }
             } else {
                 const int rt = cp.row_t;
                 const double pt = P[rt] * w + r[rt];
                 switch (tmode[kk]) {
-                    case T_STICK: {
+                    case STICK: {
                         const double tau_n = cp.kind == PairKind::clamp ? std::max(0.0, cp.preload_n - pn()) : -pn();
                         v = (cp.friction_coefficient * tau_n - std::abs(pt)) / F_ref;
                         break;
                     }
-                    case T_SLIP_POS: v = -hs[rt] * wd / V_ref; margin = kMotionMargin; break;
-                    case T_SLIP_NEG: v = hs[rt] * wd / V_ref; margin = kMotionMargin; break;
+                    case SLIP_POS: v = -hs[rt] * wd / V_ref; margin = kMotionMargin; break;
+                    case SLIP_NEG: v = hs[rt] * wd / V_ref; margin = kMotionMargin; break;
                     default: v = 1.0; break;
                 }
             }
@@ -238,12 +239,12 @@ struct CvodeStepper::Impl {
     std::string label(int kk, signed char nm, signed char tm) const {
         const auto& cp = pairs()[kk];
         if (cp.kind == PairKind::bonded) return "bonded";
-        if (cp.kind == PairKind::coulomb && nm == N_OPEN) return "open";
+        if (cp.kind == PairKind::coulomb && nm == OPEN) return "open";
         switch (tm) {
-            case T_STICK: return "stick";
-            case T_SLIP_POS: return "slip+";
-            case T_SLIP_NEG: return "slip-";
-            case T_FREE: return cp.kind == PairKind::clamp ? "released" : "closed";
+            case STICK: return "stick";
+            case SLIP_POS: return "slip+";
+            case SLIP_NEG: return "slip-";
+            case FREE: return cp.kind == PairKind::clamp ? "released" : "closed";
             default: return cp.kind == PairKind::clamp ? "clamped" : "closed";
         }
     }
@@ -258,20 +259,20 @@ struct CvodeStepper::Impl {
             bool open = false;
             if (cp.row_n >= 0) {
                 open = cp.kind == PairKind::coulomb && p[cp.row_n] >= -eps_f;
-                nm[kk] = open ? N_OPEN : N_CLOSED;
+                nm[kk] = open ? OPEN : CLOSED;
             } else if (cp.kind == PairKind::coulomb) {
                 open = true;  // no normal component: it carries no friction either
             }
             if (cp.row_t < 0) continue;
             if (cp.kind == PairKind::bonded) {
-                tm[kk] = T_STICK;
+                tm[kk] = STICK;
                 continue;
             }
             const double limit = cp.friction_coefficient * tau(kk, p);
             const double pt = p[cp.row_t];
-            if (open || cp.friction_coefficient == 0.0 || limit <= 0.0) tm[kk] = T_FREE;
-            else if (std::abs(pt) >= limit * (1.0 - 1e-9)) tm[kk] = pt > 0.0 ? T_SLIP_POS : T_SLIP_NEG;
-            else tm[kk] = T_STICK;
+            if (open || cp.friction_coefficient == 0.0 || limit <= 0.0) tm[kk] = FREE;
+            else if (std::abs(pt) >= limit * (1.0 - 1e-9)) tm[kk] = pt > 0.0 ? SLIP_POS : SLIP_NEG;
+            else tm[kk] = STICK;
         }
     }
 
@@ -298,7 +299,7 @@ struct CvodeStepper::Impl {
         Eigen::VectorXd d_la = d;
         for (int kk = 0; kk < np; ++kk) {
             const auto& cp = pairs()[kk];
-            if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != T_STICK) d_la[cp.row_t] = rel[cp.row_t];
+            if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
         }
         ev_problem.q = c * (w + dw) - d_la;
 
@@ -306,7 +307,7 @@ struct CvodeStepper::Impl {
         auto enter = [&](const std::vector<signed char>& nm, const std::vector<signed char>& tm) {
             for (int kk = 0; kk < np; ++kk) {
                 const auto& cp = pairs()[kk];
-                if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == T_STICK && tmode[kk] != T_STICK)
+                if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == STICK && tmode[kk] != STICK)
                     d[cp.row_t] = rel[cp.row_t];
             }
             nmode = nm;
@@ -324,19 +325,19 @@ struct CvodeStepper::Impl {
                 const auto& cp = pairs()[kk];
                 const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
                 if (slots[i].normal && cp.kind == PairKind::coulomb) {
-                    if (nm[kk] == N_CLOSED) {
-                        nm[kk] = N_OPEN;
-                        if (cp.row_t >= 0) tm[kk] = T_FREE;
+                    if (nm[kk] == CLOSED) {
+                        nm[kk] = OPEN;
+                        if (cp.row_t >= 0) tm[kk] = FREE;
                     } else {
-                        nm[kk] = N_CLOSED;
-                        if (cp.row_t >= 0) tm[kk] = friction ? T_STICK : T_FREE;
+                        nm[kk] = CLOSED;
+                        if (cp.row_t >= 0) tm[kk] = friction ? STICK : FREE;
                     }
                 } else if (slots[i].normal) {  // clamp released or engaged again
-                    tm[kk] = tm[kk] == T_FREE ? T_STICK : T_FREE;
-                } else if (tm[kk] == T_STICK) {
-                    tm[kk] = p_cur[cp.row_t] > 0.0 ? T_SLIP_POS : T_SLIP_NEG;
-                } else if (tm[kk] == T_SLIP_POS || tm[kk] == T_SLIP_NEG) {
-                    tm[kk] = T_STICK;
+                    tm[kk] = tm[kk] == FREE ? STICK : FREE;
+                } else if (tm[kk] == STICK) {
+                    tm[kk] = p_cur[cp.row_t] > 0.0 ? SLIP_POS : SLIP_NEG;
+                } else if (tm[kk] == SLIP_POS || tm[kk] == SLIP_NEG) {
+                    tm[kk] = STICK;
                 }
             }
             const Eigen::VectorXd d_saved = d;
@@ -400,7 +401,7 @@ struct CvodeStepper::Impl {
         const Eigen::VectorXd rel = hs * w + bs + d;
         for (int kk = 0; kk < np; ++kk) {
             const auto& cp = pairs()[kk];
-            if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != T_STICK) d_chk[cp.row_t] = rel[cp.row_t];
+            if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_chk[cp.row_t] = rel[cp.row_t];
         }
     }
 
@@ -728,6 +729,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.chk_problem.pairs = system.pairs();
     s.chk_problem.tau_rule = TauRule::current;
     s.chk_problem.tau_previous_n = Eigen::VectorXd::Zero(s.np);
+    s.chk_problem.q = Eigen::VectorXd::Zero(s.n);  // sized: ModeSet::linearize takes n from it
     s.ev_problem = s.chk_problem;
     s.chk_solver = make_solver(s.opt.solver);
     SolverOptions ev;
