@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "active_set.hpp"
+#include "step_record.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -69,7 +70,7 @@ struct CvodeStepper::Impl {
     Eigen::VectorXd c;         // coupling [-]
     Eigen::VectorXd d;         // gaps (normal rows) and anchors (tangential rows) [m]
     Eigen::VectorXd d_chk;     // anchors of the per-step check: slip rows at the previous accepted step
-    double k = 0, m = 0, f = 1, mass_whole = 0;
+    double k = 0, m = 0, f = 1;
     double F_ref = 1, L_ref = 1, V_ref = 1, omega_ref = 1;
     detail::ModeSet modes;                               // the current modes
     std::vector<signed char>& nmode = modes.nmode;       // per pair: CLOSED, OPEN (N_NONE: no normal row)
@@ -535,30 +536,14 @@ struct CvodeStepper::Impl {
 
     StepRecord make_record(double tau, double w, double wd, double D) {
         const Eigen::VectorXd p = n > 0 ? forces(w) : Eigen::VectorXd();
+        // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
+        const double strain = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + d - c * w) : 0.0) + k * w * w);
         StepRecord rec;
+        detail::fill_state(sys, chk_problem, p, w, wd, strain, f * D, e0, rec);
         rec.t_s = tau;
-        rec.w_m = w;
-        rec.w_dot_m_per_s = wd;
-        rec.force_on_mass_n = f * (c.dot(p) - k * w);
-        const int probe = sys.probe_pair();
-        const bool has_probe = sys.model().probe_pair() >= 0;
-        rec.probe_friction_force_n = !has_probe ? std::numeric_limits<double>::quiet_NaN()
-                                     : (probe >= 0 && pairs()[probe].row_t >= 0) ? p[pairs()[probe].row_t]
-                                                                                 : 0.0;
         rec.contact_iterations = static_cast<int>(iters_since);
         rec.factorizations = static_cast<int>(facts_since);
         iters_since = facts_since = 0;
-        for (int kk = 0; kk < np; ++kk) {
-            const PairState s = pair_state(chk_problem, kk, p);
-            if (s == PairState::stick) ++rec.n_stick;
-            else if (s == PairState::slip) ++rec.n_slip;
-            else ++rec.n_open;
-        }
-        rec.kinetic_energy_j = 0.5 * mass_whole * wd * wd;
-        // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
-        rec.strain_energy_j = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + d - c * w) : 0.0) + k * w * w);
-        rec.dissipated_energy_j = f * D;
-        rec.energy_balance_error_j = e0 - (rec.kinetic_energy_j + rec.strain_energy_j + rec.dissipated_energy_j);
         rec.contact_residual_m = last_check_residual;
         return rec;
     }
@@ -694,7 +679,6 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.k = system.stiffness_n_per_m();
     s.m = system.mass_kg();
     s.f = system.model().whole_spring_factor();
-    s.mass_whole = system.model().spec().rigid_body.mass_kg;
     const double w0 = system.model().spec().rigid_body.initial_displacement_m;
     const double wd0 = system.model().spec().rigid_body.initial_velocity_m_per_s;
 

@@ -6,6 +6,7 @@
 
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "step_record.hpp"
 
 namespace stackbeam {
 
@@ -196,40 +197,46 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     record_.energy_balance_error_j = 0.0;
 }
 
-void ClosedFormStepper::fill_record(int iterations, int factorizations) {
-    const double f = system_.model().whole_spring_factor();
-    const double k = system_.stiffness_n_per_m();
-    const auto& c = system_.coupling();
-    StepRecord& r = record_;
-    r.t_s = t_;
-    r.w_m = w_;
-    r.w_dot_m_per_s = wd_;
-    r.force_on_mass_n = f * (c.dot(p_) - k * w_);
+void detail::fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
+                        double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
+                        StepRecord& r) {
+    const double f = system.model().whole_spring_factor();
+    r.w_m = w_m;
+    r.w_dot_m_per_s = w_dot_m_per_s;
+    r.force_on_mass_n = f * (system.coupling().dot(p) - system.stiffness_n_per_m() * w_m);
     // The probe pair may carry no tangential component (mu = 0, or fixed by a support):
     // its friction force is then zero. NaN only when the model has no probe at all.
-    const int probe = system_.probe_pair();
-    const bool has_probe = system_.model().probe_pair() >= 0;
+    const int probe = system.probe_pair();
+    const bool has_probe = system.model().probe_pair() >= 0;
     r.probe_friction_force_n = !has_probe ? std::numeric_limits<double>::quiet_NaN()
-                               : (probe >= 0 && system_.pairs()[probe].row_t >= 0) ? p_[system_.pairs()[probe].row_t]
-                                                                                    : 0.0;
-    r.contact_iterations = iterations;
-    r.factorizations = factorizations;
+                               : (probe >= 0 && system.pairs()[probe].row_t >= 0) ? p[system.pairs()[probe].row_t]
+                                                                                   : 0.0;
     r.n_stick = r.n_slip = r.n_open = 0;
-    for (PairState s : pair_states()) {
+    for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+        const PairState s = pair_state(laws, k, p);
         if (s == PairState::stick) ++r.n_stick;
         else if (s == PairState::slip) ++r.n_slip;
         else ++r.n_open;
     }
-    r.kinetic_energy_j = 0.5 * system_.model().spec().rigid_body.mass_kg * wd_ * wd_;
+    r.kinetic_energy_j = 0.5 * system.model().spec().rigid_body.mass_kg * w_dot_m_per_s * w_dot_m_per_s;
+    r.strain_energy_j = strain_energy_j;
+    r.dissipated_energy_j = dissipated_energy_j;
+    r.energy_balance_error_j = e0_j - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
+}
+
+void ClosedFormStepper::fill_record(int iterations, int factorizations) {
+    const double f = system_.model().whole_spring_factor();
+    const double k = system_.stiffness_n_per_m();
     // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp); the
     // sparse path has z itself and never builds C'.
-    if (path_ == ContactPath::dense)
-        r.strain_energy_j = 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
-    else
-        r.strain_energy_j = 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
-    r.dissipated_energy_j = dissipated_;
-    r.energy_balance_error_j = e0_ - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
-    r.contact_residual_m = solve_.residual_m;
+    const double strain = path_ == ContactPath::dense
+                              ? 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_)
+                              : 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
+    detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, record_);
+    record_.t_s = t_;
+    record_.contact_iterations = iterations;
+    record_.factorizations = factorizations;
+    record_.contact_residual_m = solve_.residual_m;
 }
 
 std::vector<PairState> ClosedFormStepper::pair_states() const {
