@@ -6,11 +6,9 @@
 
 namespace stackbeam::detail {
 
-BoxQpResult solve_box_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& q, const Eigen::VectorXd& lower,
-                         const Eigen::VectorXd& upper, Eigen::VectorXd& x, std::vector<signed char>& at_bound,
-                         double tolerance, int max_iterations) {
-    const int n = static_cast<int>(q.size());
-    BoxQpResult r;
+void project_onto_box(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, Eigen::VectorXd& x,
+                      std::vector<signed char>& at_bound) {
+    const int n = static_cast<int>(x.size());
     at_bound.resize(n, 0);
     for (int i = 0; i < n; ++i) {  // feasible start; components with an empty interior are held
         if (x[i] <= lower[i]) { x[i] = lower[i]; if (std::isfinite(lower[i])) at_bound[i] = -1; }
@@ -20,6 +18,14 @@ BoxQpResult solve_box_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& q, con
         if (at_bound[i] != 0) x[i] = at_bound[i] < 0 ? lower[i] : upper[i];
         if (lower[i] == upper[i]) at_bound[i] = +1;
     }
+}
+
+BoxQpResult solve_box_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& q, const Eigen::VectorXd& lower,
+                         const Eigen::VectorXd& upper, Eigen::VectorXd& x, std::vector<signed char>& at_bound,
+                         double tolerance, int max_iterations) {
+    const int n = static_cast<int>(q.size());
+    BoxQpResult r;
+    project_onto_box(lower, upper, x, at_bound);
     std::vector<int> freev;
     Eigen::VectorXd y(n), rhs;
     Eigen::MatrixXd M;

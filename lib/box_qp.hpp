@@ -18,6 +18,12 @@ struct BoxQpResult {
     int factorizations = 0;
 };
 
+/// The feasible start of the box QP: x projected onto [lower, upper]; components at a
+/// finite bound are held there (at_bound -1 / +1, resized to x's size), a given hold at
+/// an infinite bound is dropped, and a box of zero width is held (+1).
+void project_onto_box(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, Eigen::VectorXd& x,
+                      std::vector<signed char>& at_bound);
+
 /// x: start on entry (projected onto the box), solution on exit. `at_bound` on entry:
 /// -1 / +1 for components to hold at their lower / upper bound (the working set), 0
 /// free; on exit the final working set. `tolerance` is the multiplier tolerance [same

@@ -48,6 +48,7 @@
 #include <limits>
 
 #include "active_set.hpp"
+#include "box_qp.hpp"
 #include "contact_solvers.hpp"
 #include "stackbeam/contact.hpp"
 #include "stackbeam/errors.hpp"
@@ -292,15 +293,7 @@ struct SparseContactSolver::Impl {
                 const Eigen::VectorXd& upper, Eigen::VectorXd& x, Eigen::VectorXd& z,
                 std::vector<signed char>& at_bound, double tolerance, int max_iterations, SolveResult& r) {
         const int m = static_cast<int>(x.size());
-        at_bound.resize(m, 0);
-        for (int i = 0; i < m; ++i) {  // feasible start; components with an empty interior are held
-            if (x[i] <= lower[i]) { x[i] = lower[i]; if (std::isfinite(lower[i])) at_bound[i] = -1; }
-            if (x[i] >= upper[i]) { x[i] = upper[i]; if (std::isfinite(upper[i])) at_bound[i] = +1; }
-            if (at_bound[i] == -1 && !std::isfinite(lower[i])) at_bound[i] = 0;
-            if (at_bound[i] == +1 && !std::isfinite(upper[i])) at_bound[i] = 0;
-            if (at_bound[i] != 0) x[i] = at_bound[i] < 0 ? lower[i] : upper[i];
-            if (lower[i] == upper[i]) at_bound[i] = +1;
-        }
+        detail::project_onto_box(lower, upper, x, at_bound);
         z = k_llt.solve(b + G.transpose() * x);
         detail::ModeLinearization qp;
         Eigen::VectorXd y, zy;
