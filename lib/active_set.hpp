@@ -224,4 +224,78 @@ bool active_set_passes(ModeSet& modes, const ContactProblem& pr, Eigen::VectorXd
     return false;
 }
 
+/// The Tresca fixed point of the exact solvers (dense and sparse): each pass solves
+/// the problem with the friction limits frozen, a box-constrained convex QP (unilateral
+/// normals in (-inf, 0], held at 0 when open; tangential rows in [-mu tau, mu tau],
+/// held at their bound while slipping); the limits are updated from its normal forces
+/// until they settle to `accept` (in metres: the change of mu tau times W's diagonal);
+/// its final working set then gives the modes, and slip forces are put at the limit of
+/// the final tau. Returns true when the limits settled within `max_iterations` passes.
+///   box_solve(lower, upper, at_bound) -> bool   solves the box QP into p (the path's
+///                                                own start, factorisations, counters)
+///   diagonal(row) -> W_row,row [m/N]
+///   tangential_s(row) -> s_row at the final p   (only where a box of zero width, tau = 0
+///                                                in the last QP, held a force without a sign)
+template <class BoxSolve, class Diagonal, class TangentialS>
+bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::VectorXd& p, double accept,
+                        int max_iterations, BoxSolve box_solve, Diagonal diagonal, TangentialS tangential_s) {
+    const int np = static_cast<int>(pr.pairs.size());
+    const double inf = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
+    std::vector<signed char> at_bound(n, 0);
+    for (int k = 0; k < np; ++k) {
+        const auto& c = pr.pairs[k];
+        if (c.row_n >= 0 && ModeSet::unilateral(c)) {
+            upper[c.row_n] = 0.0;
+            if (modes.nmode[k] == OPEN) at_bound[c.row_n] = +1;
+        }
+        if (c.row_t >= 0 && (modes.tmode[k] == SLIP_POS || modes.tmode[k] == SLIP_NEG))
+            at_bound[c.row_t] = modes.tmode[k] == SLIP_POS ? +1 : -1;
+    }
+    Eigen::VectorXd tau(np);
+    for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
+    for (int it = 0; it < max_iterations; ++it) {
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+            const double limit = c.friction_coefficient * tau[k];
+            lower[c.row_t] = -limit;
+            upper[c.row_t] = limit;
+        }
+        if (!box_solve(lower, upper, at_bound)) return false;
+        double change_m = 0.0;
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+            const double t = friction_normal_force(pr, k, p);
+            change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * diagonal(c.row_t));
+            tau[k] = t;
+        }
+        if (change_m > accept) continue;
+        // modes from the working set; slip forces put at the limit of the final tau
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && ModeSet::unilateral(c)) modes.nmode[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
+            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+            const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+            if (limit <= 0.0) {
+                modes.tmode[k] = FREE;
+                p[c.row_t] = 0.0;
+            } else if (at_bound[c.row_t] != 0) {
+                // slip against the motion; a box that had zero width (tau was 0 in the
+                // last QP) held the force without a sign: take it from s_t.
+                const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t]
+                                                                          : (tangential_s(c.row_t) > 0.0 ? -1 : +1);
+                modes.tmode[k] = sigma > 0 ? SLIP_POS : SLIP_NEG;
+                p[c.row_t] = sigma * limit;
+            } else {
+                modes.tmode[k] = STICK;
+            }
+            modes.make_consistent(pr, k);
+        }
+        return true;
+    }
+    return false;
+}
+
 }  // namespace stackbeam::detail

@@ -117,68 +117,17 @@ private:
     /// Returns true when the limits settle to kAccept x tolerance (measured in metres).
     bool tresca_fixed_point(const ContactProblem& pr, Eigen::VectorXd& p, SolveResult& r) {
         const int n = pr.size();
-        const int np = static_cast<int>(pr.pairs.size());
-        const double inf = std::numeric_limits<double>::infinity();
-        Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
-        std::vector<signed char> at_bound(n, 0);
-        for (int k = 0; k < np; ++k) {
-            const auto& c = pr.pairs[k];
-            if (c.row_n >= 0 && ModeSet::unilateral(c)) {
-                upper[c.row_n] = 0.0;
-                if (modes_.nmode[k] == OPEN) at_bound[c.row_n] = +1;
-            }
-            if (c.row_t >= 0 && (modes_.tmode[k] == SLIP_POS || modes_.tmode[k] == SLIP_NEG))
-                at_bound[c.row_t] = modes_.tmode[k] == SLIP_POS ? +1 : -1;
-        }
-        Eigen::VectorXd tau(np);
-        for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
         const double accept = kAccept * options_.tolerance_m;
-        for (int it = 0; it < kTrescaIterations; ++it) {
-            for (int k = 0; k < np; ++k) {
-                const auto& c = pr.pairs[k];
-                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                const double limit = c.friction_coefficient * tau[k];
-                lower[c.row_t] = -limit;
-                upper[c.row_t] = limit;
-            }
-            const BoxQpResult b = solve_box_qp(pr.W, pr.q, lower, upper, p, at_bound, accept, 50 * (n + 1));
-            r.iterations += b.iterations;
-            r.factorizations += b.factorizations;
-            if (!b.converged) return false;
-            double change_m = 0.0;
-            for (int k = 0; k < np; ++k) {
-                const auto& c = pr.pairs[k];
-                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                const double t = friction_normal_force(pr, k, p);
-                change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * pr.W(c.row_t, c.row_t));
-                tau[k] = t;
-            }
-            if (change_m <= accept) {
-                // modes from the working set; slip forces put at the limit of the final tau
-                for (int k = 0; k < np; ++k) {
-                    const auto& c = pr.pairs[k];
-                    if (c.row_n >= 0 && ModeSet::unilateral(c)) modes_.nmode[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
-                    if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
-                    if (limit <= 0.0) {
-                        modes_.tmode[k] = FREE;
-                        p[c.row_t] = 0.0;
-                    } else if (at_bound[c.row_t] != 0) {
-                        // slip against the motion; a box that had zero width (tau was 0 in the
-                        // last QP) held the force without a sign: take it from s_t.
-                        const double st = (pr.W.row(c.row_t) * p)(0) + pr.q[c.row_t];
-                        const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t] : (st > 0.0 ? -1 : +1);
-                        modes_.tmode[k] = sigma > 0 ? SLIP_POS : SLIP_NEG;
-                        p[c.row_t] = sigma * limit;
-                    } else {
-                        modes_.tmode[k] = STICK;
-                    }
-                    modes_.make_consistent(pr, k);
-                }
-                return true;
-            }
-        }
-        return false;
+        return detail::tresca_fixed_point(
+            modes_, pr, n, p, accept, kTrescaIterations,
+            [&](const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<signed char>& at_bound) {
+                const BoxQpResult b = solve_box_qp(pr.W, pr.q, lower, upper, p, at_bound, accept, 50 * (n + 1));
+                r.iterations += b.iterations;
+                r.factorizations += b.factorizations;
+                return b.converged;
+            },
+            [&](int row) { return pr.W(row, row); },
+            [&](int row) { return (pr.W.row(row) * p)(0) + pr.q[row]; });
     }
 
     void init_modes(const ContactProblem& pr, const Eigen::VectorXd& p) {

@@ -428,77 +428,29 @@ struct SparseContactSolver::Impl {
     /// settle to kAccept x tolerance (in metres); its final working set gives the modes.
     bool tresca_fixed_point(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p,
                             Eigen::VectorXd& z, SolveResult& r) {
-        const ContactProblem& pr = laws;
         const int n = static_cast<int>(d.size());
-        const int np = static_cast<int>(pr.pairs.size());
-        const double inf = std::numeric_limits<double>::infinity();
-        Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
-        std::vector<signed char> at_bound(n, 0);
-        auto& nmode = modes.nmode;
-        auto& tmode = modes.tmode;
-        using detail::ModeSet;
-        for (int k = 0; k < np; ++k) {
-            const auto& c = pr.pairs[k];
-            if (c.row_n >= 0 && ModeSet::unilateral(c)) {
-                upper[c.row_n] = 0.0;
-                if (nmode[k] == detail::OPEN) at_bound[c.row_n] = +1;
-            }
-            if (c.row_t >= 0 && (tmode[k] == detail::SLIP_POS || tmode[k] == detail::SLIP_NEG))
-                at_bound[c.row_t] = tmode[k] == detail::SLIP_POS ? +1 : -1;
-        }
-        Eigen::VectorXd tau(np);
-        for (int k = 0; k < np; ++k) tau[k] = friction_normal_force(pr, k, p);
         const double accept = kAccept * options.tolerance_m;
-        for (int it = 0; it < kTrescaIterations; ++it) {
-            for (int k = 0; k < np; ++k) {
-                const auto& c = pr.pairs[k];
-                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                const double limit = c.friction_coefficient * tau[k];
-                lower[c.row_t] = -limit;
-                upper[c.row_t] = limit;
-            }
-            // block principal pivoting first (few factorisations); the monotone primal method
-            // (one factorisation per working-set change, cannot cycle) if it does not settle
-            const std::vector<signed char> start = at_bound;
-            const Eigen::VectorXd p_start = p;
-            if (!box_qp_bpp(b, d, lower, upper, p, z, at_bound, accept, kBoxPasses, r)) {
+        bool s_current = false;  // s = G z - d of the final z, made once when needed
+        const bool settled = detail::tresca_fixed_point(
+            modes, laws, n, p, accept, kTrescaIterations,
+            [&](const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<signed char>& at_bound) {
+                // block principal pivoting first (few factorisations); the monotone primal method
+                // (one factorisation per working-set change, cannot cycle) if it does not settle
+                const std::vector<signed char> start = at_bound;
+                const Eigen::VectorXd p_start = p;
+                if (box_qp_bpp(b, d, lower, upper, p, z, at_bound, accept, kBoxPasses, r)) return true;
                 at_bound = start;
                 p = p_start;
-                if (!box_qp(b, d, lower, upper, p, z, at_bound, accept, 50 * (n + 1), r)) return false;
-            }
-            double change_m = 0.0;
-            for (int k = 0; k < np; ++k) {
-                const auto& c = pr.pairs[k];
-                if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                const double t = friction_normal_force(pr, k, p);
-                change_m = std::max(change_m, c.friction_coefficient * std::abs(t - tau[k]) * diag[c.row_t]);
-                tau[k] = t;
-            }
-            if (change_m <= accept) {
-                // modes from the working set; slip forces put at the limit of the final tau
-                s = G * z - d;
-                for (int k = 0; k < np; ++k) {
-                    const auto& c = pr.pairs[k];
-                    if (c.row_n >= 0 && ModeSet::unilateral(c)) nmode[k] = at_bound[c.row_n] == +1 ? detail::OPEN : detail::CLOSED;
-                    if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
-                    if (limit <= 0.0) {
-                        tmode[k] = detail::FREE;
-                        p[c.row_t] = 0.0;
-                    } else if (at_bound[c.row_t] != 0) {
-                        const double st = s[c.row_t];
-                        const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t] : (st > 0.0 ? -1 : +1);
-                        tmode[k] = sigma > 0 ? detail::SLIP_POS : detail::SLIP_NEG;
-                        p[c.row_t] = sigma * limit;
-                    } else {
-                        tmode[k] = detail::STICK;
-                    }
-                    modes.make_consistent(pr, k);
-                }
-                return true;
-            }
-        }
-        return false;
+                return box_qp(b, d, lower, upper, p, z, at_bound, accept, 50 * (n + 1), r);
+            },
+            [&](int row) { return diag[row]; },
+            [&](int row) {
+                if (!s_current) s = G * z - d;
+                s_current = true;
+                return s[row];
+            });
+        if (settled && !s_current) s = G * z - d;
+        return settled;
     }
 
 };
