@@ -71,6 +71,14 @@ struct CvodeStepper::Impl {
     Eigen::VectorXd d;         // gaps (normal rows) and anchors (tangential rows) [m]
     Eigen::VectorXd d_chk;     // anchors of the per-step check: slip rows at the previous accepted step
     double k = 0, m = 0, f = 1;
+    Loading load;              // the loading (loading.hpp), prepared
+    double m_whole = 0;        // R's whole mass [kg]
+    /// External force on R of the meshed part at t [N] (loading.hpp: F/f - m g - m y_b'').
+    double fe(double t_s) const { return load.external_force_n(t_s, m_whole) / f; }
+    /// ODE size: [w, w', D], plus the external work W_e when a loading exerts a force
+    /// (under the paper's initial conditions it is identically zero and left out, so
+    /// that CVODE's error norm, an RMS over the states, is the same as without it).
+    int nstate = 3;
     double F_ref = 1, L_ref = 1, V_ref = 1, omega_ref = 1;
     detail::ModeSet modes;                               // the current modes
     std::vector<signed char>& nmode = modes.nmode;       // per pair: CLOSED, OPEN (N_NONE: no normal row)
@@ -283,11 +291,11 @@ struct CvodeStepper::Impl {
     /// those transitions applied are tried first, and kept if they hold on the
     /// look-ahead problem (the contact iteration's stop test accepts them there);
     /// otherwise, and without `triggered`, the exact contact solver decides.
-    void decide_modes(double w, double wd, const Eigen::VectorXd& p_cur, const std::string& cause,
+    void decide_modes(double te, double w, double wd, const Eigen::VectorXd& p_cur, const std::string& cause,
                       const std::vector<int>* triggered = nullptr) {
         // s + d; in a built mode affine in w (O(n)), else (t = 0) from the forces
         const Eigen::VectorXd rel = P.size() == n ? Eigen::VectorXd(hs * w + bs + d) : Eigen::VectorXd(C * p_cur + c * w);
-        const double wdd = (c.dot(p_cur) - k * w) / m;
+        const double wdd = (c.dot(p_cur) - k * w + fe(te)) / m;
         const double target = kLookahead * L_ref;
         double delta = std::numeric_limits<double>::infinity();
         if (wd != 0.0) delta = std::min(delta, target / std::abs(wd));
@@ -426,13 +434,15 @@ struct CvodeStepper::Impl {
 
     // ---- CVODE -------------------------------------------------------------------
 
-    static int rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
+    static int rhs(sunrealtype tt, N_Vector yv, N_Vector ydot, void* user) {
         const auto* self = static_cast<const Impl*>(user);
         const double* yy = N_VGetArrayPointer(yv);
         double* dy = N_VGetArrayPointer(ydot);
+        const double fe = self->fe(tt);
         dy[0] = yy[1];
-        dy[1] = (self->a1 * yy[0] + self->a0) / self->m;
+        dy[1] = (self->a1 * yy[0] + self->a0 + fe) / self->m;
         dy[2] = -yy[1] * (self->diss_a * yy[0] + self->diss_b);
+        if (self->nstate > 3) dy[3] = fe * yy[1];  // power of the external force (meshed part)
         return 0;
     }
 
@@ -458,17 +468,19 @@ struct CvodeStepper::Impl {
 
     void init_cvode(double w0, double wd0) {
         check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
-        y = N_VNew_Serial(3, ctx);
-        ydky = N_VNew_Serial(3, ctx);
-        atol = N_VNew_Serial(3, ctx);
+        y = N_VNew_Serial(nstate, ctx);
+        ydky = N_VNew_Serial(nstate, ctx);
+        atol = N_VNew_Serial(nstate, ctx);
         double* yy = N_VGetArrayPointer(y);
         yy[0] = w0;
         yy[1] = wd0;
         yy[2] = 0.0;
+        if (nstate > 3) yy[3] = 0.0;
         double* at = N_VGetArrayPointer(atol);
         at[0] = opt.cvode.atol_m;                 // w [m]
         at[1] = opt.cvode.atol_m * omega_ref;     // w' [m/s]
         at[2] = opt.cvode.atol_m * F_ref;         // D [J]
+        if (nstate > 3) at[3] = opt.cvode.atol_m * F_ref;  // external work [J]
         cv = CVodeCreate(CV_ADAMS, ctx);
         if (!cv) throw SolverError("cvode mode: CVodeCreate failed", 0, 0.0, 0.0);
         check(CVodeSetErrHandlerFn(cv, &Impl::error_handler, this), "CVodeSetErrHandlerFn");
@@ -512,34 +524,40 @@ struct CvodeStepper::Impl {
         }
     }
 
-    void restart(double te, double w, double wd, double D) {
+    void restart(double te, double w, double wd, double D, double We) {
         accumulate_counters();
         double* yy = N_VGetArrayPointer(y);
         yy[0] = w;
         yy[1] = wd;
         yy[2] = D;
+        if (nstate > 3) yy[3] = We;
         check(CVodeReInit(cv, te, y), "CVodeReInit");
         check(CVodeSetStopTime(cv, t_final), "CVodeSetStopTime");
         ++stats.restarts;
     }
 
     /// State at time tau within the last step (CVODE's dense output).
-    void state_at(double tau, double& w, double& wd, double& D) {
+    void state_at(double tau, double& w, double& wd, double& D, double& We) {
         check(CVodeGetDky(cv, tau, 0, ydky), "CVodeGetDky");
         const double* yy = N_VGetArrayPointer(ydky);
         w = yy[0];
         wd = yy[1];
         D = yy[2];
+        We = nstate > 3 ? yy[3] : 0.0;
     }
 
     // ---- records -----------------------------------------------------------------
 
-    StepRecord make_record(double tau, double w, double wd, double D) {
+    StepRecord make_record(double tau, double w, double wd, double D, double We) {
         const Eigen::VectorXd p = n > 0 ? forces(w) : Eigen::VectorXd();
         // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
         const double strain = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + d - c * w) : 0.0) + k * w * w);
         StepRecord rec;
-        detail::fill_state(sys, chk_problem, p, w, wd, strain, f * D, e0, rec);
+        detail::LoadState ls;
+        ls.external_force_n = f * fe(tau);
+        ls.external_work_j = f * We;
+        ls.base_displacement_m = load.base_displacement_m(tau);
+        detail::fill_state(sys, chk_problem, p, w, wd, strain, f * D, e0, ls, rec);
         rec.t_s = tau;
         rec.contact_iterations = static_cast<int>(iters_since);
         rec.factorizations = static_cast<int>(facts_since);
@@ -555,9 +573,9 @@ struct CvodeStepper::Impl {
         long next = out_index + static_cast<long>(pending.size()) + 1;
         while (next <= n_out && output_time(next) <= upto) {
             const double tau = output_time(next);
-            double w, wd, D;
-            state_at(tau, w, wd, D);
-            pending.emplace_back(make_record(tau, w, wd, D), n > 0 ? forces(w) : Eigen::VectorXd());
+            double w, wd, D, We;
+            state_at(tau, w, wd, D, We);
+            pending.emplace_back(make_record(tau, w, wd, D, We), n > 0 ? forces(w) : Eigen::VectorXd());
             ++next;
         }
     }
@@ -596,7 +614,7 @@ struct CvodeStepper::Impl {
                                   " steps at t = " + format_value(tret) + " s",
                               stats.steps, tret, 0.0);
         const double* yy = N_VGetArrayPointer(y);
-        const double w = yy[0], wd = yy[1], D = yy[2];
+        const double w = yy[0], wd = yy[1], D = yy[2], We = nstate > 3 ? yy[3] : 0.0;
 
         if (flag == CV_ROOT_RETURN) {
             emit_until(tret);  // the old modes hold up to the root
@@ -605,8 +623,8 @@ struct CvodeStepper::Impl {
             const Eigen::VectorXd p_cur = forces(w);
             std::vector<int> found(slots.size(), 0);
             check(CVodeGetRootInfo(cv, found.data()), "CVodeGetRootInfo");
-            decide_modes(w, wd, p_cur, "root", &found);
-            restart(tret, w, wd, D);
+            decide_modes(tret, w, wd, p_cur, "root", &found);
+            restart(tret, w, wd, D, We);
             return true;
         }
 
@@ -647,19 +665,19 @@ struct CvodeStepper::Impl {
         const double tol_t = 1e-13 * std::max(1.0, std::abs(tret)) + 1e-9 * hlast;
         while (hi - lo > tol_t) {
             const double mid = 0.5 * (lo + hi);
-            double wm, wdm, Dm, res_m;
-            state_at(mid, wm, wdm, Dm);
+            double wm, wdm, Dm, Wm, res_m;
+            state_at(mid, wm, wdm, Dm, Wm);
             if (modes_hold(wm, wdm, res_m)) lo = mid;
             else hi = mid;
         }
-        double we, wde, De;
-        state_at(hi, we, wde, De);
+        double we, wde, De, Wee;
+        state_at(hi, we, wde, De, Wee);
         emit_until(hi);
         t = hi;
         ++stats.missed_events;
         note_event_time(hi);
-        decide_modes(we, wde, forces(we), "check");
-        restart(hi, we, wde, De);
+        decide_modes(hi, we, wde, forces(we), "check");
+        restart(hi, we, wde, De, Wee);
         return true;
     }
 };
@@ -679,15 +697,26 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.k = system.stiffness_n_per_m();
     s.m = system.mass_kg();
     s.f = system.model().whole_spring_factor();
-    const double w0 = system.model().spec().rigid_body.initial_displacement_m;
-    const double wd0 = system.model().spec().rigid_body.initial_velocity_m_per_s;
+    s.load = s.opt.loading;
+    s.load.prepare();
+    require_loading_fits(system, s.load);
+    s.m_whole = system.model().spec().rigid_body.mass_kg;
+    s.nstate = s.load.kind == LoadingKind::initial_conditions && s.load.gravity_m_per_s2 == 0.0 ? 3 : 4;
+    double w0 = system.model().spec().rigid_body.initial_displacement_m;
+    // base excitation: w is relative to the supports, the initial velocity absolute (loading.hpp)
+    const double wd0 = system.model().spec().rigid_body.initial_velocity_m_per_s - s.load.base_velocity_m_per_s(0.0);
+    // The largest external force over the run (sampled; table points included) sets a
+    // displacement scale F_e/k for the witnesses (gravity: the static deflection).
+    double fe_max = 0.0;
+    for (int i = 0; i <= 4000; ++i) fe_max = std::max(fe_max, std::abs(s.fe(s.opt.t_end_s * i / 4000.0)));
+    for (double tp : s.load.force_n.times_s) fe_max = std::max(fe_max, std::abs(s.fe(tp)));
 
     // Scales of the run: the amplitude of R on the softest stack (no contact force),
     // the stiffest frequency (everything tied), the largest clamp preload.
     const double k_tied = system.num_components() > 0 ? system.tied_stiffness_n_per_m() / s.f : s.k;
     const double omega_free = std::sqrt(s.k / s.m);
     s.omega_ref = std::sqrt(std::max(k_tied, s.k) / s.m);
-    s.L_ref = std::abs(w0) + std::abs(wd0) / omega_free;
+    s.L_ref = std::abs(w0) + std::abs(wd0) / omega_free + fe_max / s.k;
     if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;  // at rest: nothing moves; any scale will do
     double preload = 0.0;
     for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
@@ -725,17 +754,38 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
     s.ev_solver = make_solver(ev);
 
-    // Initial contact state with R held at w(0) (as the closed-form mode), then the modes.
+    // Gravity: the static equilibrium under R's weight first (as the closed-form mode):
+    // k w - c^T p = -m g, s = C'p + c w - d, then the non-stuck pairs re-anchored.
     Eigen::VectorXd p0 = Eigen::VectorXd::Zero(s.n);
-    if (w0 != 0.0 && s.n > 0) {
+    double w_static = 0.0;
+    if (s.load.gravity_m_per_s2 > 0.0) {
+        const double Fs = -s.m * s.load.gravity_m_per_s2;
+        if (s.n > 0) {
+            ContactProblem st = s.ev_problem;
+            st.W = s.C + (1.0 / s.k) * s.c * s.c.transpose();
+            st.q = s.c * (Fs / s.k) - s.d;
+            const SolveResult rs = s.ev_solver->solve(st, p0);
+            if (!rs.converged) throw SolverError("static equilibrium under gravity: " + rs.message, 0, 0.0, rs.residual_m);
+            const Eigen::VectorXd rel = st.W * p0 + st.q + s.d;
+            for (int j = 0; j < s.np; ++j) {
+                const auto& pr = system.pairs()[j];
+                if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
+                if (pair_state(st, j, p0) != PairState::stick) s.d[pr.row_t] = rel[pr.row_t];
+            }
+        }
+        w_static = (Fs + (s.n > 0 ? s.c.dot(p0) : 0.0)) / s.k;
+        w0 += w_static;
+    }
+    // Initial contact state with R held at w(0) (as the closed-form mode), then the modes.
+    if (w0 != w_static && s.n > 0) {
         s.ev_problem.q = s.c * w0 - s.d;
         const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p0);
         if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
     }
     s.modes_from_solution(p0, s.nmode, s.tmode);
-    s.decide_modes(w0, wd0, p0, "start");
+    s.decide_modes(0.0, w0, wd0, p0, "start");
     s.init_cvode(w0, wd0);
-    s.record = s.make_record(0.0, w0, wd0, 0.0);
+    s.record = s.make_record(0.0, w0, wd0, 0.0, 0.0);
     s.record.energy_balance_error_j = 0.0;
     s.e0 = s.record.kinetic_energy_j + s.record.strain_energy_j;
     s.p_out = s.n > 0 ? s.forces(w0) : Eigen::VectorXd();

@@ -17,13 +17,6 @@
 
 namespace stackbeam {
 
-const char* to_string(LoadingKind kind) {
-    switch (kind) {
-        case LoadingKind::initial_conditions: return "initial-conditions";
-    }
-    return "?";
-}
-
 namespace {
 
 const char* type_name(const toml::value& v) {
@@ -160,6 +153,23 @@ public:
         const auto& v = at(key);
         if (!v.is_boolean()) wrong_type(key, v, "a boolean (true or false): " + what);
         return v.as_boolean();
+    }
+
+    /// An array of numbers; required.
+    std::vector<double> numbers(const std::string& key, const std::string& what) const {
+        if (!has(key)) missing(key, what);
+        const auto& v = at(key);
+        if (!v.is_array()) wrong_type(key, v, "an array of numbers: " + what);
+        std::vector<double> out;
+        const auto& a = v.as_array();
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            const std::string path = element(child(path_, key), i);
+            ctx_.remember(path, a[i]);
+            if (a[i].is_floating()) out.push_back(a[i].as_floating());
+            else if (a[i].is_integer()) out.push_back(static_cast<double>(a[i].as_integer()));
+            else ctx_.fail(path, std::string("has the wrong type, ") + type_name(a[i]) + ": must be a number: " + what);
+        }
+        return out;
     }
 
     /// A required sub-table (check has() first for an optional one).
@@ -325,16 +335,66 @@ void parse_rigid_body(const Table& top, ModelSpec& spec) {
     }
 }
 
-LoadingKind parse_loading(const Table& top, ModelSpec& spec) {
-    const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s"});
-    const std::string kind = t.string("kind", "the kind of loading: 'initial-conditions'");
-    if (kind != "initial-conditions")
-        t.context().fail("loading.kind", "value '" + kind +
-                                             "' is not supported (yet): the only loading kind today is 'initial-conditions' "
-                                             "(initial displacement and velocity of the rigid body)");
+/// A time function `[loading.<key>]` (loading.hpp, TimeFunction); `unit` for messages.
+TimeFunction parse_time_function(const Table& parent, const std::string& key, const std::string& unit) {
+    const Table t = parent.table(key, {"shape", "mean", "amplitude", "frequency_hz", "phase_rad", "times_s", "values"});
+    using S = TimeFunction::Shape;
+    TimeFunction f;
+    f.shape = choice<S>(t, "shape",
+                        {{"constant", S::constant}, {"harmonic", S::harmonic}, {"triangle", S::triangle}, {"table", S::table}},
+                        nullptr);
+    auto only = [&](const std::string& k, bool allowed) {
+        if (t.has(k) && !allowed)
+            t.context().fail(child(t.path(), k), "is not used by shape '" + std::string(to_string(f.shape)) +
+                                                     "': remove it (constant: mean; harmonic, triangle: mean, amplitude, "
+                                                     "frequency_hz, phase_rad; table: times_s, values)");
+    };
+    const bool periodic = f.shape == S::harmonic || f.shape == S::triangle;
+    only("mean", f.shape != S::table);
+    only("amplitude", periodic);
+    only("frequency_hz", periodic);
+    only("phase_rad", periodic);
+    only("times_s", f.shape == S::table);
+    only("values", f.shape == S::table);
+    if (f.shape == S::constant) f.mean = t.number("mean", "the value [" + unit + "]");
+    if (periodic) {
+        f.mean = t.number_or("mean", "the offset [" + unit + "]", 0.0);
+        f.amplitude = t.number("amplitude", "the amplitude [" + unit + "], >= 0");
+        f.frequency_hz = t.number("frequency_hz", "the frequency [Hz], > 0");
+        f.phase_rad = t.number_or("phase_rad", "the phase [rad]", 0.0);
+    }
+    if (f.shape == S::table) {
+        f.times_s = t.numbers("times_s", "the times [s], strictly increasing");
+        f.values = t.numbers("values", "the values [" + unit + "], one per time");
+    }
+    return f;
+}
+
+Loading parse_loading(const Table& top, ModelSpec& spec) {
+    const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s", "gravity_m_per_s2",
+                                          "force_n", "displacement_m"});
+    Loading l;
+    l.kind = choice<LoadingKind>(t, "kind",
+                                 {{"initial-conditions", LoadingKind::initial_conditions},
+                                  {"applied-force", LoadingKind::applied_force},
+                                  {"prescribed-displacement", LoadingKind::prescribed_displacement},
+                                  {"base-excitation", LoadingKind::base_excitation}},
+                                 nullptr);
     spec.rigid_body.initial_displacement_m = t.number_or("initial_displacement_m", "w(0) [m]", 0.0);
     spec.rigid_body.initial_velocity_m_per_s = t.number_or("initial_velocity_m_per_s", "dw/dt(0) [m/s]", 0.0);
-    return LoadingKind::initial_conditions;
+    l.gravity_m_per_s2 = t.number_or("gravity_m_per_s2", "g [m/s^2], >= 0, acting in -y", 0.0);
+    const bool force = l.kind == LoadingKind::applied_force;
+    const bool disp = l.kind == LoadingKind::prescribed_displacement || l.kind == LoadingKind::base_excitation;
+    if (t.has("force_n") && !force)
+        t.context().fail("loading.force_n", "is only used with kind = 'applied-force' (kind is '" +
+                                                std::string(to_string(l.kind)) + "')");
+    if (t.has("displacement_m") && !disp)
+        t.context().fail("loading.displacement_m",
+                         "is only used with kind = 'prescribed-displacement' or 'base-excitation' (kind is '" +
+                             std::string(to_string(l.kind)) + "')");
+    if (force) l.force_n = parse_time_function(t, "force_n", "N");
+    if (disp) l.displacement_m = parse_time_function(t, "displacement_m", "m");
+    return l;
 }
 
 void parse_mesh(const Table& top, ModelSpec& spec) {
@@ -481,10 +541,11 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     parse_interfaces(top, s.model);
     parse_clamps(top, s.model);
     parse_rigid_body(top, s.model);
-    s.loading = parse_loading(top, s.model);
+    const Loading loading = parse_loading(top, s.model);
     parse_mesh(top, s.model);
     parse_probe(top, s.model);
     parse_integrator(top, s.simulation);
+    s.simulation.loading = loading;
     parse_outputs(top, s.outputs);
 
     try {

@@ -13,7 +13,8 @@ namespace stackbeam {
 std::vector<std::string> step_record_columns() {
     return {"t",           "w",              "w_dot",          "force_on_mass",     "probe_friction_force",
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
-            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations"};
+            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
+            "spring_force", "external_force", "base_displacement", "external_work"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -31,7 +32,11 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.dissipated_energy_j,
             r.energy_balance_error_j,
             r.contact_residual_m,
-            static_cast<double>(r.factorizations)};
+            static_cast<double>(r.factorizations),
+            r.spring_force_n,
+            r.external_force_n,
+            r.base_displacement_m,
+            r.external_work_j};
 }
 
 const char* to_string(Mode m) {
@@ -86,6 +91,11 @@ void SimulationOptions::validate() const {
     if (t_end_s / dt_s > 1e9)
         throw InputError("dt", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end = " + format_value(t_end_s) + " s");
     make_solver(solver);  // validates the solver options
+    loading.validate();
+    if (mode == Mode::cvode && loading.kind == LoadingKind::prescribed_displacement)
+        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode: with w(t) "
+                                         "imposed there is no equation of motion to integrate, each step is "
+                                         "quasi-static (use mode closed-form, whose step is then exact)");
     if (mode == Mode::cvode) {
         if (!std::isfinite(cvode.rtol) || cvode.rtol < 1e-14 || cvode.rtol > 1e-2)
             throw InputError("rtol", "value " + format_value(cvode.rtol) +
@@ -121,10 +131,16 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     : system_(system), options_(options) {
     options_.validate();
     require_massless_leaves(system_, Mode::closed_form);
+    options_.loading.prepare();
+    const Loading& load = options_.loading;
+    rig_ = load.kind == LoadingKind::prescribed_displacement;
+    require_loading_fits(system_, load);
     path_ = choose_contact_path(system_, options_);
     const int n = system_.num_components();
     const double k = system_.stiffness_n_per_m();
     const double m = system_.mass_kg();
+    f_ = system_.model().whole_spring_factor();
+    m_whole_ = system_.model().spec().rigid_body.mass_kg;
     omega_ = std::sqrt(k / m);
     const double x = omega_ * options_.dt_s;
     cos_ = std::cos(x);
@@ -138,72 +154,155 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     const auto& c = system_.coupling();
     d_ = system_.initial_offsets_m();
     p_ = Eigen::VectorXd::Zero(n);
-    w_ = system_.model().spec().rigid_body.initial_displacement_m;
-    wd_ = system_.model().spec().rigid_body.initial_velocity_m_per_s;
+    const auto& rb = system_.model().spec().rigid_body;
+    const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+    const int nz = static_cast<int>(K.rows());
+    w_dof_ = nz - 1;
+    if (path_ == ContactPath::sparse) {
+        krw_ = Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1));
+        gw_ = Eigen::VectorXd(G.col(w_dof_));
+    }
+
+    // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
+    //    from the unloaded stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
+    w_ = 0.0;
+    if (load.gravity_m_per_s2 > 0.0) {
+        const double Fs = -m * load.gravity_m_per_s2;  // R's weight on the meshed part [N]
+        Eigen::VectorXd rel;
+        if (path_ == ContactPath::dense) {
+            ContactProblem st = problem_;
+            st.W = system_.compliance_held() + (1.0 / k) * c * c.transpose();
+            st.q = c * (Fs / k) - d_;
+            auto solver = make_solver(options_.solver);
+            solve_ = n > 0 ? solver->solve(st, p_) : SolveResult{};
+            w_ = (Fs + (n > 0 ? c.dot(p_) : 0.0)) / k;
+            rel = st.W * p_ + st.q + d_;
+        } else {
+            SparseContactProblem st;
+            st.K = K;
+            st.G = G;
+            st.b = Eigen::VectorXd::Zero(nz);
+            st.b[w_dof_] = Fs;
+            st.d = d_;
+            st.pairs = problem_.pairs;
+            st.tau_rule = problem_.tau_rule;
+            st.tau_previous_n = problem_.tau_previous_n;
+            SparseContactSolver solver(options_.solver);
+            solve_ = solver.solve(st, p_, z_);
+            w_ = z_[w_dof_];
+            rel = G * z_;
+        }
+        if (n > 0 && !solve_.converged)
+            throw SolverError("static equilibrium under gravity: " + solve_.message, 0, 0.0, solve_.residual_m);
+        reanchor(rel);
+    }
+    // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
+    //    relative to the supports, whose velocity the initial absolute velocity excludes).
+    double w_start = w_ + rb.initial_displacement_m;
+    wd_ = rb.initial_velocity_m_per_s - load.base_velocity_m_per_s(0.0);
+    if (rig_) {
+        w_start = load.displacement_m.value(0.0);
+        wd_ = load.displacement_m.derivative(0.0);
+    }
 
     if (path_ == ContactPath::dense) {
         solver_ = make_solver(options_.solver);
-        if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0)
+        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
             problem_.W = system_.compliance_held();
-            problem_.q = c * w_ - d_;
+            problem_.q = c * w_start - d_;
             solve_ = solver_->solve(problem_, p_);
             if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
         }
-        problem_.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
+        w_ = w_start;
+        // The rig holds R: each step is quasi-static with R held (W = C'); otherwise eq. 16.
+        problem_.W = rig_ ? system_.compliance_held()
+                          : Eigen::MatrixXd(system_.compliance_held() + (gamma_ / k) * c * c.transpose());
         problem_.q = Eigen::VectorXd::Zero(n);
         rel_ = system_.compliance_held() * p_ + c * w_;
     } else {
         // Sparse path (see simulation.hpp): K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma,
         // with 1 - gamma = sin(x)/x taken directly (no cancellation for small x).
-        if (!(sin_ > 0.0))
+        if (!(sin_ > 0.0) && !rig_)
             throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
                                        " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
         const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
-        const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
-        const int nz = static_cast<int>(K.rows());
-        w_dof_ = nz - 1;
         sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver);
-        z_ = system_.reduced_displacements(p_, w_);
-        if (w_ != 0.0 && n > 0) {  // initial contact state with R held at w(0): the problem on z_r
-            const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-            SparseContactProblem held;
-            held.K = K.topLeftCorner(w_dof_, w_dof_);
-            held.G = G.leftCols(w_dof_);
-            held.b = -Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1)) * w_;
-            held.d = d_ - Eigen::VectorXd(G.col(w_dof_)) * w_;
-            held.pairs = problem_.pairs;
-            held.tau_rule = problem_.tau_rule;
-            held.tau_previous_n = problem_.tau_previous_n;
+        if (z_.size() == 0) z_ = system_.reduced_displacements(p_, w_);
+        SparseContactProblem held;  // R held at w: the problem on z_r
+        held.K = K.topLeftCorner(w_dof_, w_dof_);
+        held.G = G.leftCols(w_dof_);
+        held.pairs = problem_.pairs;
+        held.tau_rule = problem_.tau_rule;
+        held.tau_previous_n = problem_.tau_previous_n;
+        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
+            held.b = -krw_ * w_start;
+            held.d = d_ - gw_ * w_start;
             SparseContactSolver initial(options_.solver);
             Eigen::VectorXd zr;
             solve_ = initial.solve(held, p_, zr);
             if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
             z_.head(w_dof_) = zr;
+            z_[w_dof_] = w_start;
         }
-        Eigen::SparseMatrix<double> Kaug = K;
-        Kaug.coeffRef(w_dof_, w_dof_) += k * one_minus_gamma / gamma_;
-        Kaug.makeCompressed();
-        sparse_problem_.K = std::move(Kaug);
-        sparse_problem_.G = system_.contact_rows();
-        sparse_problem_.b = Eigen::VectorXd::Zero(nz);
+        w_ = w_start;
+        if (rig_) {
+            sparse_problem_ = std::move(held);
+        } else {
+            Eigen::SparseMatrix<double> Kaug = K;
+            Kaug.coeffRef(w_dof_, w_dof_) += k * one_minus_gamma / gamma_;
+            Kaug.makeCompressed();
+            sparse_problem_.K = std::move(Kaug);
+            sparse_problem_.G = G;
+            sparse_problem_.b = Eigen::VectorXd::Zero(nz);
+            sparse_problem_.pairs = problem_.pairs;
+            sparse_problem_.tau_rule = problem_.tau_rule;
+            sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        }
         sparse_problem_.d = d_;
-        sparse_problem_.pairs = problem_.pairs;
-        sparse_problem_.tau_rule = problem_.tau_rule;
-        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-        rel_ = system_.contact_rows() * z_;
+        rel_ = G * z_;
     }
+    fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
     fill_record(0, 0);
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
 }
 
+void ClosedFormStepper::reanchor(const Eigen::VectorXd& rel) {
+    // Anchors (paper, section 5): a pair that sticks keeps its d_t; any other is re-anchored where it is.
+    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
+        const auto& pr = problem_.pairs[j];
+        if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
+        if (pair_state(problem_, static_cast<int>(j), p_) != PairState::stick) d_[pr.row_t] = rel[pr.row_t];
+    }
+}
+
+void require_loading_fits(const System& system, const Loading& loading) {
+    const auto& rb = system.model().spec().rigid_body;
+    if (loading.kind == LoadingKind::prescribed_displacement) {
+        if (rb.initial_displacement_m != 0.0)
+            throw InputError("rigid_body.initial_displacement_m",
+                             "value " + format_value(rb.initial_displacement_m) +
+                                 " is not allowed with a prescribed displacement: w(0) is the prescribed w(0) (give 0)");
+        if (rb.initial_velocity_m_per_s != 0.0)
+            throw InputError("rigid_body.initial_velocity_m_per_s",
+                             "value " + format_value(rb.initial_velocity_m_per_s) +
+                                 " is not allowed with a prescribed displacement: w'(0) is the prescribed one (give 0)");
+    }
+}
+
 void detail::fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
                         double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
-                        StepRecord& r) {
+                        const LoadState& load, StepRecord& r) {
     const double f = system.model().whole_spring_factor();
     r.w_m = w_m;
     r.w_dot_m_per_s = w_dot_m_per_s;
-    r.force_on_mass_n = f * (system.coupling().dot(p) - system.stiffness_n_per_m() * w_m);
+    const double cp = p.size() > 0 ? system.coupling().dot(p) : 0.0;
+    r.spring_force_n = f * (system.stiffness_n_per_m() * w_m - cp);
+    r.external_force_n = load.external_force_n;
+    r.force_on_mass_n = load.prescribed ? load.force_on_mass_n : load.external_force_n - r.spring_force_n;
+    r.base_displacement_m = load.base_displacement_m;
+    r.external_work_j = load.external_work_j;
     // The probe pair may carry no tangential component (mu = 0, or fixed by a support):
     // its friction force is then zero. NaN only when the model has no probe at all.
     const int probe = system.probe_pair();
@@ -221,18 +320,29 @@ void detail::fill_state(const System& system, const ContactProblem& laws, const 
     r.kinetic_energy_j = 0.5 * system.model().spec().rigid_body.mass_kg * w_dot_m_per_s * w_dot_m_per_s;
     r.strain_energy_j = strain_energy_j;
     r.dissipated_energy_j = dissipated_energy_j;
-    r.energy_balance_error_j = e0_j - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
+    r.energy_balance_error_j =
+        e0_j + load.external_work_j - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
 }
 
 void ClosedFormStepper::fill_record(int iterations, int factorizations) {
-    const double f = system_.model().whole_spring_factor();
+    const double f = f_;
     const double k = system_.stiffness_n_per_m();
     // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp); the
     // sparse path has z itself and never builds C'.
     const double strain = path_ == ContactPath::dense
                               ? 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_)
                               : 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
-    detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, record_);
+    detail::LoadState load;
+    load.external_work_j = wext_;
+    load.base_displacement_m = options_.loading.base_displacement_m(t_);
+    if (rig_) {
+        load.prescribed = true;
+        load.force_on_mass_n = m_whole_ * options_.loading.displacement_m.second_derivative(t_);
+        load.external_force_n = f * (k * w_ - (p_.size() > 0 ? system_.coupling().dot(p_) : 0.0));
+    } else {
+        load.external_force_n = f * fe_;
+    }
+    detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, load, record_);
     record_.t_s = t_;
     record_.contact_iterations = iterations;
     record_.factorizations = factorizations;
@@ -249,11 +359,25 @@ const StepRecord& ClosedFormStepper::step() {
     const double k = system_.stiffness_n_per_m();
     const double dt = options_.dt_s;
     const auto& c = system_.coupling();
-    // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
-    const double F0 = c.dot(p_);
-    const double w_free = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k;
-    // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
-    if (path_ == ContactPath::dense) problem_.q = c * w_free - d_;
+    const Loading& load = options_.loading;
+    const double t1 = (step_ + 1) * dt;
+    const double w0 = w_;
+    const double spring0 = f_ * (k * w_ - c.dot(p_));
+    const double kin0 = 0.5 * m_whole_ * wd_ * wd_;
+    double w_next = 0.0, fe1 = 0.0;
+    if (rig_) {
+        // The rig: w(t+dt) prescribed, the contact problem quasi-static with R held there.
+        w_next = load.displacement_m.value(t1);
+        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
+    } else {
+        // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
+        // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
+        fe1 = load.external_force_n(t1, m_whole_) / f_;
+        const double F0 = c.dot(p_) + fe_;
+        w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
+        // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
+        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
+    }
     if (problem_.tau_rule == TauRule::previous_step)
         for (int j = 0; j < static_cast<int>(problem_.pairs.size()); ++j) {
             const auto& pr = problem_.pairs[j];
@@ -263,8 +387,16 @@ const StepRecord& ClosedFormStepper::step() {
     const Eigen::VectorXd p0 = p_;
     if (path_ == ContactPath::dense) {
         solve_ = solver_->solve(problem_, p_);
+    } else if (rig_) {
+        sparse_problem_.b = -krw_ * w_next;
+        sparse_problem_.d = d_ - gw_ * w_next;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        Eigen::VectorXd zr = z_.head(w_dof_);
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, zr);
+        z_.head(w_dof_) = zr;
+        z_[w_dof_] = w_next;
     } else {
-        sparse_problem_.b[w_dof_] = k / gamma_ * w_free;
+        sparse_problem_.b[w_dof_] = k / gamma_ * w_next;
         sparse_problem_.d = d_;
         sparse_problem_.tau_previous_n = problem_.tau_previous_n;
         solve_ = sparse_solver_->solve(sparse_problem_, p_, z_);
@@ -274,27 +406,39 @@ const StepRecord& ClosedFormStepper::step() {
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
                               format_value(step_ * dt) + " s: " + solve_.message,
                           step_, step_ * dt, solve_.residual_m);
-    const double F1 = c.dot(p_);
-    const double w1 = w_free + gamma_ * F1 / k;
-    const double wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
+    double w1 = 0.0, wd1 = 0.0;
+    if (rig_) {
+        w1 = w_next;
+        wd1 = load.displacement_m.derivative(t1);
+    } else {
+        const double F0 = c.dot(p0) + fe_;
+        const double F1 = c.dot(p_) + fe1;
+        w1 = w_next + gamma_ * c.dot(p_) / k;
+        wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
+    }
     // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
-    const Eigen::VectorXd rel1 = path_ == ContactPath::dense ? Eigen::VectorXd(problem_.W * p_ + problem_.q + d_)
-                                                             : Eigen::VectorXd(sparse_problem_.G * z_);
+    Eigen::VectorXd rel1;
+    if (path_ == ContactPath::dense) rel1 = problem_.W * p_ + problem_.q + d_;
+    else rel1 = system_.contact_rows() * z_;
     double work = 0.0;
     for (const auto& pr : problem_.pairs)
         if (pr.row_t >= 0 && pr.kind != PairKind::bonded)
             work += 0.5 * (p0[pr.row_t] + p_[pr.row_t]) * (rel1[pr.row_t] - rel_[pr.row_t]);
-    dissipated_ -= system_.model().whole_spring_factor() * work;
+    dissipated_ -= f_ * work;
+    // External work, trapezoidal: the loading's force on R over dw (exact for a constant
+    // force); the rig: its force on the spring over dw plus the kinetic energy it gives R.
+    if (rig_) {
+        const double spring1 = f_ * (k * w1 - c.dot(p_));
+        wext_ += 0.5 * (spring0 + spring1) * (w1 - w0) + 0.5 * m_whole_ * wd1 * wd1 - kin0;
+    } else {
+        wext_ += 0.5 * f_ * (fe_ + fe1) * (w1 - w0);
+        fe_ = fe1;
+    }
     rel_ = rel1;
     w_ = w1;
     wd_ = wd1;
     t_ = step_ * dt;
-    // Anchors (paper, section 5): a pair that sticks keeps its d_t; any other is re-anchored where it is.
-    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
-        const auto& pr = problem_.pairs[j];
-        if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
-        if (pair_state(problem_, static_cast<int>(j), p_) != PairState::stick) d_[pr.row_t] = rel_[pr.row_t];
-    }
+    reanchor(rel_);
     fill_record(solve_.iterations, solve_.factorizations);
     return record_;
 }

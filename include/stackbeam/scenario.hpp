@@ -16,13 +16,6 @@
 
 namespace stackbeam {
 
-/// How the rigid body is set in motion. Today only initial conditions
-/// (`[loading] kind = "initial-conditions"`), stored in ModelSpec::rigid_body.
-enum class LoadingKind {
-    initial_conditions,  ///< w(0) and dw/dt(0) of the rigid body, no external force
-};
-const char* to_string(LoadingKind kind);
-
 /// Where a run writes its results. Empty: not given in the file. Relative paths
 /// are relative to the working directory (like command-line paths), not to the file.
 struct ScenarioOutputs {
@@ -35,8 +28,9 @@ struct Scenario {
     std::string source;        ///< the file name (or the name given to parse_scenario)
     std::string description;   ///< free text (`description`), may be empty
     ModelSpec model;           ///< the stack; Model::build(model) succeeds (checked by the parser)
-    LoadingKind loading = LoadingKind::initial_conditions;
-    SimulationOptions simulation;  ///< the integrator; validate() succeeds (checked by the parser)
+    /// The integrator and the loading (`simulation.loading`, from `[loading]`; the initial
+    /// conditions go to model.rigid_body); validate() succeeds (checked by the parser).
+    SimulationOptions simulation;
     ScenarioOutputs outputs;
 };
 

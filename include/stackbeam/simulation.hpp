@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "stackbeam/contact.hpp"
+#include "stackbeam/loading.hpp"
 #include "stackbeam/system.hpp"
 
 namespace stackbeam {
@@ -36,6 +37,14 @@ struct StepRecord {
     double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
     double contact_residual_m = 0.0;    ///< ||v||_2 (eq. 9) at the converged forces [m]
     int factorizations = 0;             ///< dense factorisations of the step (exact solver)
+    // Loadings (loading.hpp); all zero under the paper's initial conditions.
+    double spring_force_n = 0.0;        ///< force of R on the stack, +y: k w - c^T p, whole spring [N]
+                                        ///< (the force the rig's load cell reads; the loop is spring_force vs w)
+    double external_force_n = 0.0;      ///< load on R besides the stack: applied force - weight - m y_b'' [N];
+                                        ///< prescribed displacement: the rig's force on the spring (= spring_force_n)
+    double base_displacement_m = 0.0;   ///< y_b of the supports [m] (base excitation): R's absolute displacement is w + y_b
+    double external_work_j = 0.0;       ///< work of the external loads since t = 0 [J]; the balance is
+                                        ///< E(0) + external work - (kinetic + strain + dissipated)
 };
 
 /// Column names of StepRecord in CSV order.
@@ -85,6 +94,7 @@ struct SimulationOptions {
     double dt_s = 1e-3;        ///< time step [s] (paper: 1e-3); in mode cvode the output interval
     CvodeOptions cvode;        ///< mode cvode only
     double t_end_s = 0.6;      ///< end time [s]
+    Loading loading;           ///< how the spring is loaded (loading.hpp); default: the paper's initial conditions
     SolverOptions solver;      ///< contact solver and its tolerance (paper: ||v|| < 2e-6 m)
     TauRule tau_rule = TauRule::current;
     /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
@@ -158,8 +168,19 @@ private:
     double e0_ = 0.0, dissipated_ = 0.0;
     long step_ = 0;
     StepRecord record_;
+    // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
+    // external work [J, whole spring], and for the rig and the sparse path R's column of
+    // K (K_rw) and of G.
+    bool rig_ = false;
+    double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
+    Eigen::VectorXd krw_, gw_;
     void fill_record(int iterations, int factorizations);
+    void reanchor(const Eigen::VectorXd& rel);
 };
+
+/// Throws InputError when the model's initial conditions contradict the loading
+/// (a prescribed displacement fixes w(0) and w'(0) itself).
+void require_loading_fits(const System& system, const Loading& loading);
 
 /// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
 /// with a density > 0 would be silently ignored there: this throws InputError naming

@@ -1,0 +1,109 @@
+#pragma once
+/// @file loading.hpp
+/// How a run loads the spring: the rigid body's initial conditions (the paper), an
+/// applied force on the rigid body, a prescribed displacement of the rigid body (the
+/// test-rig loop of a leaf spring), gravity on the rigid body with the static
+/// equilibrium computed first, and a prescribed motion of the supports (base excitation).
+///
+/// Signs (conventions.hpp): y is up; w and every force on R are +y. Forces are
+/// whole-spring values (on the half model the meshed part carries half of them, as it
+/// carries half of R's mass).
+///
+/// How each loading enters the equation of motion of R (massless leaves, system.hpp):
+///     m w'' = c^T p - k w + F_e(t)                       (meshed part)
+///     F_e(t) = F(t)/f - m g - m y_b''(t)                 (f = System::whole_spring_factor)
+///  - applied force: F(t) on R;
+///  - gravity: R's weight -m g (the leaves are massless, so they weigh nothing). The
+///    run starts from the static equilibrium under it: the contact problem of a
+///    quasi-static load step from the unloaded stack (w = (F_e + c^T p)/k), then the
+///    initial displacement and velocity are added to that state;
+///  - base excitation: every support moves by y_b(t) (the leaf ends' pins and built-in
+///    ends together; a rigid translation of the stack, which the massless leaves follow
+///    without force). The run is written in the frame of the supports: w is the
+///    deflection of R relative to them (so the spring sees w as in the other loadings),
+///    R feels the inertial force -m y_b''(t), and R's absolute displacement is
+///    w + y_b (StepRecord::base_displacement_m). Energies are those of the relative
+///    motion (kinetic energy m w'^2/2 with the relative velocity), and the work of the
+///    inertial force is the external work;
+///  - prescribed displacement: w(t) is imposed (a servo-hydraulic rig holding R); the
+///    contact problem is quasi-static at each step (s = C'p + c w(t) - d), the rig
+///    force is the spring force k w - c^T p (a load cell between rig and spring: R's
+///    own inertia is not part of the loop) and the rig's work is the external work.
+/// Energy balance of every loading: E(0) + W_ext(t) = kinetic + strain + dissipated.
+#include <string>
+#include <vector>
+
+namespace stackbeam {
+
+/// A scalar function of time, in the unit of what it describes ([N] or [m]).
+struct TimeFunction {
+    enum class Shape {
+        constant,  ///< mean
+        harmonic,  ///< mean + amplitude sin(2 pi frequency t + phase)
+        triangle,  ///< mean + amplitude tri(frequency t + phase/(2 pi)): 0 at t = 0 rising to +amplitude
+                   ///< at a quarter period, -amplitude at three quarters (a rig's constant-speed stroke)
+        table,     ///< through the points (times_s[i], values[i]); constant before the first and after the
+                   ///< last. Forces and prescribed displacements: piecewise linear. Base displacement: a C2
+                   ///< cubic spline with zero slope at both ends (its acceleration is continuous)
+    };
+    Shape shape = Shape::constant;
+    double mean = 0.0;           ///< offset (constant value) [N or m]
+    double amplitude = 0.0;      ///< [N or m], >= 0 (harmonic, triangle)
+    double frequency_hz = 0.0;   ///< [Hz], > 0 (harmonic, triangle)
+    double phase_rad = 0.0;      ///< [rad] (harmonic, triangle)
+    std::vector<double> times_s; ///< table: strictly increasing times [s], >= 2 points
+    std::vector<double> values;  ///< table: values [N or m], as many as times_s
+
+    /// Throws InputError naming `field` + ".amplitude" etc. when a value is out of range.
+    /// `smooth`: the function must have a continuous second derivative (base displacement:
+    /// a triangle is refused, a table is splined).
+    void validate(const std::string& field, bool smooth) const;
+    /// Prepares the spline of a smooth table (validate first). Called by Loading::prepare.
+    void prepare(bool smooth);
+
+    double value(double t_s) const;
+    double derivative(double t_s) const;         ///< d/dt [unit/s]
+    double second_derivative(double t_s) const;  ///< d2/dt2 [unit/s^2] (smooth functions)
+    /// Period [s] of a periodic shape (harmonic, triangle), 0 otherwise.
+    double period_s() const;
+
+    /// Spline second derivatives at the table's points (smooth tables; filled by prepare()).
+    std::vector<double> spline_m2;
+};
+
+const char* to_string(TimeFunction::Shape shape);
+
+enum class LoadingKind {
+    initial_conditions,       ///< the paper: w(0), w'(0) of the rigid body, no force
+    applied_force,            ///< force F(t) on R (plus the initial conditions)
+    prescribed_displacement,  ///< w(t) imposed on R: the test-rig loop
+    base_excitation,          ///< the supports move by y_b(t) (plus the initial conditions)
+};
+const char* to_string(LoadingKind kind);
+
+struct Loading {
+    LoadingKind kind = LoadingKind::initial_conditions;
+    TimeFunction force_n;         ///< applied_force: F(t) on R, +y, whole spring [N]
+    TimeFunction displacement_m;  ///< prescribed_displacement: w(t) [m]; base_excitation: y_b(t) [m]
+    double gravity_m_per_s2 = 0.0;///< acceleration of gravity g [m/s^2], >= 0, acting in -y on R;
+                                  ///< 0: none. Not with prescribed_displacement (the rig holds R)
+
+    /// Throws InputError naming the field ("loading.force_n.amplitude", ...) when out of range.
+    void validate() const;
+    /// validate() and the derived data (splines). Steppers call it on their copy.
+    void prepare();
+    /// True when nothing but initial conditions act (the paper).
+    bool is_free() const noexcept { return kind == LoadingKind::initial_conditions && gravity_m_per_s2 == 0.0; }
+
+    /// External force on R [N] at t, whole spring, for mass `mass_kg` (the whole R): F(t) - m g - m y_b''(t).
+    /// 0 for a prescribed displacement (the rig's force is a result).
+    double external_force_n(double t_s, double mass_kg) const;
+    /// Base displacement y_b(t) [m] (base_excitation), 0 otherwise.
+    double base_displacement_m(double t_s) const;
+    /// Base velocity y_b'(t) [m/s] (base_excitation), 0 otherwise.
+    double base_velocity_m_per_s(double t_s) const;
+    /// Period of the loading's excitation [s] (periodic shapes), 0 otherwise.
+    double period_s() const;
+};
+
+}  // namespace stackbeam
