@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "gnuplot.hpp"
 #include "stackbeam/csv.hpp"
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
@@ -178,37 +179,9 @@ std::string csv_name(PaperCase c, Mode m, const std::string& suffix = "") {
 
 // --- gnuplot -----------------------------------------------------------------------
 
-/// Single-quoted for /bin/sh.
-std::string shell_quote(const std::string& s) {
-    std::string q = "'";
-    for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-    return q + "'";
-}
-
-bool gnuplot_on_path() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
-
-/// "pngcairo" or "png", whichever this gnuplot has; nullopt if neither.
-std::optional<std::string> png_terminal() {
-    FILE* pipe = popen("gnuplot -e 'set terminal' 2>&1", "r");
-    if (!pipe) return std::nullopt;
-    std::string text;
-    char buf[512];
-    while (std::fgets(buf, sizeof buf, pipe)) text += buf;
-    pclose(pipe);
-    auto has = [&](const std::string& name) {
-        std::istringstream lines(text);
-        std::string line;
-        while (std::getline(lines, line)) {
-            std::istringstream words(line);
-            std::string first;
-            if (words >> first && first == name) return true;
-        }
-        return false;
-    };
-    if (has("pngcairo")) return std::string("pngcairo");
-    if (has("png")) return std::string("png");
-    return std::nullopt;
-}
+using stackbeam::demo::gnuplot_on_path;
+using stackbeam::demo::png_terminal;
+using stackbeam::demo::shell_quote;
 
 /// A gnuplot script drawing the figures from the CSV files in the same directory,
 /// both modes overlaid (closed-form solid, cvode dashed).

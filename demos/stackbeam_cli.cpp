@@ -23,6 +23,8 @@
 /// Every file is written to FILE.partial and renamed to FILE only when the whole run
 /// succeeded. Exit status: 0 success, 2 bad input, 3 solver failure, 1 other errors.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -37,9 +39,11 @@
 #include <string>
 #include <utility>
 
+#include "gnuplot.hpp"
 #include "stackbeam/csv.hpp"
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "stackbeam/hysteresis.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/scenario.hpp"
@@ -108,8 +112,127 @@ struct SimulateArgs {
     std::string max_iterations = "200000";
     std::string contact_path = "auto";
     std::string out;
+    std::string summary;  ///< JSON summary file
+    std::string pairs;    ///< per-pair CSV file
+    std::string plot;     ///< PNG file prefix
+    std::string gravity;  ///< g [m/s^2] on R
+    bool quiet = false;
     std::set<std::string> given;  ///< the options given on the command line
 };
+
+/// A file written as FILE.partial and renamed to FILE when the whole run succeeded.
+class PartialFile {
+public:
+    PartialFile(const std::string& path, const std::string& option) : path_(path), partial_(path + ".partial") {
+        if (path_.empty()) return;
+        stream_.open(partial_, std::ios::out | std::ios::trunc);
+        if (!stream_) throw ArgumentError(option + ": cannot open '" + partial_ + "' for writing");
+    }
+    bool active() const { return !path_.empty(); }
+    std::ofstream& stream() { return stream_; }
+    const std::string& partial() const { return partial_; }
+    /// Closes and renames; throws if writing failed.
+    void commit() {
+        if (!active()) return;
+        stream_.close();
+        if (stream_.fail()) throw std::runtime_error("writing '" + partial_ + "' failed");
+        if (std::rename(partial_.c_str(), path_.c_str()) != 0)
+            throw std::runtime_error("cannot rename '" + partial_ + "' to '" + path_ + "'");
+    }
+    /// Removes the partial file (bad input found before any result).
+    void discard() {
+        if (!active()) return;
+        stream_.close();
+        std::remove(partial_.c_str());
+    }
+
+private:
+    std::string path_, partial_;
+    std::ofstream stream_;
+};
+
+/// Progress on stderr when it is a terminal (and not --quiet): a line rewritten at
+/// most every 0.2 s wall time.
+class Progress {
+public:
+    Progress(bool enabled, double t_end_s) : enabled_(enabled && isatty(fileno(stderr)) != 0), t_end_(t_end_s) {}
+    void update(double t_s) {
+        if (!enabled_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (shown_ && now - last_ < std::chrono::milliseconds(200)) return;
+        last_ = now;
+        shown_ = true;
+        std::fprintf(stderr, "\rstackbeam: t = %.4g of %.4g s (%3.0f %%)", t_s, t_end_, 100.0 * t_s / t_end_);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (enabled_ && shown_) std::fprintf(stderr, "\r%60s\r", "");
+    }
+
+private:
+    bool enabled_;
+    double t_end_;
+    bool shown_ = false;
+    std::chrono::steady_clock::time_point last_;
+};
+
+/// 1-based column of `name` in the records' CSV (for gnuplot).
+int column_of(const std::string& name) {
+    const auto cols = stackbeam::step_record_columns();
+    for (std::size_t i = 0; i < cols.size(); ++i)
+        if (cols[i] == name) return static_cast<int>(i) + 1;
+    throw std::logic_error("no CSV column " + name);
+}
+
+/// PNG figures of a run with gnuplot from its CSV: displacement, forces, friction
+/// force at the probe, and the loop (spring force against w). Returns the files
+/// written, or a note why none were.
+std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note) {
+    using namespace stackbeam::demo;
+    if (!gnuplot_on_path()) {
+        note = "gnuplot is not on PATH: no figures (install gnuplot-nox)";
+        return {};
+    }
+    const auto terminal = png_terminal();
+    if (!terminal) {
+        note = "gnuplot has neither the pngcairo nor the png terminal: no figures";
+        return {};
+    }
+    const std::string script_path = prefix + "_figures.gp";
+    std::ofstream g(script_path);
+    if (!g) throw ArgumentError("--plot: cannot write '" + script_path + "'");
+    std::vector<std::string> files;
+    auto fig = [&](const std::string& name, const std::string& title, const std::string& xl, const std::string& yl,
+                   const std::string& curves) {
+        files.push_back(prefix + "_" + name + ".png");
+        g << "set output '" << files.back() << "'\nset title '" << title << "'\nset xlabel '" << xl
+          << "'\nset ylabel '" << yl << "'\nplot " << curves << "\n";
+    };
+    const std::string f = "'" + csv + "'";
+    const int t = column_of("t"), w = column_of("w"), fm = column_of("force_on_mass"),
+              pf = column_of("probe_friction_force"), sf = column_of("spring_force"), ef = column_of("external_force"),
+              yb = column_of("base_displacement");
+    g << "set datafile separator ','\nset terminal " << *terminal << " size 1000,620\nset grid\nset key top right\n";
+    fig("displacement", "displacement of R", "t [s]", "[mm]",
+        f + " using " + std::to_string(t) + ":(1000*$" + std::to_string(w) + ") with lines lw 2 title 'w (deflection)', " +
+            f + " using " + std::to_string(t) + ":(1000*($" + std::to_string(w) + "+$" + std::to_string(yb) +
+            ")) with lines dt 2 title 'w + y_b (absolute)'");
+    fig("force", "forces on R", "t [s]", "[N]",
+        f + " using " + std::to_string(t) + ":" + std::to_string(sf) + " with lines lw 2 title 'spring force', " + f +
+            " using " + std::to_string(t) + ":" + std::to_string(ef) + " with lines dt 2 title 'external force', " + f +
+            " using " + std::to_string(t) + ":" + std::to_string(fm) + " with lines dt 3 title 'm d^2w/dt^2'");
+    fig("friction", "friction force at the probe pair", "t [s]", "[N]",
+        f + " using " + std::to_string(t) + ":" + std::to_string(pf) + " with lines lw 2 title 'p_t'");
+    fig("loop", "force-deflection loop", "w [mm]", "spring force [N]",
+        f + " using (1000*$" + std::to_string(w) + "):" + std::to_string(sf) + " with lines lw 1.5 notitle");
+    g.close();
+    if (!g) throw std::runtime_error("writing '" + script_path + "' failed");
+    if (std::system(("gnuplot " + shell_quote(script_path)).c_str()) != 0) {
+        note = "gnuplot failed on " + script_path;
+        return {};
+    }
+    return files;
+}
 
 /// Sets the integrator options from the command line: all of them (with their
 /// defaults) for --case, only those given explicitly over a scenario's values.
@@ -143,6 +266,7 @@ int run_simulate(const SimulateArgs& a) {
     stackbeam::ModelSpec spec;
     std::string out = a.out;
     std::string events = a.events;
+    std::string summary = a.summary, pairs = a.pairs, plot = a.plot;
     std::string setup;  // first line of the summary
     if (!a.scenario.empty()) {
         // A scenario file; options given on the command line override its values.
@@ -155,6 +279,9 @@ int run_simulate(const SimulateArgs& a) {
             throw ArgumentError("--out: an output file name is required (none given, and " + a.scenario +
                                 " has no outputs.csv_path)");
         if (events.empty()) events = scenario.outputs.events_path;
+        if (summary.empty()) summary = scenario.outputs.summary_path;
+        if (pairs.empty()) pairs = scenario.outputs.pairs_path;
+        if (plot.empty()) plot = scenario.outputs.plot_prefix;
         setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
@@ -167,6 +294,10 @@ int run_simulate(const SimulateArgs& a) {
         spec = stackbeam::paper_example(pcase, example);
         setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                 " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+    }
+    if (a.given.count("--gravity")) {
+        // parse_positive refuses 0; gravity 0 is "none": accept it explicitly
+        options.loading.gravity_m_per_s2 = a.gravity == "0" ? 0.0 : parse_positive("--gravity", a.gravity, "m/s^2");
     }
     const bool cvode = options.mode == stackbeam::Mode::cvode;
     if (!cvode && !events.empty())
@@ -181,54 +312,80 @@ int run_simulate(const SimulateArgs& a) {
     const stackbeam::ContactPath path = stackbeam::choose_contact_path(system, options);
 
     // --- run, streaming rows to FILE.partial ----------------------------------------
-    const std::string partial = out + ".partial";
-    std::ofstream csv(partial, std::ios::out | std::ios::trunc);
-    if (!csv) throw ArgumentError("--out: cannot open '" + partial + "' for writing");
-    stackbeam::write_csv_header(csv);
+    PartialFile csv(out, "--out");
+    PartialFile pairs_csv(pairs, "--pairs");
+    PartialFile json(summary, "--summary");
+    stackbeam::write_csv_header(csv.stream());
+    if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
+    pairs_csv.stream().precision(17);
 
     long steps = -1;  // the first record is the initial state
     long total_iterations = 0;
     int max_iterations = 0;
-    stackbeam::StepRecord last;
+    std::vector<stackbeam::StepRecord> records;
     stackbeam::RunReport report;
+    Progress progress(!a.quiet, options.t_end_s);
+    stackbeam::PairObserver on_pairs;
+    if (pairs_csv.active())
+        on_pairs = [&](double t, const std::vector<stackbeam::PairRecord>& prs) {
+            auto& o = pairs_csv.stream();
+            for (const auto& p : prs)
+                o << t << ',' << p.pair << ',' << p.interface_index << ',' << p.x_m << ',' << stackbeam::to_string(p.state)
+                  << ',' << p.p_n_n << ',' << p.p_t_n << ',' << p.gap_m << ',' << p.slip_m << '\n';
+        };
     try {
-        stackbeam::simulate(system, options, [&](const stackbeam::StepRecord& r) {
-            stackbeam::write_csv_row(csv, r);
+        records = stackbeam::simulate(system, options, [&](const stackbeam::StepRecord& r) {
+            stackbeam::write_csv_row(csv.stream(), r);
             ++steps;
             total_iterations += r.contact_iterations;
             max_iterations = std::max(max_iterations, r.contact_iterations);
-            last = r;
-        }, &report);
+            progress.update(r.t_s);
+        }, &report, on_pairs);
+        progress.finish();
     } catch (const stackbeam::InputError&) {
         // bad input found when the run starts (e.g. an option the mode cannot use): no rows to keep
-        csv.close();
-        std::remove(partial.c_str());
+        progress.finish();
+        csv.discard();
+        pairs_csv.discard();
+        json.discard();
         throw;
     } catch (...) {
-        csv.flush();
+        progress.finish();
+        csv.stream().flush();
+        pairs_csv.stream().flush();
+        json.discard();
         std::cerr << "stackbeam: note: " << out << " was not written; the rows up to the failure are in "
-                  << partial << "\n";
+                  << csv.partial() << "\n";
         throw;
     }
-    csv.flush();
-    csv.close();
-    if (csv.fail()) throw std::runtime_error("writing '" + partial + "' failed");
+    const stackbeam::StepRecord last = records.back();
     if (!events.empty()) {
-        const std::string events_partial = events + ".partial";
-        std::ofstream ev(events_partial, std::ios::out | std::ios::trunc);
-        if (!ev) throw ArgumentError("--events: cannot open '" + events_partial + "' for writing");
-        stackbeam::write_events_csv(ev, report.events);
-        ev.close();
-        if (ev.fail()) throw std::runtime_error("writing '" + events_partial + "' failed");
-        if (std::rename(events_partial.c_str(), events.c_str()) != 0)
-            throw std::runtime_error("cannot rename '" + events_partial + "' to '" + events + "'");
+        PartialFile ev(events, "--events");
+        stackbeam::write_events_csv(ev.stream(), report.events);
+        ev.commit();
     }
-    if (std::rename(partial.c_str(), out.c_str()) != 0)
-        throw std::runtime_error("cannot rename '" + partial + "' to '" + out + "'");
+    csv.commit();
+    pairs_csv.commit();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
+    // --- loop figures: the last period of a periodic loading -------------------------
+    std::optional<stackbeam::HysteresisMetrics> loop;
+    std::string loop_note;
+    if (options.loading.period_s() > 0.0) {
+        try {
+            const auto cyc = stackbeam::last_cycle(records, options.loading.period_s());
+            loop = stackbeam::hysteresis_metrics(records, cyc.first, cyc.second);
+        } catch (const stackbeam::InputError& e) {
+            loop_note = e.what();
+        }
+    } else {
+        loop_note = "no periodic loading: no steady cycle";
+    }
+    double max_balance = 0.0;
+    for (const auto& r : records) max_balance = std::max(max_balance, std::abs(r.energy_balance_error_j));
+
     // --- summary ----------------------------------------------------------------------
-    const double e0 = 0.5 * model.spec().rigid_body.mass_kg * std::pow(model.spec().rigid_body.initial_velocity_m_per_s, 2);
+    const double e0 = records.front().kinetic_energy_j + records.front().strain_energy_j;
     std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", setup.c_str(), stackbeam::to_string(options.mode),
                 stackbeam::to_string(options.solver.kind), options.dt_s, options.t_end_s);
     if (cvode) {
@@ -248,11 +405,91 @@ int run_simulate(const SimulateArgs& a) {
                 max_iterations, steps > 0 ? static_cast<double>(total_iterations) / steps : 0.0);
     std::printf("final state                t %.6g s, w %.6g m, w_dot %.6g m/s\n", last.t_s, last.w_m,
                 last.w_dot_m_per_s);
-    std::printf("energy balance error       %.3e J (initial energy %.6g J, dissipated %.6g J)\n",
-                last.energy_balance_error_j, e0, last.dissipated_energy_j);
+    std::printf("loading                    %s%s\n", stackbeam::to_string(options.loading.kind),
+                options.loading.gravity_m_per_s2 > 0.0
+                    ? (", gravity " + std::to_string(options.loading.gravity_m_per_s2) + " m/s^2").c_str()
+                    : "");
+    std::printf("energy balance error       %.3e J at the end, %.3e J largest (initial energy %.6g J, external work %.6g J, "
+                "dissipated %.6g J)\n",
+                last.energy_balance_error_j, max_balance, e0, last.external_work_j, last.dissipated_energy_j);
+    if (loop) {
+        std::printf("loop                       t %.6g to %.6g s: area %.6g J per cycle (friction work %.6g J), secant stiffness %.6g N/m,\n"
+                    "                           dynamic rate %.6g N/m, loss factor %.4g, equivalent damping ratio %.4g\n",
+                    loop->t_start_s, loop->t_end_s, loop->loop_area_j, loop->dissipated_j, loop->secant_stiffness_n_per_m,
+                    loop->dynamic_rate_n_per_m, loop->loss_factor, loop->equivalent_damping_ratio);
+    } else {
+        std::printf("loop                       none (%s)\n", loop_note.c_str());
+    }
     std::printf("wall time                  %.3f s\n", wall_s);
     std::printf("output                     %s\n", out.c_str());
     if (!events.empty()) std::printf("event log                  %s\n", events.c_str());
+    if (pairs_csv.active()) std::printf("pairs                      %s\n", pairs.c_str());
+    if (!plot.empty()) {
+        std::string note;
+        const auto files = plot_run(out, plot, note);
+        for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
+        if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
+    }
+    if (json.active()) {
+        nlohmann::json j;
+        j["setup"] = setup;
+        j["mode"] = stackbeam::to_string(options.mode);
+        j["solver"] = stackbeam::to_string(options.solver.kind);
+        j["dt_s"] = options.dt_s;
+        j["t_end_s"] = options.t_end_s;
+        j["loading"] = {{"kind", stackbeam::to_string(options.loading.kind)},
+                        {"gravity_m_per_s2", options.loading.gravity_m_per_s2},
+                        {"period_s", options.loading.period_s()}};
+        j["counts"] = {{"records", records.size()},
+                       {"steps", report.steps},
+                       {"contact_iterations", report.contact_iterations},
+                       {"factorizations", report.factorizations},
+                       {"events", report.events.size()}};
+        if (cvode)
+            j["cvode"] = {{"rtol", options.cvode.rtol},          {"atol_m", options.cvode.atol_m},
+                          {"steps", report.cvode.steps},         {"rhs_evaluations", report.cvode.rhs_evaluations},
+                          {"event_times", report.cvode.events},  {"missed_events", report.cvode.missed_events},
+                          {"restarts", report.cvode.restarts}};
+        double wmin = last.w_m, wmax = last.w_m, fmin = last.spring_force_n, fmax = last.spring_force_n;
+        for (const auto& r : records) {
+            wmin = std::min(wmin, r.w_m);
+            wmax = std::max(wmax, r.w_m);
+            fmin = std::min(fmin, r.spring_force_n);
+            fmax = std::max(fmax, r.spring_force_n);
+        }
+        j["extremes"] = {{"w_min_m", wmin}, {"w_max_m", wmax}, {"spring_force_min_n", fmin}, {"spring_force_max_n", fmax}};
+        j["final"] = {{"t_s", last.t_s}, {"w_m", last.w_m}, {"w_dot_m_per_s", last.w_dot_m_per_s}};
+        j["energy_j"] = {{"initial", e0},
+                         {"external_work", last.external_work_j},
+                         {"dissipated", last.dissipated_energy_j},
+                         {"kinetic", last.kinetic_energy_j},
+                         {"strain", last.strain_energy_j},
+                         {"balance_error_final", last.energy_balance_error_j},
+                         {"balance_error_max_abs", max_balance}};
+        if (loop) {
+            j["hysteresis"] = {{"t_start_s", loop->t_start_s},
+                               {"t_end_s", loop->t_end_s},
+                               {"loop_area_j", loop->loop_area_j},
+                               {"friction_work_j", loop->dissipated_j},
+                               {"secant_stiffness_n_per_m", loop->secant_stiffness_n_per_m},
+                               {"dynamic_rate_n_per_m", loop->dynamic_rate_n_per_m},
+                               {"loss_factor", loop->loss_factor},
+                               {"energy_loss_factor", loop->energy_loss_factor},
+                               {"equivalent_damping_ratio", loop->equivalent_damping_ratio},
+                               {"w_min_m", loop->w_min_m},
+                               {"w_max_m", loop->w_max_m},
+                               {"force_min_n", loop->force_min_n},
+                               {"force_max_n", loop->force_max_n}};
+        } else {
+            j["hysteresis"] = nullptr;
+            j["hysteresis_note"] = loop_note;
+        }
+        j["wall_time_s"] = wall_s;
+        j["outputs"] = {{"csv", out}, {"events", events}, {"pairs", pairs}};
+        json.stream() << j.dump(2) << "\n";
+        json.commit();
+        std::printf("summary                    %s\n", summary.c_str());
+    }
     return exit_ok;
 }
 
@@ -327,6 +564,15 @@ int main(int argc, char** argv) {
                         " contact components, else sparse) | dense | sparse (exact solver only)")
         ->type_name("PATH")
         ->capture_default_str();
+    sim->add_option("--summary", a.summary, "write a JSON summary (counts, energies, loop figures) to this file")
+        ->type_name("FILE");
+    sim->add_option("--pairs", a.pairs, "write every contact pair at every output time (forces, gap, slip) to this CSV")
+        ->type_name("FILE");
+    sim->add_option("--plot", a.plot, "draw PNG figures with gnuplot: PREFIX_displacement/force/friction/loop.png")
+        ->type_name("PREFIX");
+    sim->add_option("--gravity", a.gravity, "weight of R: gravity [m/s^2] (static equilibrium first; 0: none)")
+        ->type_name("G");
+    sim->add_flag("--quiet", a.quiet, "no progress line on the terminal");
     sim->add_option("--out", a.out,
                     "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names one")
         ->type_name("FILE.csv");

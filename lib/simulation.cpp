@@ -443,8 +443,38 @@ const StepRecord& ClosedFormStepper::step() {
     return record_;
 }
 
+namespace {
+
+/// The pairs at one time from the forces p and the relative positions rel = s + d.
+std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+                                     const Eigen::VectorXd& rel) {
+    std::vector<PairRecord> out(laws.pairs.size());
+    const Eigen::VectorXd& d0 = system.initial_offsets_m();
+    for (std::size_t k = 0; k < out.size(); ++k) {
+        const ContactPair& pr = laws.pairs[k];
+        const PairSpec& spec = system.pair_spec(static_cast<int>(k));
+        PairRecord& r = out[k];
+        r.pair = static_cast<int>(k);
+        r.interface_index = spec.interface_index;
+        r.x_m = spec.x_m;
+        r.state = pair_state(laws, static_cast<int>(k), p);
+        if (pr.row_n >= 0) {
+            r.p_n_n = p[pr.row_n];
+            r.gap_m = std::max(0.0, d0[pr.row_n] - rel[pr.row_n]);
+        }
+        if (pr.row_t >= 0) {
+            r.p_t_n = p[pr.row_t];
+            r.slip_m = rel[pr.row_t];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
-                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report) {
+                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report,
+                                 const PairObserver& on_pairs) {
     options.validate();
     const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
     std::vector<StepRecord> out;
@@ -457,8 +487,22 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     rep.mode = options.mode;
     if (options.mode == Mode::cvode) {
         CvodeStepper stepper(system, options);
+        ContactProblem laws;
+        laws.pairs = system.pairs();
+        laws.tau_rule = TauRule::current;
+        auto pairs_out = [&] {
+            if (!on_pairs) return;
+            const Eigen::VectorXd& p = stepper.contact_forces();
+            const Eigen::VectorXd rel = p.size() > 0 ? Eigen::VectorXd(system.compliance_held() * p + system.coupling() * out.back().w_m)
+                                                     : Eigen::VectorXd();
+            on_pairs(out.back().t_s, pair_records(system, laws, p, rel));
+        };
         keep(stepper.current());
-        for (long i = 0; i < n; ++i) keep(stepper.advance());
+        pairs_out();
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.advance());
+            pairs_out();
+        }
         rep.cvode = stepper.stats();
         rep.events = stepper.events();
         rep.steps = rep.cvode.steps;
@@ -466,9 +510,16 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         rep.factorizations = rep.cvode.mode_factorizations;
     } else {
         ClosedFormStepper stepper(system, options);
+        auto pairs_out = [&] {
+            if (on_pairs)
+                on_pairs(out.back().t_s, pair_records(system, stepper.last_problem(), stepper.contact_forces(),
+                                                      stepper.relative_positions()));
+        };
         keep(stepper.current());
+        pairs_out();
         for (long i = 0; i < n; ++i) {
             keep(stepper.step());
+            pairs_out();
             rep.contact_iterations += out.back().contact_iterations;
             rep.factorizations += out.back().factorizations;
         }

@@ -2,7 +2,7 @@
 # packages the project needs, if missing, and configures and builds it in build/.
 
 # The packages every build needs.
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev)
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.

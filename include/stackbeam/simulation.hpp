@@ -189,12 +189,28 @@ void require_massless_leaves(const System& system, Mode mode);
 
 struct RunReport;  // cvode_stepper.hpp
 
+/// One contact pair at one time (simulate's per-pair output; meshed part, signs of
+/// conventions.hpp).
+struct PairRecord {
+    int pair = 0;             ///< index in System::pairs()
+    int interface_index = 0;  ///< interface i: leaf i above, leaf i+1 below
+    double x_m = 0.0;         ///< position along the leaves [m]
+    PairState state = PairState::open;
+    double p_n_n = 0.0;       ///< normal force [N], < 0 compression (0 when the pair has no normal row)
+    double p_t_n = 0.0;       ///< tangential (friction) force on the upper leaf, +x [N] (0: no tangential row)
+    double gap_m = 0.0;       ///< normal gap d_n - approach [m]: > 0 open, 0 closed (0: no normal row)
+    double slip_m = 0.0;      ///< tangential displacement of the upper surface relative to the lower, +x [m]
+};
+/// Receives the pairs at each record's time (t [s], one entry per System::pairs()).
+using PairObserver = std::function<void(double t_s, const std::vector<PairRecord>&)>;
+
 /// Runs from t = 0 to options.t_end_s in options.mode; the first record is the
 /// initial state, then one per dt_s (a step of the closed-form mode, an output time
 /// of the cvode mode). `on_step` (optional) sees every record as it is made;
-/// `report` (optional) receives the counters and, in mode cvode, the event log.
+/// `report` (optional) receives the counters and, in mode cvode, the event log;
+/// `on_pairs` (optional) sees every pair at every record's time.
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
                                  const std::function<void(const StepRecord&)>& on_step = {},
-                                 RunReport* report = nullptr);
+                                 RunReport* report = nullptr, const PairObserver& on_pairs = {});
 
 }  // namespace stackbeam
