@@ -699,7 +699,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.f = system.model().whole_spring_factor();
     s.load = s.opt.loading;
     s.load.prepare();
-    require_loading_fits(system, s.load);
+    require_loading_fits(system.model().spec(), s.load);
     s.m_whole = system.model().spec().rigid_body.mass_kg;
     s.nstate = s.load.kind == LoadingKind::initial_conditions && s.load.gravity_m_per_s2 == 0.0 ? 3 : 4;
     double w0 = system.model().spec().rigid_body.initial_displacement_m;

@@ -554,6 +554,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     try {
         Model::build(s.model);
         s.simulation.validate();
+        require_loading_fits(s.model, s.simulation.loading);
     } catch (const InputError& e) {
         rethrow_in_file(ctx, e);
     }

@@ -134,7 +134,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     options_.loading.prepare();
     const Loading& load = options_.loading;
     rig_ = load.kind == LoadingKind::prescribed_displacement;
-    require_loading_fits(system_, load);
+    require_loading_fits(system_.model().spec(), load);
     path_ = choose_contact_path(system_, options_);
     const int n = system_.num_components();
     const double k = system_.stiffness_n_per_m();
@@ -277,8 +277,8 @@ void ClosedFormStepper::reanchor(const Eigen::VectorXd& rel) {
     }
 }
 
-void require_loading_fits(const System& system, const Loading& loading) {
-    const auto& rb = system.model().spec().rigid_body;
+void require_loading_fits(const ModelSpec& model, const Loading& loading) {
+    const auto& rb = model.rigid_body;
     if (loading.kind == LoadingKind::prescribed_displacement) {
         if (rb.initial_displacement_m != 0.0)
             throw InputError("rigid_body.initial_displacement_m",

@@ -8,7 +8,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
 source scripts/common.sh
 
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}"
+install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" gnuplot-nox  # gnuplot: the CLI test of --plot
 build
 ctest --test-dir build --output-on-failure
 

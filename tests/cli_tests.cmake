@@ -15,6 +15,8 @@ if(CMAKE_SCRIPT_MODE_FILE)
   # -DCLI=<exe> -DARGS=<args separated by |> -DEXPECT_RC=<n> [-DEXPECT_TEXT=<substring of stdout+stderr>]
   # [-DOUT=<file that must exist after the run, or must not when EXPECT_RC != 0>]
   # [-DHEADER_PREFIX=<prefix of OUT's first line>] [-DMIN_LINES=<n>]
+  # [-DJSON=<a JSON file the run writes> -DJSON_PATH=<keys separated by |> -DJSON_RANGE=<lo|hi>]:
+  #   the number at JSON_PATH in JSON must lie in [lo, hi]
   string(REPLACE "|" ";" args "${ARGS}")
   if(DEFINED OUT)
     file(REMOVE "${OUT}" "${OUT}.partial")
@@ -55,6 +57,22 @@ if(CMAKE_SCRIPT_MODE_FILE)
       message(FATAL_ERROR "${OUT} exists after a failed run")
     endif()
   endif()
+  if(DEFINED JSON)
+    file(READ "${JSON}" json_text)
+    string(REPLACE "|" ";" json_keys "${JSON_PATH}")
+    string(JSON value ERROR_VARIABLE json_error GET "${json_text}" ${json_keys})
+    if(json_error)
+      message(FATAL_ERROR "${JSON}: ${JSON_PATH}: ${json_error}")
+    endif()
+    string(REPLACE "|" ";" range "${JSON_RANGE}")
+    list(GET range 0 lo)
+    list(GET range 1 hi)
+    # if(LESS/GREATER) compare the values as floating-point numbers
+    if(value LESS lo OR value GREATER hi)
+      message(FATAL_ERROR "${JSON}: ${JSON_PATH} = ${value}, expected in [${lo}, ${hi}]")
+    endif()
+    message(STATUS "${JSON_PATH} = ${value} in [${lo}, ${hi}]")
+  endif()
   return()
 endif()
 
@@ -63,10 +81,10 @@ endif()
 # stackbeam_cli_test(NAME <name> ARGS <arg>... EXPECT_RC <n> [EXPECT_TEXT <text>] [OUT <file>]
 #                    [HEADER_PREFIX <prefix>] [MIN_LINES <n>])
 function(stackbeam_cli_test)
-  cmake_parse_arguments(T "" "NAME;EXPECT_RC;EXPECT_TEXT;OUT;HEADER_PREFIX;MIN_LINES" "ARGS" ${ARGN})
+  cmake_parse_arguments(T "" "NAME;EXPECT_RC;EXPECT_TEXT;OUT;HEADER_PREFIX;MIN_LINES;JSON;JSON_PATH;JSON_RANGE" "ARGS" ${ARGN})
   string(REPLACE ";" "|" args "${T_ARGS}")
   set(defs -DCLI=$<TARGET_FILE:stackbeam_cli> "-DARGS=${args}" -DEXPECT_RC=${T_EXPECT_RC})
-  foreach(opt EXPECT_TEXT OUT HEADER_PREFIX MIN_LINES)
+  foreach(opt EXPECT_TEXT OUT HEADER_PREFIX MIN_LINES JSON JSON_PATH JSON_RANGE)
     if(DEFINED T_${opt})
       list(APPEND defs "-D${opt}=${T_${opt}}")
     endif()
@@ -189,3 +207,33 @@ stackbeam_cli_test(NAME cli_scenario_missing_file
 stackbeam_cli_test(NAME cli_neither_case_nor_scenario
                    ARGS simulate --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "--case or --scenario: one of them is required" OUT ${_cli_out_dir}/cli_x.csv)
+
+# Loadings and outputs (issue 6): the rig test's loop figures in the summary and in the
+# JSON file (loop area 5.33 J per cycle: tests/test_loadings.cpp proves it equals the
+# friction work), the per-pair CSV (header + 21 pairs x 11 records), gravity from the
+# command line, base excitation in mode cvode, and the figures.
+stackbeam_cli_test(NAME cli_rig_summary
+                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --t-end 2 --out ${_cli_out_dir}/cli_rig.csv
+                        --summary ${_cli_out_dir}/cli_rig.json
+                   EXPECT_RC 0 EXPECT_TEXT "t 1 to 2 s: area 5.33" OUT ${_cli_out_dir}/cli_rig.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_rig.json JSON_PATH "hysteresis|loop_area_j" JSON_RANGE "5.33|5.34")
+stackbeam_cli_test(NAME cli_pairs_csv
+                   ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
+                   EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"
+                   MIN_LINES 200)
+stackbeam_cli_test(NAME cli_gravity
+                   ARGS simulate --case bonded --gravity 9.81 --t-end 0.01 --out ${_cli_out_dir}/cli_g.csv
+                        --summary ${_cli_out_dir}/cli_g.json
+                   EXPECT_RC 0 EXPECT_TEXT "gravity 9.81" OUT ${_cli_out_dir}/cli_g.csv
+                   JSON ${_cli_out_dir}/cli_g.json JSON_PATH "loading|gravity_m_per_s2" JSON_RANGE "9.81|9.81")
+stackbeam_cli_test(NAME cli_bad_gravity
+                   ARGS simulate --case bonded --gravity -1 --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--gravity: value '-1' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_base_cvode
+                   ARGS simulate --scenario ${_scenarios}/base_friction.toml --t-end 0.25 --quiet --out ${_cli_out_dir}/cli_base.csv
+                        --summary ${_cli_out_dir}/cli_base.json --events ${_cli_out_dir}/cli_base_events.csv
+                   EXPECT_RC 0 EXPECT_TEXT "loop                       t 0.125 to 0.25 s" OUT ${_cli_out_dir}/cli_base.csv
+                   JSON ${_cli_out_dir}/cli_base.json JSON_PATH "cvode|steps" JSON_RANGE "1|1000000")
+stackbeam_cli_test(NAME cli_plot
+                   ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
+                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)

@@ -305,7 +305,7 @@ BOOST_AUTO_TEST_CASE(loading_input_is_checked) {
     l.kind = LoadingKind::prescribed_displacement;
     l.displacement_m = harmonic(0.02, 1.0);
     try {  // the rig fixes w'(0): the model's 2 m/s contradicts it
-        ClosedFormStepper s(sys, options(Mode::closed_form, 1e-3, 0.1, l));
+        ClosedFormStepper stepper(sys, options(Mode::closed_form, 1e-3, 0.1, l));
         BOOST_FAIL("no error");
     } catch (const InputError& e) {
         BOOST_TEST(e.field() == "rigid_body.initial_velocity_m_per_s");

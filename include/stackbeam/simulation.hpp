@@ -180,7 +180,7 @@ private:
 
 /// Throws InputError when the model's initial conditions contradict the loading
 /// (a prescribed displacement fixes w(0) and w'(0) itself).
-void require_loading_fits(const System& system, const Loading& loading);
+void require_loading_fits(const ModelSpec& model, const Loading& loading);
 
 /// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
 /// with a density > 0 would be silently ignored there: this throws InputError naming
