@@ -345,3 +345,56 @@ BOOST_AUTO_TEST_CASE(loading_input_is_checked) {
         BOOST_TEST(e.field() == "loading.kind");
     }
 }
+
+BOOST_AUTO_TEST_CASE(force_table_ramp_on_the_frictionless_spring) {
+    // A piecewise-linear force table with its points on the step grid: F rises linearly
+    // to F1 over T = 0.1 s, then holds. The closed-form step assumes F linear over each
+    // step (eq. 14), which is then exact: w = F1/(k T) (t - sin(omega t)/omega) for t <= T,
+    // and after T the free vibration about F1/k from the state at T. Round-off: 1e-12 m.
+    const System sys = paper_system(PaperCase::frictionless);
+    const double k = sys.free_stiffness_n_per_m(), om = std::sqrt(k / kMass), F1 = 150.0, T = 0.1;
+    Loading l;
+    l.kind = LoadingKind::applied_force;
+    l.force_n.shape = TimeFunction::Shape::table;
+    l.force_n.times_s = {0.0, T};
+    l.force_n.values = {0.0, F1};
+    const double wT = F1 / (k * T) * (T - std::sin(om * T) / om), vT = F1 / (k * T) * (1 - std::cos(om * T));
+    auto exact = [&](double t) {
+        if (t <= T) return F1 / (k * T) * (t - std::sin(om * t) / om);
+        return F1 / k + (wT - F1 / k) * std::cos(om * (t - T)) + vT / om * std::sin(om * (t - T));
+    };
+    for (const auto& x : simulate(sys, options(Mode::closed_form, 1e-3, 0.4, l)))
+        BOOST_CHECK_SMALL(x.w_m - exact(x.t_s), 1e-12);
+}
+
+BOOST_AUTO_TEST_CASE(pair_output_agrees_with_the_records) {
+    // The per-pair output (simulate's PairObserver) against the step records of the same
+    // run, both modes: the state counts and the probe pair's friction force are the
+    // same numbers (exactly), every closed pair has zero gap and every open one zero
+    // normal force, and no unilateral pair pulls (p_n <= 0, to 1e-9 N of round-off; clamp
+    // pairs are bilateral and may).
+    const System sys = paper_system(PaperCase::friction, 2.0);
+    for (Mode mode : {Mode::closed_form, Mode::cvode}) {
+        BOOST_TEST_CONTEXT(to_string(mode)) {
+            std::vector<std::vector<PairRecord>> pairs;
+            const auto r = simulate(sys, options(mode, 1e-3, 0.1, Loading{}), {}, nullptr,
+                                    [&](double, const std::vector<PairRecord>& p) { pairs.push_back(p); });
+            BOOST_TEST(pairs.size() == r.size());
+            for (std::size_t i = 0; i < r.size(); ++i) {
+                int stick = 0, slip = 0, open = 0;
+                for (const auto& p : pairs[i]) {
+                    if (p.state == PairState::stick) ++stick;
+                    else if (p.state == PairState::slip) ++slip;
+                    else ++open;
+                    if (sys.pairs()[p.pair].kind == PairKind::coulomb) BOOST_TEST(p.p_n_n <= 1e-9);
+                    if (p.state == PairState::open) BOOST_CHECK_SMALL(p.p_n_n, 1e-9);
+                    if (p.p_n_n < -1e-6) BOOST_CHECK_SMALL(p.gap_m, 1e-9);
+                }
+                BOOST_TEST(stick == r[i].n_stick);
+                BOOST_TEST(slip == r[i].n_slip);
+                BOOST_TEST(open == r[i].n_open);
+                BOOST_TEST(pairs[i][sys.probe_pair()].p_t_n == r[i].probe_friction_force_n);
+            }
+        }
+    }
+}
