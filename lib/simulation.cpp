@@ -6,6 +6,7 @@
 
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "stackbeam/newmark_stepper.hpp"
 #include "step_record.hpp"
 
 namespace stackbeam {
@@ -13,7 +14,8 @@ namespace stackbeam {
 std::vector<std::string> step_record_columns() {
     return {"t",           "w",              "w_dot",          "force_on_mass",     "probe_friction_force",
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
-            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations"};
+            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
+            "leaf_kinetic_energy", "impact_loss"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -31,13 +33,16 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.dissipated_energy_j,
             r.energy_balance_error_j,
             r.contact_residual_m,
-            static_cast<double>(r.factorizations)};
+            static_cast<double>(r.factorizations),
+            r.leaf_kinetic_energy_j,
+            r.impact_loss_j};
 }
 
 const char* to_string(Mode m) {
     switch (m) {
         case Mode::closed_form: return "closed-form";
         case Mode::cvode: return "cvode";
+        case Mode::newmark: return "newmark";
     }
     return "?";
 }
@@ -45,7 +50,8 @@ const char* to_string(Mode m) {
 Mode parse_mode(const std::string& text, const std::string& field) {
     if (text == "closed-form") return Mode::closed_form;
     if (text == "cvode") return Mode::cvode;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode");
+    if (text == "newmark") return Mode::newmark;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
 }
 
 const char* to_string(ContactPath path) {
@@ -114,7 +120,7 @@ void require_massless_leaves(const System& system, Mode mode) {
             throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
                              "value " + format_value(leaves[i].density_kg_per_m3) + " is not used by mode " +
                                  to_string(mode) + ", which treats the leaves as massless (the paper): give 0 "
-                                 "(the leaves' inertia is not integrated in time yet; modal_analysis() uses it)");
+                                 "(mode newmark integrates the leaves' inertia)");
 }
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
@@ -320,6 +326,15 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         rep.steps = rep.cvode.steps;
         rep.contact_iterations = rep.cvode.contact_iterations;
         rep.factorizations = rep.cvode.mode_factorizations;
+    } else if (options.mode == Mode::newmark) {
+        NewmarkStepper stepper(system, options);
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.step());
+            rep.contact_iterations += out.back().contact_iterations;
+            rep.factorizations += out.back().factorizations;
+        }
+        rep.steps = n;
     } else {
         ClosedFormStepper stepper(system, options);
         keep(stepper.current());
