@@ -74,6 +74,18 @@ double parse_positive(const std::string& option, const std::string& text, const 
     return value;
 }
 
+/// --beam-density: a finite density >= 0 [kg/m^3] (0: massless leaves, the paper).
+double parse_density(const std::string& option, const std::string& text) {
+    if (text == "0") return 0.0;
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    const double value = std::strtod(begin, &end);
+    if (text.empty() || end == begin || *end != '\0' || !std::isfinite(value) || value < 0.0)
+        throw ArgumentError(option + ": value '" + text +
+                            "' is not allowed: must be a finite number >= 0 [kg/m^3] (0: massless leaves, the paper)");
+    return value;
+}
+
 /// Parses an integer >= 1 from `text`, all of it, or throws naming `option`.
 int parse_count(const std::string& option, const std::string& text) {
     const std::string allowed = "must be an integer >= 1";
@@ -107,6 +119,7 @@ struct SimulateArgs {
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
     std::string contact_path = "auto";
+    std::string beam_density = "0";
     std::string out;
     std::set<std::string> given;  ///< the options given on the command line
 };
@@ -155,6 +168,8 @@ int run_simulate(const SimulateArgs& a) {
             throw ArgumentError("--out: an output file name is required (none given, and " + a.scenario +
                                 " has no outputs.csv_path)");
         if (events.empty()) events = scenario.outputs.events_path;
+        if (a.given.count("--beam-density"))
+            for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = parse_density("--beam-density", a.beam_density);
         setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
@@ -165,9 +180,14 @@ int run_simulate(const SimulateArgs& a) {
         example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
         if (out.empty()) throw ArgumentError("--out: an output file name is required");
         spec = stackbeam::paper_example(pcase, example);
+        for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = parse_density("--beam-density", a.beam_density);
         setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                 " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }
+    if ((a.scenario.empty() || a.given.count("--beam-density")) && options.mode != stackbeam::Mode::newmark &&
+        parse_density("--beam-density", a.beam_density) > 0.0)
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (mode " +
+                            stackbeam::to_string(options.mode) + " treats the leaves as massless, the paper)");
     const bool cvode = options.mode == stackbeam::Mode::cvode;
     if (!cvode && !events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
@@ -189,11 +209,12 @@ int run_simulate(const SimulateArgs& a) {
     long steps = -1;  // the first record is the initial state
     long total_iterations = 0;
     int max_iterations = 0;
-    stackbeam::StepRecord last;
+    stackbeam::StepRecord first, last;
     stackbeam::RunReport report;
     try {
         stackbeam::simulate(system, options, [&](const stackbeam::StepRecord& r) {
             stackbeam::write_csv_row(csv, r);
+            if (steps < 0) first = r;
             ++steps;
             total_iterations += r.contact_iterations;
             max_iterations = std::max(max_iterations, r.contact_iterations);
@@ -228,7 +249,8 @@ int run_simulate(const SimulateArgs& a) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // --- summary ----------------------------------------------------------------------
-    const double e0 = 0.5 * model.spec().rigid_body.mass_kg * std::pow(model.spec().rigid_body.initial_velocity_m_per_s, 2);
+    // the initial energy: the body's, and the leaves' in mode newmark (the first record)
+    const double e0 = first.kinetic_energy_j + first.strain_energy_j;
     std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", setup.c_str(), stackbeam::to_string(options.mode),
                 stackbeam::to_string(options.solver.kind), options.dt_s, options.t_end_s);
     if (cvode) {
@@ -250,6 +272,9 @@ int run_simulate(const SimulateArgs& a) {
                 last.w_dot_m_per_s);
     std::printf("energy balance error       %.3e J (initial energy %.6g J, dissipated %.6g J)\n",
                 last.energy_balance_error_j, e0, last.dissipated_energy_j);
+    if (options.mode == stackbeam::Mode::newmark)
+        std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",
+                    last.impact_loss_j, last.leaf_kinetic_energy_j);
     std::printf("wall time                  %.3f s\n", wall_s);
     std::printf("output                     %s\n", out.c_str());
     if (!events.empty()) std::printf("event log                  %s\n", events.c_str());
@@ -297,7 +322,8 @@ int main(int argc, char** argv) {
             ->excludes(case_opt);
     sim->add_option("--mode", a.mode,
                     "time stepping: closed-form (the paper's exact step, fixed dt) | cvode (SUNDIALS CVODE, "
-                    "root-finding on every stick-slip and open-close transition)")
+                    "root-finding on every stick-slip and open-close transition) | newmark (leaves with mass, "
+                    "--beam-density: average-acceleration Newmark, fixed dt)")
         ->type_name("MODE")
         ->capture_default_str();
     sim->add_option("--t-end", a.t_end, "end time [s]")->type_name("S")->capture_default_str();
@@ -326,6 +352,11 @@ int main(int argc, char** argv) {
                     "contact problem: auto (dense below " + std::to_string(stackbeam::kSparsePathMinComponents) +
                         " contact components, else sparse) | dense | sparse (exact solver only)")
         ->type_name("PATH")
+        ->capture_default_str();
+    sim->add_option("--beam-density", a.beam_density,
+                    "density of every leaf [kg/m^3]: 0 = massless leaves (the paper; modes closed-form, cvode), "
+                    "> 0 = leaves with mass (mode newmark)")
+        ->type_name("KG_PER_M3")
         ->capture_default_str();
     sim->add_option("--out", a.out,
                     "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names one")
