@@ -184,10 +184,10 @@ int run_simulate(const SimulateArgs& a) {
         setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                 " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }
-    if ((a.scenario.empty() || a.given.count("--beam-density")) && options.mode != stackbeam::Mode::newmark &&
+    if ((a.scenario.empty() || a.given.count("--beam-density")) && options.mode == stackbeam::Mode::closed_form &&
         parse_density("--beam-density", a.beam_density) > 0.0)
-        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (mode " +
-                            stackbeam::to_string(options.mode) + " treats the leaves as massless, the paper)");
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded "
+                            "stacks so far): mode closed-form treats the leaves as massless, the paper");
     const bool cvode = options.mode == stackbeam::Mode::cvode;
     if (!cvode && !events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
@@ -354,8 +354,8 @@ int main(int argc, char** argv) {
         ->type_name("PATH")
         ->capture_default_str();
     sim->add_option("--beam-density", a.beam_density,
-                    "density of every leaf [kg/m^3]: 0 = massless leaves (the paper; modes closed-form, cvode), "
-                    "> 0 = leaves with mass (mode newmark)")
+                    "density of every leaf [kg/m^3]: 0 = massless leaves (the paper), > 0 = leaves with mass "
+                    "(mode newmark; mode cvode on bonded stacks so far)")
         ->type_name("KG_PER_M3")
         ->capture_default_str();
     sim->add_option("--out", a.out,

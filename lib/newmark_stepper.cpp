@@ -8,6 +8,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "step_record.hpp"
+#include "tied_shape.hpp"
 
 namespace stackbeam {
 
@@ -16,53 +17,6 @@ struct NewmarkStepper::Factor {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
 };
 
-namespace {
-
-/// Velocity shape of the stack per unit w' (newmark_stepper.hpp): the static shape for a
-/// unit displacement of R with the contact components in `tied` held (G_S z = 0):
-///     [K_rr  G_Sr^T] [z_r]   [-K_rw  ]
-///     [G_Sr  0     ] [ l ] = [-G_Sw  ],   z_w = 1,
-/// one sparse LU of the saddle-point matrix (it is only needed once).
-Eigen::VectorXd tied_shape(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& G,
-                           const std::vector<int>& tied) {
-    const int n = static_cast<int>(K.rows());
-    const int nr = n - 1;
-    const int ns = static_cast<int>(tied.size());
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(K.nonZeros() + 2 * G.nonZeros()));
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nr + ns);
-    for (int col = 0; col < K.outerSize(); ++col)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) {
-            if (it.row() < nr && it.col() < nr) t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
-            else if (it.row() < nr && it.col() == nr) rhs[it.row()] -= it.value();
-        }
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> Gr = G;
-    for (int i = 0; i < ns; ++i)
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Gr, tied[i]); it; ++it) {
-            const int col = static_cast<int>(it.col());
-            if (col < nr) {
-                t.emplace_back(nr + i, col, it.value());
-                t.emplace_back(col, nr + i, it.value());
-            } else {
-                rhs[nr + i] -= it.value();
-            }
-        }
-    Eigen::SparseMatrix<double> A(nr + ns, nr + ns);
-    A.setFromTriplets(t.begin(), t.end());
-    A.makeCompressed();
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-    lu.compute(A);
-    if (lu.info() != Eigen::Success)
-        throw SolverError("newmark: the initial velocity shape (static shape with the closed contact components "
-                          "tied) is singular: " + lu.lastErrorMessage(), 0, 0.0, 0.0);
-    const Eigen::VectorXd x = lu.solve(rhs);
-    Eigen::VectorXd z(n);
-    z.head(nr) = x.head(nr);
-    z[nr] = 1.0;
-    return z;
-}
-
-}  // namespace
 
 NewmarkStepper::~NewmarkStepper() = default;
 
@@ -123,13 +77,8 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
 
     // Leaves all massive (contact between massive points: impacts, velocity projection) or
     // all massless (the paper's statically condensed contact): a mix is refused.
+    detail::require_uniform_leaf_mass(system_, "newmark");
     const auto& leaves = system_.model().spec().leaves;
-    for (std::size_t i = 1; i < leaves.size(); ++i)
-        if ((leaves[i].density_kg_per_m3 > 0.0) != (leaves[0].density_kg_per_m3 > 0.0))
-            throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
-                             "value " + format_value(leaves[i].density_kg_per_m3) + " with leaves[0] at " +
-                                 format_value(leaves[0].density_kg_per_m3) +
-                                 ": mode newmark needs every leaf massive (> 0) or every leaf massless (0)");
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
 
     // Initial velocity: w'(0) times the static shape per unit w with the closed contact
@@ -148,7 +97,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
             if (closed && pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0))
                 tied.push_back(pr.row_t);
         }
-        v_ = wd0 * tied_shape(K_, G, tied);
+        v_ = wd0 * detail::tied_shape(K_, G, tied, 1.0, Eigen::VectorXd::Zero(m));
     }
     // Initial acceleration from the equations of motion on the massive DOFs:
     // M_SS a_S = (G^T p0 - K z0)_S (the massless rows of the residual are zero: static shape).

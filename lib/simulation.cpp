@@ -6,6 +6,7 @@
 
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "cvode_inertia.hpp"
 #include "stackbeam/newmark_stepper.hpp"
 #include "step_record.hpp"
 
@@ -317,7 +318,13 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     };
     RunReport rep;
     rep.mode = options.mode;
-    if (options.mode == Mode::cvode) {
+    if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
+        detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) keep(stepper.advance());
+        rep.cvode = stepper.stats();
+        rep.steps = rep.cvode.steps;
+    } else if (options.mode == Mode::cvode) {
         CvodeStepper stepper(system, options);
         keep(stepper.current());
         for (long i = 0; i < n; ++i) keep(stepper.advance());
