@@ -203,13 +203,16 @@ double NewmarkStepper::project_velocities() {
     if (held.empty()) return 0.0;
     const int nh = static_cast<int>(held.size());
     const Eigen::VectorXd gv = system_.contact_rows() * v_;
-    Eigen::MatrixXd Ahh(nh, nh);
-    Eigen::VectorXd rhs(nh);
-    for (int i = 0; i < nh; ++i) {
-        rhs[i] = gv[held[i]];
-        for (int k = 0; k < nh; ++k) Ahh(i, k) = A_(held[i], held[k]);
+    if (held != held_) {  // factorise A_hh once per held set
+        Eigen::MatrixXd Ahh(nh, nh);
+        for (int i = 0; i < nh; ++i)
+            for (int k = 0; k < nh; ++k) Ahh(i, k) = A_(held[i], held[k]);
+        held_factor_.compute(Ahh);
+        held_ = held;
     }
-    const Eigen::VectorXd l = Ahh.ldlt().solve(rhs);
+    Eigen::VectorXd rhs(nh);
+    for (int i = 0; i < nh; ++i) rhs[i] = gv[held[i]];
+    const Eigen::VectorXd l = held_factor_.solve(rhs);
     Eigen::VectorXd dv = Eigen::VectorXd::Zero(v_.size());
     for (int i = 0; i < nh; ++i) dv += Z_.col(held[i]) * l[i];
     v_ -= dv;

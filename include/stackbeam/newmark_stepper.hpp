@@ -104,6 +104,8 @@ private:
     std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
     bool massive_leaves_ = false;
     Eigen::MatrixXd Z_, A_;       // M^-1 G^T and G M^-1 G^T (impact law, massive leaves)
+    std::vector<int> held_;       // the held rows of the last projection
+    Eigen::LDLT<Eigen::MatrixXd> held_factor_;  // and A restricted to them
     double t_ = 0.0;
     double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
     long step_ = 0;
