@@ -15,6 +15,7 @@ namespace stackbeam {
 struct NewmarkStepper::Factor {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
 };
 
 
@@ -118,12 +119,13 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     for (int i = 0; i < n; ++i)
         if (massless_[i]) v_[i] = a_[i] = 0.0;
 
-    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection.
+    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
+    // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
     if (massive_leaves_) {
         factor_->mass.compute(M_);
         if (factor_->mass.info() != Eigen::Success)
             throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
-        if (m > 0) {
+        if (m > 0 && path_ == ContactPath::dense) {
             Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
             const Eigen::MatrixXd A = G * Z_;
             A_ = 0.5 * (A + A.transpose());
@@ -202,6 +204,36 @@ double NewmarkStepper::project_velocities() {
     }
     if (held.empty()) return 0.0;
     const int nh = static_cast<int>(held.size());
+    if (path_ == ContactPath::sparse) {
+        // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
+        const int n = static_cast<int>(v_.size());
+        if (held != held_) {
+            std::vector<Eigen::Triplet<double>> t;
+            for (int col = 0; col < M_.outerSize(); ++col)
+                for (Eigen::SparseMatrix<double>::InnerIterator it(M_, col); it; ++it)
+                    t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+            const Eigen::SparseMatrix<double, Eigen::RowMajor> Gr = system_.contact_rows();
+            for (int i = 0; i < nh; ++i)
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Gr, held[i]); it; ++it) {
+                    t.emplace_back(n + i, static_cast<int>(it.col()), it.value());
+                    t.emplace_back(static_cast<int>(it.col()), n + i, it.value());
+                }
+            Eigen::SparseMatrix<double> S(n + nh, n + nh);
+            S.setFromTriplets(t.begin(), t.end());
+            S.makeCompressed();
+            factor_->saddle.compute(S);
+            if (factor_->saddle.info() != Eigen::Success)
+                throw SolverError("newmark: the impact projection's matrix is singular at step " + std::to_string(step_),
+                                  step_, step_ * options_.dt_s, 0.0);
+            held_ = held;
+        }
+        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
+        rhs.head(n) = M_ * v_;
+        const Eigen::VectorXd x = factor_->saddle.solve(rhs);
+        const Eigen::VectorXd dv = v_ - x.head(n);
+        v_ = x.head(n);
+        return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
+    }
     const Eigen::VectorXd gv = system_.contact_rows() * v_;
     if (held != held_) {  // factorise A_hh once per held set
         Eigen::MatrixXd Ahh(nh, nh);
