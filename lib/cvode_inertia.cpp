@@ -110,7 +110,8 @@ struct CvodeInertiaStepper::Impl {
         const Eigen::VectorXd v = NPhi * xid;
         const Eigen::VectorXd a = NPhi * Eigen::VectorXd(g - om.cwiseProduct(om).cwiseProduct(xi));
         // the held components' forces: G^T p = M a + K z (least squares: exact on range(G^T))
-        const Eigen::VectorXd p = GGt.solve(Gd * Eigen::VectorXd(M * a + K * z));
+        const Eigen::VectorXd p = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(M * a + K * z)))
+                                                : Eigen::VectorXd();
         const double f = sys.model().whole_spring_factor();
         const double strain = 0.5 * f * z.dot(K * z);
         fill_state(sys, laws, p, z[n - 1], v[n - 1], strain, 0.0, e0, rec);
@@ -148,14 +149,21 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     s.laws.pairs = pairs;
     s.laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
     // null(G) from a QR of G^T: its last n - rank columns of Q
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s.Gd.transpose());
-    const int rank = static_cast<int>(qr.rank());
-    s.r = s.n - rank;
-    const Eigen::MatrixXd Q = qr.householderQ();
-    s.N = Q.rightCols(s.r);
-    s.GGt.compute(s.Gd * s.Gd.transpose());
     const Eigen::VectorXd& d = system.initial_offsets_m();
-    s.zp = s.Gd.transpose() * s.GGt.solve(d);
+    if (m > 0) {
+        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s.Gd.transpose());
+        const int rank = static_cast<int>(qr.rank());
+        s.r = s.n - rank;
+        const Eigen::MatrixXd Q = qr.householderQ();
+        s.N = Q.rightCols(s.r);
+        s.GGt.compute(s.Gd * s.Gd.transpose());
+        s.zp = s.Gd.transpose() * s.GGt.solve(d);
+    } else {  // no contact pair: every DOF free
+        s.r = s.n;
+        s.N = Eigen::MatrixXd::Identity(s.n, s.n);
+        s.zp = Eigen::VectorXd::Zero(s.n);
+    }
+    if (s.r < 1) throw InputError("mode", "value 'cvode' with leaf inertia: the held stack has no free motion");
     const Eigen::MatrixXd Mt = s.N.transpose() * (s.M * s.N);
     const Eigen::MatrixXd Kt = s.N.transpose() * (s.K * s.N);
     if (Eigen::LLT<Eigen::MatrixXd>(Mt).info() != Eigen::Success)
