@@ -186,8 +186,8 @@ int run_simulate(const SimulateArgs& a) {
     }
     if ((a.scenario.empty() || a.given.count("--beam-density")) && options.mode == stackbeam::Mode::closed_form &&
         parse_density("--beam-density", a.beam_density) > 0.0)
-        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded "
-                            "stacks so far): mode closed-form treats the leaves as massless, the paper");
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded and "
+                            "frictionless stacks so far): mode closed-form treats the leaves as massless, the paper");
     const bool cvode = options.mode == stackbeam::Mode::cvode;
     if (!cvode && !events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
@@ -355,7 +355,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     sim->add_option("--beam-density", a.beam_density,
                     "density of every leaf [kg/m^3]: 0 = massless leaves (the paper), > 0 = leaves with mass "
-                    "(mode newmark; mode cvode on bonded stacks so far)")
+                    "(mode newmark; mode cvode on bonded and frictionless stacks so far)")
         ->type_name("KG_PER_M3")
         ->capture_default_str();
     sim->add_option("--out", a.out,

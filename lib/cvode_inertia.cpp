@@ -1,4 +1,4 @@
-// Mode "cvode" with leaf inertia, bonded stacks (cvode_inertia.hpp, docs/inertia.md).
+// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/inertia.md).
 #include "cvode_inertia.hpp"
 
 #include <cvode/cvode.h>
@@ -32,7 +32,10 @@ struct CvodeInertiaStepper::Impl {
     SimulationOptions opt;
     int n = 0, r = 0;
     Eigen::SparseMatrix<double> K, M;
-    Eigen::MatrixXd Gd;        // contact rows, dense [-]
+    std::vector<int> held;     // the held contact rows (bonded: both; mu = 0: the normal one)
+    Eigen::MatrixXd Gd;        // the held contact rows of G, dense [-]
+    Eigen::VectorXd dC;        // their offsets [m]
+    double F_ref = 1.0;        // force scale of the release check [N]
     Eigen::MatrixXd N;         // orthonormal basis of null(G), n x r
     Eigen::VectorXd zp;        // particular solution of G z = d [m]
     Eigen::MatrixXd Phi;       // mass-normalised modes of (N^T K N, N^T M N): q = Phi xi
@@ -110,8 +113,18 @@ struct CvodeInertiaStepper::Impl {
         const Eigen::VectorXd v = NPhi * xid;
         const Eigen::VectorXd a = NPhi * Eigen::VectorXd(g - om.cwiseProduct(om).cwiseProduct(xi));
         // the held components' forces: G^T p = M a + K z (least squares: exact on range(G^T))
-        const Eigen::VectorXd p = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(M * a + K * z)))
-                                                : Eigen::VectorXd();
+        const Eigen::VectorXd pC = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(M * a + K * z)))
+                                                 : Eigen::VectorXd();
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(sys.num_components());
+        for (int k = 0; k < static_cast<int>(held.size()); ++k) p[held[k]] = pC[k];
+        // a held unilateral pair must stay compressed (p_n <= 0): a release is an event,
+        // not built yet with massive leaves
+        for (const auto& pr : laws.pairs)
+            if (pr.kind == PairKind::coulomb && pr.row_n >= 0 && p[pr.row_n] > 1e-6 * F_ref)
+                throw SolverError("cvode mode (leaf inertia): a frictionless pair goes into tension (p_n = " +
+                                      format_value(p[pr.row_n]) + " N) at t = " + format_value(t) +
+                                      " s: contact events between massive leaves are not built yet, use mode newmark",
+                                  out_index, t, 0.0);
         const double f = sys.model().whole_spring_factor();
         const double strain = 0.5 * f * z.dot(K * z);
         fill_state(sys, laws, p, z[n - 1], v[n - 1], strain, 0.0, e0, rec);
@@ -124,7 +137,7 @@ struct CvodeInertiaStepper::Impl {
         rec.t_s = t;
         rec.contact_iterations = 0;
         rec.factorizations = 0;
-        rec.contact_residual_m = (Gd * z - sys.initial_offsets_m()).norm();
+        rec.contact_residual_m = (Gd * z - dC).norm();
     }
 };
 
@@ -136,20 +149,33 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     s.opt.validate();
     require_uniform_leaf_mass(system, "cvode");
     const auto& pairs = system.pairs();
-    for (std::size_t j = 0; j < pairs.size(); ++j)
-        if (pairs[j].kind != PairKind::bonded)
-            throw InputError("mode", std::string("value 'cvode' with leaves of density > 0 handles bonded stacks only so "
-                                                 "far (pair ") + std::to_string(j) + " is " + to_string(pairs[j].kind) +
+    for (std::size_t j = 0; j < pairs.size(); ++j) {
+        const auto& pr = pairs[j];
+        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0)
+            throw InputError("mode", std::string("value 'cvode' with leaves of density > 0 handles bonded and frictionless "
+                                                 "stacks only so far (pair ") + std::to_string(j) + " is " +
+                                         to_string(pr.kind) + " with mu = " + format_value(pr.friction_coefficient) +
                                          ": contact events between massive leaves are not built yet): use mode newmark");
+        if (pr.row_n >= 0) s.held.push_back(pr.row_n);
+        if (pr.row_t >= 0 && pr.kind == PairKind::bonded) s.held.push_back(pr.row_t);
+    }
     s.K = system.stiffness_reduced();
     s.M = system.mass_reduced();
     s.n = static_cast<int>(s.K.rows());
-    const int m = system.num_components();
-    s.Gd = Eigen::MatrixXd(system.contact_rows());
+    const int m = static_cast<int>(s.held.size());
+    {
+        const Eigen::MatrixXd Gall(system.contact_rows());
+        s.Gd.resize(m, s.n);
+        s.dC.resize(m);
+        for (int k = 0; k < m; ++k) {
+            s.Gd.row(k) = Gall.row(s.held[k]);
+            s.dC[k] = system.initial_offsets_m()[s.held[k]];
+        }
+    }
     s.laws.pairs = pairs;
     s.laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
     // null(G) from a QR of G^T: its last n - rank columns of Q
-    const Eigen::VectorXd& d = system.initial_offsets_m();
+    const Eigen::VectorXd& d = s.dC;
     if (m > 0) {
         Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s.Gd.transpose());
         const int rank = static_cast<int>(qr.rank());
@@ -178,11 +204,11 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
 
     // initial state: the tied static shape at w(0), the tied shape per unit w times w'(0)
     const auto& body = system.model().spec().rigid_body;
-    std::vector<int> all(static_cast<std::size_t>(m));
-    for (int i = 0; i < m; ++i) all[i] = i;
-    const Eigen::VectorXd z0 = tied_shape(s.K, system.contact_rows(), all, body.initial_displacement_m, d);
-    const Eigen::VectorXd v0 =
-        body.initial_velocity_m_per_s * tied_shape(s.K, system.contact_rows(), all, 1.0, Eigen::VectorXd::Zero(m));
+    const Eigen::VectorXd z0 =
+        tied_shape(s.K, system.contact_rows(), s.held, body.initial_displacement_m, system.initial_offsets_m());
+    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s *
+                               tied_shape(s.K, system.contact_rows(), s.held, 1.0,
+                                          Eigen::VectorXd::Zero(system.num_components()));
 
     s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create");
     s.y = N_VNew_Serial(2 * s.r, s.ctx);
@@ -204,6 +230,8 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     // amplitude: BDF damps it), and at least the user's atol on w as an energy-norm
     // amplitude of the body's mode, sqrt(m) omega atol_m.
     const double omega = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
+    s.F_ref = system.tied_stiffness_n_per_m() / system.model().whole_spring_factor() *
+              std::max(std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega, 1e-6);
     const double e_meshed = 0.5 * N_VDotProd(s.y, s.y);
     N_VConst(std::max(std::sqrt(system.mass_kg()) * omega * s.opt.cvode.atol_m,
                       s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed)),

@@ -1,14 +1,17 @@
 #pragma once
 // Internal: mode "cvode" with leaves of density > 0 (docs/inertia.md), first part: a
-// stack whose contact components are all held for good (every kept pair bonded), so
-// the contact mode never changes. The motion lies in the null space of the contact
-// rows, G (z - z_p) = 0, z = z_p + N q with N an orthonormal basis of null(G):
+// stack whose contact components are held for good, so the contact mode never changes:
+// every kept pair bonded (both components held) or frictionless (mu = 0: the normal
+// component held, which a unilateral pair allows while it stays compressed; a tension
+// above 1e-6 of the force scale at an output is a SolverError: the release event is
+// not built yet). The motion lies in the null space of the held rows G_C,
+// G_C (z - z_p) = 0, z = z_p + N q with N an orthonormal basis of null(G_C):
 //     (N^T M N) q'' + N^T K N q = -N^T K z_p,
 // a stiff linear ODE (leaf bending modes up to ~1e5..1e6 rad/s next to the 70 rad/s
 // body mode) integrated by CVODE's BDF at order <= 2 (higher orders are unstable on
 // the lightly damped oscillatory modes), Newton with a dense direct solver and the
 // analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N.
-// Stacks with pairs that may open, close, stick or slip are refused (InputError):
+// Stacks with friction (pairs that may stick or slip) are refused (InputError):
 // events between massive leaves are not built yet (use mode newmark).
 #include <memory>
 
