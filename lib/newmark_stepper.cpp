@@ -18,12 +18,12 @@ struct NewmarkStepper::Factor {
     Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
 };
 
-
 NewmarkStepper::~NewmarkStepper() = default;
 
 NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
     : system_(system), options_(options), factor_(std::make_unique<Factor>()) {
     options_.validate();
+    detail::require_uniform_leaf_mass(system_, "newmark");
     path_ = choose_contact_path(system_, options_);
     const double dt = options_.dt_s;
     const int m = system_.num_components();
@@ -77,8 +77,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     }
 
     // Leaves all massive (contact between massive points: impacts, velocity projection) or
-    // all massless (the paper's statically condensed contact): a mix is refused.
-    detail::require_uniform_leaf_mass(system_, "newmark");
+    // all massless (the paper's statically condensed contact): a mix was refused above.
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
 
