@@ -12,6 +12,10 @@
 //    simulated second (set-up + stepping, scaled from the simulated time), contact
 //    components, factorisations per step. Each is one run (Iterations(1)): the large
 //    ones take seconds to minutes and the machine is shared.
+//  - Inertia: 1 s of the paper example with steel leaves (7850 kg/m^3): mode newmark
+//    (friction and bonded) and mode cvode (bonded; the friction case needs the events
+//    between massive leaves, not built yet). Counters: steps, contact iterations and
+//    factorisations (newmark), CVODE steps, Jacobians and Newton matrices (cvode).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -22,6 +26,7 @@
 #include <memory>
 #include <vector>
 
+#include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/simulation.hpp"
 
@@ -137,8 +142,37 @@ void Scaling(benchmark::State& state) {
     state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
 }
 
+/// args: case (0 bonded, 1 friction), mode (0 newmark, 1 cvode), dt [us] (newmark) or -log10(rtol) (cvode).
+void Inertia(benchmark::State& state) {
+    const PaperCase c = state.range(0) == 0 ? PaperCase::bonded : PaperCase::friction;
+    const bool cvode = state.range(1) == 1;
+    ModelSpec spec = paper_example(c);
+    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = 7850.0;
+    SimulationOptions so;
+    so.t_end_s = 1.0;
+    so.mode = cvode ? Mode::cvode : Mode::newmark;
+    if (cvode) so.cvode.rtol = std::pow(10.0, -static_cast<double>(state.range(2)));
+    else so.dt_s = 1e-6 * static_cast<double>(state.range(2));
+    RunReport rep;
+    for (auto _ : state) {
+        const System s(Model::build(spec));
+        simulate(s, so, {}, &rep);
+    }
+    state.SetLabel(std::string(to_string(c)) + ", " + to_string(so.mode));
+    state.counters["steps"] = static_cast<double>(rep.steps);
+    state.counters["contact_iter"] = static_cast<double>(rep.contact_iterations);
+    state.counters["fact"] = static_cast<double>(rep.factorizations);
+    state.counters["jac"] = static_cast<double>(rep.cvode.jacobian_evaluations);
+    state.counters["newton_mat"] = static_cast<double>(rep.cvode.linear_setups);
+}
+
 }  // namespace
 
+BENCHMARK(Inertia)
+    ->ArgNames({"friction", "cvode", "dt_us|rtol"})
+    ->Args({1, 0, 1000})->Args({1, 0, 100})->Args({0, 0, 1000})->Args({0, 0, 100})
+    ->Args({0, 1, 6})->Args({0, 1, 8})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(ContactSolve, bonded_exact_1e6, PaperCase::bonded, SolverKind::exact, 1e-6)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(ContactSolve, bonded_exact_1e8, PaperCase::bonded, SolverKind::exact, 1e-8)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(ContactSolve, friction_exact_1e6, PaperCase::friction, SolverKind::exact, 1e-6)->Unit(benchmark::kMillisecond);

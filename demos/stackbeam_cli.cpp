@@ -78,6 +78,18 @@ double parse_positive(const std::string& option, const std::string& text, const 
     return value;
 }
 
+/// --beam-density: a finite density >= 0 [kg/m^3] (0: massless leaves, the paper).
+double parse_density(const std::string& option, const std::string& text) {
+    if (text == "0") return 0.0;
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    const double value = std::strtod(begin, &end);
+    if (text.empty() || end == begin || *end != '\0' || !std::isfinite(value) || value < 0.0)
+        throw ArgumentError(option + ": value '" + text +
+                            "' is not allowed: must be a finite number >= 0 [kg/m^3] (0: massless leaves, the paper)");
+    return value;
+}
+
 /// Parses an integer >= 1 from `text`, all of it, or throws naming `option`.
 int parse_count(const std::string& option, const std::string& text) {
     const std::string allowed = "must be an integer >= 1";
@@ -111,6 +123,7 @@ struct SimulateArgs {
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
     std::string contact_path = "auto";
+    std::string beam_density = "0";
     std::string out;
     std::string summary;  ///< JSON summary file
     std::string pairs;    ///< per-pair CSV file
@@ -282,6 +295,8 @@ int run_simulate(const SimulateArgs& a) {
         if (summary.empty()) summary = scenario.outputs.summary_path;
         if (pairs.empty()) pairs = scenario.outputs.pairs_path;
         if (plot.empty()) plot = scenario.outputs.plot_prefix;
+        if (a.given.count("--beam-density"))
+            for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = parse_density("--beam-density", a.beam_density);
         setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
@@ -292,6 +307,7 @@ int run_simulate(const SimulateArgs& a) {
         example.symmetry = a.full_model ? stackbeam::Symmetry::full : stackbeam::Symmetry::half;
         if (out.empty()) throw ArgumentError("--out: an output file name is required");
         spec = stackbeam::paper_example(pcase, example);
+        for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = parse_density("--beam-density", a.beam_density);
         setup = std::string("case ") + stackbeam::to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                 " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }
@@ -299,6 +315,10 @@ int run_simulate(const SimulateArgs& a) {
         // parse_positive refuses 0; gravity 0 is "none": accept it explicitly
         options.loading.gravity_m_per_s2 = a.gravity == "0" ? 0.0 : parse_positive("--gravity", a.gravity, "m/s^2");
     }
+    if ((a.scenario.empty() || a.given.count("--beam-density")) && options.mode == stackbeam::Mode::closed_form &&
+        parse_density("--beam-density", a.beam_density) > 0.0)
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded and "
+                            "frictionless stacks so far): mode closed-form treats the leaves as massless, the paper");
     const bool cvode = options.mode == stackbeam::Mode::cvode;
     if (!cvode && !events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
@@ -385,6 +405,7 @@ int run_simulate(const SimulateArgs& a) {
     for (const auto& r : records) max_balance = std::max(max_balance, std::abs(r.energy_balance_error_j));
 
     // --- summary ----------------------------------------------------------------------
+    // the initial energy: the body's, and the leaves' in mode newmark (the first record)
     const double e0 = records.front().kinetic_energy_j + records.front().strain_energy_j;
     std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", setup.c_str(), stackbeam::to_string(options.mode),
                 stackbeam::to_string(options.solver.kind), options.dt_s, options.t_end_s);
@@ -420,6 +441,9 @@ int run_simulate(const SimulateArgs& a) {
     } else {
         std::printf("loop                       none (%s)\n", loop_note.c_str());
     }
+    if (options.mode == stackbeam::Mode::newmark)
+        std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",
+                    last.impact_loss_j, last.leaf_kinetic_energy_j);
     std::printf("wall time                  %.3f s\n", wall_s);
     std::printf("output                     %s\n", out.c_str());
     if (!events.empty()) std::printf("event log                  %s\n", events.c_str());
@@ -534,7 +558,8 @@ int main(int argc, char** argv) {
             ->excludes(case_opt);
     sim->add_option("--mode", a.mode,
                     "time stepping: closed-form (the paper's exact step, fixed dt) | cvode (SUNDIALS CVODE, "
-                    "root-finding on every stick-slip and open-close transition)")
+                    "root-finding on every stick-slip and open-close transition) | newmark (leaves with mass, "
+                    "--beam-density: average-acceleration Newmark, fixed dt)")
         ->type_name("MODE")
         ->capture_default_str();
     sim->add_option("--t-end", a.t_end, "end time [s]")->type_name("S")->capture_default_str();
@@ -573,6 +598,11 @@ int main(int argc, char** argv) {
     sim->add_option("--gravity", a.gravity, "weight of R: gravity [m/s^2] (static equilibrium first; 0: none)")
         ->type_name("G");
     sim->add_flag("--quiet", a.quiet, "no progress line on the terminal");
+    sim->add_option("--beam-density", a.beam_density,
+                    "density of every leaf [kg/m^3]: 0 = massless leaves (the paper), > 0 = leaves with mass "
+                    "(mode newmark; mode cvode on bonded and frictionless stacks so far)")
+        ->type_name("KG_PER_M3")
+        ->capture_default_str();
     sim->add_option("--out", a.out,
                     "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names one")
         ->type_name("FILE.csv");

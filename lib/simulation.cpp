@@ -6,6 +6,8 @@
 
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "cvode_inertia.hpp"
+#include "stackbeam/newmark_stepper.hpp"
 #include "step_record.hpp"
 
 namespace stackbeam {
@@ -14,7 +16,8 @@ std::vector<std::string> step_record_columns() {
     return {"t",           "w",              "w_dot",          "force_on_mass",     "probe_friction_force",
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
             "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
-            "spring_force", "external_force", "base_displacement", "external_work"};
+            "spring_force", "external_force", "base_displacement", "external_work", "leaf_kinetic_energy",
+            "impact_loss"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -36,13 +39,16 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.spring_force_n,
             r.external_force_n,
             r.base_displacement_m,
-            r.external_work_j};
+            r.external_work_j,
+            r.leaf_kinetic_energy_j,
+            r.impact_loss_j};
 }
 
 const char* to_string(Mode m) {
     switch (m) {
         case Mode::closed_form: return "closed-form";
         case Mode::cvode: return "cvode";
+        case Mode::newmark: return "newmark";
     }
     return "?";
 }
@@ -50,7 +56,8 @@ const char* to_string(Mode m) {
 Mode parse_mode(const std::string& text, const std::string& field) {
     if (text == "closed-form") return Mode::closed_form;
     if (text == "cvode") return Mode::cvode;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode");
+    if (text == "newmark") return Mode::newmark;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
 }
 
 const char* to_string(ContactPath path) {
@@ -124,7 +131,7 @@ void require_massless_leaves(const System& system, Mode mode) {
             throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
                              "value " + format_value(leaves[i].density_kg_per_m3) + " is not used by mode " +
                                  to_string(mode) + ", which treats the leaves as massless (the paper): give 0 "
-                                 "(the leaves' inertia is not integrated in time yet; modal_analysis() uses it)");
+                                 "(mode newmark integrates the leaves' inertia)");
 }
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
@@ -485,7 +492,13 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     };
     RunReport rep;
     rep.mode = options.mode;
-    if (options.mode == Mode::cvode) {
+    if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
+        detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) keep(stepper.advance());
+        rep.cvode = stepper.stats();
+        rep.steps = rep.cvode.steps;
+    } else if (options.mode == Mode::cvode) {
         CvodeStepper stepper(system, options);
         ContactProblem laws;
         laws.pairs = system.pairs();
@@ -508,6 +521,15 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         rep.steps = rep.cvode.steps;
         rep.contact_iterations = rep.cvode.contact_iterations;
         rep.factorizations = rep.cvode.mode_factorizations;
+    } else if (options.mode == Mode::newmark) {
+        NewmarkStepper stepper(system, options);
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.step());
+            rep.contact_iterations += out.back().contact_iterations;
+            rep.factorizations += out.back().factorizations;
+        }
+        rep.steps = n;
     } else {
         ClosedFormStepper stepper(system, options);
         auto pairs_out = [&] {

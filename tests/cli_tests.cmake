@@ -116,6 +116,9 @@ set(_cli_bad_cases
   "max_step_zero|--max-step|0|--max-step: value '0'"
   "events_without_cvode|--events|ev.csv|--events: the event log exists in mode cvode only"
   "contact_path_unknown|--contact-path|banded|--contact-path: value 'banded' is not a contact path: allowed auto, dense, sparse"
+  "beam_density_negative|--beam-density|-7850|--beam-density: value '-7850' is not allowed: must be a finite number >= 0 [kg/m^3]"
+  "beam_density_nan|--beam-density|nan|--beam-density: value 'nan' is not allowed"
+  "beam_density_massless_mode|--beam-density|7850|--beam-density: value '7850' needs --mode newmark"
 )
 foreach(entry IN LISTS _cli_bad_cases)
   string(REPLACE "|" ";" fields "${entry}")
@@ -180,6 +183,24 @@ stackbeam_cli_test(NAME cli_cvode_failure
                    ARGS simulate --case friction --mode cvode --t-end 0.1 --max-step 1e-6 --max-steps 1000
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv
                    EXPECT_RC 3 EXPECT_TEXT "cvode mode" OUT ${CMAKE_BINARY_DIR}/cli_cvode_fail.csv)
+# Mode newmark: leaves with mass (--beam-density), a complete CSV with the energy columns.
+stackbeam_cli_test(NAME cli_ok_newmark
+                   ARGS simulate --case bonded --mode newmark --beam-density 7850 --t-end 0.01
+                        --out ${CMAKE_BINARY_DIR}/cli_newmark.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${CMAKE_BINARY_DIR}/cli_newmark.csv
+                   HEADER_PREFIX "t,w,w_dot,force_on_mass,probe_friction_force" MIN_LINES 12)
+stackbeam_cli_test(NAME cli_ok_newmark_scenario
+                   ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/paper_friction.toml --mode newmark
+                        --beam-density 7850 --t-end 0.01 --out ${_cli_out_dir}/cli_newmark_scenario.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${_cli_out_dir}/cli_newmark_scenario.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
+                   ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
+                        --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode cvode" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_bad_cvode_inertia_friction
+                   ARGS simulate --case friction --mode cvode --beam-density 7850 --t-end 0.01
+                        --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
+                   EXPECT_RC 2 EXPECT_TEXT "handles bonded and frictionless stacks only so far" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv)
 # Scenario files: a good run (options given override the file), the file's output path
 # (relative to the working directory, here the test's: build/tests), and the combinations
 # that are rejected. The bad-input suite of scenario files is bad_input_tests.cmake.

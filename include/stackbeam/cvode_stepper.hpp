@@ -86,6 +86,8 @@ struct CvodeStats {
     double max_check_residual_m = 0.0; ///< largest ||v|| (eq. 9) of the mode solution in the per-step check [m]
     double max_check_force_difference_n = 0.0; ///< largest change the per-step contact iteration made to the
                                                 ///< mode solution it accepted [N]
+    long jacobian_evaluations = 0; ///< Jacobian evaluations (leaf inertia: BDF with Newton; 0 otherwise)
+    long linear_setups = 0;        ///< Newton matrix factorisations (leaf inertia; 0 otherwise)
 };
 
 /// The CVODE integration (mode "cvode"). Outputs come on the grid t = i * dt_s

@@ -31,7 +31,7 @@ struct StepRecord {
     double probe_friction_force_n = 0.0;///< tangential contact force p_t at the probe pair [N] (0 if it has none; NaN: no probe)
     int contact_iterations = 0;         ///< solver iterations of this step
     int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
-    double kinetic_energy_j = 0.0;      ///< m w_dot^2 / 2 [J]
+    double kinetic_energy_j = 0.0;      ///< kinetic energy [J]: m w_dot^2 / 2, plus the leaves' v^T M v / 2 in mode newmark
     double strain_energy_j = 0.0;       ///< elastic energy of the leaves [J]
     double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
     double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
@@ -45,6 +45,9 @@ struct StepRecord {
     double base_displacement_m = 0.0;   ///< y_b of the supports [m] (base excitation): R's absolute displacement is w + y_b
     double external_work_j = 0.0;       ///< work of the external loads since t = 0 [J]; the balance is
                                         ///< E(0) + external work - (kinetic + strain + dissipated)
+    double leaf_kinetic_energy_j = 0.0; ///< the leaves' share of kinetic_energy_j [J] (0 with massless leaves)
+    double impact_loss_j = 0.0;         ///< cumulative energy lost at contact closures net of openings [J]
+                                        ///< (mode newmark: the normal contact work, newmark_stepper.hpp)
 };
 
 /// Column names of StepRecord in CSV order.
@@ -52,10 +55,11 @@ std::vector<std::string> step_record_columns();
 /// Values of a record in the order of step_record_columns().
 std::vector<double> step_record_values(const StepRecord& r);
 
-/// The integrators of the massless-leaf model.
+/// The integrators.
 enum class Mode {
-    closed_form,  ///< the paper's closed-form step (eq. 16), fixed dt: the reference
-    cvode,        ///< SUNDIALS CVODE between events, root-finding on every contact transition
+    closed_form,  ///< the paper's closed-form step (eq. 16), fixed dt: the reference (massless leaves)
+    cvode,        ///< SUNDIALS CVODE between events, root-finding on every contact transition (massless leaves)
+    newmark,      ///< leaves with mass: average-acceleration Newmark, fixed dt (newmark_stepper.hpp)
 };
 const char* to_string(Mode m);
 Mode parse_mode(const std::string& text, const std::string& field);
