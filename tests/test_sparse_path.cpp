@@ -211,3 +211,41 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
         BOOST_TEST(msg.find("auto, dense, sparse") != std::string::npos);
     }
 }
+
+BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
+    // The sparse path's diagonal of W = G K^-1 G^T (selected inverse of K without the
+    // rigid body's DOFs plus a rank-h correction for them, contact_sparse.cpp) against the
+    // dense W of to_dense() (m full solves). Both are exact up to round-off: the entries
+    // are sums of a few products of O(1) coefficients with entries of K^-1 whose relative
+    // error is about cond(K) x 1e-16 (cond ~ 1e8-1e10 here: EA/L against EI/L^3 and the
+    // mesh), so 1e-7 relative to the largest W_ii; observed at most 2e-13.
+    auto check = [](const ModelSpec& spec) {
+        const System sys(Model::build(spec));
+        SimulationOptions so;
+        so.solver.tolerance_m = kTol;
+        so.contact_path = ContactPath::sparse;
+        ClosedFormStepper st(sys, so);
+        st.step();
+        const SparseContactProblem& pr = st.last_sparse_problem();
+        SparseContactSolver solver(so.solver);
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
+        solver.solve(pr, p, z);
+        const Eigen::VectorXd ref = pr.to_dense().W.diagonal();
+        const double err = (solver.compliance_diagonal() - ref).lpNorm<Eigen::Infinity>() / ref.lpNorm<Eigen::Infinity>();
+        BOOST_TEST_MESSAGE("compliance diagonal: max relative difference " << err);
+        BOOST_TEST(err < 1e-7);
+    };
+    check(paper_example(PaperCase::friction));
+    check(paper_example(PaperCase::bonded));
+    PaperExampleOptions full;
+    full.symmetry = Symmetry::full;  // two hubs: w and the seat rotation
+    check(paper_example(PaperCase::friction, full));
+    PaperExampleOptions fine;
+    fine.elements_per_half_leaf = 60;
+    ModelSpec five = paper_example(PaperCase::friction, fine);
+    while (five.leaves.size() < 5) {
+        five.leaves.push_back(five.leaves.back());
+        five.interfaces.push_back(five.interfaces.back());
+    }
+    check(five);
+}
