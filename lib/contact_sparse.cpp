@@ -283,6 +283,10 @@ struct SparseContactSolver::Impl {
     ContactProblem laws;                 // pairs and tau rule; W empty, q zero (sizes only)
     detail::ModeSet modes;
     detail::ModeLinearization lin;
+    // the modes `lin` was made from (solve_modes keeps it while they stay)
+    bool lin_ok = false;
+    std::vector<signed char> lin_nmode, lin_tmode, lin_key;
+    TauRule lin_tau_rule = TauRule::current;
     // factorisation of the current modes
     std::vector<signed char> lu_key;
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> lu;
@@ -325,6 +329,7 @@ struct SparseContactSolver::Impl {
         const_ok = false;
         unit_dof = -1;
         modes.nmode.clear();
+        lin_ok = false;
     }
 
     /// s = G z - d for z = K^-1 (b + G^T p).
@@ -340,10 +345,22 @@ struct SparseContactSolver::Impl {
     /// O(1), and unscaled the LU's pivoting would lose digits. Each cached solve gets one
     /// step of iterative refinement, so held rows come out at s = 0 to round-off.
     int solve_modes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-        modes.linearize(laws, lin);
-        std::vector<signed char> key = modes.key();
-        key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
-        const int f = solve_held(lin, key, b, d, p, z);
+        // the linearisation depends on the modes and the tau rule (and, with the previous
+        // step's rule, on tau_previous_n): kept while they stay (a step whose modes stay
+        // makes none)
+        const bool same = lin_ok && laws.tau_rule == TauRule::current && lin_tau_rule == laws.tau_rule &&
+                          lin_nmode == modes.nmode && lin_tmode == modes.tmode;
+        if (!same) {
+            modes.linearize(laws, lin);
+            lin_key = modes.key();
+            lin_key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
+            lin_nmode = modes.nmode;
+            lin_tmode = modes.tmode;
+            lin_tau_rule = laws.tau_rule;
+            lin_ok = true;
+        }
+        std::vector<signed char> key = lin_key == lu_key ? std::vector<signed char>() : lin_key;
+        const int f = solve_held(lin, key, b, d, p, z, lin_key == lu_key);
         modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
         return f;
     }
@@ -351,14 +368,14 @@ struct SparseContactSolver::Impl {
     /// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
     /// factorised unless `key` names the current factorisation.
     int solve_held(const detail::ModeLinearization& lin, std::vector<signed char>& key, const Eigen::VectorXd& b,
-                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z, bool key_is_current = false) {
         const int n = static_cast<int>(K.rows()), m = static_cast<int>(d.size());
         const auto& S = lin.S;
         const int ms = static_cast<int>(S.size());
         pos.assign(m, -1);
         for (int i = 0; i < ms; ++i) pos[S[i]] = i;
         int factorised = 0;
-        if (key != lu_key) {
+        if (!key_is_current && key != lu_key) {
             row_scale.resize(ms);
             for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
             // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
@@ -616,13 +633,18 @@ SparseContactSolver::~SparseContactSolver() = default;
 const Eigen::VectorXd& SparseContactSolver::relative_positions() const { return impl_->s; }
 const Eigen::VectorXd& SparseContactSolver::compliance_diagonal() const { return impl_->diag; }
 
-SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                                       bool structure_unchanged) {
     Impl& im = *impl_;
     const int m = problem.size();
     const int np = static_cast<int>(problem.pairs.size());
-    if (!same_matrix(problem.K, im.K) || !same_matrix(problem.G, im.G) || !same_laws(im.laws.pairs, problem.pairs) ||
-        im.laws.q.size() != m)
+    const bool known = im.laws.q.size() == m && static_cast<int>(im.laws.pairs.size()) == np && im.K.rows() == problem.K.rows() &&
+                       im.G.rows() == problem.G.rows() && im.G.cols() == problem.G.cols();
+    if (!known || (!structure_unchanged && (!same_matrix(problem.K, im.K) || !same_matrix(problem.G, im.G) ||
+                                            !same_laws(im.laws.pairs, problem.pairs))))
         im.reset_structure(problem);
+    else if (problem.b.size() != problem.K.rows() || problem.d.size() != m)
+        problem.validate();  // throws InputError naming the field
     im.laws.tau_rule = problem.tau_rule;
     im.laws.tau_previous_n = problem.tau_previous_n;
     if (static_cast<int>(im.modes.nmode.size()) != np) {

@@ -151,6 +151,7 @@ private:
     SparseContactProblem sparse_problem_;
     Eigen::VectorXd z_;
     int w_dof_ = -1;
+    double k_r_ = 0.0;  // sparse path: the rigid body's spring k_R [N/m] in K_aug
     SolveResult solve_;
     Eigen::VectorXd p_, d_, rel_;
     double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
@@ -158,7 +159,7 @@ private:
     double e0_ = 0.0, dissipated_ = 0.0;
     long step_ = 0;
     StepRecord record_;
-    void fill_record(int iterations, int factorizations);
+    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
 };
 
 /// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
