@@ -56,6 +56,7 @@
 namespace stackbeam {
 
 using SpMat = Eigen::SparseMatrix<double>;
+using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 void SparseContactProblem::validate() const {
     const int n = static_cast<int>(K.rows());
@@ -102,6 +103,8 @@ constexpr int kBoxPasses = 50;          // block principal pivoting passes per b
 constexpr int kBoxBudget = 8;
 constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
+// cached columns K^-1 g_i^T: at most this many doubles (80 MB)
+constexpr double kColumnCacheDoubles = 1e7;
 constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
 
 /// diag(G K^-1 G^T) [m/N], the compliance of each contact row alone (it scales force
@@ -275,6 +278,8 @@ bool same_laws(const std::vector<ContactPair>& a, const std::vector<ContactPair>
 
 struct SparseContactSolver::Impl {
     SolverOptions options;
+    SparsePathTuning tuning;
+    int updates = 0;                     // bordered solves (low-rank updates) in the current solve()
     // structure of the last problem
     SpMat K, G;
     Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> k_llt;
@@ -297,12 +302,28 @@ struct SparseContactSolver::Impl {
     Eigen::VectorXd row_scale;           // scaling of the held rows (1/||G_i Dz||)
     SpMat A;                             // the scaled saddle-point matrix of the current modes
     // cached back-solves of the current factorisation
-    int unit_dof = -1;                   // x_unit solves [e_unit_dof; 0]
-    Eigen::VectorXd x_unit;
-    Eigen::VectorXd const_e, const_dS;   // x_const solves [G^T e; d_S] for these e, d_S
-    Eigen::VectorXd x_const;
+    int unit_dof = -1;                   // (zu, pu) are for a unit load on this DOF
+    Eigen::VectorXd const_e, const_dS;   // (zc, pc) are for these e, d_S
     bool const_ok = false;
     Eigen::VectorXd s, x, rhs;
+    // the affine map of the load for the current factorisation: (z, p_S) = (zc, pc) + b_w (zu, pu)
+    Eigen::VectorXd zc, pc, zu, pu;
+    // Schur-complement way (solve_held): the held rows' dense LU and the cached columns K^-1 g_i^T
+    bool lu_schur = false;
+    // low-rank updates of the sparse LU (try_border): the base's held set and the border
+    bool base_valid = false;
+    std::vector<int> base_S, base_pos;
+    bool border_active = false;
+    std::vector<int> border_rows;        // the freed base rows first (border_nr of them), then the added rows
+    int border_nr = 0;
+    std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
+    int key_uses = 0;                    // solves with the current factorisation
+    Eigen::MatrixXd Mschur;              // the Schur complement (for refinement)
+    Eigen::PartialPivLU<Eigen::MatrixXd> dlu;
+    std::vector<Eigen::VectorXd> xcol;  // per contact row; empty = not computed
+    std::size_t xcol_count = 0;
+    SpMat Gt;                            // G^T (columns: contact rows)
+    RowMat Grow;                         // G, row-major
 
     void reset_structure(const SparseContactProblem& pr) {
         pr.validate();
@@ -330,6 +351,13 @@ struct SparseContactSolver::Impl {
         unit_dof = -1;
         modes.nmode.clear();
         lin_ok = false;
+        Gt = SpMat(G.transpose());
+        Grow = G;
+        xcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
+        bcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
+        base_valid = false;
+        border_active = false;
+        xcol_count = 0;
     }
 
     /// s = G z - d for z = K^-1 (b + G^T p).
@@ -366,7 +394,19 @@ struct SparseContactSolver::Impl {
     }
 
     /// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
-    /// factorised unless `key` names the current factorisation.
+    /// factorised unless `key` names the current factorisation. Two ways, by the number of
+    /// held rows:
+    ///  - up to tuning.schur_max_rows: the Schur complement on the held rows, M p_S = d_S - G_S z0,
+    ///    M = G_S K^-1 (G_S^T + G_slip^T D) (dense, ms x ms, LU with partial pivoting, as the
+    ///    dense solver's W_SS), z = z0 + K^-1 G^T (E p_S), z0 = K^-1 (b + G^T e). K is
+    ///    factorised once per run (k_llt) and the columns K^-1 g_i^T are cached per row, so
+    ///    a change of the held set costs the solves of the rows new to the cache and a small
+    ///    dense LU, not a sparse factorisation of the whole saddle-point system. This is
+    ///    the friction case's usual situation: most pairs of identical leaves open, the
+    ///    clamps held (tens of rows out of thousands).
+    ///  - more held rows (bonded, frictionless, the first passes of a large transition):
+    ///    the sparse saddle-point LU below.
+    /// Both cache the affine map of the load: (z, p_S) = (zc, pc) + b_w (zu, pu).
     int solve_held(const detail::ModeLinearization& lin, std::vector<signed char>& key, const Eigen::VectorXd& b,
                    const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z, bool key_is_current = false) {
         const int n = static_cast<int>(K.rows()), m = static_cast<int>(d.size());
@@ -375,45 +415,92 @@ struct SparseContactSolver::Impl {
         pos.assign(m, -1);
         for (int i = 0; i < ms; ++i) pos[S[i]] = i;
         int factorised = 0;
-        if (!key_is_current && key != lu_key) {
-            row_scale.resize(ms);
-            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
-            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
-            std::vector<Eigen::Triplet<double>> t;
-            t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
-            for (int j = 0; j < n; ++j)
-                for (SpMat::InnerIterator it(K, j); it; ++it)
-                    t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
-            for (int i = 0; i < ms; ++i)
-                for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
-                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
-                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
-                }
-            for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
-                const int col = pos[lin.coupled[a].second];
-                if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
-                for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
-                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
-            }
-            A.resize(n + ms, n + ms);
-            A.setFromTriplets(t.begin(), t.end());
-            A.makeCompressed();
-            lu.compute(A);
-            lu_ok = lu.info() == Eigen::Success;
+        if (!key_is_current && key != lu_key && try_border(lin)) {
+            ++updates;
             lu_key = std::move(key);
+            key_uses = 0;
+            const_ok = false;
+            unit_dof = -1;
+        } else if (!key_is_current && key != lu_key) {
+            border_active = false;
+            lu_schur = ms <= tuning.schur_max_rows;
+            if (lu_schur) {
+                factor_schur(lin);
+            } else {
+                row_scale.resize(ms);
+                for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
+                // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+                std::vector<Eigen::Triplet<double>> t;
+                t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
+                for (int j = 0; j < n; ++j)
+                    for (SpMat::InnerIterator it(K, j); it; ++it)
+                        t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+                for (int i = 0; i < ms; ++i)
+                    for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
+                        t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                        t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+                    }
+                for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+                    const int col = pos[lin.coupled[a].second];
+                    if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+                    for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
+                        t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+                }
+                A.resize(n + ms, n + ms);
+                A.setFromTriplets(t.begin(), t.end());
+                A.makeCompressed();
+                lu.compute(A);
+                lu_ok = lu.info() == Eigen::Success;
+                base_valid = lu_ok && lin.coupled.empty();
+                base_S = S;
+                base_pos = pos;
+                for (auto& c : bcol) c.resize(0);
+            }
+            lu_key = std::move(key);
+            key_uses = 0;
             const_ok = false;
             unit_dof = -1;
             factorised = 1;
         }
         if (!lu_ok) throw SingularModes{};
-        // right-hand side [Dz (b + G^T e); R d_S] = b-part + constant part
         Eigen::VectorXd dS(ms);
         for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
+        Eigen::VectorXd pS;
+        if (border_active) {
+            border_solve(lin, b, d, p, z);
+            return factorised;
+        }
+        if (++key_uses == 1) {
+            // first use of a factorisation (most active-set passes use it once): one solve
+            // with the whole load; the affine caches are made if it is used again
+            const Eigen::VectorXd f = b + G.transpose() * lin.e;
+            if (lu_schur) {
+                schur_solve(lin, k_llt.solve(f), dS, pS, z);
+            } else {
+                rhs.resize(n + ms);
+                rhs.head(n) = dz.cwiseProduct(f);
+                rhs.tail(ms) = row_scale.cwiseProduct(dS);
+                x = refined_solve(rhs);
+                z = dz.cwiseProduct(x.head(n));
+                pS = row_scale.cwiseProduct(x.tail(ms));
+            }
+            p = lin.e;
+            for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
+            for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+                p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+            return factorised;
+        }
         if (!const_ok || const_e != lin.e || const_dS != dS) {
-            rhs.resize(n + ms);
-            rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
-            rhs.tail(ms) = row_scale.cwiseProduct(dS);
-            x_const = refined_solve(rhs);
+            if (lu_schur) {
+                schur_solve(lin, k_llt.solve(G.transpose() * lin.e), dS, pc, zc);
+            } else {  // right-hand side [Dz G^T e; R d_S]
+                rhs.resize(n + ms);
+                rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
+                rhs.tail(ms) = row_scale.cwiseProduct(dS);
+                x = refined_solve(rhs);
+                zc = dz.cwiseProduct(x.head(n));
+                pc = row_scale.cwiseProduct(x.tail(ms));
+            }
             const_e = lin.e;
             const_dS = dS;
             const_ok = true;
@@ -427,26 +514,238 @@ struct SparseContactSolver::Impl {
                 ++count;
             }
         if (count == 0) {
-            x = x_const;
+            z = zc;
+            pS = pc;
         } else if (count == 1) {
             if (unit_dof != nz) {
-                rhs.setZero(n + ms);
-                rhs[nz] = dz[nz];
-                x_unit = refined_solve(rhs);
+                load_solve(lin, Eigen::VectorXd::Unit(n, nz), pu, zu);
                 unit_dof = nz;
             }
-            x = x_const + b[nz] * x_unit;
+            z = zc + b[nz] * zu;
+            pS = pc + b[nz] * pu;
         } else {
-            rhs.setZero(n + ms);
-            rhs.head(n) = dz.cwiseProduct(b);
-            x = x_const + refined_solve(rhs);
+            Eigen::VectorXd pb, zb;
+            load_solve(lin, b, pb, zb);
+            z = zc + zb;
+            pS = pc + pb;
         }
-        z = dz.cwiseProduct(x.head(n));
         p = lin.e;
-        for (int i = 0; i < ms; ++i) p[S[i]] = row_scale[i] * x[n + i];
+        for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
         for (std::size_t a = 0; a < lin.coupled.size(); ++a)
             p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
         return factorised;
+    }
+
+    /// Low-rank updates of the sparse saddle-point LU (the "base", held set S0, no slip
+    /// coupling) for a held set S near S0, without refactorising: the system of S is the
+    /// base system bordered by one row and column per changed row,
+    ///     [A0 U; W^T 0] [x; y] = [f; g],
+    ///  - a row of S0 no longer held (its force fixed at e_i): U = the unit column of its
+    ///    multiplier's equation (y_i is the slack that frees that equation), W^T x picks
+    ///    its force unknown, g = e_i (scaled);
+    ///  - a held row not in S0: U = [-g_a Dz s_a; 0], W^T = [s_a g_a Dz, 0], g = s_a d_a,
+    ///    y its force (scaled by s_a = 1/||g_a Dz||).
+    /// With Z = A0^-1 U (one base solve per changed row, cached while the base stays) the
+    /// capacitance matrix C = -W^T Z (k x k, dense LU) gives y = C^-1 (g - W^T A0^-1 f)
+    /// and x = A0^-1 f - Z y; one step of iterative refinement on the whole bordered
+    /// system follows. This is what the box QP's primal active-set method needs: it
+    /// changes one row per iteration (hundreds of iterations per box QP on 10 leaves x 400
+    /// elements, each a 0.15-0.5 s sparse LU before). The base is refactorised when more
+    /// than tuning.max_border_rows rows differ.
+    bool try_border(const detail::ModeLinearization& lin) {
+        const auto& S = lin.S;
+        if (!base_valid || !lin.coupled.empty() || static_cast<int>(S.size()) <= tuning.schur_max_rows) return false;
+        std::vector<int> rows;
+        for (int i : base_S)
+            if (pos[i] < 0) rows.push_back(i);
+        const int nr = static_cast<int>(rows.size());
+        if (nr > tuning.max_border_rows) return false;
+        for (int i : S)
+            if (base_pos[i] < 0) rows.push_back(i);
+        if (static_cast<int>(rows.size()) > tuning.max_border_rows) return false;
+        border_rows = std::move(rows);
+        border_nr = nr;
+        border_active = true;
+        lu_schur = false;
+        lu_ok = true;
+        return true;
+    }
+
+    /// Bordered solve of the current held set (see try_border) for load b and offsets d.
+    void border_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                      Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        const int n = static_cast<int>(K.rows());
+        const int ms0 = static_cast<int>(base_S.size());
+        const int k = static_cast<int>(border_rows.size());
+        auto scale_of = [&](int a) { return 1.0 / Gt_scaled.col(a).norm(); };
+        // U y added to v
+        auto add_U = [&](const Eigen::VectorXd& y, Eigen::VectorXd& v) {
+            for (int j = 0; j < k; ++j) {
+                const int i = border_rows[static_cast<std::size_t>(j)];
+                if (j < border_nr) v[n + base_pos[i]] += y[j];
+                else v.head(n) -= (scale_of(i) * y[j]) * Gt_scaled.col(i);
+            }
+        };
+        auto apply_Wt = [&](const Eigen::VectorXd& v) {
+            Eigen::VectorXd out(k);
+            for (int j = 0; j < k; ++j) {
+                const int i = border_rows[static_cast<std::size_t>(j)];
+                out[j] = j < border_nr ? v[n + base_pos[i]] : scale_of(i) * Gt_scaled.col(i).dot(v.head(n));
+            }
+            return out;
+        };
+        // columns A0^-1 U_j (cached per row while the base stays)
+        Eigen::MatrixXd C(k, k);
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            Eigen::VectorXd& col = bcol[static_cast<std::size_t>(i)];
+            if (col.size() == 0) {
+                Eigen::VectorXd u = Eigen::VectorXd::Zero(n + ms0);
+                if (j < border_nr) u[n + base_pos[i]] = 1.0;
+                else u.head(n) = -scale_of(i) * Gt_scaled.col(i);
+                col = refined_solve(u);
+            }
+            C.col(j) = -apply_Wt(col);
+        }
+        const Eigen::PartialPivLU<Eigen::MatrixXd> clu(C);
+        // right-hand side: forces of the freed base rows are unknowns held by the border
+        Eigen::VectorXd ep = lin.e;
+        for (int j = 0; j < border_nr; ++j) ep[border_rows[static_cast<std::size_t>(j)]] = 0.0;
+        Eigen::VectorXd f(n + ms0), g(k);
+        f.head(n) = dz.cwiseProduct(b + G.transpose() * ep);
+        for (int i = 0; i < ms0; ++i) f[n + i] = row_scale[i] * d[base_S[static_cast<std::size_t>(i)]];
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            g[j] = j < border_nr ? lin.e[i] / row_scale[base_pos[i]] : scale_of(i) * d[i];
+        }
+        auto solve_bordered = [&](const Eigen::VectorXd& ff, const Eigen::VectorXd& gg, Eigen::VectorXd& xx,
+                                  Eigen::VectorXd& yy) {
+            const Eigen::VectorXd h = refined_solve(ff);
+            yy = k > 0 ? Eigen::VectorXd(clu.solve(gg - apply_Wt(h))) : Eigen::VectorXd();
+            xx = h;
+            for (int j = 0; j < k; ++j) xx -= yy[j] * bcol[static_cast<std::size_t>(border_rows[static_cast<std::size_t>(j)])];
+        };
+        Eigen::VectorXd xx, yy, dx, dy;
+        solve_bordered(f, g, xx, yy);
+        {  // one step of iterative refinement on the bordered system
+            Eigen::VectorXd rf = f - A * xx;
+            Eigen::VectorXd uy = Eigen::VectorXd::Zero(n + ms0);
+            add_U(yy, uy);
+            rf -= uy;
+            const Eigen::VectorXd rg = g - apply_Wt(xx);
+            solve_bordered(rf, rg, dx, dy);
+            xx += dx;
+            yy += dy;
+        }
+        z = dz.cwiseProduct(xx.head(n));
+        p = lin.e;
+        for (int i = 0; i < ms0; ++i) {
+            const int r = base_S[static_cast<std::size_t>(i)];
+            if (pos[r] >= 0) p[r] = row_scale[i] * xx[n + i];
+        }
+        for (int j = border_nr; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            p[i] = scale_of(i) * yy[j];
+        }
+    }
+
+    /// (p_S, z) for load `f` alone (e = 0, d_S = 0) with the current factorisation.
+    void load_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS,
+                    Eigen::VectorXd& zf) {
+        const int n = static_cast<int>(K.rows()), ms = static_cast<int>(lin.S.size());
+        if (lu_schur) {
+            schur_solve(lin, k_llt.solve(f), Eigen::VectorXd::Zero(ms), pS, zf);
+        } else {
+            rhs.setZero(n + ms);
+            rhs.head(n) = dz.cwiseProduct(f);
+            x = refined_solve(rhs);
+            zf = dz.cwiseProduct(x.head(n));
+            pS = row_scale.cwiseProduct(x.tail(ms));
+        }
+    }
+
+    /// Column K^-1 g_i^T of contact row i [m/N per unit force], cached (solved in blocks
+    /// for the rows in `rows` not cached yet; the cache is dropped when it would exceed
+    /// kColumnCacheDoubles).
+    void ensure_columns(const std::vector<int>& rows) {
+        const int n = static_cast<int>(K.rows());
+        std::vector<int> missing;
+        for (int r : rows)
+            if (xcol[static_cast<std::size_t>(r)].size() == 0) missing.push_back(r);
+        if (missing.empty()) return;
+        if (static_cast<double>(xcol_count + missing.size()) * n > kColumnCacheDoubles) {
+            for (auto& c : xcol) c.resize(0);
+            xcol_count = 0;
+            missing.clear();
+            for (int r : rows) missing.push_back(r);
+        }
+        constexpr int kBlock = 32;
+        Eigen::MatrixXd Y;
+        for (std::size_t j0 = 0; j0 < missing.size(); j0 += kBlock) {
+            const int nb = static_cast<int>(std::min<std::size_t>(kBlock, missing.size() - j0));
+            Y.setZero(n, nb);
+            for (int c = 0; c < nb; ++c)
+                for (SpMat::InnerIterator it(Gt, missing[j0 + static_cast<std::size_t>(c)]); it; ++it)
+                    Y(it.row(), c) = it.value();
+            Y = k_llt.solve(Y).eval();
+            for (int c = 0; c < nb; ++c) {
+                xcol[static_cast<std::size_t>(missing[j0 + static_cast<std::size_t>(c)])] = Y.col(c);
+                ++xcol_count;
+            }
+        }
+    }
+
+    /// g_r . v for a contact row r and a vector v of n entries.
+    double row_dot(int r, const Eigen::VectorXd& v) const {
+        double sum = 0.0;
+        for (RowMat::InnerIterator it(Grow, r); it; ++it) sum += it.value() * v[it.col()];
+        return sum;
+    }
+
+    /// The Schur complement M = G_S K^-1 (G_S^T + G_slip^T D) of the held rows, LU-factorised.
+    void factor_schur(const detail::ModeLinearization& lin) {
+        const auto& S = lin.S;
+        const int ms = static_cast<int>(S.size());
+        std::vector<int> rows(S);
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            if (pos[lin.coupled[a].second] >= 0) rows.push_back(lin.coupled[a].first);
+        ensure_columns(rows);
+        Eigen::MatrixXd M(ms, ms);
+        for (int c = 0; c < ms; ++c) {
+            const Eigen::VectorXd& xc = xcol[static_cast<std::size_t>(S[c])];
+            for (int r = 0; r < ms; ++r) M(r, c) = row_dot(S[r], xc);
+        }
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int c = pos[lin.coupled[a].second];
+            if (c < 0) continue;
+            const Eigen::VectorXd& xt = xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+            for (int r = 0; r < ms; ++r) M(r, c) += lin.coef[a] * row_dot(S[r], xt);
+        }
+        dlu.compute(M);
+        // a singular set of modes (dependent held rows) is left to the caller, as with the sparse LU
+        lu_ok = ms == 0 || (M.allFinite() && dlu.rcond() > 1e-14);
+        Mschur = std::move(M);
+    }
+
+    /// Held-row solve with the Schur complement: p_S from M p_S = target - G_S z0 (one
+    /// step of iterative refinement with M, as the sparse LU's solves get) and
+    /// z = z0 + sum_S (p_S,c K^-1 g_c^T + coef p_S,c K^-1 g_t^T).
+    void schur_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
+                     Eigen::VectorXd& pS, Eigen::VectorXd& zout) {
+        const auto& S = lin.S;
+        const int ms = static_cast<int>(S.size());
+        zout = z0;
+        pS.setZero(ms);
+        if (ms == 0) return;
+        Eigen::VectorXd res(ms);
+        for (int r = 0; r < ms; ++r) res[r] = target[r] - row_dot(S[r], z0);
+        pS = dlu.solve(res);
+        pS += dlu.solve(res - Mschur * pS);
+        for (int c = 0; c < ms; ++c) zout += pS[c] * xcol[static_cast<std::size_t>(S[c])];
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int c = pos[lin.coupled[a].second];
+            if (c >= 0) zout += (lin.coef[a] * pS[c]) * xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+        }
     }
 
     /// The box-constrained QP min 1/2 x^T W x + q^T x, lower <= x <= upper, by the monotone
@@ -619,8 +918,14 @@ struct SparseContactSolver::Impl {
 
 };
 
-SparseContactSolver::SparseContactSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
+SparseContactSolver::SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning)
+    : impl_(std::make_unique<Impl>()) {
     make_solver(options);  // validates the options
+    if (tuning.schur_max_rows < 0)
+        throw InputError("tuning.schur_max_rows", "value " + std::to_string(tuning.schur_max_rows) + " must be >= 0");
+    if (tuning.max_border_rows < 0)
+        throw InputError("tuning.max_border_rows", "value " + std::to_string(tuning.max_border_rows) + " must be >= 0");
+    impl_->tuning = tuning;
     if (options.kind != SolverKind::exact)
         throw InputError("solver.kind", std::string("value '") + to_string(options.kind) +
                                             "' is not available on the sparse contact path: it has the exact "
@@ -652,6 +957,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.modes.init(im.laws, p, im.positions_of(problem, p, z));
     }
     SolveResult r;
+    im.updates = 0;
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     try {
@@ -702,6 +1008,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.s = im.positions_of(problem, p, z);
         im.modes.init(im.laws, p, im.s);
     }
+    r.updates = im.updates;
     r.residual_m = error_vector(im.laws, p, im.s).norm();
     r.natural_residual_m = detail::natural_map_diag(im.laws, im.diag, p, im.s).norm();
     if (r.converged && !(r.residual_m < im.options.tolerance_m)) {
