@@ -554,7 +554,9 @@ struct SparseContactSolver::Impl {
     /// than tuning.max_border_rows rows differ.
     bool try_border(const detail::ModeLinearization& lin) {
         const auto& S = lin.S;
-        if (!base_valid || !lin.coupled.empty() || static_cast<int>(S.size()) <= tuning.schur_max_rows) return false;
+        if (tuning.max_border_rows == 0 || !base_valid || !lin.coupled.empty() ||
+            static_cast<int>(S.size()) <= tuning.schur_max_rows)
+            return false;
         std::vector<int> rows;
         for (int i : base_S)
             if (pos[i] < 0) rows.push_back(i);
