@@ -12,7 +12,8 @@
 //    whose size and fill grow linearly with the number of elements (the contact rows
 //    are local: each touches the DOFs of two leaves at one node). It is not symmetric
 //    when a slip row is coupled to its normal force, and it is indefinite, so it is
-//    factorised by a sparse LU (Eigen::SparseLU, COLAMD ordering: no extra package).
+//    factorised by a sparse LU (Eigen::SparseLU, COLAMD ordering: no extra package)
+//    when many rows are held (bonded and frictionless runs: thousands).
 //  - The factorisation depends only on the modes; it is kept and reused while they
 //    stay, like the dense solver's LU. Within one set of modes the solution is affine in
 //    the right-hand side; on the closed-form stepper only b (the rigid body's load,
@@ -20,25 +21,41 @@
 //    do. So two back-solves per set of modes ({unit b entry} and {e, d_S}) are cached
 //    and a step whose modes stay costs O(n) (a linear combination, one product with G),
 //    not a back-solve.
+//  - Few held rows (up to SparsePathTuning::schur_max_rows, 400): the same linear
+//    problem by the dense Schur complement of the held rows, M p_S = d_S - G_S z0 with
+//    M = G_S K^-1 (G_S^T + G_slip^T D), on a Cholesky factor of K made once per (K, G).
+//    The columns K^-1 g_i^T are cached per contact row, so a new set of modes costs the
+//    solves of the rows new to the cache and a small dense LU (solve_held, factor_schur).
+//    This is the usual situation of friction runs on identical leaves: most pairs open,
+//    the clamps held.
+//  - Held sets near the last sparse LU's (at most SparsePathTuning::max_border_rows
+//    rows differ, no slip coupling, e.g. the box QP's primal active-set iterations, one
+//    row per iteration): the LU is bordered by the changed rows (a low-rank update: a
+//    back-solve per changed row, cached, and a dense LU of the k x k capacitance
+//    matrix; try_border, border_solve) instead of refactorised.
 //  - The diagonal of W scales force violations to metres, exactly as in the dense
-//    solver (so both take the same decisions). It is computed once per (K, G) from a
-//    sparse Cholesky factor K = P^T L L^T P as W_ii = ||L^-1 P g_i||^2, in blocks of
-//    columns. This is the one part whose cost is not linear (about m times the
-//    factor's fill); it is done once per run (0.35 s at 10 leaves x 400 elements).
+//    solver (so both take the same decisions). It is computed once per (K, G) from the
+//    selected inverse of K (selected_compliance_diagonal: Takahashi's recurrence on the
+//    Cholesky factor of K without the rigid body's DOFs, plus a rank-h correction for
+//    them), a few milliseconds at 10 leaves x 400 elements (m triangular solves before:
+//    0.35-0.65 s).
 //  - Mode switching (violations, block principal pivoting, Murty's rule) is the code
 //    of the dense solver (active_set.hpp), and so is the handling of transitions: after
 //    max_active_set_iterations passes, a Tresca fixed point (friction limits frozen: a
 //    box-constrained convex QP) whose working set gives the modes of a final Coulomb
 //    solve. The box QP is solved by block principal pivoting (a few factorisations)
 //    and, if that stalls, by the dense solver's monotone primal active-set method (one
-//    factorisation per working-set change, cannot cycle), each step a sparse solve.
+//    working-set change per iteration, cannot cycle), each step a sparse solve.
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
 //    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
 //    with a message.
-//  - Cost: a step whose modes stay is O(n); a transition costs a sparse factorisation
-//    per pass (0.27 s at 10 leaves x 400 elements, Eigen's SparseLU), and a friction
-//    step on many identical leaves needs 100-300 of them. That, not the formulation,
-//    is what keeps large friction runs slow (BENCHMARKS.md).
+//  - Cost: a step whose modes stay is O(n); a transition costs a factorisation or an
+//    update per pass, and the first steps of a friction run on many identical leaves
+//    (all pairs closed at rest, most of them opening) need thousands of passes: the
+//    contact problem there is degenerate (identical leaves bend alike: forces and gaps
+//    ~0), and the box QP's block principal pivoting stalls, so the primal method
+//    changes one row per iteration. That pass count, not the cost of a pass, is what
+//    keeps large friction runs slow (BENCHMARKS.md).
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
