@@ -779,6 +779,11 @@ struct SparseContactSolver::Impl {
         z = k_llt.solve(b + G.transpose() * x);
         detail::ModeLinearization qp;
         Eigen::VectorXd y, zy;
+        struct Blocking { int row; double t; signed char side; };
+        std::vector<Blocking> blocking_rows;
+        std::vector<int> wrong_rows;
+        bool single = false;  // release one bound per iteration (after a zero step)
+        int released = 0;     // bounds released by the last release
         for (int iter = 0; iter < max_iterations; ++iter) {
             ++r.iterations;
             qp.S.clear();
@@ -791,37 +796,59 @@ struct SparseContactSolver::Impl {
             std::vector<signed char> key(at_bound);
             key.push_back(100);  // a box-QP working set, not a set of modes
             r.factorizations += solve_held(qp, key, b, d, y, zy);
+            // step towards y up to the first bound; every row that reaches its bound at that
+            // step length (ties: in degenerate problems many rows sit at a bound with a zero
+            // step) joins the bounds at once. The iterate stays feasible and the objective
+            // does not rise (y minimises it on the subspace, which holds x).
             double alpha = 1.0;
-            int blocking = -1;
-            signed char side = 0;
+            blocking_rows.clear();
             for (int i : qp.S) {
                 const double dd = y[i] - x[i];
-                if (dd < 0.0 && y[i] < lower[i]) {
-                    const double t = (lower[i] - x[i]) / dd;
-                    if (t < alpha) { alpha = t; blocking = i; side = -1; }
-                } else if (dd > 0.0 && y[i] > upper[i]) {
-                    const double t = (upper[i] - x[i]) / dd;
-                    if (t < alpha) { alpha = t; blocking = i; side = +1; }
-                }
+                double t = 2.0;
+                signed char side = 0;
+                if (dd < 0.0 && y[i] < lower[i]) { t = (lower[i] - x[i]) / dd; side = -1; }
+                else if (dd > 0.0 && y[i] > upper[i]) { t = (upper[i] - x[i]) / dd; side = +1; }
+                if (side == 0) continue;
+                t = std::max(t, 0.0);
+                alpha = std::min(alpha, t);
+                blocking_rows.push_back({i, t, side});
             }
-            alpha = std::max(alpha, 0.0);
             x += alpha * (y - x);
             z += alpha * (zy - z);
-            if (blocking >= 0) {
-                at_bound[blocking] = side;
-                x[blocking] = side < 0 ? lower[blocking] : upper[blocking];
+            bool blocked = false;
+            for (const auto& c : blocking_rows)
+                if (c.t <= alpha + 1e-14) {
+                    at_bound[c.row] = c.side;
+                    x[c.row] = c.side < 0 ? lower[c.row] : upper[c.row];
+                    blocked = true;
+                }
+            if (blocked) {
+                // a zero step right after releasing several rows: release one at a time from
+                // now on (the classical rule, which cannot cycle)
+                if (alpha == 0.0 && released > 1) single = true;
+                released = 0;
                 continue;
             }
+            // release the bounds whose multiplier has the wrong sign: all of them (the step to
+            // the new subspace minimiser still lowers the objective), or the worst one only
             const Eigen::VectorXd sx = G * z - d;
             int worst = -1;
             double worst_size = tolerance;
+            wrong_rows.clear();
             for (int i = 0; i < m; ++i) {
                 if (at_bound[i] == 0 || lower[i] == upper[i]) continue;
                 const double wrong = at_bound[i] < 0 ? -sx[i] : sx[i];
+                if (wrong > tolerance) wrong_rows.push_back(i);
                 if (wrong > worst_size) { worst_size = wrong; worst = i; }
             }
             if (worst < 0) return true;
-            at_bound[worst] = 0;
+            if (single) {
+                at_bound[worst] = 0;
+                released = 1;
+            } else {
+                for (int i : wrong_rows) at_bound[i] = 0;
+                released = static_cast<int>(wrong_rows.size());
+            }
         }
         return false;
     }
