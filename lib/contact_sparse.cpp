@@ -334,6 +334,7 @@ struct SparseContactSolver::Impl {
     std::vector<int> border_rows;        // the freed base rows first (border_nr of them), then the added rows
     int border_nr = 0;
     std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
+    std::size_t bcol_count = 0;          // non-empty entries of bcol
     int key_uses = 0;                    // solves with the current factorisation
     Eigen::MatrixXd Mschur;              // the Schur complement (for refinement)
     Eigen::PartialPivLU<Eigen::MatrixXd> dlu;
@@ -372,6 +373,7 @@ struct SparseContactSolver::Impl {
         Grow = G;
         xcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
         bcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
+        bcol_count = 0;
         base_valid = false;
         border_active = false;
         xcol_count = 0;
@@ -472,6 +474,7 @@ struct SparseContactSolver::Impl {
                 base_S = S;
                 base_pos = pos;
                 for (auto& c : bcol) c.resize(0);
+                bcol_count = 0;
             }
             lu_key = std::move(key);
             key_uses = 0;
@@ -613,7 +616,12 @@ struct SparseContactSolver::Impl {
             }
             return out;
         };
-        // columns A0^-1 U_j (cached per row while the base stays)
+        // columns A0^-1 U_j (cached per row while the base stays; at most 4 x max_border_rows
+        // of them, (n + ms0) doubles each: the cache is dropped past that)
+        if (bcol_count > 4 * static_cast<std::size_t>(tuning.max_border_rows)) {
+            for (auto& c : bcol) c.resize(0);
+            bcol_count = 0;
+        }
         Eigen::MatrixXd C(k, k);
         for (int j = 0; j < k; ++j) {
             const int i = border_rows[static_cast<std::size_t>(j)];
@@ -623,6 +631,7 @@ struct SparseContactSolver::Impl {
                 if (j < border_nr) u[n + base_pos[i]] = 1.0;
                 else u.head(n) = -scale_of(i) * Gt_scaled.col(i);
                 col = refined_solve(u);
+                ++bcol_count;
             }
             C.col(j) = -apply_Wt(col);
         }
