@@ -1064,8 +1064,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.modes.init(im.laws, p, im.s);
     }
     r.updates = im.updates;
-    r.residual_m = error_vector(im.laws, p, im.s).norm();
-    r.natural_residual_m = detail::natural_map_diag(im.laws, im.diag, p, im.s).norm();
+    detail::residual_norms(im.laws, im.diag, p, im.s, r.residual_m, r.natural_residual_m);
     if (r.converged && !(r.residual_m < im.options.tolerance_m)) {
         r.converged = false;
         r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +
