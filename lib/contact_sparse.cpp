@@ -840,7 +840,7 @@ struct SparseContactSolver::Impl {
             }
             // release the bounds whose multiplier has the wrong sign: all of them (the step to
             // the new subspace minimiser still lowers the objective), or the worst one only
-            const Eigen::VectorXd sx = G * z - d;
+            const Eigen::VectorXd sx = Grow * z - d;
             int worst = -1;
             double worst_size = tolerance;
             wrong_rows.clear();
@@ -870,7 +870,7 @@ struct SparseContactSolver::Impl {
     }
 
     int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
-        s = G * z - d;
+        s = Grow * z - d;  // row-major: a gather per row, the same sums as G * z
         const double roundoff = 1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
         return modes.count_violations(laws, p, s, diag, std::max(kAccept * options.tolerance_m, roundoff));
     }
@@ -912,7 +912,7 @@ struct SparseContactSolver::Impl {
             std::vector<signed char> key(at_bound);
             key.push_back(100);  // a box-QP working set, not a set of modes
             r.factorizations += solve_held(qp, key, b, d, x, z);
-            const Eigen::VectorXd sx = G * z - d;
+            const Eigen::VectorXd sx = Grow * z - d;
             viol.clear();
             for (int i = 0; i < m; ++i) {
                 double v = 0.0;
@@ -963,11 +963,11 @@ struct SparseContactSolver::Impl {
             },
             [&](int row) { return diag[row]; },
             [&](int row) {
-                if (!s_current) s = G * z - d;
+                if (!s_current) s = Grow * z - d;
                 s_current = true;
                 return s[row];
             });
-        if (settled && !s_current) s = G * z - d;
+        if (settled && !s_current) s = Grow * z - d;
         return settled;
     }
 

@@ -281,8 +281,10 @@ const StepRecord& ClosedFormStepper::step() {
     const double w1 = w_free + gamma_ * F1 / k;
     const double wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
     // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
-    const Eigen::VectorXd rel1 = path_ == ContactPath::dense ? Eigen::VectorXd(problem_.W * p_ + problem_.q + d_)
-                                                             : Eigen::VectorXd(sparse_problem_.G * z_);
+    // G z on the sparse path: the solver's s = G z - d at the solution, plus d
+    const Eigen::VectorXd rel1 = path_ == ContactPath::dense
+                                     ? Eigen::VectorXd(problem_.W * p_ + problem_.q + d_)
+                                     : Eigen::VectorXd(sparse_solver_->relative_positions() + sparse_problem_.d);
     double work = 0.0;
     for (const auto& pr : problem_.pairs)
         if (pr.row_t >= 0 && pr.kind != PairKind::bonded)
