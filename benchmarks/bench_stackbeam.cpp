@@ -205,8 +205,10 @@ BENCHMARK(Scaling)
     ->Args({20, 6, 0, 0, 200})->Args({20, 6, 0, 1, 200})->Args({20, 6, 1, 0, 50})->Args({20, 6, 1, 1, 50})
     ->Args({20, 10, 0, 0, 200})->Args({20, 10, 0, 1, 200})->Args({20, 10, 1, 0, 20})->Args({20, 10, 1, 1, 20})
     // the target size: 10 leaves x 400 elements per half leaf (sparse; bonded and frictionless;
-    // a friction step there takes minutes: not run)
+    // its first friction step takes over 10 minutes and fails: not run, see BENCHMARKS.md);
+    // friction on 10 leaves x 100 elements (1,782 rows), 20 steps
     ->Args({80, 10, 0, 1, 1000})->Args({400, 10, 0, 1, 1000})->Args({400, 10, 2, 1, 1000})
+    ->Args({100, 10, 1, 1, 20})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

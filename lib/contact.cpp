@@ -132,6 +132,41 @@ Eigen::VectorXd detail::natural_map_diag(const ContactProblem& problem, const Ei
     return r;
 }
 
+void detail::residual_norms(const ContactProblem& problem, const Eigen::VectorXd& diag, const Eigen::VectorXd& p,
+                            const Eigen::VectorXd& s, double& error_norm_m, double& natural_norm_m) {
+    // the same formulas as error_vector and natural_map_diag, component by component
+    double v2 = 0.0, r2 = 0.0;
+    for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
+        const auto& c = problem.pairs[k];
+        if (c.row_n >= 0) {
+            const double pn = p[c.row_n], sn = s[c.row_n];
+            if (c.kind != PairKind::coulomb || pn < 0.0 || sn > 0.0) v2 += sn * sn;
+            double r = sn;
+            if (c.kind == PairKind::coulomb) {
+                const double w = diag[c.row_n];
+                r = w * (pn - std::min(0.0, pn - sn / w));
+            }
+            r2 += r * r;
+        }
+        if (c.row_t >= 0) {
+            const double pt = p[c.row_t], st = s[c.row_t];
+            if (c.kind == PairKind::bonded) {
+                v2 += st * st;
+                r2 += st * st;
+                continue;
+            }
+            const double limit = c.friction_coefficient * friction_normal_force(problem, static_cast<int>(k), p);
+            const double w = diag[c.row_t];
+            const double r = w * (pt - std::clamp(pt - st / w, -limit, limit));
+            r2 += r * r;
+            if (limit <= 0.0) continue;
+            if (std::abs(pt) < limit * (1.0 - 1e-12) || pt * st > 0.0) v2 += st * st;
+        }
+    }
+    error_norm_m = std::sqrt(v2);
+    natural_norm_m = std::sqrt(r2);
+}
+
 PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
     const auto& c = problem.pairs[k];
     if (c.kind == PairKind::bonded) return PairState::stick;

@@ -16,6 +16,10 @@ void validate_laws(const std::vector<ContactPair>& pairs, int n, TauRule tau_rul
 /// natural_map() with the diagonal of W given (the sparse path has no dense W).
 Eigen::VectorXd natural_map_diag(const ContactProblem& problem, const Eigen::VectorXd& diag,
                                  const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+/// ||error_vector(problem, p, s)||_2 and ||natural_map_diag(problem, diag, p, s)||_2 in
+/// one pass over the pairs, without the two vectors (the sparse path's per-step report).
+void residual_norms(const ContactProblem& problem, const Eigen::VectorXd& diag, const Eigen::VectorXd& p,
+                    const Eigen::VectorXd& s, double& error_norm_m, double& natural_norm_m);
 
 /// Exact solution of pair k's own problem s_k = W_kk p_k + b_k (b_k the free
 /// term with every other pair's force fixed): open, stick or slip, whichever is

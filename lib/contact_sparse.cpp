@@ -12,7 +12,8 @@
 //    whose size and fill grow linearly with the number of elements (the contact rows
 //    are local: each touches the DOFs of two leaves at one node). It is not symmetric
 //    when a slip row is coupled to its normal force, and it is indefinite, so it is
-//    factorised by a sparse LU (Eigen::SparseLU, COLAMD ordering: no extra package).
+//    factorised by a sparse LU (Eigen::SparseLU, COLAMD ordering: no extra package)
+//    when many rows are held (bonded and frictionless runs: thousands).
 //  - The factorisation depends only on the modes; it is kept and reused while they
 //    stay, like the dense solver's LU. Within one set of modes the solution is affine in
 //    the right-hand side; on the closed-form stepper only b (the rigid body's load,
@@ -20,25 +21,41 @@
 //    do. So two back-solves per set of modes ({unit b entry} and {e, d_S}) are cached
 //    and a step whose modes stay costs O(n) (a linear combination, one product with G),
 //    not a back-solve.
+//  - Few held rows (up to SparsePathTuning::schur_max_rows, 400): the same linear
+//    problem by the dense Schur complement of the held rows, M p_S = d_S - G_S z0 with
+//    M = G_S K^-1 (G_S^T + G_slip^T D), on a Cholesky factor of K made once per (K, G).
+//    The columns K^-1 g_i^T are cached per contact row, so a new set of modes costs the
+//    solves of the rows new to the cache and a small dense LU (solve_held, factor_schur).
+//    This is the usual situation of friction runs on identical leaves: most pairs open,
+//    the clamps held.
+//  - Held sets near the last sparse LU's (at most SparsePathTuning::max_border_rows
+//    rows differ, no slip coupling, e.g. the box QP's primal active-set iterations, one
+//    row per iteration): the LU is bordered by the changed rows (a low-rank update: a
+//    back-solve per changed row, cached, and a dense LU of the k x k capacitance
+//    matrix; try_border, border_solve) instead of refactorised.
 //  - The diagonal of W scales force violations to metres, exactly as in the dense
-//    solver (so both take the same decisions). It is computed once per (K, G) from a
-//    sparse Cholesky factor K = P^T L L^T P as W_ii = ||L^-1 P g_i||^2, in blocks of
-//    columns. This is the one part whose cost is not linear (about m times the
-//    factor's fill); it is done once per run (0.35 s at 10 leaves x 400 elements).
+//    solver (so both take the same decisions). It is computed once per (K, G) from the
+//    selected inverse of K (selected_compliance_diagonal: Takahashi's recurrence on the
+//    Cholesky factor of K without the rigid body's DOFs, plus a rank-h correction for
+//    them), a few milliseconds at 10 leaves x 400 elements (m triangular solves before:
+//    0.35-0.65 s).
 //  - Mode switching (violations, block principal pivoting, Murty's rule) is the code
 //    of the dense solver (active_set.hpp), and so is the handling of transitions: after
 //    max_active_set_iterations passes, a Tresca fixed point (friction limits frozen: a
 //    box-constrained convex QP) whose working set gives the modes of a final Coulomb
 //    solve. The box QP is solved by block principal pivoting (a few factorisations)
 //    and, if that stalls, by the dense solver's monotone primal active-set method (one
-//    factorisation per working-set change, cannot cycle), each step a sparse solve.
+//    working-set change per iteration, cannot cycle), each step a sparse solve.
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
 //    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
 //    with a message.
-//  - Cost: a step whose modes stay is O(n); a transition costs a sparse factorisation
-//    per pass (0.27 s at 10 leaves x 400 elements, Eigen's SparseLU), and a friction
-//    step on many identical leaves needs 100-300 of them. That, not the formulation,
-//    is what keeps large friction runs slow (BENCHMARKS.md).
+//  - Cost: a step whose modes stay is O(n); a transition costs a factorisation or an
+//    update per pass, and the first steps of a friction run on many identical leaves
+//    (all pairs closed at rest, most of them opening) need thousands of passes: the
+//    contact problem there is degenerate (identical leaves bend alike: forces and gaps
+//    ~0), and the box QP's block principal pivoting stalls, so the primal method
+//    changes one row per iteration. That pass count, not the cost of a pass, is what
+//    keeps large friction runs slow (BENCHMARKS.md).
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -56,6 +73,7 @@
 namespace stackbeam {
 
 using SpMat = Eigen::SparseMatrix<double>;
+using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 void SparseContactProblem::validate() const {
     const int n = static_cast<int>(K.rows());
@@ -102,7 +120,166 @@ constexpr int kBoxPasses = 50;          // block principal pivoting passes per b
 constexpr int kBoxBudget = 8;
 constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
+// cached columns K^-1 g_i^T: at most this many doubles (80 MB)
+constexpr double kColumnCacheDoubles = 1e7;
 constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
+
+/// diag(G K^-1 G^T) [m/N], the compliance of each contact row alone (it scales force
+/// violations to metres). Each row g_i of G touches a few DOFs (two leaves at one
+/// node), so W_ii = sum_{a,b} g_ia g_ib (K^-1)_ab needs a few entries of K^-1 only:
+///  - The leaves are coupled in K only through the rigid body's DOFs ("hubs": w, and
+///    the seat rotation on the full model), which tie the attachment node of every tied
+///    leaf. With K = [A B; B^T C] (C: the hubs, at most kMaxHubs DOFs of degree above
+///    kHubDegree), K^-1 = [A^-1 + X S^-1 X^T, -X S^-1; -S^-1 X^T, S^-1] with
+///    X = A^-1 B and S = C - B^T X, so
+///        W_ii = g_A^T A^-1 g_A + t^T S^-1 t,   t = X^T g_A - g_C.
+///  - A^-1 is needed on pairs of DOFs within one cross-section of one leaf: taken from
+///    the selected inverse of A (the entries of A^-1 on the pattern of its Cholesky
+///    factor L, L L^T = P A P^T), by Takahashi's recurrence from the last column back,
+///        Z_ij = (delta_ij / L_jj - sum_{k > j} Z_ik L_kj) / L_jj,  i in struct(L_:j) + {j},
+///    which only reads entries of the pattern (a column's structure is a clique of the
+///    filled graph); cost sum_j |L_:j|^2, about that of the factorisation. An entry
+///    between different connected components of A (different leaves) is exactly 0.
+///  - A row that needs an entry of A^-1 off the pattern within one component (not met
+///    with the models here) is computed directly from K's factor as ||L_K^-1 P_K g_i||^2.
+/// All of it is exact to round-off (test: sparse_compliance_diagonal_is_exact). Before,
+/// the whole diagonal was m dense triangular solves: 0.35-0.65 s at 10 leaves x 400
+/// elements, now a few milliseconds.
+template <class LLT>
+Eigen::VectorXd selected_compliance_diagonal(const SpMat& K, const SpMat& G, const LLT& k_llt) {
+    using RowMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+    constexpr int kHubDegree = 12;  // a beam DOF couples to at most 9 (its node and the two neighbours)
+    constexpr int kMaxHubs = 8;
+    const int n = static_cast<int>(K.rows()), m = static_cast<int>(G.rows());
+    std::vector<int> hubs;
+    for (int j = 0; j < n; ++j)
+        if (K.outerIndexPtr()[j + 1] - K.outerIndexPtr()[j] > kHubDegree) hubs.push_back(j);
+    if (static_cast<int>(hubs.size()) > kMaxHubs || static_cast<int>(hubs.size()) >= n) hubs.clear();
+    const int h = static_cast<int>(hubs.size()), na = n - h;
+    std::vector<int> index(static_cast<std::size_t>(n));  // DOF -> index in A (>= 0) or -1 - index in C
+    {
+        int ia = 0, ic = 0;
+        for (int j = 0; j < n; ++j) {
+            const bool hub = std::binary_search(hubs.begin(), hubs.end(), j);
+            index[static_cast<std::size_t>(j)] = hub ? -1 - ic++ : ia++;
+        }
+    }
+    std::vector<Eigen::Triplet<double>> ta, tb;
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(h, h);
+    for (int j = 0; j < n; ++j)
+        for (SpMat::InnerIterator it(K, j); it; ++it) {
+            const int r = index[static_cast<std::size_t>(it.row())], c = index[static_cast<std::size_t>(j)];
+            if (r >= 0 && c >= 0) ta.emplace_back(r, c, it.value());
+            else if (r >= 0) tb.emplace_back(r, -1 - c, it.value());
+            else if (c < 0) C(-1 - r, -1 - c) = it.value();
+        }
+    SpMat A(na, na), B(na, h);
+    A.setFromTriplets(ta.begin(), ta.end());
+    B.setFromTriplets(tb.begin(), tb.end());
+    Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt(A);
+    if (llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
+    const Eigen::MatrixXd X = h > 0 ? Eigen::MatrixXd(llt.solve(Eigen::MatrixXd(B))) : Eigen::MatrixXd(na, 0);
+    const Eigen::LLT<Eigen::MatrixXd> s_llt(C - B.transpose() * X);
+    // selected inverse of A
+    const SpMat& L = llt.matrixL().nestedExpression();  // column-major, diagonal first, rows ascending
+    const int* Lp = L.outerIndexPtr();
+    const int* Li = L.innerIndexPtr();
+    const double* Lx = L.valuePtr();
+    std::vector<double> Z(static_cast<std::size_t>(L.nonZeros()), 0.0);
+    auto find = [&](int i, int k) -> long {  // position of (i, k), i != k, in the pattern, or -1
+        const int c = std::min(i, k), r = std::max(i, k);
+        const int* e = Li + Lp[c + 1];
+        const int* f = std::lower_bound(Li + Lp[c] + 1, e, r);
+        return (f != e && *f == r) ? static_cast<long>(f - Li) : -1L;
+    };
+    auto at = [&](long pos) -> double& { return Z[static_cast<std::size_t>(pos)]; };
+    for (int j = na - 1; j >= 0; --j) {
+        const int p0 = Lp[j], p1 = Lp[j + 1];
+        const double ljj = Lx[p0];
+        for (int pi = p0 + 1; pi < p1; ++pi) {
+            const int i = Li[pi];
+            double sum = 0.0;
+            for (int pk = p0 + 1; pk < p1; ++pk) {
+                const int k = Li[pk];
+                sum += (k == i ? at(Lp[i]) : at(find(i, k))) * Lx[pk];
+            }
+            at(pi) = -sum / ljj;
+        }
+        double sum = 0.0;
+        for (int pk = p0 + 1; pk < p1; ++pk) sum += at(pk) * Lx[pk];
+        at(p0) = (1.0 / ljj - sum) / ljj;
+    }
+    // connected components of A's graph (union-find, path halving)
+    std::vector<int> parent(static_cast<std::size_t>(na));
+    for (int i = 0; i < na; ++i) parent[static_cast<std::size_t>(i)] = i;
+    auto root = [&](int i) {
+        while (parent[static_cast<std::size_t>(i)] != i) {
+            parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+            i = parent[static_cast<std::size_t>(i)];
+        }
+        return i;
+    };
+    for (int j = 0; j < na; ++j)
+        for (SpMat::InnerIterator it(A, j); it; ++it) {
+            const int a = root(static_cast<int>(it.row())), b = root(j);
+            if (a != b) parent[static_cast<std::size_t>(a)] = b;
+        }
+    const auto& perm = llt.permutationP().indices();
+    const RowMat Grow = G;  // the rows of G
+    Eigen::VectorXd diag(m), t(h);
+    std::vector<int> direct;
+    for (int r = 0; r < m; ++r) {
+        double w = 0.0;
+        bool ok = true;
+        t.setZero();
+        for (RowMat::InnerIterator a(Grow, r); a && ok; ++a) {
+            const int ia = index[static_cast<std::size_t>(a.col())];
+            if (ia < 0) {
+                t[-1 - ia] -= a.value();
+                continue;
+            }
+            t += a.value() * X.row(ia).transpose();
+            for (RowMat::InnerIterator b(Grow, r); b; ++b) {
+                const int ib = index[static_cast<std::size_t>(b.col())];
+                if (ib < 0) continue;
+                const int pa = perm[ia], pb = perm[ib];
+                double z = 0.0;
+                if (pa == pb) {
+                    z = at(Lp[pa]);
+                } else if (root(ia) == root(ib)) {
+                    const long f = find(pa, pb);
+                    if (f < 0) {
+                        ok = false;
+                        break;
+                    }
+                    z = at(f);
+                }
+                w += a.value() * b.value() * z;
+            }
+        }
+        if (!ok) {
+            direct.push_back(r);
+            continue;
+        }
+        diag[r] = h > 0 ? w + t.dot(s_llt.solve(t)) : w;
+    }
+    // rows off the pattern: column norms of L_K^-1 P_K g_i, in blocks of columns
+    if (!direct.empty()) {
+        const SpMat Gt = SpMat(G.transpose());
+        const auto& kperm = k_llt.permutationP().indices();
+        constexpr int kBlock = 64;
+        for (std::size_t j0 = 0; j0 < direct.size(); j0 += kBlock) {
+            const int nb = static_cast<int>(std::min<std::size_t>(kBlock, direct.size() - j0));
+            Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(n, nb);
+            for (int c = 0; c < nb; ++c)
+                for (SpMat::InnerIterator it(Gt, direct[j0 + static_cast<std::size_t>(c)]); it; ++it)
+                    Y(kperm[it.row()], c) = it.value();
+            k_llt.matrixL().solveInPlace(Y);
+            for (int c = 0; c < nb; ++c) diag[direct[j0 + static_cast<std::size_t>(c)]] = Y.col(c).squaredNorm();
+        }
+    }
+    return diag;
+}
 
 struct SingularModes {};            // a set of modes whose saddle-point system is singular
 
@@ -118,6 +295,8 @@ bool same_laws(const std::vector<ContactPair>& a, const std::vector<ContactPair>
 
 struct SparseContactSolver::Impl {
     SolverOptions options;
+    SparsePathTuning tuning;
+    int updates = 0;                     // bordered solves (low-rank updates) in the current solve()
     // structure of the last problem
     SpMat K, G;
     Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> k_llt;
@@ -126,6 +305,10 @@ struct SparseContactSolver::Impl {
     ContactProblem laws;                 // pairs and tau rule; W empty, q zero (sizes only)
     detail::ModeSet modes;
     detail::ModeLinearization lin;
+    // the modes `lin` was made from (solve_modes keeps it while they stay)
+    bool lin_ok = false;
+    std::vector<signed char> lin_nmode, lin_tmode, lin_key;
+    TauRule lin_tau_rule = TauRule::current;
     // factorisation of the current modes
     std::vector<signed char> lu_key;
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> lu;
@@ -136,12 +319,29 @@ struct SparseContactSolver::Impl {
     Eigen::VectorXd row_scale;           // scaling of the held rows (1/||G_i Dz||)
     SpMat A;                             // the scaled saddle-point matrix of the current modes
     // cached back-solves of the current factorisation
-    int unit_dof = -1;                   // x_unit solves [e_unit_dof; 0]
-    Eigen::VectorXd x_unit;
-    Eigen::VectorXd const_e, const_dS;   // x_const solves [G^T e; d_S] for these e, d_S
-    Eigen::VectorXd x_const;
+    int unit_dof = -1;                   // (zu, pu) are for a unit load on this DOF
+    Eigen::VectorXd const_e, const_dS;   // (zc, pc) are for these e, d_S
     bool const_ok = false;
     Eigen::VectorXd s, x, rhs;
+    // the affine map of the load for the current factorisation: (z, p_S) = (zc, pc) + b_w (zu, pu)
+    Eigen::VectorXd zc, pc, zu, pu;
+    // Schur-complement way (solve_held): the held rows' dense LU and the cached columns K^-1 g_i^T
+    bool lu_schur = false;
+    // low-rank updates of the sparse LU (try_border): the base's held set and the border
+    bool base_valid = false;
+    std::vector<int> base_S, base_pos;
+    bool border_active = false;
+    std::vector<int> border_rows;        // the freed base rows first (border_nr of them), then the added rows
+    int border_nr = 0;
+    std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
+    std::size_t bcol_count = 0;          // non-empty entries of bcol
+    int key_uses = 0;                    // solves with the current factorisation
+    Eigen::MatrixXd Mschur;              // the Schur complement (for refinement)
+    Eigen::PartialPivLU<Eigen::MatrixXd> dlu;
+    std::vector<Eigen::VectorXd> xcol;  // per contact row; empty = not computed
+    std::size_t xcol_count = 0;
+    SpMat Gt;                            // G^T (columns: contact rows)
+    RowMat Grow;                         // G, row-major
 
     void reset_structure(const SparseContactProblem& pr) {
         pr.validate();
@@ -151,18 +351,8 @@ struct SparseContactSolver::Impl {
         G.makeCompressed();
         k_llt.compute(K);
         if (k_llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
-        // diag(G K^-1 G^T) = column norms of L^-1 P G^T, in blocks of columns
         const int m = pr.size();
-        diag.resize(m);
-        const SpMat PGt = k_llt.permutationP() * SpMat(G.transpose());
-        constexpr int kBlock = 64;
-        Eigen::MatrixXd Y;
-        for (int j0 = 0; j0 < m; j0 += kBlock) {
-            const int nb = std::min(kBlock, m - j0);
-            Y = Eigen::MatrixXd(PGt.middleCols(j0, nb));
-            k_llt.matrixL().solveInPlace(Y);
-            diag.segment(j0, nb) = Y.colwise().squaredNorm().transpose();
-        }
+        diag = selected_compliance_diagonal(K, G, k_llt);
         g_norm_inf = 0.0;
         const SpMat absG = G.cwiseAbs();
         const Eigen::VectorXd rows = absG * Eigen::VectorXd::Ones(G.cols());
@@ -178,6 +368,15 @@ struct SparseContactSolver::Impl {
         const_ok = false;
         unit_dof = -1;
         modes.nmode.clear();
+        lin_ok = false;
+        Gt = SpMat(G.transpose());
+        Grow = G;
+        xcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
+        bcol.assign(static_cast<std::size_t>(m), Eigen::VectorXd());
+        bcol_count = 0;
+        base_valid = false;
+        border_active = false;
+        xcol_count = 0;
     }
 
     /// s = G z - d for z = K^-1 (b + G^T p).
@@ -193,63 +392,135 @@ struct SparseContactSolver::Impl {
     /// O(1), and unscaled the LU's pivoting would lose digits. Each cached solve gets one
     /// step of iterative refinement, so held rows come out at s = 0 to round-off.
     int solve_modes(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-        modes.linearize(laws, lin);
-        std::vector<signed char> key = modes.key();
-        key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
-        const int f = solve_held(lin, key, b, d, p, z);
+        // the linearisation depends on the modes and the tau rule (and, with the previous
+        // step's rule, on tau_previous_n): kept while they stay (a step whose modes stay
+        // makes none)
+        const bool same = lin_ok && laws.tau_rule == TauRule::current && lin_tau_rule == laws.tau_rule &&
+                          lin_nmode == modes.nmode && lin_tmode == modes.tmode;
+        if (!same) {
+            modes.linearize(laws, lin);
+            lin_key = modes.key();
+            lin_key.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
+            lin_nmode = modes.nmode;
+            lin_tmode = modes.tmode;
+            lin_tau_rule = laws.tau_rule;
+            lin_ok = true;
+        }
+        std::vector<signed char> key = lin_key == lu_key ? std::vector<signed char>() : lin_key;
+        const int f = solve_held(lin, key, b, d, p, z, lin_key == lu_key);
         modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
         return f;
     }
 
     /// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
-    /// factorised unless `key` names the current factorisation.
+    /// factorised unless `key` names the current factorisation. Two ways, by the number of
+    /// held rows:
+    ///  - up to tuning.schur_max_rows: the Schur complement on the held rows, M p_S = d_S - G_S z0,
+    ///    M = G_S K^-1 (G_S^T + G_slip^T D) (dense, ms x ms, LU with partial pivoting, as the
+    ///    dense solver's W_SS), z = z0 + K^-1 G^T (E p_S), z0 = K^-1 (b + G^T e). K is
+    ///    factorised once per run (k_llt) and the columns K^-1 g_i^T are cached per row, so
+    ///    a change of the held set costs the solves of the rows new to the cache and a small
+    ///    dense LU, not a sparse factorisation of the whole saddle-point system. This is
+    ///    the friction case's usual situation: most pairs of identical leaves open, the
+    ///    clamps held (tens of rows out of thousands).
+    ///  - more held rows (bonded, frictionless, the first passes of a large transition):
+    ///    the sparse saddle-point LU below.
+    /// Both cache the affine map of the load: (z, p_S) = (zc, pc) + b_w (zu, pu).
     int solve_held(const detail::ModeLinearization& lin, std::vector<signed char>& key, const Eigen::VectorXd& b,
-                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z, bool key_is_current = false) {
         const int n = static_cast<int>(K.rows()), m = static_cast<int>(d.size());
         const auto& S = lin.S;
         const int ms = static_cast<int>(S.size());
         pos.assign(m, -1);
         for (int i = 0; i < ms; ++i) pos[S[i]] = i;
         int factorised = 0;
-        if (key != lu_key) {
-            row_scale.resize(ms);
-            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
-            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
-            std::vector<Eigen::Triplet<double>> t;
-            t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
-            for (int j = 0; j < n; ++j)
-                for (SpMat::InnerIterator it(K, j); it; ++it)
-                    t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
-            for (int i = 0; i < ms; ++i)
-                for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
-                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
-                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
-                }
-            for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
-                const int col = pos[lin.coupled[a].second];
-                if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
-                for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
-                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
-            }
-            A.resize(n + ms, n + ms);
-            A.setFromTriplets(t.begin(), t.end());
-            A.makeCompressed();
-            lu.compute(A);
-            lu_ok = lu.info() == Eigen::Success;
+        if (!key_is_current && key != lu_key && try_border(lin)) {
+            ++updates;
             lu_key = std::move(key);
+            key_uses = 0;
+            const_ok = false;
+            unit_dof = -1;
+        } else if (!key_is_current && key != lu_key) {
+            border_active = false;
+            lu_schur = ms <= tuning.schur_max_rows;
+            if (lu_schur) {
+                factor_schur(lin);
+            } else {
+                row_scale.resize(ms);
+                for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
+                // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+                std::vector<Eigen::Triplet<double>> t;
+                t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
+                for (int j = 0; j < n; ++j)
+                    for (SpMat::InnerIterator it(K, j); it; ++it)
+                        t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+                for (int i = 0; i < ms; ++i)
+                    for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
+                        t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                        t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+                    }
+                for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+                    const int col = pos[lin.coupled[a].second];
+                    if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+                    for (SpMat::InnerIterator it(Gt_scaled, lin.coupled[a].first); it; ++it)
+                        t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+                }
+                A.resize(n + ms, n + ms);
+                A.setFromTriplets(t.begin(), t.end());
+                A.makeCompressed();
+                lu.compute(A);
+                lu_ok = lu.info() == Eigen::Success;
+                base_valid = lu_ok && lin.coupled.empty();
+                base_S = S;
+                base_pos = pos;
+                for (auto& c : bcol) c.resize(0);
+                bcol_count = 0;
+            }
+            lu_key = std::move(key);
+            key_uses = 0;
             const_ok = false;
             unit_dof = -1;
             factorised = 1;
         }
         if (!lu_ok) throw SingularModes{};
-        // right-hand side [Dz (b + G^T e); R d_S] = b-part + constant part
         Eigen::VectorXd dS(ms);
         for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
+        Eigen::VectorXd pS;
+        if (border_active) {
+            border_solve(lin, b, d, p, z);
+            return factorised;
+        }
+        if (++key_uses == 1) {
+            // first use of a factorisation (most active-set passes use it once): one solve
+            // with the whole load; the affine caches are made if it is used again
+            const Eigen::VectorXd f = b + G.transpose() * lin.e;
+            if (lu_schur) {
+                schur_solve(lin, k_llt.solve(f), dS, pS, z);
+            } else {
+                rhs.resize(n + ms);
+                rhs.head(n) = dz.cwiseProduct(f);
+                rhs.tail(ms) = row_scale.cwiseProduct(dS);
+                x = refined_solve(rhs);
+                z = dz.cwiseProduct(x.head(n));
+                pS = row_scale.cwiseProduct(x.tail(ms));
+            }
+            p = lin.e;
+            for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
+            for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+                p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+            return factorised;
+        }
         if (!const_ok || const_e != lin.e || const_dS != dS) {
-            rhs.resize(n + ms);
-            rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
-            rhs.tail(ms) = row_scale.cwiseProduct(dS);
-            x_const = refined_solve(rhs);
+            if (lu_schur) {
+                schur_solve(lin, k_llt.solve(G.transpose() * lin.e), dS, pc, zc);
+            } else {  // right-hand side [Dz G^T e; R d_S]
+                rhs.resize(n + ms);
+                rhs.head(n) = dz.cwiseProduct(G.transpose() * lin.e);
+                rhs.tail(ms) = row_scale.cwiseProduct(dS);
+                x = refined_solve(rhs);
+                zc = dz.cwiseProduct(x.head(n));
+                pc = row_scale.cwiseProduct(x.tail(ms));
+            }
             const_e = lin.e;
             const_dS = dS;
             const_ok = true;
@@ -263,26 +534,246 @@ struct SparseContactSolver::Impl {
                 ++count;
             }
         if (count == 0) {
-            x = x_const;
+            z = zc;
+            pS = pc;
         } else if (count == 1) {
             if (unit_dof != nz) {
-                rhs.setZero(n + ms);
-                rhs[nz] = dz[nz];
-                x_unit = refined_solve(rhs);
+                load_solve(lin, Eigen::VectorXd::Unit(n, nz), pu, zu);
                 unit_dof = nz;
             }
-            x = x_const + b[nz] * x_unit;
+            z = zc + b[nz] * zu;
+            pS = pc + b[nz] * pu;
         } else {
-            rhs.setZero(n + ms);
-            rhs.head(n) = dz.cwiseProduct(b);
-            x = x_const + refined_solve(rhs);
+            Eigen::VectorXd pb, zb;
+            load_solve(lin, b, pb, zb);
+            z = zc + zb;
+            pS = pc + pb;
         }
-        z = dz.cwiseProduct(x.head(n));
         p = lin.e;
-        for (int i = 0; i < ms; ++i) p[S[i]] = row_scale[i] * x[n + i];
+        for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
         for (std::size_t a = 0; a < lin.coupled.size(); ++a)
             p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
         return factorised;
+    }
+
+    /// Low-rank updates of the sparse saddle-point LU (the "base", held set S0, no slip
+    /// coupling) for a held set S near S0, without refactorising: the system of S is the
+    /// base system bordered by one row and column per changed row,
+    ///     [A0 U; W^T 0] [x; y] = [f; g],
+    ///  - a row of S0 no longer held (its force fixed at e_i): U = the unit column of its
+    ///    multiplier's equation (y_i is the slack that frees that equation), W^T x picks
+    ///    its force unknown, g = e_i (scaled);
+    ///  - a held row not in S0: U = [-g_a Dz s_a; 0], W^T = [s_a g_a Dz, 0], g = s_a d_a,
+    ///    y its force (scaled by s_a = 1/||g_a Dz||).
+    /// With Z = A0^-1 U (one base solve per changed row, cached while the base stays) the
+    /// capacitance matrix C = -W^T Z (k x k, dense LU) gives y = C^-1 (g - W^T A0^-1 f)
+    /// and x = A0^-1 f - Z y; one step of iterative refinement on the whole bordered
+    /// system follows. This is what the box QP's primal active-set method needs: it
+    /// changes one row per iteration (hundreds of iterations per box QP on 10 leaves x 400
+    /// elements, each a 0.15-0.5 s sparse LU before). The base is refactorised when more
+    /// than tuning.max_border_rows rows differ.
+    bool try_border(const detail::ModeLinearization& lin) {
+        const auto& S = lin.S;
+        if (tuning.max_border_rows == 0 || !base_valid || !lin.coupled.empty() ||
+            static_cast<int>(S.size()) <= tuning.schur_max_rows)
+            return false;
+        std::vector<int> rows;
+        for (int i : base_S)
+            if (pos[i] < 0) rows.push_back(i);
+        const int nr = static_cast<int>(rows.size());
+        if (nr > tuning.max_border_rows) return false;
+        for (int i : S)
+            if (base_pos[i] < 0) rows.push_back(i);
+        if (static_cast<int>(rows.size()) > tuning.max_border_rows) return false;
+        border_rows = std::move(rows);
+        border_nr = nr;
+        border_active = true;
+        lu_schur = false;
+        lu_ok = true;
+        return true;
+    }
+
+    /// Bordered solve of the current held set (see try_border) for load b and offsets d.
+    void border_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                      Eigen::VectorXd& p, Eigen::VectorXd& z) {
+        const int n = static_cast<int>(K.rows());
+        const int ms0 = static_cast<int>(base_S.size());
+        const int k = static_cast<int>(border_rows.size());
+        auto scale_of = [&](int a) { return 1.0 / Gt_scaled.col(a).norm(); };
+        // U y added to v
+        auto add_U = [&](const Eigen::VectorXd& y, Eigen::VectorXd& v) {
+            for (int j = 0; j < k; ++j) {
+                const int i = border_rows[static_cast<std::size_t>(j)];
+                if (j < border_nr) v[n + base_pos[i]] += y[j];
+                else v.head(n) -= (scale_of(i) * y[j]) * Gt_scaled.col(i);
+            }
+        };
+        auto apply_Wt = [&](const Eigen::VectorXd& v) {
+            Eigen::VectorXd out(k);
+            for (int j = 0; j < k; ++j) {
+                const int i = border_rows[static_cast<std::size_t>(j)];
+                out[j] = j < border_nr ? v[n + base_pos[i]] : scale_of(i) * Gt_scaled.col(i).dot(v.head(n));
+            }
+            return out;
+        };
+        // columns A0^-1 U_j (cached per row while the base stays; at most 4 x max_border_rows
+        // of them, (n + ms0) doubles each: the cache is dropped past that)
+        if (bcol_count > 4 * static_cast<std::size_t>(tuning.max_border_rows)) {
+            for (auto& c : bcol) c.resize(0);
+            bcol_count = 0;
+        }
+        Eigen::MatrixXd C(k, k);
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            Eigen::VectorXd& col = bcol[static_cast<std::size_t>(i)];
+            if (col.size() == 0) {
+                Eigen::VectorXd u = Eigen::VectorXd::Zero(n + ms0);
+                if (j < border_nr) u[n + base_pos[i]] = 1.0;
+                else u.head(n) = -scale_of(i) * Gt_scaled.col(i);
+                col = refined_solve(u);
+                ++bcol_count;
+            }
+            C.col(j) = -apply_Wt(col);
+        }
+        const Eigen::PartialPivLU<Eigen::MatrixXd> clu(C);
+        // right-hand side: forces of the freed base rows are unknowns held by the border
+        Eigen::VectorXd ep = lin.e;
+        for (int j = 0; j < border_nr; ++j) ep[border_rows[static_cast<std::size_t>(j)]] = 0.0;
+        Eigen::VectorXd f(n + ms0), g(k);
+        f.head(n) = dz.cwiseProduct(b + G.transpose() * ep);
+        for (int i = 0; i < ms0; ++i) f[n + i] = row_scale[i] * d[base_S[static_cast<std::size_t>(i)]];
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            g[j] = j < border_nr ? lin.e[i] / row_scale[base_pos[i]] : scale_of(i) * d[i];
+        }
+        auto solve_bordered = [&](const Eigen::VectorXd& ff, const Eigen::VectorXd& gg, Eigen::VectorXd& xx,
+                                  Eigen::VectorXd& yy) {
+            const Eigen::VectorXd h = refined_solve(ff);
+            yy = k > 0 ? Eigen::VectorXd(clu.solve(gg - apply_Wt(h))) : Eigen::VectorXd();
+            xx = h;
+            for (int j = 0; j < k; ++j) xx -= yy[j] * bcol[static_cast<std::size_t>(border_rows[static_cast<std::size_t>(j)])];
+        };
+        Eigen::VectorXd xx, yy, dx, dy;
+        solve_bordered(f, g, xx, yy);
+        {  // one step of iterative refinement on the bordered system
+            Eigen::VectorXd rf = f - A * xx;
+            Eigen::VectorXd uy = Eigen::VectorXd::Zero(n + ms0);
+            add_U(yy, uy);
+            rf -= uy;
+            const Eigen::VectorXd rg = g - apply_Wt(xx);
+            solve_bordered(rf, rg, dx, dy);
+            xx += dx;
+            yy += dy;
+        }
+        z = dz.cwiseProduct(xx.head(n));
+        p = lin.e;
+        for (int i = 0; i < ms0; ++i) {
+            const int r = base_S[static_cast<std::size_t>(i)];
+            if (pos[r] >= 0) p[r] = row_scale[i] * xx[n + i];
+        }
+        for (int j = border_nr; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            p[i] = scale_of(i) * yy[j];
+        }
+    }
+
+    /// (p_S, z) for load `f` alone (e = 0, d_S = 0) with the current factorisation.
+    void load_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS,
+                    Eigen::VectorXd& zf) {
+        const int n = static_cast<int>(K.rows()), ms = static_cast<int>(lin.S.size());
+        if (lu_schur) {
+            schur_solve(lin, k_llt.solve(f), Eigen::VectorXd::Zero(ms), pS, zf);
+        } else {
+            rhs.setZero(n + ms);
+            rhs.head(n) = dz.cwiseProduct(f);
+            x = refined_solve(rhs);
+            zf = dz.cwiseProduct(x.head(n));
+            pS = row_scale.cwiseProduct(x.tail(ms));
+        }
+    }
+
+    /// Column K^-1 g_i^T of contact row i [m/N per unit force], cached (solved in blocks
+    /// for the rows in `rows` not cached yet; the cache is dropped when it would exceed
+    /// kColumnCacheDoubles).
+    void ensure_columns(const std::vector<int>& rows) {
+        const int n = static_cast<int>(K.rows());
+        std::vector<int> missing;
+        for (int r : rows)
+            if (xcol[static_cast<std::size_t>(r)].size() == 0) missing.push_back(r);
+        if (missing.empty()) return;
+        if (static_cast<double>(xcol_count + missing.size()) * n > kColumnCacheDoubles) {
+            for (auto& c : xcol) c.resize(0);
+            xcol_count = 0;
+            missing.clear();
+            for (int r : rows) missing.push_back(r);
+        }
+        constexpr int kBlock = 32;
+        Eigen::MatrixXd Y;
+        for (std::size_t j0 = 0; j0 < missing.size(); j0 += kBlock) {
+            const int nb = static_cast<int>(std::min<std::size_t>(kBlock, missing.size() - j0));
+            Y.setZero(n, nb);
+            for (int c = 0; c < nb; ++c)
+                for (SpMat::InnerIterator it(Gt, missing[j0 + static_cast<std::size_t>(c)]); it; ++it)
+                    Y(it.row(), c) = it.value();
+            Y = k_llt.solve(Y).eval();
+            for (int c = 0; c < nb; ++c) {
+                xcol[static_cast<std::size_t>(missing[j0 + static_cast<std::size_t>(c)])] = Y.col(c);
+                ++xcol_count;
+            }
+        }
+    }
+
+    /// g_r . v for a contact row r and a vector v of n entries.
+    double row_dot(int r, const Eigen::VectorXd& v) const {
+        double sum = 0.0;
+        for (RowMat::InnerIterator it(Grow, r); it; ++it) sum += it.value() * v[it.col()];
+        return sum;
+    }
+
+    /// The Schur complement M = G_S K^-1 (G_S^T + G_slip^T D) of the held rows, LU-factorised.
+    void factor_schur(const detail::ModeLinearization& lin) {
+        const auto& S = lin.S;
+        const int ms = static_cast<int>(S.size());
+        std::vector<int> rows(S);
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            if (pos[lin.coupled[a].second] >= 0) rows.push_back(lin.coupled[a].first);
+        ensure_columns(rows);
+        Eigen::MatrixXd M(ms, ms);
+        for (int c = 0; c < ms; ++c) {
+            const Eigen::VectorXd& xc = xcol[static_cast<std::size_t>(S[c])];
+            for (int r = 0; r < ms; ++r) M(r, c) = row_dot(S[r], xc);
+        }
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int c = pos[lin.coupled[a].second];
+            if (c < 0) continue;
+            const Eigen::VectorXd& xt = xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+            for (int r = 0; r < ms; ++r) M(r, c) += lin.coef[a] * row_dot(S[r], xt);
+        }
+        dlu.compute(M);
+        // a singular set of modes (dependent held rows) is left to the caller, as with the sparse LU
+        lu_ok = ms == 0 || (M.allFinite() && dlu.rcond() > 1e-14);
+        Mschur = std::move(M);
+    }
+
+    /// Held-row solve with the Schur complement: p_S from M p_S = target - G_S z0 (one
+    /// step of iterative refinement with M, as the sparse LU's solves get) and
+    /// z = z0 + sum_S (p_S,c K^-1 g_c^T + coef p_S,c K^-1 g_t^T).
+    void schur_solve(const detail::ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
+                     Eigen::VectorXd& pS, Eigen::VectorXd& zout) {
+        const auto& S = lin.S;
+        const int ms = static_cast<int>(S.size());
+        zout = z0;
+        pS.setZero(ms);
+        if (ms == 0) return;
+        Eigen::VectorXd res(ms);
+        for (int r = 0; r < ms; ++r) res[r] = target[r] - row_dot(S[r], z0);
+        pS = dlu.solve(res);
+        pS += dlu.solve(res - Mschur * pS);
+        for (int c = 0; c < ms; ++c) zout += pS[c] * xcol[static_cast<std::size_t>(S[c])];
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int c = pos[lin.coupled[a].second];
+            if (c >= 0) zout += (lin.coef[a] * pS[c]) * xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+        }
     }
 
     /// The box-constrained QP min 1/2 x^T W x + q^T x, lower <= x <= upper, by the monotone
@@ -297,6 +788,11 @@ struct SparseContactSolver::Impl {
         z = k_llt.solve(b + G.transpose() * x);
         detail::ModeLinearization qp;
         Eigen::VectorXd y, zy;
+        struct Blocking { int row; double t; signed char side; };
+        std::vector<Blocking> blocking_rows;
+        std::vector<int> wrong_rows;
+        bool single = false;  // release one bound per iteration (after a zero step)
+        int released = 0;     // bounds released by the last release
         for (int iter = 0; iter < max_iterations; ++iter) {
             ++r.iterations;
             qp.S.clear();
@@ -309,37 +805,59 @@ struct SparseContactSolver::Impl {
             std::vector<signed char> key(at_bound);
             key.push_back(100);  // a box-QP working set, not a set of modes
             r.factorizations += solve_held(qp, key, b, d, y, zy);
+            // step towards y up to the first bound; every row that reaches its bound at that
+            // step length (ties: in degenerate problems many rows sit at a bound with a zero
+            // step) joins the bounds at once. The iterate stays feasible and the objective
+            // does not rise (y minimises it on the subspace, which holds x).
             double alpha = 1.0;
-            int blocking = -1;
-            signed char side = 0;
+            blocking_rows.clear();
             for (int i : qp.S) {
                 const double dd = y[i] - x[i];
-                if (dd < 0.0 && y[i] < lower[i]) {
-                    const double t = (lower[i] - x[i]) / dd;
-                    if (t < alpha) { alpha = t; blocking = i; side = -1; }
-                } else if (dd > 0.0 && y[i] > upper[i]) {
-                    const double t = (upper[i] - x[i]) / dd;
-                    if (t < alpha) { alpha = t; blocking = i; side = +1; }
-                }
+                double t = 2.0;
+                signed char side = 0;
+                if (dd < 0.0 && y[i] < lower[i]) { t = (lower[i] - x[i]) / dd; side = -1; }
+                else if (dd > 0.0 && y[i] > upper[i]) { t = (upper[i] - x[i]) / dd; side = +1; }
+                if (side == 0) continue;
+                t = std::max(t, 0.0);
+                alpha = std::min(alpha, t);
+                blocking_rows.push_back({i, t, side});
             }
-            alpha = std::max(alpha, 0.0);
             x += alpha * (y - x);
             z += alpha * (zy - z);
-            if (blocking >= 0) {
-                at_bound[blocking] = side;
-                x[blocking] = side < 0 ? lower[blocking] : upper[blocking];
+            bool blocked = false;
+            for (const auto& c : blocking_rows)
+                if (c.t <= alpha + 1e-14) {
+                    at_bound[c.row] = c.side;
+                    x[c.row] = c.side < 0 ? lower[c.row] : upper[c.row];
+                    blocked = true;
+                }
+            if (blocked) {
+                // a zero step right after releasing several rows: release one at a time from
+                // now on (the classical rule, which cannot cycle)
+                if (alpha == 0.0 && released > 1) single = true;
+                released = 0;
                 continue;
             }
-            const Eigen::VectorXd sx = G * z - d;
+            // release the bounds whose multiplier has the wrong sign: all of them (the step to
+            // the new subspace minimiser still lowers the objective), or the worst one only
+            const Eigen::VectorXd sx = Grow * z - d;
             int worst = -1;
             double worst_size = tolerance;
+            wrong_rows.clear();
             for (int i = 0; i < m; ++i) {
                 if (at_bound[i] == 0 || lower[i] == upper[i]) continue;
                 const double wrong = at_bound[i] < 0 ? -sx[i] : sx[i];
+                if (wrong > tolerance) wrong_rows.push_back(i);
                 if (wrong > worst_size) { worst_size = wrong; worst = i; }
             }
             if (worst < 0) return true;
-            at_bound[worst] = 0;
+            if (single) {
+                at_bound[worst] = 0;
+                released = 1;
+            } else {
+                for (int i : wrong_rows) at_bound[i] = 0;
+                released = static_cast<int>(wrong_rows.size());
+            }
         }
         return false;
     }
@@ -352,7 +870,7 @@ struct SparseContactSolver::Impl {
     }
 
     int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
-        s = G * z - d;
+        s = Grow * z - d;  // row-major: a gather per row, the same sums as G * z
         const double roundoff = 1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
         return modes.count_violations(laws, p, s, diag, std::max(kAccept * options.tolerance_m, roundoff));
     }
@@ -394,7 +912,7 @@ struct SparseContactSolver::Impl {
             std::vector<signed char> key(at_bound);
             key.push_back(100);  // a box-QP working set, not a set of modes
             r.factorizations += solve_held(qp, key, b, d, x, z);
-            const Eigen::VectorXd sx = G * z - d;
+            const Eigen::VectorXd sx = Grow * z - d;
             viol.clear();
             for (int i = 0; i < m; ++i) {
                 double v = 0.0;
@@ -445,18 +963,24 @@ struct SparseContactSolver::Impl {
             },
             [&](int row) { return diag[row]; },
             [&](int row) {
-                if (!s_current) s = G * z - d;
+                if (!s_current) s = Grow * z - d;
                 s_current = true;
                 return s[row];
             });
-        if (settled && !s_current) s = G * z - d;
+        if (settled && !s_current) s = Grow * z - d;
         return settled;
     }
 
 };
 
-SparseContactSolver::SparseContactSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
+SparseContactSolver::SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning)
+    : impl_(std::make_unique<Impl>()) {
     make_solver(options);  // validates the options
+    if (tuning.schur_max_rows < 0)
+        throw InputError("tuning.schur_max_rows", "value " + std::to_string(tuning.schur_max_rows) + " must be >= 0");
+    if (tuning.max_border_rows < 0)
+        throw InputError("tuning.max_border_rows", "value " + std::to_string(tuning.max_border_rows) + " must be >= 0");
+    impl_->tuning = tuning;
     if (options.kind != SolverKind::exact)
         throw InputError("solver.kind", std::string("value '") + to_string(options.kind) +
                                             "' is not available on the sparse contact path: it has the exact "
@@ -469,13 +993,18 @@ SparseContactSolver::~SparseContactSolver() = default;
 const Eigen::VectorXd& SparseContactSolver::relative_positions() const { return impl_->s; }
 const Eigen::VectorXd& SparseContactSolver::compliance_diagonal() const { return impl_->diag; }
 
-SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                                       bool structure_unchanged) {
     Impl& im = *impl_;
     const int m = problem.size();
     const int np = static_cast<int>(problem.pairs.size());
-    if (!same_matrix(problem.K, im.K) || !same_matrix(problem.G, im.G) || !same_laws(im.laws.pairs, problem.pairs) ||
-        im.laws.q.size() != m)
+    const bool known = im.laws.q.size() == m && static_cast<int>(im.laws.pairs.size()) == np && im.K.rows() == problem.K.rows() &&
+                       im.G.rows() == problem.G.rows() && im.G.cols() == problem.G.cols();
+    if (!known || (!structure_unchanged && (!same_matrix(problem.K, im.K) || !same_matrix(problem.G, im.G) ||
+                                            !same_laws(im.laws.pairs, problem.pairs))))
         im.reset_structure(problem);
+    else if (problem.b.size() != problem.K.rows() || problem.d.size() != m)
+        problem.validate();  // throws InputError naming the field
     im.laws.tau_rule = problem.tau_rule;
     im.laws.tau_previous_n = problem.tau_previous_n;
     if (static_cast<int>(im.modes.nmode.size()) != np) {
@@ -483,6 +1012,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.modes.init(im.laws, p, im.positions_of(problem, p, z));
     }
     SolveResult r;
+    im.updates = 0;
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     try {
@@ -533,8 +1063,8 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         im.s = im.positions_of(problem, p, z);
         im.modes.init(im.laws, p, im.s);
     }
-    r.residual_m = error_vector(im.laws, p, im.s).norm();
-    r.natural_residual_m = detail::natural_map_diag(im.laws, im.diag, p, im.s).norm();
+    r.updates = im.updates;
+    detail::residual_norms(im.laws, im.diag, p, im.s, r.residual_m, r.natural_residual_m);
     if (r.converged && !(r.residual_m < im.options.tolerance_m)) {
         r.converged = false;
         r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +

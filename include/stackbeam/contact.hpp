@@ -100,7 +100,10 @@ struct SolveResult {
     int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact)
     double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
     double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
-    int factorizations = 0;    ///< dense factorisations done in this solve (exact solver)
+    int factorizations = 0;    ///< factorisations done in this solve (exact solver; sparse path: sparse LU
+                               ///< of the saddle-point system or dense LU of the held rows' Schur complement)
+    int updates = 0;           ///< sparse path: sets of modes solved by a low-rank update of the last
+                               ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not
 };
@@ -148,23 +151,44 @@ struct SparseContactProblem {
 ///     [ K                       -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
 ///     [ G_S                      0                  ] [p_S] = [d_S      ]
 /// (S: rows held by s = 0; slip rows carry p_t = e_t + D p_n), factorised by a sparse
-/// LU once per set of modes and reused while the modes stay. The mode switching and the
+/// LU once per set of modes and reused while the modes stay (few held rows: the dense
+/// Schur complement on K's Cholesky factor instead; near the last LU's held set: a
+/// low-rank update of it; see SparsePathTuning). The mode switching and the
 /// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
 /// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
 /// both paths reach the same solution. If that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message.
+/// How SparseContactSolver solves the linear problem of a set of modes (the defaults
+/// are the measured choices, BENCHMARKS.md; tests set them to force each way):
+///  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on
+///    a Cholesky factor of K made once per run (columns K^-1 g_i^T cached per row);
+///  - more: a sparse LU of the saddle-point system, and a set of modes without slip
+///    coupling that differs from the last LU's held set in at most `max_border_rows`
+///    rows is solved by bordering that LU (low-rank update: a solve per changed row and
+///    a small dense LU) instead of a new factorisation.
+struct SparsePathTuning {
+    int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
+    int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+};
+
 class SparseContactSolver {
 public:
-    /// options.kind must be SolverKind::exact; throws InputError otherwise.
-    explicit SparseContactSolver(const SolverOptions& options);
+    /// options.kind must be SolverKind::exact; throws InputError otherwise (and for a
+    /// negative tuning field, naming it).
+    explicit SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning = {});
     ~SparseContactSolver();
     SparseContactSolver(const SparseContactSolver&) = delete;
     SparseContactSolver& operator=(const SparseContactSolver&) = delete;
 
     /// Solves `problem`; p is the warm start on entry and the forces [N] on exit; z the
-    /// displacements on exit. It keeps its factorisations while K and G stay the same.
-    SolveResult solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// displacements on exit. It keeps its factorisations while K and G stay the same:
+    /// it compares them with the previous call's (O(nnz)), unless the caller passes
+    /// `structure_unchanged` = true, a promise that K, G and the pairs are those of the
+    /// previous call on this solver (the closed-form stepper's are constant over a run;
+    /// at 10 leaves x 400 elements the comparison was a quarter of a step's cost).
+    SolveResult solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                      bool structure_unchanged = false);
     /// s = G z - d at the last solution [m].
     const Eigen::VectorXd& relative_positions() const;
     /// Diagonal of W = G K^-1 G^T [m/N] (computed once per K, G: it scales the force

@@ -165,6 +165,7 @@ private:
     SparseContactProblem sparse_problem_;
     Eigen::VectorXd z_;
     int w_dof_ = -1;
+    double k_r_ = 0.0;  // sparse path: the rigid body's spring k_R [N/m] in K_aug
     SolveResult solve_;
     Eigen::VectorXd p_, d_, rel_;
     double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
@@ -178,7 +179,7 @@ private:
     bool rig_ = false;
     double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
     Eigen::VectorXd krw_, gw_;
-    void fill_record(int iterations, int factorizations);
+    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
     void reanchor(const Eigen::VectorXd& rel);
 };
 
