@@ -47,6 +47,8 @@
 #include "stackbeam/csv.hpp"
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
+#include "stackbeam/hysteresis.hpp"
+#include "stackbeam/modal.hpp"
 #include "stackbeam/model.hpp"
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/simulation.hpp"
@@ -288,16 +290,116 @@ std::string figure_script(const std::string& terminal, const std::map<PaperCase,
 }
 
 void print_usage(std::ostream& os) {
-    os << "usage: paper_demo [--out-dir DIR]\n"
+    os << "usage: paper_demo [--out-dir DIR] [--beam-density KG_PER_M3]\n"
           "Runs the paper's section 5 example (three leaves, four clamps, 20 kg body at 2 m/s) in the\n"
           "bonded, friction and frictionless cases; prints a table, writes CSV time series and, if gnuplot\n"
-          "is on PATH, PNG figures to DIR (default out/).\n";
+          "is on PATH, PNG figures to DIR (default out/). Then a rig test of the friction spring (its\n"
+          "hysteresis loop). With --beam-density > 0 also the three cases with leaves of that density\n"
+          "(mode newmark) against the massless runs and the eigen-solve.\n";
+}
+
+/// Mean circular frequency [rad/s] from the upward zero crossings of w (w(0) = 0 rising counts).
+double measured_omega(const std::vector<StepRecord>& r) {
+    std::vector<double> t{0.0};
+    for (std::size_t i = 1; i < r.size(); ++i)
+        if (r[i - 1].w_m < 0.0 && r[i].w_m >= 0.0)
+            t.push_back(r[i - 1].t_s + (r[i].t_s - r[i - 1].t_s) * (-r[i - 1].w_m) / (r[i].w_m - r[i - 1].w_m));
+    if (t.size() < 2) return 0.0;
+    return 2.0 * M_PI * static_cast<double>(t.size() - 1) / (t.back() - t.front());
+}
+
+/// First maximum of w [m] (the first peak of the response).
+double first_peak(const std::vector<StepRecord>& r) {
+    for (std::size_t i = 1; i + 1 < r.size(); ++i)
+        if (r[i].w_m >= r[i - 1].w_m && r[i].w_m > r[i + 1].w_m) return r[i].w_m;
+    return 0.0;
+}
+
+/// The rig test of the friction spring: +-20 mm triangle stroke at 1 Hz, three cycles,
+/// the last one's loop figures (hysteresis.hpp). Writes rig_friction.csv. False on failure.
+bool rig_section(const fs::path& out_dir) {
+    std::printf("Rig test of the friction spring: the rig holds R and strokes it +-20 mm (triangle, 1 Hz, constant\n"
+                "speed), 3 cycles, closed-form quasi-static steps of 1 ms; the last cycle's loop:\n");
+    try {
+        stackbeam::PaperExampleOptions o;
+        o.initial_velocity_m_per_s = 0.0;
+        const stackbeam::System system(stackbeam::Model::build(stackbeam::paper_example(PaperCase::friction, o)));
+        stackbeam::SimulationOptions options;
+        options.dt_s = 1e-3;
+        options.t_end_s = 3.0;
+        options.solver.tolerance_m = 1e-9;
+        options.loading.kind = stackbeam::LoadingKind::prescribed_displacement;
+        options.loading.displacement_m.shape = stackbeam::TimeFunction::Shape::triangle;
+        options.loading.displacement_m.amplitude = 0.02;
+        options.loading.displacement_m.frequency_hz = 1.0;
+        const auto records = stackbeam::simulate(system, options);
+        const auto cyc = stackbeam::last_cycle(records, options.loading.period_s());
+        const auto h = stackbeam::hysteresis_metrics(records, cyc.first, cyc.second);
+        std::printf("  loop area (dissipated per cycle)  %.5f J   (friction work of the cycle %.5f J)\n"
+                    "  secant stiffness                  %.1f N/m (no contact force %.1f, every pair stuck %.1f)\n"
+                    "  dynamic rate |F1/w1|              %.1f N/m\n"
+                    "  loss factor (first harmonics)     %.4f\n"
+                    "  equivalent viscous damping ratio  %.4f\n"
+                    "  force range                       %.1f to %.1f N\n",
+                    h.loop_area_j, h.dissipated_j, h.secant_stiffness_n_per_m, system.free_stiffness_n_per_m(),
+                    system.tied_stiffness_n_per_m(), h.dynamic_rate_n_per_m, h.loss_factor, h.equivalent_damping_ratio,
+                    h.force_min_n, h.force_max_n);
+        write_csv_file(out_dir, "rig_friction.csv", records);
+        std::printf("wrote %s (the loop: columns w and spring_force)\n\n", (out_dir / "rig_friction.csv").string().c_str());
+        return true;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "paper_demo: error: rig test: %s\n", e.what());
+        return false;
+    }
+}
+
+/// The three cases with leaves of density `rho` (mode newmark, dt = 0.1 ms) against the
+/// massless closed-form runs and the eigen-solve of the stack with mass. False on failure.
+bool inertia_section(double rho) {
+    std::printf("Leaves with mass (density %g kg/m^3): mode newmark (average acceleration, dt = 0.1 ms, the paper's\n"
+                "contact problem every step) against the massless closed-form run and the eigen-solve (modal.hpp):\n",
+                rho);
+    std::printf("%-13s %14s %14s %14s %14s %14s %13s\n", "case", "omega [rad/s]", "eigen-solve", "massless",
+                "1st peak [m]", "massless", "impact [J]");
+    bool ok = true;
+    for (PaperCase c : kCases) {
+        try {
+            stackbeam::PaperExampleOptions o;
+            const stackbeam::System light(stackbeam::Model::build(stackbeam::paper_example(c, o)));
+            o.density_kg_per_m3 = rho;
+            const stackbeam::System heavy(stackbeam::Model::build(stackbeam::paper_example(c, o)));
+            stackbeam::SimulationOptions options;
+            options.t_end_s = 0.3;
+            const auto massless = stackbeam::simulate(light, options);
+            options.mode = Mode::newmark;
+            options.dt_s = 1e-4;
+            const auto massive = stackbeam::simulate(heavy, options);
+            double eig = 0.0;
+            if (c != PaperCase::friction) {
+                const auto modal = stackbeam::modal_analysis(
+                    heavy, c == PaperCase::bonded ? stackbeam::ModalTie::all : stackbeam::ModalTie::normal, 8);
+                Eigen::Index k = 0;
+                modal.w_amplitude.cwiseAbs().maxCoeff(&k);
+                eig = modal.omega_rad_per_s[k];
+            }
+            std::printf("%-13s %14.3f %14s %14.3f %14.5f %14.5f %13.3e\n", stackbeam::to_string(c), measured_omega(massive),
+                        eig > 0.0 ? std::to_string(eig).substr(0, 8).c_str() : "-", measured_omega(massless),
+                        first_peak(massive), first_peak(massless), massive.back().impact_loss_j);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "paper_demo: error: case %s with leaf mass: %s\n", stackbeam::to_string(c), e.what());
+            ok = false;
+        }
+    }
+    std::printf("(omega from the upward zero crossings of w over 0.3 s; eigen-solve: the mode that moves R most, with\n"
+                " every contact component tied (bonded) or the normal ones (frictionless); friction: no linear modes)\n\n");
+    return ok;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
     fs::path out_dir = "out";
+    double beam_density = 0.0;  // [kg/m^3]
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -307,6 +409,15 @@ int main(int argc, char** argv) {
             out_dir = argv[++i];
         } else if (arg.rfind("--out-dir=", 0) == 0) {
             out_dir = arg.substr(10);
+        } else if (arg == "--beam-density" && i + 1 < argc) {
+            const std::string text = argv[++i];
+            char* end = nullptr;
+            beam_density = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !std::isfinite(beam_density) || beam_density < 0.0) {
+                std::cerr << "paper_demo: error: --beam-density: value '" << text
+                          << "' is not allowed: must be a finite number >= 0 [kg/m^3]\n";
+                return 2;
+            }
         } else {
             std::cerr << "paper_demo: error: unknown or incomplete argument '" << arg << "'\n";
             print_usage(std::cerr);
@@ -323,7 +434,7 @@ int main(int argc, char** argv) {
         // stale CSV or figure is taken for a result of this run.
         for (const auto& entry : fs::directory_iterator(out_dir)) {
             const std::string name = entry.path().filename().string();
-            bool ours = name == "figures.gp" || name == "fig_displacement_all.png" ||
+            bool ours = name == "figures.gp" || name == "fig_displacement_all.png" || name == "rig_friction.csv" ||
                         name == "fig_friction_force_friction.png" || name == "fig_hysteresis_friction.png";
             for (PaperCase c : kCases) {
                 const std::string cs = stackbeam::to_string(c);
@@ -446,6 +557,10 @@ int main(int argc, char** argv) {
     std::printf("(mesh: the discretised stack, bonded = all contact components tied; 1-beam: paper_analytic(), "
                 "48EI/L^3 of the equivalent beam; omega [rad/s], amplitude v0/omega [m];\n dev 1-beam: max |w - "
                 "v0/omega sin(omega t)| with the one-beam omega [m])\n\n");
+
+    // --- the rig test's loop, and leaves with mass on request ----------------------------------
+    if (!rig_section(out_dir)) all_ok = false;
+    if (beam_density > 0.0 && !inertia_section(beam_density)) all_ok = false;
 
     // --- CSV files ----------------------------------------------------------------------------
     std::map<PaperCase, std::vector<const Run*>> plotted;
