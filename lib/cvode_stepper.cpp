@@ -759,21 +759,9 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     Eigen::VectorXd p0 = Eigen::VectorXd::Zero(s.n);
     double w_static = 0.0;
     if (s.load.gravity_m_per_s2 > 0.0) {
-        const double Fs = -s.m * s.load.gravity_m_per_s2;
-        if (s.n > 0) {
-            ContactProblem st = s.ev_problem;
-            st.W = s.C + (1.0 / s.k) * s.c * s.c.transpose();
-            st.q = s.c * (Fs / s.k) - s.d;
-            const SolveResult rs = s.ev_solver->solve(st, p0);
-            if (!rs.converged) throw SolverError("static equilibrium under gravity: " + rs.message, 0, 0.0, rs.residual_m);
-            const Eigen::VectorXd rel = st.W * p0 + st.q + s.d;
-            for (int j = 0; j < s.np; ++j) {
-                const auto& pr = system.pairs()[j];
-                if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
-                if (pair_state(st, j, p0) != PairState::stick) s.d[pr.row_t] = rel[pr.row_t];
-            }
-        }
-        w_static = (Fs + (s.n > 0 ? s.c.dot(p0) : 0.0)) / s.k;
+        w_static = detail::static_equilibrium_dense(system, s.ev_problem, -s.m * s.load.gravity_m_per_s2, *s.ev_solver,
+                                                    p0, s.d, "static equilibrium under gravity")
+                       .w_m;
         w0 += w_static;
     }
     // Initial contact state with R held at w(0) (as the closed-form mode), then the modes.

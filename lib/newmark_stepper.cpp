@@ -261,12 +261,7 @@ const StepRecord& NewmarkStepper::step() {
     const Eigen::VectorXd r = massive_leaves_
                                   ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
                                   : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
-    if (problem_.tau_rule == TauRule::previous_step)
-        for (int j = 0; j < static_cast<int>(problem_.pairs.size()); ++j) {
-            const auto& pr = problem_.pairs[j];
-            const double pn = pr.row_n >= 0 ? p_[pr.row_n] : 0.0;
-            problem_.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
-        }
+    if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     Eigen::VectorXd z1;
     if (path_ == ContactPath::dense) {
@@ -316,12 +311,7 @@ const StepRecord& NewmarkStepper::step() {
     rel_ = rel1;
     if (massive_leaves_) impact_loss_ += project_velocities();
     t_ = step_ * dt;
-    // Anchors (paper, section 5): a pair that sticks keeps its d_t; any other is re-anchored where it is.
-    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
-        const auto& pr = problem_.pairs[j];
-        if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
-        if (pair_state(problem_, static_cast<int>(j), p_) != PairState::stick) d_[pr.row_t] = rel_[pr.row_t];
-    }
+    detail::reanchor(problem_, p_, rel_, d_);  // paper, section 5
     fill_record(solve_.iterations, solve_.factorizations);
     return record_;
 }

@@ -176,15 +176,12 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     w_ = 0.0;
     if (load.gravity_m_per_s2 > 0.0) {
         const double Fs = -m * load.gravity_m_per_s2;  // R's weight on the meshed part [N]
-        Eigen::VectorXd rel;
+        const std::string what = "static equilibrium under gravity";
         if (path_ == ContactPath::dense) {
-            ContactProblem st = problem_;
-            st.W = system_.compliance_held() + (1.0 / k) * c * c.transpose();
-            st.q = c * (Fs / k) - d_;
             auto solver = make_solver(options_.solver);
-            solve_ = n > 0 ? solver->solve(st, p_) : SolveResult{};
-            w_ = (Fs + (n > 0 ? c.dot(p_) : 0.0)) / k;
-            rel = st.W * p_ + st.q + d_;
+            const detail::StaticState st = detail::static_equilibrium_dense(system_, problem_, Fs, *solver, p_, d_, what);
+            w_ = st.w_m;
+            solve_ = st.solve;
         } else {
             SparseContactProblem st;
             st.K = K;
@@ -197,12 +194,10 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             st.tau_previous_n = problem_.tau_previous_n;
             SparseContactSolver solver(options_.solver);
             solve_ = solver.solve(st, p_, z_);
+            if (n > 0 && !solve_.converged) throw SolverError(what + ": " + solve_.message, 0, 0.0, solve_.residual_m);
             w_ = z_[w_dof_];
-            rel = G * z_;
+            detail::reanchor(problem_, p_, Eigen::VectorXd(G * z_), d_);
         }
-        if (n > 0 && !solve_.converged)
-            throw SolverError("static equilibrium under gravity: " + solve_.message, 0, 0.0, solve_.residual_m);
-        reanchor(rel);
     }
     // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
     //    relative to the supports, whose velocity the initial absolute velocity excludes).
@@ -276,13 +271,39 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     record_.energy_balance_error_j = 0.0;
 }
 
-void ClosedFormStepper::reanchor(const Eigen::VectorXd& rel) {
-    // Anchors (paper, section 5): a pair that sticks keeps its d_t; any other is re-anchored where it is.
-    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
-        const auto& pr = problem_.pairs[j];
+void detail::reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel,
+                      Eigen::VectorXd& d) {
+    for (std::size_t j = 0; j < laws.pairs.size(); ++j) {
+        const auto& pr = laws.pairs[j];
         if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
-        if (pair_state(problem_, static_cast<int>(j), p_) != PairState::stick) d_[pr.row_t] = rel[pr.row_t];
+        if (pair_state(laws, static_cast<int>(j), p) != PairState::stick) d[pr.row_t] = rel[pr.row_t];
     }
+}
+
+void detail::set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p) {
+    for (int j = 0; j < static_cast<int>(problem.pairs.size()); ++j) {
+        const auto& pr = problem.pairs[j];
+        const double pn = pr.row_n >= 0 ? p[pr.row_n] : 0.0;
+        problem.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
+    }
+}
+
+detail::StaticState detail::static_equilibrium_dense(const System& system, const ContactProblem& laws, double force_n,
+                                                     ContactSolver& solver, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                                                     const std::string& what) {
+    const double k = system.stiffness_n_per_m();
+    const Eigen::VectorXd& c = system.coupling();
+    StaticState out;
+    if (system.num_components() > 0) {
+        ContactProblem st = laws;
+        st.W = system.compliance_held() + (1.0 / k) * c * c.transpose();
+        st.q = c * (force_n / k) - d;
+        out.solve = solver.solve(st, p);
+        if (!out.solve.converged) throw SolverError(what + ": " + out.solve.message, 0, 0.0, out.solve.residual_m);
+        reanchor(st, p, Eigen::VectorXd(st.W * p + st.q + d), d);
+    }
+    out.w_m = (force_n + (system.num_components() > 0 ? c.dot(p) : 0.0)) / k;
+    return out;
 }
 
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {
@@ -388,12 +409,7 @@ const StepRecord& ClosedFormStepper::step() {
         // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
         if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
     }
-    if (problem_.tau_rule == TauRule::previous_step)
-        for (int j = 0; j < static_cast<int>(problem_.pairs.size()); ++j) {
-            const auto& pr = problem_.pairs[j];
-            const double pn = pr.row_n >= 0 ? p_[pr.row_n] : 0.0;
-            problem_.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
-        }
+    if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     if (path_ == ContactPath::dense) {
         solve_ = solver_->solve(problem_, p_);
@@ -451,7 +467,7 @@ const StepRecord& ClosedFormStepper::step() {
     w_ = w1;
     wd_ = wd1;
     t_ = step_ * dt;
-    reanchor(rel_);
+    detail::reanchor(problem_, p_, rel_, d_);
     // Sparse path: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
     // (the solved system, K_aug = K + k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2,
     // with G z = rel_ (made above). b_w w and k_R w^2 are each about 1/gamma times U

@@ -180,7 +180,6 @@ private:
     double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
     Eigen::VectorXd krw_, gw_;
     void fill_record(int iterations, int factorizations, double strain_j = -1.0);
-    void reanchor(const Eigen::VectorXd& rel);
 };
 
 /// Throws InputError when the model's initial conditions contradict the loading
