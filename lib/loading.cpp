@@ -201,10 +201,11 @@ void Loading::prepare() {
 }
 
 double Loading::external_force_n(double t, double mass_kg) const {
+    if (kind == LoadingKind::prescribed_displacement) return 0.0;  // the rig's force is a result
     double F = -mass_kg * gravity_m_per_s2;
     if (kind == LoadingKind::applied_force) F += force_n.value(t);
     if (kind == LoadingKind::base_excitation) F -= mass_kg * displacement_m.second_derivative(t);
-    return kind == LoadingKind::prescribed_displacement ? 0.0 : F;
+    return F;
 }
 
 double Loading::base_displacement_m(double t) const {

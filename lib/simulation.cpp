@@ -393,9 +393,9 @@ const StepRecord& ClosedFormStepper::step() {
     const Loading& load = options_.loading;
     const double t1 = (step_ + 1) * dt;
     const double w0 = w_;
-    const double spring0 = f_ * (k * w_ - c.dot(p_));
+    const double cp0 = c.dot(p_);  // c^T p at t [N]
     const double kin0 = 0.5 * m_whole_ * wd_ * wd_;
-    double w_next = 0.0, fe1 = 0.0;
+    double w_next = 0.0, fe1 = 0.0, F0 = 0.0;
     if (rig_) {
         // The rig: w(t+dt) prescribed, the contact problem quasi-static with R held there.
         w_next = load.displacement_m.value(t1);
@@ -404,7 +404,7 @@ const StepRecord& ClosedFormStepper::step() {
         // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
         // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
         fe1 = load.external_force_n(t1, m_whole_) / f_;
-        const double F0 = c.dot(p_) + fe_;
+        F0 = cp0 + fe_;
         w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
         // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
         if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
@@ -432,14 +432,14 @@ const StepRecord& ClosedFormStepper::step() {
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
                               format_value(step_ * dt) + " s: " + solve_.message,
                           step_, step_ * dt, solve_.residual_m);
+    const double cp1 = c.dot(p_);  // c^T p at t + dt [N]
     double w1 = 0.0, wd1 = 0.0;
     if (rig_) {
         w1 = w_next;
         wd1 = load.displacement_m.derivative(t1);
     } else {
-        const double F0 = c.dot(p0) + fe_;
-        const double F1 = c.dot(p_) + fe1;
-        w1 = w_next + gamma_ * c.dot(p_) / k;
+        const double F1 = cp1 + fe1;
+        w1 = w_next + gamma_ * cp1 / k;
         wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
     }
     // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
@@ -457,7 +457,7 @@ const StepRecord& ClosedFormStepper::step() {
     // External work, trapezoidal: the loading's force on R over dw (exact for a constant
     // force); the rig: its force on the spring over dw plus the kinetic energy it gives R.
     if (rig_) {
-        const double spring1 = f_ * (k * w1 - c.dot(p_));
+        const double spring0 = f_ * (k * w0 - cp0), spring1 = f_ * (k * w1 - cp1);
         wext_ += 0.5 * (spring0 + spring1) * (w1 - w0) + 0.5 * m_whole_ * wd1 * wd1 - kin0;
     } else {
         wext_ += 0.5 * f_ * (fe_ + fe1) * (w1 - w0);
