@@ -701,7 +701,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.load.prepare();
     require_loading_fits(system.model().spec(), s.load);
     s.m_whole = system.model().spec().rigid_body.mass_kg;
-    s.nstate = s.load.kind == LoadingKind::initial_conditions && s.load.gravity_m_per_s2 == 0.0 ? 3 : 4;
+    s.nstate = s.load.is_free() ? 3 : 4;
     double w0 = system.model().spec().rigid_body.initial_displacement_m;
     // base excitation: w is relative to the supports, the initial velocity absolute (loading.hpp)
     const double wd0 = system.model().spec().rigid_body.initial_velocity_m_per_s - s.load.base_velocity_m_per_s(0.0);
