@@ -119,6 +119,7 @@ struct SimulateArgs {
     std::string atol = "1e-12";
     std::string max_step = "";
     std::string max_steps = "10000000";
+    std::string modal_cutoff = "0";
     std::string events;
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
@@ -262,6 +263,9 @@ void apply_simulation_options(const SimulateArgs& a, bool only_given, stackbeam:
     if (use("--atol")) options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
     if (use("--max-step") && !a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
     if (use("--max-steps")) options.cvode.max_steps = parse_count("--max-steps", a.max_steps);
+    if (use("--modal-cutoff"))
+        options.cvode.modal_cutoff_rad_per_s =
+            a.modal_cutoff == "0" ? 0.0 : parse_positive("--modal-cutoff", a.modal_cutoff, "rad/s; 0: the default");
     if (use("--contact-path")) options.contact_path = stackbeam::parse_contact_path(a.contact_path, "--contact-path");
     if (use("--tol")) options.solver.tolerance_m = parse_positive("--tol", a.tol, "m");
     if (use("--alpha-fraction")) {
@@ -416,6 +420,10 @@ int run_simulate(const SimulateArgs& a) {
         std::printf("events                     %ld event times (%ld found by the per-step check), %zu transitions, "
                     "%ld restarts, %ld mode factorisations\n",
                     cs.events, cs.missed_events, report.events.size(), cs.restarts, cs.mode_factorizations);
+        if (cs.retained_modes > 0)
+            std::printf("leaf inertia               %d modes up to %g rad/s carry it, the rest quasi-static "
+                        "(massless contact layer)\n",
+                        cs.retained_modes, cs.modal_cutoff_rad_per_s);
         std::printf("outputs                    %ld (every %g s)\n", steps, options.dt_s);
     } else {
         std::printf("contact path               %s (%d contact components)\n", stackbeam::to_string(path),
@@ -474,6 +482,10 @@ int run_simulate(const SimulateArgs& a) {
                           {"steps", report.cvode.steps},         {"rhs_evaluations", report.cvode.rhs_evaluations},
                           {"event_times", report.cvode.events},  {"missed_events", report.cvode.missed_events},
                           {"restarts", report.cvode.restarts}};
+        if (cvode && report.cvode.retained_modes > 0) {
+            j["cvode"]["retained_modes"] = report.cvode.retained_modes;
+            j["cvode"]["modal_cutoff_rad_per_s"] = report.cvode.modal_cutoff_rad_per_s;
+        }
         double wmin = last.w_m, wmax = last.w_m, fmin = last.spring_force_n, fmax = last.spring_force_n;
         for (const auto& r : records) {
             wmin = std::min(wmin, r.w_m);
@@ -530,6 +542,7 @@ std::string option_of_field(const std::string& field) {
         {"atol", "--atol"},
         {"max_step", "--max-step"},
         {"max_steps", "--max-steps"},
+        {"modal_cutoff", "--modal-cutoff"},
         {"contact_path", "--contact-path"},
     };
     for (const auto& [f, o] : map)
@@ -568,6 +581,11 @@ int main(int argc, char** argv) {
     sim->add_option("--atol", a.atol, "cvode: absolute tolerance on w [m]")->type_name("A")->capture_default_str();
     sim->add_option("--max-step", a.max_step, "cvode: largest internal step [s] (default: no limit)")->type_name("S");
     sim->add_option("--max-steps", a.max_steps, "cvode: limit on CVODE's steps over the run")->type_name("N")->capture_default_str();
+    sim->add_option("--modal-cutoff", a.modal_cutoff,
+                    "cvode with --beam-density on a stack with friction: the stack's modes up to this circular frequency "
+                    "carry the inertia, those above respond quasi-statically [rad/s] (0: 10 x the first; docs/inertia.md)")
+        ->type_name("RAD_PER_S")
+        ->capture_default_str();
     sim->add_option("--events", a.events, "cvode: write the event log (time, interface, x, pair, transition) to this CSV")
         ->type_name("FILE.csv");
     sim->add_option("--elements", a.elements, "--case: elements per half leaf")->type_name("N")->capture_default_str()->excludes(scenario_opt);

@@ -24,6 +24,12 @@ bool has_leaf_mass(const System& system) {
     return false;
 }
 
+bool has_mode_changes(const System& system) {
+    for (const auto& pr : system.pairs())
+        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0) return true;
+    return false;
+}
+
 struct CvodeInertiaStepper::Impl {
     Impl(const System& system, const SimulationOptions& options) : sys(system), opt(options) {}
     Impl(const Impl&) = delete;

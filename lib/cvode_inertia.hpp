@@ -13,7 +13,9 @@
 // analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N.
 // Stacks with friction (pairs that may stick or slip) are refused (InputError):
 // events between massive leaves are not built yet (use mode newmark).
+#include <Eigen/Dense>
 #include <memory>
+#include <vector>
 
 #include "stackbeam/cvode_stepper.hpp"
 #include "stackbeam/simulation.hpp"
@@ -35,6 +37,37 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+/// Mode "cvode" with leaf inertia on stacks with friction (pairs that stick, slip, open
+/// and close): the retained modes of the stack below CvodeOptions::modal_cutoff_rad_per_s
+/// carry the inertia, the modes above it respond quasi-statically (residual
+/// flexibility), so the contact points are massless and the events are those of the
+/// massless cvode mode (cvode_modal.cpp, docs/inertia.md).
+class CvodeModalStepper {
+public:
+    CvodeModalStepper(const System& system, const SimulationOptions& options);
+    ~CvodeModalStepper();
+    CvodeModalStepper(const CvodeModalStepper&) = delete;
+    CvodeModalStepper& operator=(const CvodeModalStepper&) = delete;
+    /// Integrates to the next output time (t = i dt_s) and returns its record.
+    const StepRecord& advance();
+    const StepRecord& current() const noexcept;
+    const CvodeStats& stats() const noexcept;
+    /// Every mode transition, in time order (cause "start", "root" or "check").
+    const std::vector<ContactEvent>& events() const noexcept;
+    /// Contact forces p [N] (all rows, conventions.hpp) at the last output.
+    const Eigen::VectorXd& contact_forces() const noexcept;
+    /// Relative positions s + d [m] (all rows) at the last output.
+    const Eigen::VectorXd& relative_positions() const noexcept;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// True when a pair of `system` carries friction (it may stick or slip): mode cvode with
+/// leaf mass then runs the modal stepper; without friction the held-for-good one.
+bool has_mode_changes(const System& system);
 
 /// True when mode cvode runs `system` with leaf inertia (a leaf has density > 0).
 bool has_leaf_mass(const System& system);

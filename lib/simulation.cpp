@@ -113,6 +113,10 @@ void SimulationOptions::validate() const {
         if (!std::isfinite(cvode.max_step_s) || cvode.max_step_s < 0.0)
             throw InputError("max_step", "value " + format_value(cvode.max_step_s) +
                                              " is not allowed: the largest step must be finite and >= 0 (0: no limit) [s]");
+        if (!std::isfinite(cvode.modal_cutoff_rad_per_s) || cvode.modal_cutoff_rad_per_s < 0.0)
+            throw InputError("modal_cutoff", "value " + format_value(cvode.modal_cutoff_rad_per_s) +
+                                                 " is not allowed: the modal cut-off must be finite and >= 0 "
+                                                 "(0: the default) [rad/s]");
         if (cvode.max_steps < 1)
             throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
     }
@@ -524,7 +528,27 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     };
     RunReport rep;
     rep.mode = options.mode;
-    if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
+    if (options.mode == Mode::cvode && detail::has_leaf_mass(system) && detail::has_mode_changes(system)) {
+        detail::CvodeModalStepper stepper(system, options);  // docs/inertia.md
+        ContactProblem laws;
+        laws.pairs = system.pairs();
+        laws.tau_rule = TauRule::current;
+        auto pairs_out = [&] {
+            if (on_pairs)
+                on_pairs(out.back().t_s, pair_records(system, laws, stepper.contact_forces(), stepper.relative_positions()));
+        };
+        keep(stepper.current());
+        pairs_out();
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.advance());
+            pairs_out();
+        }
+        rep.cvode = stepper.stats();
+        rep.events = stepper.events();
+        rep.steps = rep.cvode.steps;
+        rep.contact_iterations = rep.cvode.contact_iterations;
+        rep.factorizations = rep.cvode.mode_factorizations;
+    } else if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
         detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
         keep(stepper.current());
         for (long i = 0; i < n; ++i) keep(stepper.advance());

@@ -197,10 +197,15 @@ stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
                    ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv
                    EXPECT_RC 0 EXPECT_TEXT "mode cvode" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv MIN_LINES 12)
-stackbeam_cli_test(NAME cli_bad_cvode_inertia_friction
-                   ARGS simulate --case friction --mode cvode --beam-density 7850 --t-end 0.01
-                        --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
-                   EXPECT_RC 2 EXPECT_TEXT "handles bonded and frictionless stacks only so far" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv)
+stackbeam_cli_test(NAME cli_ok_cvode_inertia_friction
+                   ARGS simulate --case friction --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
+                        --modal-cutoff 1000 --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
+                   EXPECT_RC 0 EXPECT_TEXT "4 modes up to 1000 rad/s" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
+                   MIN_LINES 12)
+stackbeam_cli_test(NAME cli_bad_modal_cutoff
+                   ARGS simulate --case friction --mode cvode --beam-density 7850 --modal-cutoff -5 --t-end 0.01
+                        --out ${CMAKE_BINARY_DIR}/cli_cvode_modal_bad.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--modal-cutoff: value '-5' is not allowed" OUT ${CMAKE_BINARY_DIR}/cli_cvode_modal_bad.csv)
 # Scenario files: a good run (options given override the file), the file's output path
 # (relative to the working directory, here the test's: build/tests), and the combinations
 # that are rejected. The bad-input suite of scenario files is bad_input_tests.cmake.

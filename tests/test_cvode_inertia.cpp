@@ -126,16 +126,3 @@ BOOST_AUTO_TEST_CASE(response_converges_to_the_massless_mode_as_density_falls) {
         prev = dev;
     }
 }
-
-BOOST_AUTO_TEST_CASE(stacks_with_contact_events_are_refused_by_name) {
-    // Pairs with friction (stick, slip) need the events between massive leaves, not
-    // built yet: a clear InputError naming the mode, pointing to mode newmark.
-    const System s = massive(PaperCase::friction);
-    try {
-        run(s, Mode::cvode, 0.01, 1e-3);
-        BOOST_ERROR("no error");
-    } catch (const InputError& e) {
-        BOOST_TEST(e.field() == "mode");
-        BOOST_TEST(std::string(e.what()).find("use mode newmark") != std::string::npos);
-    }
-}

@@ -88,6 +88,10 @@ struct CvodeStats {
                                                 ///< mode solution it accepted [N]
     long jacobian_evaluations = 0; ///< Jacobian evaluations (leaf inertia: BDF with Newton; 0 otherwise)
     long linear_setups = 0;        ///< Newton matrix factorisations (leaf inertia; 0 otherwise)
+    int retained_modes = 0;        ///< leaf inertia with friction: modes carrying the inertia (0 otherwise)
+    double modal_cutoff_rad_per_s = 0.0; ///< leaf inertia with friction: the cut used [rad/s]
+    double min_jump_dissipation_j = 0.0; ///< leaf inertia with friction: the smallest energy taken by a force
+                                         ///< jump at an event (>= 0 up to round-off: a jump cannot add energy) [J]
 };
 
 /// The CVODE integration (mode "cvode"). Outputs come on the grid t = i * dt_s

@@ -91,6 +91,10 @@ struct CvodeOptions {
     bool root_finding = true;    ///< locate transitions by CVODE root-finding (false: only the per-step
                                  ///< contact check finds them, by bisection; for testing that safety net)
     long max_steps = 10000000;   ///< limit on CVODE's internal steps over the whole run
+    double modal_cutoff_rad_per_s = 0.0;  ///< leaf inertia with friction only: the stack's modes up to this
+                                          ///< circular frequency carry the inertia, those above respond
+                                          ///< quasi-statically [rad/s]; 0 = 10 x the stack's first
+                                          ///< frequency (docs/inertia.md)
 };
 
 struct SimulationOptions {
