@@ -30,6 +30,7 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <deque>
@@ -49,6 +50,9 @@ constexpr double kForceMargin = 1e-9;    // as cvode_stepper.cpp
 constexpr double kMotionMargin = 1e-12;
 constexpr double kLookahead = 1e-7;
 constexpr int kMaxEventsAtOneTime = 200;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 std::string flag_text(long flag) {
     char* name = CVodeGetReturnFlagName(flag);
@@ -268,6 +272,8 @@ struct CvodeModalStepper::Impl {
     /// look-ahead away; otherwise the exact solver on that look-ahead problem decides.
     void decide_modes(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
                       const Eigen::VectorXd& p_cur, const std::string& cause, const std::vector<int>* triggered) {
+        const auto t_start = Clock::now();
+        const double contact_before = stats.contact_time_s;
         const Eigen::VectorXd rel = W * p_cur + GPhi * q;  // s + d
         const Eigen::VectorXd qdd = P.size() > 0 ? Eigen::VectorXd(A1 * q + a0) : Eigen::VectorXd::Zero(r);
         // look-ahead: the contact points move by ~kLookahead L_ref (the fastest row)
@@ -343,7 +349,9 @@ struct CvodeModalStepper::Impl {
         }
         if (!decided) {
             Eigen::VectorXd p_la = p_cur;
+            const auto t_solve = Clock::now();
             const SolveResult res = ev_solver->solve(ev_problem, p_la);
+            stats.contact_time_s += seconds_since(t_solve);
             stats.contact_iterations += res.iterations;
             iters_since += res.iterations;
             if (!res.converged)
@@ -405,6 +413,7 @@ struct CvodeModalStepper::Impl {
         const double jump = (p_new - p_cur).lpNorm<Eigen::Infinity>();
         if (cause != "start") stats.max_force_jump_n = std::max(stats.max_force_jump_n, jump);
         reset_check_anchors(q);
+        stats.event_time_s += seconds_since(t_start) - (stats.contact_time_s - contact_before);
     }
 
     void reset_check_anchors(const Eigen::Ref<const Eigen::VectorXd>& q) {
@@ -490,10 +499,12 @@ struct CvodeModalStepper::Impl {
     }
 
     void restart(double te) {
+        const auto t0 = Clock::now();
         accumulate_counters();
         check(CVodeReInit(cv, te, y), "CVodeReInit");
         check(CVodeSetStopTime(cv, t_final), "CVodeSetStopTime");
         ++stats.restarts;
+        stats.event_time_s += seconds_since(t0);
     }
 
     Eigen::Map<Eigen::VectorXd> state(N_Vector v) const { return {N_VGetArrayPointer(v), nstate}; }
@@ -561,7 +572,9 @@ struct CvodeModalStepper::Impl {
     bool step_once() {
         if (t >= t_final) return false;
         double tret = t;
+        const auto t_cv = Clock::now();
         const int flag = CVode(cv, t_final, y, &tret, CV_ONE_STEP);
+        stats.cvode_time_s += seconds_since(t_cv);
         update_stats();
         if (flag < 0) {
             double h = 0.0;
@@ -588,6 +601,7 @@ struct CvodeModalStepper::Impl {
             return true;
         }
         // the contact iteration at the accepted step (as cvode_stepper.cpp)
+        const auto t_check = Clock::now();
         double residual = 0.0;
         bool witnesses_ok = false;
         bool ok = modes_hold(Y.head(r), Y.segment(r, r), residual, &witnesses_ok);
@@ -606,6 +620,7 @@ struct CvodeModalStepper::Impl {
                 stats.max_check_force_difference_n =
                     std::max(stats.max_check_force_difference_n, (p - pm).lpNorm<Eigen::Infinity>());
         }
+        stats.contact_time_s += seconds_since(t_check);
         if (ok) {
             emit_until(tret);
             t = tret;

@@ -90,6 +90,10 @@ struct CvodeStats {
     long linear_setups = 0;        ///< Newton matrix factorisations (leaf inertia; 0 otherwise)
     int retained_modes = 0;        ///< leaf inertia with friction: modes carrying the inertia (0 otherwise)
     double modal_cutoff_rad_per_s = 0.0; ///< leaf inertia with friction: the cut used [rad/s]
+    // Leaf inertia with friction: where the wall-clock time went [s].
+    double cvode_time_s = 0.0;     ///< inside CVode() (right-hand sides, root functions, steps)
+    double contact_time_s = 0.0;   ///< contact iterations: per-step checks and event decisions' solves
+    double event_time_s = 0.0;     ///< the rest of event handling: new modes, records of events, CVodeReInit
     double min_jump_dissipation_j = 0.0; ///< leaf inertia with friction: the smallest energy taken by a force
                                          ///< jump at an event (>= 0 up to round-off: a jump cannot add energy) [J]
 };
