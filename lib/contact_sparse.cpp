@@ -120,10 +120,10 @@ constexpr int kBoxPasses = 50;          // block principal pivoting passes per b
 constexpr int kBoxBudget = 8;
 constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
-// semismooth Newton (Impl::semismooth_newton): iteration limit, line-search halvings,
+// semismooth Newton (Impl::semismooth_newton): iteration limit, line-search grid (octaves of a),
 // full steps taken although they raise the merit function
 constexpr int kNewtonIterations = 60;
-constexpr int kNewtonHalvings = 12;
+constexpr int kLineSearchOctaves = 12;
 constexpr int kNewtonNonmonotone = 5;
 // cached columns K^-1 g_i^T: at most this many doubles (80 MB)
 constexpr double kColumnCacheDoubles = 1e7;
@@ -1028,6 +1028,19 @@ struct SparseContactSolver::Impl {
         }
     }
 
+    /// The modes of a start from rest: every unilateral pair open, only the bilateral rows
+    /// held (clamps sticking, bonds). On identical leaves most pairs open in the first steps
+    /// (measured: 850 of 891 pairs at 10 leaves x 100 elements), where "all closed" (the
+    /// stepper's modes at rest) is the worst start.
+    void set_open_modes() {
+        for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+            const auto& c = laws.pairs[k];
+            if (c.row_n >= 0) modes.nmode[k] = detail::ModeSet::unilateral(c) ? detail::OPEN : detail::CLOSED;
+            if (c.row_t >= 0) modes.tmode[k] = detail::STICK;
+            modes.make_consistent(laws, k);
+        }
+    }
+
     /// Semismooth Newton method on the natural map (Alart-Curnier / Pang's natural-map
     /// Newton, planar: the tangential direction is a scalar), for transitions where nearly
     /// every pair changes mode (identical leaves starting from rest: forces and gaps ~0).
@@ -1038,10 +1051,11 @@ struct SparseContactSolver::Impl {
     ///     (solve_modes: the sparse saddle-point system, its low-rank update or the Schur
     ///     complement, as for the active-set passes), giving (p1, z1); F is piecewise linear
     ///     in p, so this is the full Newton step p1 - p;
-    ///  3. a backtracking (Armijo) line search on theta = ||F||^2 / 2 along it: s is affine in
-    ///     p, so s(p + a (p1 - p)) = s + a (s1 - s) and a trial costs O(m), no solve. Where no
-    ///     trial decreases theta the full step is taken (a non-monotone step; at most
+    ///  3. a line search on theta = ||F||^2 along it: s is affine in p, so
+    ///     s(p + a (p1 - p)) = s + a (s1 - s) and a trial costs O(m), no solve. Where no trial
+    ///     decreases theta the full step is taken (a non-monotone step; at most
     ///     kNewtonNonmonotone of them) rather than stalling.
+    /// From rest (p = 0) it starts from the open modes' solution (set_open_modes).
     /// Unlike block principal pivoting, the modes come from p - s / w (forces and gaps
     /// together), and a damped step moves every component part of the way, so many pairs
     /// change per iteration without the ping-pong of full switches. Stops when every
@@ -1052,6 +1066,20 @@ struct SparseContactSolver::Impl {
     bool semismooth_newton(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p,
                            Eigen::VectorXd& z, SolveResult& r) {
         const int m = static_cast<int>(d.size());
+        if (m > 0 && p.isZero(0.0)) {
+            // a start from rest (no force anywhere, the first step of a run): the linear problem
+            // of the open modes (set_open_modes) instead of the natural map's modes at p = 0, where
+            // every closed pair sits on the kink of its friction limit (tau = 0)
+            set_open_modes();
+            ++r.iterations;
+            ++r.newton_iterations;
+            try {
+                r.factorizations += solve_modes(b, d, p, z);
+            } catch (const SingularModes&) {
+                lu_key.clear();
+                return false;
+            }
+        }
         Eigen::VectorXd sk = Grow * z - d, F, F1, pa, sa, p1, z1, s1;
         natural_residual(p, sk, F, false);
         double theta = F.squaredNorm();
@@ -1078,30 +1106,27 @@ struct SparseContactSolver::Impl {
                 return false;
             }
             s1 = Grow * z1 - d;
-            // Armijo: theta(a) <= (1 - 2 sigma a) theta, sigma = 1e-4, a = 1, 1/2, ..., 1/2^kNewtonHalvings
-            double a = 1.0, best_a = 1.0, best_theta = std::numeric_limits<double>::infinity();
-            bool accepted = false;
-            for (int h = 0; h <= kNewtonHalvings; ++h, a *= 0.5) {
-                pa = p + a * (p1 - p);
-                sa = sk + a * (s1 - sk);
+            // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
+            // (each trial O(m)); theta is piecewise quadratic along the step with many kinks
+            // (every component that changes branch), so the grid's best point is taken rather
+            // than the first that passes Armijo's test (measured: 26 instead of 48 iterations
+            // on the first step of 10 leaves x 100 elements). Where no trial lowers theta, the
+            // full step is taken (non-monotone; at most kNewtonNonmonotone times).
+            double a = 1.0, best_theta = std::numeric_limits<double>::infinity();
+            for (int j = 0; j <= 4 * kLineSearchOctaves; ++j) {
+                const double aj = std::pow(2.0, -0.25 * j);
+                pa = p + aj * (p1 - p);
+                sa = sk + aj * (s1 - sk);
                 natural_residual(pa, sa, F1, false);
-                const double t = F1.squaredNorm();
-                if (t < best_theta) {
-                    best_theta = t;
-                    best_a = a;
-                }
-                if (t <= (1.0 - 2e-4 * a) * theta) {
-                    accepted = true;
-                    break;
+                const double tj = F1.squaredNorm();
+                if (tj < best_theta) {
+                    best_theta = tj;
+                    a = aj;
                 }
             }
-            if (!accepted) {
-                if (best_theta < theta) {
-                    a = best_a;
-                } else {
-                    if (++nonmonotone > kNewtonNonmonotone) return false;
-                    a = 1.0;
-                }
+            if (!(best_theta < theta)) {
+                if (++nonmonotone > kNewtonNonmonotone) return false;
+                a = 1.0;
             }
             full_step = a == 1.0;
             if (full_step) {
