@@ -46,16 +46,29 @@
 //    solve. The box QP is solved by block principal pivoting (a few factorisations)
 //    and, if that stalls, by the dense solver's monotone primal active-set method (one
 //    working-set change per iteration, cannot cycle), each step a sparse solve.
+//    Before that Tresca fixed point (SparsePathTuning::transition = newton, the default):
+//    a semismooth Newton method on the natural map of the contact laws (paper eq. 8; the
+//    natural map is zero exactly where eq. 10's error vector is), semismooth_newton: each
+//    iteration takes the modes of F's generalised Jacobian at the iterate (from p - s / w,
+//    forces and gaps together, so many pairs change at once), solves that set of modes's
+//    linear problem (one factorisation, update or cached Schur solve, as a pass) and
+//    searches along the step on ||F||^2 (s is affine in p: O(m) per trial). From rest it
+//    starts from the open modes (set_open_modes). Its final modes are confirmed by the
+//    passes, so its answer is the exact solver's. At 10 leaves x 100 elements it took the
+//    friction run from 50-53 to 2.4 factorisations per step (BENCHMARKS.md); at 10 x 400
+//    its first step still does not converge (BENCHMARKS.md: where it stalls).
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
 //    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
 //    with a message.
 //  - Cost: a step whose modes stay is O(n); a transition costs a factorisation or an
 //    update per pass, and the first steps of a friction run on many identical leaves
-//    (all pairs closed at rest, most of them opening) need thousands of passes: the
-//    contact problem there is degenerate (identical leaves bend alike: forces and gaps
-//    ~0), and the box QP's block principal pivoting stalls, so the primal method
-//    changes one row per iteration. That pass count, not the cost of a pass, is what
-//    keeps large friction runs slow (BENCHMARKS.md).
+//    (all pairs closed at rest, most of them opening) are a degenerate contact problem
+//    (identical leaves bend alike: forces and gaps ~0). Without the Newton method the box
+//    QP's block principal pivoting stalls there and the primal method changes one row per
+//    iteration (thousands of passes); with it, tens of Newton iterations (10 x 100), but at
+//    10 x 400 the Newton method stalls near the solution (kinks of F next to the iterate:
+//    the line search finds no decrease) and the Tresca fixed point still has to finish.
+//    That count, not the cost of a pass, is what keeps large friction runs slow.
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -1151,6 +1164,8 @@ SparseContactSolver::SparseContactSolver(const SolverOptions& options, const Spa
     make_solver(options);  // validates the options
     if (tuning.schur_max_rows < 0)
         throw InputError("tuning.schur_max_rows", "value " + std::to_string(tuning.schur_max_rows) + " must be >= 0");
+    if (tuning.newton_min_rows < 0)
+        throw InputError("tuning.newton_min_rows", "value " + std::to_string(tuning.newton_min_rows) + " must be >= 0");
     if (tuning.max_border_rows < 0)
         throw InputError("tuning.max_border_rows", "value " + std::to_string(tuning.max_border_rows) + " must be >= 0");
     impl_->tuning = tuning;
@@ -1197,7 +1212,8 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         //     start), then the active-set passes from its modes (one pass, normally: they
         //     re-solve its last set of modes and find no violation, so the answer is the exact
         //     solver's linear solution of those modes).
-        if (!r.converged && im.tuning.transition == TransitionMethod::newton) {
+        if (!r.converged && im.tuning.transition == TransitionMethod::newton &&
+            (m >= im.tuning.newton_min_rows || im.tuning.newton_first)) {
             const Eigen::VectorXd p_passes = p;
             const std::vector<signed char> nmode_passes = im.modes.nmode, tmode_passes = im.modes.tmode;
             p = p_start;

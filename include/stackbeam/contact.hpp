@@ -159,7 +159,10 @@ struct SparseContactProblem {
 /// low-rank update of it; see SparsePathTuning). The mode switching and the
 /// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
 /// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
-/// both paths reach the same solution. If that fails, a problem of at most 4000 rows is
+/// both paths reach the same solution. Before the Tresca fixed point, a transition is
+/// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
+/// pairs change mode per iteration, one linear solve of a set of modes each; its final
+/// modes are confirmed by the active-set passes, SolveResult::newton_iterations). If that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message.
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
@@ -182,6 +185,12 @@ struct SparsePathTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
     TransitionMethod transition = TransitionMethod::newton;
+    /// >= 0: the Newton method is tried on problems of at least this many contact rows (smaller
+    /// ones, e.g. the paper example's 76, settle quickly by the passes and the Tresca fixed
+    /// point, and keep exactly the answers they had: their near-degenerate pairs may settle in
+    /// another of the modes within the threshold, e.g. 1.03e-9 J against 0.70e-9 J of
+    /// energy-balance round-off on the paper example with steel leaves)
+    int newton_min_rows = 200;
     /// Tests: every solve starts with the semismooth Newton method from the warm start (no
     /// active-set passes from the previous modes first), so its answers can be checked alone.
     bool newton_first = false;
