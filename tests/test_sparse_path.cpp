@@ -474,3 +474,55 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {
     }
     compare_paths(spec, 1e-3, 20, kTol, true, TauRule::current, 1e-7);
 }
+
+BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
+    // The same 20 replayed problems of 3 leaves x 160 elements from rest (636 rows, the
+    // first steps a transition of most pairs), solved with the default transition method
+    // (passes, then the semismooth Newton method) and with the Tresca fixed point alone
+    // (TransitionMethod::tresca, the method before): both end in an exact solve of the
+    // same modes, so the forces agree to round-off (1e-7 relative, as the finer-stack
+    // comparison above), and the Newton method is used by the default only.
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 160;
+    const System sys(Model::build(paper_example(PaperCase::friction, o)));
+    SimulationOptions so;
+    so.solver.tolerance_m = kTol;
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper st(sys, so);
+    std::vector<SparseContactProblem> problems;
+    for (int i = 0; i < 20; ++i) {
+        st.step();
+        problems.push_back(st.last_sparse_problem());
+    }
+    auto replay = [&](const SparsePathTuning& tuning, int& newton) {
+        SparseContactSolver solver(so.solver, tuning);
+        std::vector<Eigen::VectorXd> out;
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
+        newton = 0;
+        for (const auto& pr : problems) {
+            const SolveResult r = solver.solve(pr, p, z);
+            BOOST_TEST(r.converged);
+            newton += r.newton_iterations;
+            out.push_back(p);
+        }
+        return out;
+    };
+    SparsePathTuning tresca;
+    tresca.transition = TransitionMethod::tresca;
+    int n_default = 0, n_tresca = 0;
+    const auto a = replay(SparsePathTuning{}, n_default);
+    const auto b = replay(tresca, n_tresca);
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        scale = std::max(scale, b[i].lpNorm<Eigen::Infinity>());
+        diff = std::max(diff, (a[i] - b[i]).lpNorm<Eigen::Infinity>());
+    }
+    BOOST_TEST_MESSAGE("Newton iterations: default " << n_default << ", Tresca only " << n_tresca
+                                                     << "; max force difference " << diff / scale);
+    BOOST_TEST(n_default > 0);
+    BOOST_TEST(n_tresca == 0);
+    BOOST_CHECK_SMALL(diff / scale, 1e-7);
+    SparsePathTuning bad;
+    bad.newton_min_rows = -1;
+    BOOST_CHECK_THROW(SparseContactSolver(so.solver, bad), InputError);
+}
