@@ -10,7 +10,8 @@
 //    repeated: stack(), below), dense and sparse contact path, bonded and friction
 //    case. Counters: set-up (model, condensation, stepper) and wall time per
 //    simulated second (set-up + stepping, scaled from the simulated time), contact
-//    components, factorisations per step. Each is one run (Iterations(1)): the large
+//    components, factorisations per step, semismooth Newton iterations per step (sparse
+//    path, SolveResult::newton_iterations) and the first step's time. Each is one run (Iterations(1)): the large
 //    ones take seconds to minutes and the machine is shared.
 //  - Inertia: 1 s of the paper example with steel leaves (7850 kg/m^3): mode newmark
 //    (friction and bonded) and mode cvode (bonded; the friction case needs the events
@@ -117,7 +118,7 @@ void Scaling(benchmark::State& state) {
     const ContactPath path = state.range(3) == 0 ? ContactPath::dense : ContactPath::sparse;
     const double t_sim = 1e-3 * static_cast<double>(state.range(4));
     const ModelSpec spec = stack(c, elements, leaves);
-    double setup = 0.0, total = 0.0, factorizations = 0.0;
+    double setup = 0.0, total = 0.0, factorizations = 0.0, newton = 0.0, first_step = 0.0;
     int components = 0;
     long steps = 0;
     for (auto _ : state) {
@@ -129,8 +130,12 @@ void Scaling(benchmark::State& state) {
         ClosedFormStepper st(s, so);
         setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
-        factorizations = 0.0;
-        for (long i = 0; i < steps; ++i) factorizations += st.step().factorizations;
+        factorizations = newton = 0.0;
+        for (long i = 0; i < steps; ++i) {
+            factorizations += st.step().factorizations;
+            newton += st.last_solve().newton_iterations;
+            if (i == 0) first_step = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - setup;
+        }
         total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         components = s.num_components();
     }
@@ -140,6 +145,8 @@ void Scaling(benchmark::State& state) {
     state.counters["s_per_sim_s"] = total / t_sim;
     state.counters["ms_per_step"] = 1e3 * (total - setup) / static_cast<double>(steps);
     state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
+    state.counters["newton_per_step"] = newton / static_cast<double>(steps);  // sparse path: semismooth Newton iterations
+    state.counters["first_step_s"] = first_step;
 }
 
 /// args: case (0 bonded, 1 friction), mode (0 newmark, 1 cvode), dt [us] (newmark) or -log10(rtol) (cvode),

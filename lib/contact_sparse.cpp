@@ -46,16 +46,29 @@
 //    solve. The box QP is solved by block principal pivoting (a few factorisations)
 //    and, if that stalls, by the dense solver's monotone primal active-set method (one
 //    working-set change per iteration, cannot cycle), each step a sparse solve.
+//    Before that Tresca fixed point (SparsePathTuning::transition = newton, the default):
+//    a semismooth Newton method on the natural map of the contact laws (paper eq. 8; the
+//    natural map is zero exactly where eq. 10's error vector is), semismooth_newton: each
+//    iteration takes the modes of F's generalised Jacobian at the iterate (from p - s / w,
+//    forces and gaps together, so many pairs change at once), solves that set of modes's
+//    linear problem (one factorisation, update or cached Schur solve, as a pass) and
+//    searches along the step on ||F||^2 (s is affine in p: O(m) per trial). From rest it
+//    starts from the open modes (set_open_modes). Its final modes are confirmed by the
+//    passes, so its answer is the exact solver's. At 10 leaves x 100 elements it took the
+//    friction run from 50-53 to 2.4 factorisations per step (BENCHMARKS.md); at 10 x 400
+//    its first step still does not converge (BENCHMARKS.md: where it stalls).
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
 //    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
 //    with a message.
 //  - Cost: a step whose modes stay is O(n); a transition costs a factorisation or an
 //    update per pass, and the first steps of a friction run on many identical leaves
-//    (all pairs closed at rest, most of them opening) need thousands of passes: the
-//    contact problem there is degenerate (identical leaves bend alike: forces and gaps
-//    ~0), and the box QP's block principal pivoting stalls, so the primal method
-//    changes one row per iteration. That pass count, not the cost of a pass, is what
-//    keeps large friction runs slow (BENCHMARKS.md).
+//    (all pairs closed at rest, most of them opening) are a degenerate contact problem
+//    (identical leaves bend alike: forces and gaps ~0). Without the Newton method the box
+//    QP's block principal pivoting stalls there and the primal method changes one row per
+//    iteration (thousands of passes); with it, tens of Newton iterations (10 x 100), but at
+//    10 x 400 the Newton method stalls near the solution (kinks of F next to the iterate:
+//    the line search finds no decrease) and the Tresca fixed point still has to finish.
+//    That count, not the cost of a pass, is what keeps large friction runs slow.
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -120,6 +133,11 @@ constexpr int kBoxPasses = 50;          // block principal pivoting passes per b
 constexpr int kBoxBudget = 8;
 constexpr int kDenseFallbackMaxRows = 4000;  // the dense fallback: m^2 doubles (128 MB at 4000)
 constexpr int kBudget = 3;          // as in the dense solver
+// semismooth Newton (Impl::semismooth_newton): iteration limit, line-search grid (octaves of a),
+// full steps taken although they raise the merit function
+constexpr int kNewtonIterations = 60;
+constexpr int kLineSearchOctaves = 12;
+constexpr int kNewtonNonmonotone = 5;
 // cached columns K^-1 g_i^T: at most this many doubles (80 MB)
 constexpr double kColumnCacheDoubles = 1e7;
 constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
@@ -971,6 +989,174 @@ struct SparseContactSolver::Impl {
         return settled;
     }
 
+    /// The natural map F(p, s) of the contact laws (paper eq. 8; zero exactly where eq. 10's
+    /// error vector is), per component in metres (contact.hpp, natural_map), into `F`, and
+    /// optionally the modes of its generalised Jacobian at (p, s) into `modes`:
+    ///   unilateral normal  F = w (p_n - min(0, p_n - s_n / w)):  closed (F = s_n) where
+    ///                      p_n - s_n / w < 0, else open (F = w p_n);
+    ///   tangential         F = w (p_t - clamp(a, -mu tau, mu tau)), a = p_t - s_t / w: stick
+    ///                      (F = s_t) inside the limit, slip with sigma = sign(a) (F = w (p_t -
+    ///                      sigma mu tau(p_n)), tau linearised as in ModeSet::linearize) outside,
+    ///                      free (F = w p_t) where the pair is open or tau cannot be positive;
+    ///   bilateral, bonded  F = s (held).
+    /// With w = W_kk (diag) both parts of each component are in metres, so the Newton step
+    /// of the modes (the linear problem solve_modes solves) zeroes F for those modes.
+    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F,
+                          bool set_modes) {
+        F = s;
+        const bool prev = laws.tau_rule == TauRule::previous_step;
+        for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+            const auto& c = laws.pairs[k];
+            bool closed = true;
+            if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
+                const double w = diag[c.row_n], pn = p[c.row_n];
+                const double a = pn - s[c.row_n] / w;
+                F[c.row_n] = w * (pn - std::min(0.0, a));
+                closed = a < 0.0;
+                if (set_modes) modes.nmode[k] = closed ? detail::CLOSED : detail::OPEN;
+            } else if (c.kind == PairKind::coulomb) {
+                closed = false;  // no normal row: the unilateral pair has no normal force
+            }
+            if (c.row_t < 0) continue;
+            if (c.kind == PairKind::bonded) {
+                if (set_modes) modes.tmode[k] = detail::STICK;
+                continue;
+            }
+            const double w = diag[c.row_t], pt = p[c.row_t];
+            const double limit = c.friction_coefficient * friction_normal_force(laws, k, p);
+            const double a = pt - s[c.row_t] / w;
+            F[c.row_t] = w * (pt - std::clamp(a, -limit, limit));
+            if (!set_modes) continue;
+            // can the friction limit be positive in the Newton step's linearisation?
+            bool carries = c.friction_coefficient > 0.0;
+            if (c.kind == PairKind::coulomb) carries = carries && closed && (!prev || limit > 0.0);
+            else if (c.kind == PairKind::clamp) carries = carries && (prev ? limit > 0.0 : c.preload_n - (c.row_n >= 0 ? p[c.row_n] : 0.0) > 0.0);
+            signed char mode = detail::FREE;
+            if (carries) {
+                if (std::abs(a) < limit || a == 0.0) mode = detail::STICK;
+                else mode = a > 0.0 ? detail::SLIP_POS : detail::SLIP_NEG;
+            }
+            modes.tmode[k] = mode;
+            modes.make_consistent(laws, k);
+        }
+    }
+
+    /// The modes of a start from rest: every unilateral pair open, only the bilateral rows
+    /// held (clamps sticking, bonds). On identical leaves most pairs open in the first steps
+    /// (measured: 850 of 891 pairs at 10 leaves x 100 elements), where "all closed" (the
+    /// stepper's modes at rest) is the worst start.
+    void set_open_modes() {
+        for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+            const auto& c = laws.pairs[k];
+            if (c.row_n >= 0) modes.nmode[k] = detail::ModeSet::unilateral(c) ? detail::OPEN : detail::CLOSED;
+            if (c.row_t >= 0) modes.tmode[k] = detail::STICK;
+            modes.make_consistent(laws, k);
+        }
+    }
+
+    /// Semismooth Newton method on the natural map (Alart-Curnier / Pang's natural-map
+    /// Newton, planar: the tangential direction is a scalar), for transitions where nearly
+    /// every pair changes mode (identical leaves starting from rest: forces and gaps ~0).
+    /// Each iteration:
+    ///  1. the modes of the generalised Jacobian of F at the iterate (natural_residual): which
+    ///     part of each min / clamp is active there;
+    ///  2. the Newton step: the linear problem of those modes, s_S = 0, fixed and slip forces
+    ///     (solve_modes: the sparse saddle-point system, its low-rank update or the Schur
+    ///     complement, as for the active-set passes), giving (p1, z1); F is piecewise linear
+    ///     in p, so this is the full Newton step p1 - p;
+    ///  3. a line search on theta = ||F||^2 along it: s is affine in p, so
+    ///     s(p + a (p1 - p)) = s + a (s1 - s) and a trial costs O(m), no solve. Where no trial
+    ///     decreases theta the full step is taken (a non-monotone step; at most
+    ///     kNewtonNonmonotone of them) rather than stalling.
+    /// From rest (p = 0) it starts from the open modes' solution (set_open_modes).
+    /// Unlike block principal pivoting, the modes come from p - s / w (forces and gaps
+    /// together), and a damped step moves every component part of the way, so many pairs
+    /// change per iteration without the ping-pong of full switches. Stops when every
+    /// component of F is within `accept` [m] (half the active-set threshold, so the passes
+    /// that follow see no violated mode); returns false after kNewtonIterations or on a
+    /// singular set of modes (p and z are then the last iterate). On entry z must be
+    /// K^-1 (b + G^T p).
+    bool semismooth_newton(const Eigen::VectorXd& b, const Eigen::VectorXd& d, Eigen::VectorXd& p,
+                           Eigen::VectorXd& z, SolveResult& r) {
+        const int m = static_cast<int>(d.size());
+        if (m > 0 && p.isZero(0.0)) {
+            // a start from rest (no force anywhere, the first step of a run): the linear problem
+            // of the open modes (set_open_modes) instead of the natural map's modes at p = 0, where
+            // every closed pair sits on the kink of its friction limit (tau = 0)
+            set_open_modes();
+            ++r.iterations;
+            ++r.newton_iterations;
+            try {
+                r.factorizations += solve_modes(b, d, p, z);
+            } catch (const SingularModes&) {
+                lu_key.clear();
+                return false;
+            }
+        }
+        Eigen::VectorXd sk = Grow * z - d, F, F1, pa, sa, p1, z1, s1;
+        natural_residual(p, sk, F, false);
+        double theta = F.squaredNorm();
+        int nonmonotone = 0;
+        bool full_step = false;  // p is the linear solution of the current modes
+        for (int it = 0; it < kNewtonIterations; ++it) {
+            const double roundoff =
+                1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
+            const double accept = std::max(0.5 * kAccept * options.tolerance_m, roundoff);
+            if (m == 0 || F.lpNorm<Eigen::Infinity>() <= accept) {
+                // the modes for the passes that follow: those of the last full step (its linear
+                // problem gave p, so the passes reuse its factorisation), else those at p
+                if (!full_step) natural_residual(p, sk, F, true);
+                return true;
+            }
+            ++r.iterations;
+            ++r.newton_iterations;
+            natural_residual(p, sk, F, true);
+            p1 = p;
+            try {
+                r.factorizations += solve_modes(b, d, p1, z1);
+            } catch (const SingularModes&) {
+                lu_key.clear();
+                return false;
+            }
+            s1 = Grow * z1 - d;
+            // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
+            // (each trial O(m)); theta is piecewise quadratic along the step with many kinks
+            // (every component that changes branch), so the grid's best point is taken rather
+            // than the first that passes Armijo's test (measured: 26 instead of 48 iterations
+            // on the first step of 10 leaves x 100 elements). Where no trial lowers theta, the
+            // full step is taken (non-monotone; at most kNewtonNonmonotone times).
+            double a = 1.0, best_theta = std::numeric_limits<double>::infinity();
+            for (int j = 0; j <= 4 * kLineSearchOctaves; ++j) {
+                const double aj = std::pow(2.0, -0.25 * j);
+                pa = p + aj * (p1 - p);
+                sa = sk + aj * (s1 - sk);
+                natural_residual(pa, sa, F1, false);
+                const double tj = F1.squaredNorm();
+                if (tj < best_theta) {
+                    best_theta = tj;
+                    a = aj;
+                }
+            }
+            if (!(best_theta < theta)) {
+                if (++nonmonotone > kNewtonNonmonotone) return false;
+                a = 1.0;
+            }
+            full_step = a == 1.0;
+            if (full_step) {
+                p = p1;
+                z = z1;
+                sk = s1;
+            } else {
+                p += a * (p1 - p);
+                z += a * (z1 - z);
+                sk += a * (s1 - sk);
+            }
+            natural_residual(p, sk, F, false);
+            theta = F.squaredNorm();
+        }
+        return false;
+    }
+
 };
 
 SparseContactSolver::SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning)
@@ -978,6 +1164,8 @@ SparseContactSolver::SparseContactSolver(const SolverOptions& options, const Spa
     make_solver(options);  // validates the options
     if (tuning.schur_max_rows < 0)
         throw InputError("tuning.schur_max_rows", "value " + std::to_string(tuning.schur_max_rows) + " must be >= 0");
+    if (tuning.newton_min_rows < 0)
+        throw InputError("tuning.newton_min_rows", "value " + std::to_string(tuning.newton_min_rows) + " must be >= 0");
     if (tuning.max_border_rows < 0)
         throw InputError("tuning.max_border_rows", "value " + std::to_string(tuning.max_border_rows) + " must be >= 0");
     impl_->tuning = tuning;
@@ -1017,8 +1205,28 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     const Eigen::VectorXd p_start = p;
     try {
         // 1. From the previous step's modes: most steps end here in one pass.
-        r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
-        // 2. A transition the passes do not settle: the Tresca fixed point, then the coupled
+        if (!im.tuning.newton_first)
+            r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+        // 2a. A transition the passes do not settle: the semismooth Newton method on the
+        //     natural map from the previous step's forces (for the first step: the stepper's
+        //     start), then the active-set passes from its modes (one pass, normally: they
+        //     re-solve its last set of modes and find no violation, so the answer is the exact
+        //     solver's linear solution of those modes).
+        if (!r.converged && im.tuning.transition == TransitionMethod::newton &&
+            (m >= im.tuning.newton_min_rows || im.tuning.newton_first)) {
+            const Eigen::VectorXd p_passes = p;
+            const std::vector<signed char> nmode_passes = im.modes.nmode, tmode_passes = im.modes.tmode;
+            p = p_start;
+            im.s = im.positions_of(problem, p, z);
+            if (im.semismooth_newton(problem.b, problem.d, p, z, r))
+                r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
+            if (!r.converged) {  // the Tresca fixed point below starts where the passes ended
+                p = p_passes;
+                im.modes.nmode = nmode_passes;
+                im.modes.tmode = tmode_passes;
+            }
+        }
+        // 2b. Otherwise (or if it failed): the Tresca fixed point, then the coupled
         //    Coulomb problem from its modes; if that polish fails, the settled fixed point
         //    (Coulomb to within kAccept x tolerance) is taken and flagged, as in the dense solver.
         if (!r.converged) {

@@ -386,3 +386,143 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_finer_stack) {
     o.elements_per_half_leaf = 160;
     compare_paths(paper_example(PaperCase::friction, o), 1e-3, 20, kTol, true, TauRule::current, 1e-7);
 }
+
+namespace {
+
+/// Replays the sparse problems of `steps` closed-form steps of `spec` (recorded from a
+/// sparse run) with the semismooth Newton method alone (SparsePathTuning::newton_first:
+/// every solve starts with it from the previous forces, the passes only confirm its
+/// modes) and with the dense exact solver on to_dense(), each warm-started from its own
+/// previous forces, and compares the forces step by step. Also checks the contact
+/// conditions independently: the natural map (contact.hpp) of the Newton answer on the
+/// dense W, q.
+void newton_equals_dense(const ModelSpec& spec, int steps, double rel) {
+    const System sys(Model::build(spec));
+    SimulationOptions so;
+    so.solver.tolerance_m = kTol;
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper st(sys, so);
+    std::vector<SparseContactProblem> problems;
+    for (int i = 0; i < steps; ++i) {
+        st.step();
+        problems.push_back(st.last_sparse_problem());
+    }
+    SparsePathTuning tuning;
+    tuning.newton_first = true;
+    SparseContactSolver newton(so.solver, tuning);
+    const auto dense_solver = make_solver(so.solver);
+    Eigen::VectorXd pn = Eigen::VectorXd::Zero(problems.front().size()), pd = pn, z;
+    double scale = 0.0, diff = 0.0, worst_natural = 0.0;
+    int newton_iterations = 0, factorizations = 0, transitions = 0;
+    for (const auto& pr : problems) {
+        const SolveResult rn = newton.solve(pr, pn, z);
+        BOOST_TEST(rn.converged);
+        BOOST_TEST(!rn.fell_back);  // the Newton method's answer, not the Tresca fixed point's or the dense one's
+        newton_iterations += rn.newton_iterations;
+        factorizations += rn.factorizations;
+        if (rn.newton_iterations > 0) ++transitions;
+        const ContactProblem dense = pr.to_dense();
+        const SolveResult rd = dense_solver->solve(dense, pd);
+        BOOST_TEST(rd.converged);
+        scale = std::max(scale, pd.lpNorm<Eigen::Infinity>());
+        diff = std::max(diff, (pn - pd).lpNorm<Eigen::Infinity>());
+        const Eigen::VectorXd s = dense.W * pn + dense.q;
+        worst_natural = std::max(worst_natural, natural_map(dense, pn, s).norm());
+        BOOST_TEST(error_vector(dense, pn, s).norm() < kTol);  // eq. 10: v = 0 to the tolerance
+    }
+    BOOST_TEST_MESSAGE("semismooth Newton: " << newton_iterations << " iterations in " << transitions
+                                             << " solves that needed it, " << factorizations
+                                             << " factorisations; max force difference to the dense exact solver "
+                                             << diff / scale << " (relative), worst natural-map residual "
+                                             << worst_natural << " m");
+    BOOST_TEST(transitions > 0);  // the method was exercised (the warm start was not already a solution)
+    BOOST_CHECK_SMALL(diff / scale, rel);
+    // the Newton method stops at |F_i| <= kAccept x tolerance / 2 per component and the
+    // passes then solve its modes exactly, so the natural map is round-off: below kTol
+    BOOST_CHECK_SMALL(worst_natural, kTol);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_the_paper_friction_case) {
+    // 300 steps of the paper's friction case (76 rows): stick-slip transitions at the
+    // clamps every few steps. Both answers are the linear solution of the same set of
+    // modes (a dense LU of W_SS against the Schur complement on K's factor), so they differ
+    // by round-off amplified by cond(W) ~ 1e5: 1e-9 relative, as kRel above; a different
+    // mode at one step gives >= 1e-6.
+    newton_equals_dense(paper_example(PaperCase::friction), 300, kRel);
+}
+
+BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_a_finer_friction_stack) {
+    // 3 leaves x 160 elements (636 rows), 20 steps from rest: the first steps are the
+    // degenerate transition (most pairs open at once). Tolerance 1e-7 relative, as
+    // sparse_equals_dense_on_a_finer_stack: cond(W) grows ~ elements^2 (64x the
+    // example's), observed round-off differences up to 1e-8.
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 160;
+    newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7);
+}
+
+BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {
+    // 10 identical leaves x 20 elements (342 rows), friction, 20 steps from rest: the
+    // degenerate transition the semismooth Newton method is for (the default sparse
+    // path: passes from the previous modes, then Newton). Tolerance as the finer stack.
+    ModelSpec spec = paper_example(PaperCase::friction);
+    while (spec.leaves.size() < 10) {
+        spec.leaves.push_back(spec.leaves.back());
+        spec.interfaces.push_back(spec.interfaces.back());
+    }
+    compare_paths(spec, 1e-3, 20, kTol, true, TauRule::current, 1e-7);
+}
+
+BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
+    // The same 20 replayed problems of 3 leaves x 160 elements from rest (636 rows, the
+    // first steps a transition of most pairs), solved with the default transition method
+    // (passes, then the semismooth Newton method) and with the Tresca fixed point alone
+    // (TransitionMethod::tresca, the method before): both end in an exact solve of the
+    // same modes, so the forces agree to round-off (1e-7 relative, as the finer-stack
+    // comparison above), and the Newton method is used by the default only.
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 160;
+    const System sys(Model::build(paper_example(PaperCase::friction, o)));
+    SimulationOptions so;
+    so.solver.tolerance_m = kTol;
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper st(sys, so);
+    std::vector<SparseContactProblem> problems;
+    for (int i = 0; i < 20; ++i) {
+        st.step();
+        problems.push_back(st.last_sparse_problem());
+    }
+    auto replay = [&](const SparsePathTuning& tuning, int& newton) {
+        SparseContactSolver solver(so.solver, tuning);
+        std::vector<Eigen::VectorXd> out;
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
+        newton = 0;
+        for (const auto& pr : problems) {
+            const SolveResult r = solver.solve(pr, p, z);
+            BOOST_TEST(r.converged);
+            newton += r.newton_iterations;
+            out.push_back(p);
+        }
+        return out;
+    };
+    SparsePathTuning tresca;
+    tresca.transition = TransitionMethod::tresca;
+    int n_default = 0, n_tresca = 0;
+    const auto a = replay(SparsePathTuning{}, n_default);
+    const auto b = replay(tresca, n_tresca);
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        scale = std::max(scale, b[i].lpNorm<Eigen::Infinity>());
+        diff = std::max(diff, (a[i] - b[i]).lpNorm<Eigen::Infinity>());
+    }
+    BOOST_TEST_MESSAGE("Newton iterations: default " << n_default << ", Tresca only " << n_tresca
+                                                     << "; max force difference " << diff / scale);
+    BOOST_TEST(n_default > 0);
+    BOOST_TEST(n_tresca == 0);
+    BOOST_CHECK_SMALL(diff / scale, 1e-7);
+    SparsePathTuning bad;
+    bad.newton_min_rows = -1;
+    BOOST_CHECK_THROW(SparseContactSolver(so.solver, bad), InputError);
+}

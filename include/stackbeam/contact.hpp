@@ -97,13 +97,16 @@ struct SolverOptions {
 /// What a solve reports. A solve that does not converge says so; it never passes silently.
 struct SolveResult {
     bool converged = false;
-    int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact)
+    int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact; sparse path:
+                               ///< also the semismooth Newton iterations, counted in newton_iterations too)
     double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
     double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
     int factorizations = 0;    ///< factorisations done in this solve (exact solver; sparse path: sparse LU
                                ///< of the saddle-point system or dense LU of the held rows' Schur complement)
     int updates = 0;           ///< sparse path: sets of modes solved by a low-rank update of the last
                                ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
+    int newton_iterations = 0; ///< sparse path: iterations of the semismooth Newton method (each one linear
+                               ///< solve of a set of modes: a factorisation, an update or a cached one)
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not
 };
@@ -156,7 +159,10 @@ struct SparseContactProblem {
 /// low-rank update of it; see SparsePathTuning). The mode switching and the
 /// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
 /// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
-/// both paths reach the same solution. If that fails, a problem of at most 4000 rows is
+/// both paths reach the same solution. Before the Tresca fixed point, a transition is
+/// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
+/// pairs change mode per iteration, one linear solve of a set of modes each; its final
+/// modes are confirmed by the active-set passes, SolveResult::newton_iterations). If that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message.
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
@@ -167,9 +173,27 @@ struct SparseContactProblem {
 ///    coupling that differs from the last LU's held set in at most `max_border_rows`
 ///    rows is solved by bordering that LU (low-rank update: a solve per changed row and
 ///    a small dense LU) instead of a new factorisation.
+/// How the sparse path solves a transition that the active-set passes from the previous
+/// modes do not settle (SparseContactSolver::solve, step 2).
+enum class TransitionMethod {
+    newton,  ///< semismooth Newton on the natural map with a line search, then (if it fails) the Tresca
+             ///< fixed point (default: many pairs change per iteration, no cycling in the measured runs)
+    tresca,  ///< the Tresca fixed point on a box QP only (the method before the Newton one)
+};
+
 struct SparsePathTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+    TransitionMethod transition = TransitionMethod::newton;
+    /// >= 0: the Newton method is tried on problems of at least this many contact rows (smaller
+    /// ones, e.g. the paper example's 76, settle quickly by the passes and the Tresca fixed
+    /// point, and keep exactly the answers they had: their near-degenerate pairs may settle in
+    /// another of the modes within the threshold, e.g. 1.03e-9 J against 0.70e-9 J of
+    /// energy-balance round-off on the paper example with steel leaves)
+    int newton_min_rows = 200;
+    /// Tests: every solve starts with the semismooth Newton method from the warm start (no
+    /// active-set passes from the previous modes first), so its answers can be checked alone.
+    bool newton_first = false;
 };
 
 class SparseContactSolver {
