@@ -11,8 +11,8 @@
 // body mode) integrated by CVODE's BDF at order <= 2 (higher orders are unstable on
 // the lightly damped oscillatory modes), Newton with a dense direct solver and the
 // analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N.
-// Stacks with friction (pairs that may stick or slip) are refused (InputError):
-// events between massive leaves are not built yet (use mode newmark).
+// Stacks with friction (pairs that may stick or slip) run CvodeModalStepper below;
+// called directly with one, this stepper refuses it (InputError naming `mode`).
 #include <Eigen/Dense>
 #include <memory>
 #include <vector>
