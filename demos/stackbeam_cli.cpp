@@ -120,6 +120,7 @@ struct SimulateArgs {
     std::string max_step = "";
     std::string max_steps = "10000000";
     std::string modal_cutoff = "0";
+    std::string restitution = "0";
     std::string events;
     std::string alpha_fraction = "0.9";
     std::string max_iterations = "200000";
@@ -263,6 +264,12 @@ void apply_simulation_options(const SimulateArgs& a, bool only_given, stackbeam:
     if (use("--atol")) options.cvode.atol_m = parse_positive("--atol", a.atol, "m");
     if (use("--max-step") && !a.max_step.empty()) options.cvode.max_step_s = parse_positive("--max-step", a.max_step, "s");
     if (use("--max-steps")) options.cvode.max_steps = parse_count("--max-steps", a.max_steps);
+    if (use("--restitution")) {
+        options.restitution = a.restitution == "0" ? 0.0 : parse_positive("--restitution", a.restitution, "-; 0 to 1");
+        if (options.restitution > 1.0)
+            throw ArgumentError("--restitution: value '" + a.restitution +
+                                "' is not allowed: the restitution coefficient must be in [0, 1]");
+    }
     if (use("--modal-cutoff"))
         options.cvode.modal_cutoff_rad_per_s =
             a.modal_cutoff == "0" ? 0.0 : parse_positive("--modal-cutoff", a.modal_cutoff, "rad/s; 0: the default");
@@ -543,6 +550,7 @@ std::string option_of_field(const std::string& field) {
         {"max_step", "--max-step"},
         {"max_steps", "--max-steps"},
         {"modal_cutoff", "--modal-cutoff"},
+        {"restitution", "--restitution"},
         {"contact_path", "--contact-path"},
     };
     for (const auto& [f, o] : map)
@@ -581,6 +589,11 @@ int main(int argc, char** argv) {
     sim->add_option("--atol", a.atol, "cvode: absolute tolerance on w [m]")->type_name("A")->capture_default_str();
     sim->add_option("--max-step", a.max_step, "cvode: largest internal step [s] (default: no limit)")->type_name("S");
     sim->add_option("--max-steps", a.max_steps, "cvode: limit on CVODE's steps over the run")->type_name("N")->capture_default_str();
+    sim->add_option("--restitution", a.restitution,
+                    "newmark with --beam-density: the impact law's normal restitution coefficient, 0 (inelastic) to 1 "
+                    "(elastic) [-]")
+        ->type_name("E")
+        ->capture_default_str();
     sim->add_option("--modal-cutoff", a.modal_cutoff,
                     "cvode with --beam-density on a stack with friction: the stack's modes up to this circular frequency "
                     "carry the inertia, those above respond quasi-statically [rad/s] (0: 10 x the first; docs/inertia.md)")

@@ -81,6 +81,10 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // all massless (the paper's statically condensed contact): a mix was refused above.
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
+    if (!massive_leaves_ && options_.restitution > 0.0)
+        throw InputError("restitution", "value " + format_value(options_.restitution) +
+                                            " is not used with massless leaves (no impacts: the contact points are "
+                                            "condensed statically): give 0, or a leaf density > 0");
 
     // Initial velocity: w'(0) times the static shape per unit w with the closed contact
     // components tied (bilateral ones always; unilateral ones whose gap is closed; their
@@ -186,7 +190,7 @@ void NewmarkStepper::fill_record(int iterations, int factorizations) {
     record_.contact_residual_m = solve_.residual_m;
 }
 
-double NewmarkStepper::project_velocities() {
+double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0) {
     // The held components at t1: normal rows of closed pairs (compressed, or bilateral),
     // tangential rows of sticking and bonded pairs. Their relative velocity is set to zero
     // by the impulse G_C^T l that changes the kinetic energy least (M-orthogonal projection):
@@ -204,6 +208,22 @@ double NewmarkStepper::project_velocities() {
     }
     if (held.empty()) return 0.0;
     const int nh = static_cast<int>(held.size());
+    // Restitution e (SimulationOptions::restitution): a unilateral normal component closed
+    // at t1 that was open at t0 (p0_n = 0) and approaching (s_n' = (G v0)_n > 0) leaves
+    // with G_n v+ = b_n = -e (G v0)_n; every other held component with 0. The impulse
+    // solves (G_C M^-1 G_C^T) l = G_C v - b and the kinetic energy removed is
+    // 1/2 l^T (G_C v + b) = (1 - e^2) times the e = 0 loss of the closing rows.
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(nh);
+    const double e = options_.restitution;
+    if (e > 0.0) {
+        for (int i = 0; i < nh; ++i) {
+            const int row = held[i];
+            for (const auto& pr : problem_.pairs) {
+                if (pr.row_n != row || pr.kind != PairKind::coulomb) continue;
+                if (p0[row] == 0.0 && gv0[row] > 0.0) b[i] = -e * gv0[row];
+            }
+        }
+    }
     if (path_ == ContactPath::sparse) {
         // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
         const int n = static_cast<int>(v_.size());
@@ -229,10 +249,14 @@ double NewmarkStepper::project_velocities() {
         }
         Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
         rhs.head(n) = M_ * v_;
+        rhs.tail(nh) = b;
         const Eigen::VectorXd x = factor_->saddle.solve(rhs);
         const Eigen::VectorXd dv = v_ - x.head(n);
         v_ = x.head(n);
-        return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
+        if (e == 0.0) return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
+        // M dv = G_C^T l: l^T (G_C v + b) = dv^T M (2 v - dv) = dv^T M v + ... (kinetic energy change)
+        const Eigen::VectorXd vold = v_ + dv;
+        return 0.5 * system_.model().whole_spring_factor() * (vold.dot(M_ * vold) - v_.dot(M_ * v_));
     }
     const Eigen::VectorXd gv = system_.contact_rows() * v_;
     if (held != held_) {  // factorise A_hh once per held set
@@ -244,12 +268,12 @@ double NewmarkStepper::project_velocities() {
     }
     Eigen::VectorXd rhs(nh);
     for (int i = 0; i < nh; ++i) rhs[i] = gv[held[i]];
-    const Eigen::VectorXd l = held_factor_.solve(rhs);
+    const Eigen::VectorXd l = held_factor_.solve(Eigen::VectorXd(rhs - b));
     Eigen::VectorXd dv = Eigen::VectorXd::Zero(v_.size());
     for (int i = 0; i < nh; ++i) dv += Z_.col(held[i]) * l[i];
     v_ -= dv;
-    // 1/2 dv^T M dv = 1/2 l^T A_hh l (dv = M^-1 G_C^T l)
-    return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs);
+    // 1/2 l^T (G_C v + b) (= 1/2 dv^T M dv = 1/2 l^T A_hh l when b = 0; dv = M^-1 G_C^T l)
+    return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
 }
 
 const StepRecord& NewmarkStepper::step() {
@@ -263,6 +287,7 @@ const StepRecord& NewmarkStepper::step() {
                                   : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
+    const Eigen::VectorXd gv0 = massive_leaves_ && options_.restitution > 0.0 ? Eigen::VectorXd(G * v_) : Eigen::VectorXd();
     Eigen::VectorXd z1;
     if (path_ == ContactPath::dense) {
         const Eigen::VectorXd u = factor_->llt.solve(r);
@@ -309,7 +334,7 @@ const StepRecord& NewmarkStepper::step() {
     for (int i = 0; i < static_cast<int>(z_.size()); ++i)
         if (massless_[i]) v_[i] = a_[i] = 0.0;
     rel_ = rel1;
-    if (massive_leaves_) impact_loss_ += project_velocities();
+    if (massive_leaves_) impact_loss_ += project_velocities(p0, gv0);
     t_ = step_ * dt;
     detail::reanchor(problem_, p_, rel_, d_);  // paper, section 5
     fill_record(solve_.iterations, solve_.factorizations);

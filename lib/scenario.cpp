@@ -416,7 +416,7 @@ void parse_probe(const Table& top, ModelSpec& spec) {
 }
 
 void parse_integrator(const Table& top, SimulationOptions& o) {
-    const Table t = top.table("integrator", {"mode", "dt_s", "t_end_s", "tau_rule", "solver", "cvode"});
+    const Table t = top.table("integrator", {"mode", "dt_s", "t_end_s", "tau_rule", "solver", "cvode", "restitution"});
     const std::string mode = t.string("mode", "the time stepping mode");
     try {
         o.mode = parse_mode(mode, "integrator.mode");  // the message names this build's modes
@@ -425,6 +425,12 @@ void parse_integrator(const Table& top, SimulationOptions& o) {
     }
     o.dt_s = t.number("dt_s", "the time step (mode cvode: the output interval) [s], > 0");
     o.t_end_s = t.number("t_end_s", "the end time [s], > 0");
+    o.restitution = t.number_or("restitution", "the impact law's restitution coefficient [-] (mode newmark, massive "
+                                               "leaves), 0 <= e <= 1", o.restitution);
+    if (!std::isfinite(o.restitution) || o.restitution < 0.0 || o.restitution > 1.0)
+        t.context().fail("integrator.restitution", "value " + format_value(o.restitution) +
+                                                       " is not allowed: must be in [0, 1] (0: perfectly inelastic, "
+                                                       "1: elastic)");
     const TauRule current = TauRule::current;
     o.tau_rule = choice<TauRule>(t, "tau_rule", {{"current", TauRule::current}, {"previous-step", TauRule::previous_step}},
                                  &current);

@@ -120,6 +120,13 @@ void SimulationOptions::validate() const {
         if (cvode.max_steps < 1)
             throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
     }
+    if (!std::isfinite(restitution) || restitution < 0.0 || restitution > 1.0)
+        throw InputError("restitution", "value " + format_value(restitution) +
+                                            " is not allowed: the restitution coefficient must be in [0, 1] "
+                                            "(0: perfectly inelastic impacts, 1: elastic)");
+    if (restitution > 0.0 && mode != Mode::newmark)
+        throw InputError("restitution", "value " + format_value(restitution) + " is not used by mode " + to_string(mode) +
+                                            ": only mode newmark with massive leaves has impacts (give 0)");
     if (mode == Mode::cvode && contact_path == ContactPath::sparse)
         throw InputError("contact_path", "value 'sparse' is not available in mode cvode: its mode sets are factorised "
                                          "on the dense compliance C' (use auto or dense)");

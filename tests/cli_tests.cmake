@@ -202,6 +202,13 @@ stackbeam_cli_test(NAME cli_ok_cvode_inertia_friction
                         --modal-cutoff 1000 --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
                    EXPECT_RC 0 EXPECT_TEXT "4 modes up to 1000 rad/s" OUT ${CMAKE_BINARY_DIR}/cli_cvode_inertia_f.csv
                    MIN_LINES 12)
+stackbeam_cli_test(NAME cli_ok_newmark_restitution
+                   ARGS simulate --case friction --mode newmark --beam-density 7850 --restitution 0.5 --t-end 0.01
+                        --dt 1e-4 --out ${CMAKE_BINARY_DIR}/cli_newmark_e.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${CMAKE_BINARY_DIR}/cli_newmark_e.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_bad_restitution_mode
+                   ARGS simulate --case friction --restitution 0.5 --t-end 0.01 --out ${CMAKE_BINARY_DIR}/cli_e_bad.csv
+                   EXPECT_RC 2 EXPECT_TEXT "only mode newmark with massive leaves has impacts" OUT ${CMAKE_BINARY_DIR}/cli_e_bad.csv)
 stackbeam_cli_test(NAME cli_bad_modal_cutoff
                    ARGS simulate --case friction --mode cvode --beam-density 7850 --modal-cutoff -5 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_modal_bad.csv

@@ -111,7 +111,7 @@ private:
     long step_ = 0;
     StepRecord record_;
     void fill_record(int iterations, int factorizations);
-    double project_velocities();
+    double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
 };
 
 }  // namespace stackbeam

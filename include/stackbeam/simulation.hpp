@@ -110,6 +110,12 @@ struct SimulationOptions {
     /// Throw SolverError when a step's contact solve does not converge (default);
     /// if false the step is kept and flagged by its residual.
     bool stop_on_nonconvergence = true;
+    /// Mode newmark with massive leaves: the normal restitution coefficient e [-] of the
+    /// impact law, 0 <= e <= 1. A normal component that closes in a step leaves it with
+    /// its relative velocity reversed to -e times its approach velocity at the step's
+    /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
+    /// ends with relative velocity 0. Docs: docs/inertia.md.
+    double restitution = 0.0;
     /// Throws InputError naming the option when a value is out of range.
     void validate() const;
 };
