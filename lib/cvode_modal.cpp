@@ -38,6 +38,7 @@
 #include <string>
 
 #include "active_set.hpp"
+#include "cvode_modes.hpp"
 #include "cvode_inertia.hpp"
 #include "stackbeam/errors.hpp"
 #include "step_record.hpp"
@@ -46,20 +47,9 @@
 namespace stackbeam::detail {
 
 namespace {
-constexpr double kForceMargin = 1e-9;    // as cvode_stepper.cpp
-constexpr double kMotionMargin = 1e-12;
-constexpr double kLookahead = 1e-7;
-constexpr int kMaxEventsAtOneTime = 200;
-
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-std::string flag_text(long flag) {
-    char* name = CVodeGetReturnFlagName(flag);
-    std::string out = name ? name : "unknown flag";
-    free(name);
-    return out;
-}
 }  // namespace
 
 struct CvodeModalStepper::Impl {
@@ -129,7 +119,7 @@ struct CvodeModalStepper::Impl {
 
     void check(int flag, const char* what) const {
         if (flag < 0)
-            throw SolverError(std::string("cvode mode (leaf inertia): ") + what + " failed: " + flag_text(flag) +
+            throw SolverError(std::string("cvode mode (leaf inertia): ") + what + " failed: " + cvode_flag_name(flag) +
                                   (cv_error.empty() ? "" : " (" + cv_error + ")"),
                               stats.steps, t, 0.0);
     }
@@ -227,45 +217,6 @@ struct CvodeModalStepper::Impl {
         }
     }
 
-    std::string label(int kk, signed char nm, signed char tm) const {
-        const auto& cp = pairs()[kk];
-        if (cp.kind == PairKind::bonded) return "bonded";
-        if (cp.kind == PairKind::coulomb && nm == OPEN) return "open";
-        switch (tm) {
-            case STICK: return "stick";
-            case SLIP_POS: return "slip+";
-            case SLIP_NEG: return "slip-";
-            case FREE: return cp.kind == PairKind::clamp ? "released" : "closed";
-            default: return cp.kind == PairKind::clamp ? "clamped" : "closed";
-        }
-    }
-
-    void modes_from_solution(const Eigen::VectorXd& p, std::vector<signed char>& nm, std::vector<signed char>& tm) const {
-        nm.assign(np, NONE);
-        tm.assign(np, NONE);
-        const double eps_f = 1e-12 * F_ref;
-        for (int kk = 0; kk < np; ++kk) {
-            const auto& cp = pairs()[kk];
-            bool open = false;
-            if (cp.row_n >= 0) {
-                open = cp.kind == PairKind::coulomb && p[cp.row_n] >= -eps_f;
-                nm[kk] = open ? OPEN : CLOSED;
-            } else if (cp.kind == PairKind::coulomb) {
-                open = true;
-            }
-            if (cp.row_t < 0) continue;
-            if (cp.kind == PairKind::bonded) {
-                tm[kk] = STICK;
-                continue;
-            }
-            const double limit = cp.friction_coefficient * friction_normal_force(chk_problem, kk, p);
-            const double pt = p[cp.row_t];
-            if (open || cp.friction_coefficient == 0.0 || limit <= 0.0) tm[kk] = FREE;
-            else if (std::abs(pt) >= limit * (1.0 - 1e-9)) tm[kk] = pt > 0.0 ? SLIP_POS : SLIP_NEG;
-            else tm[kk] = STICK;
-        }
-    }
-
     /// The contact iteration decides the modes at (q, q') with forces p_cur in the old
     /// modes, as cvode_stepper.cpp: CVODE's transitions applied to the old modes first,
     /// kept if the contact iteration's stop test and every witness accept them a
@@ -314,23 +265,8 @@ struct CvodeModalStepper::Impl {
             for (std::size_t i = 0; i < slots.size(); ++i) {
                 if ((*triggered)[i] == 0) continue;
                 const int kk = slots[i].pair;
-                const auto& cp = pairs()[kk];
-                const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
-                if (slots[i].normal && cp.kind == PairKind::coulomb) {
-                    if (nm[kk] == CLOSED) {
-                        nm[kk] = OPEN;
-                        if (cp.row_t >= 0) tm[kk] = FREE;
-                    } else {
-                        nm[kk] = CLOSED;
-                        if (cp.row_t >= 0) tm[kk] = friction ? STICK : FREE;
-                    }
-                } else if (slots[i].normal) {
-                    tm[kk] = tm[kk] == FREE ? STICK : FREE;
-                } else if (tm[kk] == STICK) {
-                    tm[kk] = p_cur[cp.row_t] > 0.0 ? SLIP_POS : SLIP_NEG;
-                } else if (tm[kk] == SLIP_POS || tm[kk] == SLIP_NEG) {
-                    tm[kk] = STICK;
-                }
+                apply_transition(pairs()[kk], slots[i].normal, pairs()[kk].row_t >= 0 ? p_cur[pairs()[kk].row_t] : 0.0,
+                                 nm[kk], tm[kk]);
             }
             const Eigen::VectorXd d_saved = d;
             const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
@@ -358,7 +294,7 @@ struct CvodeModalStepper::Impl {
                 throw SolverError("cvode mode (leaf inertia): the contact iteration deciding the modes at t = " +
                                       format_value(t) + " s (" + cause + ") did not converge: " + res.message,
                                   stats.steps, t, res.residual_m);
-            modes_from_solution(p_la, nm, tm);
+            modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
             // A slipping pair slips against its slip rate: where the new modes' rate at
             // (q, q') contradicts the solver's sign beyond the margin (a rate the
             // look-ahead's motion is too short to resolve), the sign follows the rate.
@@ -391,8 +327,8 @@ struct CvodeModalStepper::Impl {
             const PairSpec& spec = sys.pair_spec(kk);
             e.interface_index = spec.interface_index;
             e.x_m = spec.x_m;
-            e.from = cause == "start" ? "none" : label(kk, nmode[kk], tmode[kk]);
-            e.to = label(kk, nm[kk], tm[kk]);
+            e.from = cause == "start" ? "none" : mode_label(pairs()[kk], nmode[kk], tmode[kk]);
+            e.to = mode_label(pairs()[kk], nm[kk], tm[kk]);
             e.cause = cause;
             e.w_m = phiw.dot(q) + rw.dot(p_cur);
             e.w_dot_m_per_s = phiw.dot(qd);
@@ -579,7 +515,7 @@ struct CvodeModalStepper::Impl {
         if (flag < 0) {
             double h = 0.0;
             CVodeGetLastStep(cv, &h);
-            throw SolverError("cvode mode (leaf inertia): CVODE failed (" + flag_text(flag) + ") at t = " +
+            throw SolverError("cvode mode (leaf inertia): CVODE failed (" + cvode_flag_name(flag) + ") at t = " +
                                   format_value(tret) + " s after " + std::to_string(stats.steps) +
                                   " steps, last step size " + format_value(h) + " s" +
                                   (cv_error.empty() ? "" : ": " + cv_error),
@@ -774,7 +710,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
         const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p_init);
         if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
     }
-    s.modes_from_solution(p_init, s.nmode, s.tmode);
+    modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.build_mode();
     s.decide_modes(Y.head(s.r), Y.segment(s.r, s.r), p_init, "start", nullptr);
 

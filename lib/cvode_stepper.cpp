@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "active_set.hpp"
+#include "cvode_modes.hpp"
 #include "step_record.hpp"
 #include "stackbeam/errors.hpp"
 
@@ -30,30 +31,11 @@ using detail::OPEN;
 using detail::SLIP_NEG;
 using detail::SLIP_POS;
 using detail::STICK;
+using detail::kForceMargin;
+using detail::kLookahead;
+using detail::kMaxEventsAtOneTime;
+using detail::kMotionMargin;
 constexpr signed char N_NONE = detail::NONE, T_NONE = detail::NONE;
-
-/// Every witness is positive by a margin (relative to its scale) while its mode
-/// holds, so that pairs that merely touch (p = s = 0 up to round-off) do not chatter.
-/// Forces come from an LU of the mode's conditions (cond(C') ~ 1e5: round-off
-/// ~1e-11 F_ref), so force witnesses get 1e-9: a friction limit or a contact
-/// release is passed by 1e-9 F_ref before it counts. Gaps and slip rates are
-/// products of C' with the forces (round-off ~1e-16 L_ref): 1e-12, so that a gap
-/// closing into penetration by 1e-12 L_ref makes a force jump of only ~1e-12 L_ref / C'_nn.
-constexpr double kForceMargin = 1e-9;
-constexpr double kMotionMargin = 1e-12;
-/// The look-ahead at an event moves R by this fraction of L_ref: large against
-/// round-off (1e-16 L_ref), small against every margin that matters.
-constexpr double kLookahead = 1e-7;
-/// At most this many events at one instant before the run is declared chattering.
-constexpr int kMaxEventsAtOneTime = 200;
-
-/// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).
-std::string flag_name(long flag) {
-    char* name = CVodeGetReturnFlagName(flag);
-    std::string out = name ? name : "unknown flag";
-    free(name);
-    return out;
-}
 
 }  // namespace
 
@@ -199,14 +181,6 @@ struct CvodeStepper::Impl {
 
     Eigen::VectorXd forces(double w) const { return P * w + r; }
 
-    /// Friction normal force tau [N] of pair kk (contact.hpp) for forces p.
-    double tau(int kk, const Eigen::VectorXd& p) const {
-        const auto& cp = pairs()[kk];
-        const double pn = cp.row_n >= 0 ? p[cp.row_n] : 0.0;
-        if (cp.kind == PairKind::clamp) return std::max(0.0, cp.preload_n - pn);
-        return std::max(0.0, -pn);
-    }
-
     /// Witness functions at (w, w'): positive while the modes hold.
     void witnesses(double w, double wd, double* g) const {
         for (std::size_t i = 0; i < slots.size(); ++i) {
@@ -241,47 +215,6 @@ struct CvodeStepper::Impl {
                 }
             }
             g[i] = v + margin;
-        }
-    }
-
-    /// Mode label of pair kk for the event log.
-    std::string label(int kk, signed char nm, signed char tm) const {
-        const auto& cp = pairs()[kk];
-        if (cp.kind == PairKind::bonded) return "bonded";
-        if (cp.kind == PairKind::coulomb && nm == OPEN) return "open";
-        switch (tm) {
-            case STICK: return "stick";
-            case SLIP_POS: return "slip+";
-            case SLIP_NEG: return "slip-";
-            case FREE: return cp.kind == PairKind::clamp ? "released" : "closed";
-            default: return cp.kind == PairKind::clamp ? "clamped" : "closed";
-        }
-    }
-
-    /// Modes of the contact solution p (s = W p + q of `pr`).
-    void modes_from_solution(const Eigen::VectorXd& p, std::vector<signed char>& nm, std::vector<signed char>& tm) const {
-        nm.assign(np, N_NONE);
-        tm.assign(np, T_NONE);
-        const double eps_f = 1e-12 * F_ref;
-        for (int kk = 0; kk < np; ++kk) {
-            const auto& cp = pairs()[kk];
-            bool open = false;
-            if (cp.row_n >= 0) {
-                open = cp.kind == PairKind::coulomb && p[cp.row_n] >= -eps_f;
-                nm[kk] = open ? OPEN : CLOSED;
-            } else if (cp.kind == PairKind::coulomb) {
-                open = true;  // no normal component: it carries no friction either
-            }
-            if (cp.row_t < 0) continue;
-            if (cp.kind == PairKind::bonded) {
-                tm[kk] = STICK;
-                continue;
-            }
-            const double limit = cp.friction_coefficient * tau(kk, p);
-            const double pt = p[cp.row_t];
-            if (open || cp.friction_coefficient == 0.0 || limit <= 0.0) tm[kk] = FREE;
-            else if (std::abs(pt) >= limit * (1.0 - 1e-9)) tm[kk] = pt > 0.0 ? SLIP_POS : SLIP_NEG;
-            else tm[kk] = STICK;
         }
     }
 
@@ -331,23 +264,8 @@ struct CvodeStepper::Impl {
             for (std::size_t i = 0; i < slots.size(); ++i) {
                 if ((*triggered)[i] == 0) continue;
                 const int kk = slots[i].pair;
-                const auto& cp = pairs()[kk];
-                const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
-                if (slots[i].normal && cp.kind == PairKind::coulomb) {
-                    if (nm[kk] == CLOSED) {
-                        nm[kk] = OPEN;
-                        if (cp.row_t >= 0) tm[kk] = FREE;
-                    } else {
-                        nm[kk] = CLOSED;
-                        if (cp.row_t >= 0) tm[kk] = friction ? STICK : FREE;
-                    }
-                } else if (slots[i].normal) {  // clamp released or engaged again
-                    tm[kk] = tm[kk] == FREE ? STICK : FREE;
-                } else if (tm[kk] == STICK) {
-                    tm[kk] = p_cur[cp.row_t] > 0.0 ? SLIP_POS : SLIP_NEG;
-                } else if (tm[kk] == SLIP_POS || tm[kk] == SLIP_NEG) {
-                    tm[kk] = STICK;
-                }
+                detail::apply_transition(pairs()[kk], slots[i].normal,
+                                         pairs()[kk].row_t >= 0 ? p_cur[pairs()[kk].row_t] : 0.0, nm[kk], tm[kk]);
             }
             const Eigen::VectorXd d_saved = d;
             const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
@@ -375,7 +293,7 @@ struct CvodeStepper::Impl {
                 throw SolverError("cvode mode: the contact iteration deciding the modes at t = " + format_value(t) +
                                       " s (" + cause + ") did not converge: " + res.message,
                                   stats.steps, t, res.residual_m);
-            modes_from_solution(p_la, nm, tm);
+            detail::modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
         }
 
         // Log the transitions, enter the new modes, refactorise (unless the candidate was).
@@ -389,8 +307,8 @@ struct CvodeStepper::Impl {
             const PairSpec& spec = sys.pair_spec(kk);
             e.interface_index = spec.interface_index;
             e.x_m = spec.x_m;
-            e.from = cause == "start" ? "none" : label(kk, nmode[kk], tmode[kk]);
-            e.to = label(kk, nm[kk], tm[kk]);
+            e.from = cause == "start" ? "none" : detail::mode_label(pairs()[kk], nmode[kk], tmode[kk]);
+            e.to = detail::mode_label(pairs()[kk], nm[kk], tm[kk]);
             e.cause = cause;
             e.w_m = w;
             e.w_dot_m_per_s = wd;
@@ -461,7 +379,7 @@ struct CvodeStepper::Impl {
 
     void check(int flag, const char* what) const {
         if (flag < 0)
-            throw SolverError(std::string("cvode mode: ") + what + " failed: " + flag_name(flag) +
+            throw SolverError(std::string("cvode mode: ") + what + " failed: " + detail::cvode_flag_name(flag) +
                                   (cv_error.empty() ? "" : " (" + cv_error + ")"),
                               stats.steps, t, 0.0);
     }
@@ -603,7 +521,7 @@ struct CvodeStepper::Impl {
         if (flag < 0) {
             double h = 0.0;
             CVodeGetLastStep(cv, &h);
-            throw SolverError("cvode mode: CVODE failed (" + flag_name(flag) + ") at t = " +
+            throw SolverError("cvode mode: CVODE failed (" + detail::cvode_flag_name(flag) + ") at t = " +
                                   format_value(tret) + " s after " + std::to_string(stats.steps) +
                                   " steps, last step size " + format_value(h) + " s" +
                                   (cv_error.empty() ? "" : ": " + cv_error),
@@ -770,7 +688,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
         const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p0);
         if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
     }
-    s.modes_from_solution(p0, s.nmode, s.tmode);
+    detail::modes_from_solution(s.chk_problem, p0, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.decide_modes(0.0, w0, wd0, p0, "start");
     s.init_cvode(w0, wd0);
     s.record = s.make_record(0.0, w0, wd0, 0.0, 0.0);

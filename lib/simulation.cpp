@@ -535,14 +535,15 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     };
     RunReport rep;
     rep.mode = options.mode;
-    if (options.mode == Mode::cvode && detail::has_leaf_mass(system) && detail::has_mode_changes(system)) {
-        detail::CvodeModalStepper stepper(system, options);  // docs/inertia.md
-        ContactProblem laws;
-        laws.pairs = system.pairs();
-        laws.tau_rule = TauRule::current;
+    // The event-driven cvode steppers: records, per-pair output (rel: the pairs'
+    // relative positions s + d at the output), counters and the event log.
+    ContactProblem cvode_laws;
+    cvode_laws.pairs = system.pairs();
+    cvode_laws.tau_rule = TauRule::current;
+    auto run_events = [&](auto& stepper, const auto& relative_positions) {
         auto pairs_out = [&] {
             if (on_pairs)
-                on_pairs(out.back().t_s, pair_records(system, laws, stepper.contact_forces(), stepper.relative_positions()));
+                on_pairs(out.back().t_s, pair_records(system, cvode_laws, stepper.contact_forces(), relative_positions()));
         };
         keep(stepper.current());
         pairs_out();
@@ -555,6 +556,10 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         rep.steps = rep.cvode.steps;
         rep.contact_iterations = rep.cvode.contact_iterations;
         rep.factorizations = rep.cvode.mode_factorizations;
+    };
+    if (options.mode == Mode::cvode && detail::has_leaf_mass(system) && detail::has_mode_changes(system)) {
+        detail::CvodeModalStepper stepper(system, options);  // docs/inertia.md
+        run_events(stepper, [&] { return stepper.relative_positions(); });
     } else if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
         detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
         keep(stepper.current());
@@ -563,27 +568,11 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         rep.steps = rep.cvode.steps;
     } else if (options.mode == Mode::cvode) {
         CvodeStepper stepper(system, options);
-        ContactProblem laws;
-        laws.pairs = system.pairs();
-        laws.tau_rule = TauRule::current;
-        auto pairs_out = [&] {
-            if (!on_pairs) return;
+        run_events(stepper, [&] {
             const Eigen::VectorXd& p = stepper.contact_forces();
-            const Eigen::VectorXd rel = p.size() > 0 ? Eigen::VectorXd(system.compliance_held() * p + system.coupling() * out.back().w_m)
-                                                     : Eigen::VectorXd();
-            on_pairs(out.back().t_s, pair_records(system, laws, p, rel));
-        };
-        keep(stepper.current());
-        pairs_out();
-        for (long i = 0; i < n; ++i) {
-            keep(stepper.advance());
-            pairs_out();
-        }
-        rep.cvode = stepper.stats();
-        rep.events = stepper.events();
-        rep.steps = rep.cvode.steps;
-        rep.contact_iterations = rep.cvode.contact_iterations;
-        rep.factorizations = rep.cvode.mode_factorizations;
+            return p.size() > 0 ? Eigen::VectorXd(system.compliance_held() * p + system.coupling() * out.back().w_m)
+                                : Eigen::VectorXd();
+        });
     } else if (options.mode == Mode::newmark) {
         NewmarkStepper stepper(system, options);
         keep(stepper.current());
