@@ -228,4 +228,67 @@ BENCHMARK(Scaling)
     ->Args({100, 10, 1, 1, 20})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
+/// A graduated 10-leaf spring from the paper's leaf: the main leaf pinned at both ends,
+/// leaf k below it shorter by 8 % of L per leaf (0.5 m down to 0.14 m), centred, free
+/// ends; two clamps of 1000 N at x = 0.2 and 0.3 m (inside every leaf), mu = 0.5.
+ModelSpec graduated_stack(int elements, int leaves) {
+    ModelSpec spec = stack(PaperCase::friction, elements, leaves);
+    const double L = spec.leaves[0].length_m;
+    for (int k = 1; k < leaves; ++k) {
+        auto& leaf = spec.leaves[static_cast<std::size_t>(k)];
+        leaf.length_m = L * (1.0 - 0.72 * k / (leaves - 1));
+        leaf.x_start_m = 0.5 * (L - leaf.length_m);
+        leaf.left_support = leaf.right_support = SupportKind::free;
+    }
+    spec.clamps = {{0.2, 1000.0}, {0.3, 1000.0}};
+    return spec;
+}
+
+/// The sparse path's transition methods on friction runs of 10 leaves (closed-form mode,
+/// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
+/// transition (0 newton: semismooth then smoothing, 1 semismooth only, 3 Tresca only:
+/// TransitionMethod's values), simulated time in ms.
+void Transitions(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : stack(PaperCase::friction, elements, 10);
+    const double t_sim = 1e-3 * static_cast<double>(state.range(3));
+    double total = 0.0, factorizations = 0.0, newton = 0.0, smoothing = 0.0, worst_step = 0.0;
+    long steps = 0, tresca = 0;
+    int components = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const System s(Model::build(spec));
+        SimulationOptions so;
+        so.t_end_s = t_sim;
+        so.contact_path = ContactPath::sparse;
+        so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
+        ClosedFormStepper st(s, so);
+        steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
+        factorizations = newton = smoothing = worst_step = 0.0;
+        tresca = 0;
+        for (long i = 0; i < steps; ++i) {
+            const auto t1 = std::chrono::steady_clock::now();
+            factorizations += st.step().factorizations;
+            worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+            newton += st.last_solve().newton_iterations;
+            smoothing += st.last_solve().smoothing_iterations;
+            if (st.last_solve().fell_back) ++tresca;
+        }
+        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        components = s.num_components();
+    }
+    state.counters["components"] = components;
+    state.counters["s_per_sim_s"] = total / t_sim;
+    state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
+    state.counters["newton_per_step"] = newton / static_cast<double>(steps);
+    state.counters["smooth_per_step"] = smoothing / static_cast<double>(steps);
+    state.counters["fell_back_steps"] = static_cast<double>(tresca);  // answers of the Tresca fixed point (or the dense solver)
+    state.counters["worst_step_s"] = worst_step;
+}
+BENCHMARK(Transitions)
+    ->ArgNames({"el", "graduated", "transition", "ms"})
+    ->Args({100, 1, 0, 100})->Args({100, 1, 1, 100})
+    ->Args({100, 0, 0, 300})->Args({100, 0, 1, 300})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+
 BENCHMARK_MAIN();

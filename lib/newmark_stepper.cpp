@@ -60,7 +60,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
             held.pairs = problem_.pairs;
             held.tau_rule = problem_.tau_rule;
             held.tau_previous_n = problem_.tau_previous_n;
-            SparseContactSolver initial(options_.solver);
+            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
             Eigen::VectorXd zr;
             solve_ = initial.solve(held, p_, zr);
         }
@@ -153,7 +153,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         problem_.q = Eigen::VectorXd::Zero(m);
     } else {
         // (K_eff / kappa) z1 = r / kappa + G^T p1
-        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver);
+        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
         sparse_problem_.K = (1.0 / kappa) * Keff;
         sparse_problem_.G = G;
         sparse_problem_.b = Eigen::VectorXd::Zero(n);

@@ -203,7 +203,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             st.pairs = problem_.pairs;
             st.tau_rule = problem_.tau_rule;
             st.tau_previous_n = problem_.tau_previous_n;
-            SparseContactSolver solver(options_.solver);
+            SparseContactSolver solver(options_.solver, options_.sparse_tuning);
             solve_ = solver.solve(st, p_, z_);
             if (n > 0 && !solve_.converged) throw SolverError(what + ": " + solve_.message, 0, 0.0, solve_.residual_m);
             w_ = z_[w_dof_];
@@ -240,7 +240,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
                                        " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
         const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
-        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver);
+        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
         if (z_.size() == 0) z_ = system_.reduced_displacements(p_, w_);
         SparseContactProblem held;  // R held at w: the problem on z_r
         held.K = K.topLeftCorner(w_dof_, w_dof_);
@@ -251,7 +251,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
         if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
             held.b = -krw_ * w_start;
             held.d = d_ - gw_ * w_start;
-            SparseContactSolver initial(options_.solver);
+            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
             Eigen::VectorXd zr;
             solve_ = initial.solve(held, p_, zr);
             if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);

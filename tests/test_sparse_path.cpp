@@ -396,7 +396,9 @@ namespace {
 /// previous forces, and compares the forces step by step. Also checks the contact
 /// conditions independently: the natural map (contact.hpp) of the Newton answer on the
 /// dense W, q.
-void newton_equals_dense(const ModelSpec& spec, int steps, double rel) {
+void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
+                         TransitionMethod method = TransitionMethod::newton) {
+    const bool smoothing = method == TransitionMethod::smoothing;
     const System sys(Model::build(spec));
     SimulationOptions so;
     so.solver.tolerance_m = kTol;
@@ -409,6 +411,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel) {
     }
     SparsePathTuning tuning;
     tuning.newton_first = true;
+    tuning.transition = method;
     SparseContactSolver newton(so.solver, tuning);
     const auto dense_solver = make_solver(so.solver);
     Eigen::VectorXd pn = Eigen::VectorXd::Zero(problems.front().size()), pd = pn, z;
@@ -418,9 +421,10 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel) {
         const SolveResult rn = newton.solve(pr, pn, z);
         BOOST_TEST(rn.converged);
         BOOST_TEST(!rn.fell_back);  // the Newton method's answer, not the Tresca fixed point's or the dense one's
-        newton_iterations += rn.newton_iterations;
+        const int its = smoothing ? rn.smoothing_iterations : rn.newton_iterations;
+        newton_iterations += its;
         factorizations += rn.factorizations;
-        if (rn.newton_iterations > 0) ++transitions;
+        if (its > 0) ++transitions;
         const ContactProblem dense = pr.to_dense();
         const SolveResult rd = dense_solver->solve(dense, pd);
         BOOST_TEST(rd.converged);
@@ -430,7 +434,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel) {
         worst_natural = std::max(worst_natural, natural_map(dense, pn, s).norm());
         BOOST_TEST(error_vector(dense, pn, s).norm() < kTol);  // eq. 10: v = 0 to the tolerance
     }
-    BOOST_TEST_MESSAGE("semismooth Newton: " << newton_iterations << " iterations in " << transitions
+    BOOST_TEST_MESSAGE((smoothing ? "smoothing Newton: " : "semismooth Newton: ") << newton_iterations << " iterations in " << transitions
                                              << " solves that needed it, " << factorizations
                                              << " factorisations; max force difference to the dense exact solver "
                                              << diff / scale << " (relative), worst natural-map residual "
@@ -461,6 +465,23 @@ BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_a_finer_friction_stack) {
     PaperExampleOptions o;
     o.elements_per_half_leaf = 160;
     newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7);
+}
+
+BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_the_paper_friction_case) {
+    // The smoothing Newton method alone (TransitionMethod::smoothing, from the warm start
+    // at every step) on the 300 replayed steps of newton_equals_dense_exact_on_the_paper_
+    // friction_case: it stops at |F_i| <= kAccept x tolerance / 2 of the natural map and the
+    // passes then solve its modes exactly, so the answer is again the linear solution of
+    // the dense solver's modes: the same round-off bound, 1e-9 relative (kRel).
+    newton_equals_dense(paper_example(PaperCase::friction), 300, kRel, TransitionMethod::smoothing);
+}
+
+BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_a_finer_friction_stack) {
+    // 3 x 160 from rest, 20 steps (the degenerate transition), smoothing method alone;
+    // tolerance as for the semismooth method on this stack (cond(W) ~ 64x the example's).
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 160;
+    newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::smoothing);
 }
 
 BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {

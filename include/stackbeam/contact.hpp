@@ -107,6 +107,8 @@ struct SolveResult {
                                ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
     int newton_iterations = 0; ///< sparse path: iterations of the semismooth Newton method (each one linear
                                ///< solve of a set of modes: a factorisation, an update or a cached one)
+    int smoothing_iterations = 0;  ///< sparse path: iterations of the smoothing Newton method (each one sparse LU
+                                   ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not
 };
@@ -162,7 +164,11 @@ struct SparseContactProblem {
 /// both paths reach the same solution. Before the Tresca fixed point, a transition is
 /// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
 /// pairs change mode per iteration, one linear solve of a set of modes each; its final
-/// modes are confirmed by the active-set passes, SolveResult::newton_iterations). If that fails, a problem of at most 4000 rows is
+/// modes are confirmed by the active-set passes, SolveResult::newton_iterations), and if
+/// that stalls, by a smoothing Newton method (the natural map with every max(0, .)
+/// smoothed, the smoothing driven to zero with the residual; one sparse LU of its
+/// Jacobian per iteration, SolveResult::smoothing_iterations; its modes are confirmed the
+/// same way). If all that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message.
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
@@ -176,9 +182,12 @@ struct SparseContactProblem {
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class TransitionMethod {
-    newton,  ///< semismooth Newton on the natural map with a line search, then (if it fails) the Tresca
-             ///< fixed point (default: many pairs change per iteration, no cycling in the measured runs)
-    tresca,  ///< the Tresca fixed point on a box QP only (the method before the Newton one)
+    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
+                 ///< Newton method; if that fails, the Tresca fixed point (default)
+    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
+                 ///< smoothing method (kept for comparison, BENCHMARKS.md)
+    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
+    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
 };
 
 struct SparsePathTuning {

@@ -107,6 +107,9 @@ struct SimulationOptions {
     TauRule tau_rule = TauRule::current;
     /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
     ContactPath contact_path = ContactPath::automatic;
+    /// Sparse path only: how its exact solver solves the linear problems and the transitions
+    /// (contact.hpp; the defaults are the measured choices, BENCHMARKS.md).
+    SparsePathTuning sparse_tuning;
     /// Throw SolverError when a step's contact solve does not converge (default);
     /// if false the step is kept and flagged by its residual.
     bool stop_on_nonconvergence = true;
