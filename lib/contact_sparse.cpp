@@ -1447,11 +1447,13 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
                 if (im.semismooth_newton(problem.b, problem.d, p, z, r))
                     r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
             }
-            if (!r.converged && (tm == TransitionMethod::newton || tm == TransitionMethod::smoothing)) {
-                // from the semismooth method's best iterate, not the start (measured on the graduated
-                // 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s, BENCHMARKS.md)
-                p = p_start;
-                if (tm == TransitionMethod::newton && im.best_p.size() == m) p = im.best_p;
+            // the smoothing method from the semismooth method's best iterate (measured on the
+            // graduated 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s from the
+            // start, BENCHMARKS.md), and if that or the passes after it fail, from the start
+            const bool from_best = tm == TransitionMethod::newton && im.best_p.size() == m;
+            for (int attempt = from_best ? 0 : 1; attempt < 2 && !r.converged; ++attempt) {
+                if (tm != TransitionMethod::newton && tm != TransitionMethod::smoothing) break;
+                p = attempt == 0 ? im.best_p : p_start;
                 im.s = im.positions_of(problem, p, z);
                 if (im.smoothing_newton(problem.d, p, z, r))
                     r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
