@@ -384,7 +384,8 @@ struct SparseContactSolver::Impl {
     SpMat Js;
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> js_lu;
     bool js_analysed = false;            // js_lu's ordering is for the current (K, G)
-    Eigen::VectorXd row_h;               // ||G_i Dz|| per contact row
+    Eigen::VectorXd row_h;               // ||G_i Dz|| per contact row (1 for an empty row): the row scaling
+                                         // of the saddle-point systems (solve_held, try_border, smoothing)
     Eigen::VectorXd best_p;              // semismooth_newton's iterate of smallest ||F||
 
     void reset_structure(const SparseContactProblem& pr) {
@@ -427,6 +428,14 @@ struct SparseContactSolver::Impl {
             const double h = Gt_scaled.col(i).norm();
             row_h[i] = h > 0.0 ? h : 1.0;
         }
+    }
+
+    /// Appends Dz K Dz (the stiffness block of both saddle-point systems, scaled by
+    /// Dz = diag(K)^-1/2) to t.
+    void append_scaled_K(std::vector<Eigen::Triplet<double>>& t) const {
+        for (int j = 0; j < K.outerSize(); ++j)
+            for (SpMat::InnerIterator it(K, j); it; ++it)
+                t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
     }
 
     /// s = G z - d for z = K^-1 (b + G^T p).
@@ -497,13 +506,11 @@ struct SparseContactSolver::Impl {
                 factor_schur(lin);
             } else {
                 row_scale.resize(ms);
-                for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / (Gt_scaled.col(S[i]).norm());
+                for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / row_h[S[i]];
                 // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
                 std::vector<Eigen::Triplet<double>> t;
                 t.reserve(static_cast<std::size_t>(K.nonZeros() + 4 * G.nonZeros()));
-                for (int j = 0; j < n; ++j)
-                    for (SpMat::InnerIterator it(K, j); it; ++it)
-                        t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+                append_scaled_K(t);
                 for (int i = 0; i < ms; ++i)
                     for (SpMat::InnerIterator it(Gt_scaled, S[i]); it; ++it) {
                         t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
@@ -649,7 +656,7 @@ struct SparseContactSolver::Impl {
         const int n = static_cast<int>(K.rows());
         const int ms0 = static_cast<int>(base_S.size());
         const int k = static_cast<int>(border_rows.size());
-        auto scale_of = [&](int a) { return 1.0 / Gt_scaled.col(a).norm(); };
+        auto scale_of = [&](int a) { return 1.0 / row_h[a]; };
         // U y added to v
         auto add_U = [&](const Eigen::VectorXd& y, Eigen::VectorXd& v) {
             for (int j = 0; j < k; ++j) {
@@ -1214,7 +1221,7 @@ struct SparseContactSolver::Impl {
     /// The natural map of natural_residual with every max(0, .) (and so every min and clamp,
     /// and the friction limit's tau) smoothed by smax with e = eps_m / w (w = W_ii of the
     /// row, so eps_m is in metres like F): F_eps is smooth for eps_m > 0, within about
-    /// eps_m of F per component, and F_0 is the natural map exactly. Per component:
+    /// eps_m of F per component, and F_0 is the natural map (natural_residual). Per component:
     ///   unilateral normal  F = w (p_n + smax(s_n / w - p_n, e))         (= w (p_n - min(0, a)))
     ///   tangential         F = w (p_t - clip(a)),  a = p_t - s_t / w,
     ///                      clip(a) = -L + smax(a + L, e) - smax(a - L, e),  L = mu tau_eps(p_n)
@@ -1276,9 +1283,7 @@ struct SparseContactSolver::Impl {
         const int n = static_cast<int>(K.rows()), m = static_cast<int>(F.size());
         std::vector<Eigen::Triplet<double>> t;
         t.reserve(static_cast<std::size_t>(K.nonZeros() + 2 * G.nonZeros() + 2 * m));
-        for (int j = 0; j < n; ++j)
-            for (SpMat::InnerIterator it(K, j); it; ++it)
-                t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+        append_scaled_K(t);
         for (int i = 0; i < m; ++i) {
             const double hi = row_h[i];
             for (SpMat::InnerIterator it(Gt_scaled, i); it; ++it) {
@@ -1329,7 +1334,7 @@ struct SparseContactSolver::Impl {
         if (m == 0) return true;
         Eigen::VectorXd sk = Grow * z - d, F, Fn, Ft, dp, dzv, ds, pa, sa;
         std::vector<SmoothRow> J;
-        smoothed_residual(p, sk, 0.0, Fn, nullptr);
+        natural_residual(p, sk, Fn, false);
         double nat = Fn.lpNorm<Eigen::Infinity>();
         double eps = kSmoothStart * nat, best = nat;
         int since_best = 0;
@@ -1366,7 +1371,7 @@ struct SparseContactSolver::Impl {
             p = pa;
             sk = sa;
             z += a * dzv;
-            smoothed_residual(p, sk, 0.0, Fn, nullptr);
+            natural_residual(p, sk, Fn, false);
             nat = Fn.lpNorm<Eigen::Infinity>();
             eps = std::min(eps, kSmoothTrack * nat);
             // a stall (measured at 10 leaves x 400 elements: a local minimum of ||F_eps|| where
@@ -1450,9 +1455,9 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             // the smoothing method from the semismooth method's best iterate (measured on the
             // graduated 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s from the
             // start, BENCHMARKS.md), and if that or the passes after it fail, from the start
+            const bool smoothing = tm == TransitionMethod::newton || tm == TransitionMethod::smoothing;
             const bool from_best = tm == TransitionMethod::newton && im.best_p.size() == m;
-            for (int attempt = from_best ? 0 : 1; attempt < 2 && !r.converged; ++attempt) {
-                if (tm != TransitionMethod::newton && tm != TransitionMethod::smoothing) break;
+            for (int attempt = from_best ? 0 : 1; smoothing && attempt < 2 && !r.converged; ++attempt) {
                 p = attempt == 0 ? im.best_p : p_start;
                 im.s = im.positions_of(problem, p, z);
                 if (im.smoothing_newton(problem.d, p, z, r))
