@@ -246,14 +246,14 @@ ModelSpec graduated_stack(int elements, int leaves) {
 
 /// The sparse path's transition methods on friction runs of 10 leaves (closed-form mode,
 /// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
-/// transition (0 newton: semismooth then smoothing, 1 semismooth only, 3 Tresca only:
-/// TransitionMethod's values), simulated time in ms.
+/// transition (0 newton: semismooth, smoothing, then continuation; 1 semismooth only; 3 Tresca
+/// only; 4 continuation only: TransitionMethod's values), simulated time in ms.
 void Transitions(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : stack(PaperCase::friction, elements, 10);
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
     double total = 0.0, factorizations = 0.0, newton = 0.0, smoothing = 0.0, worst_step = 0.0;
-    long steps = 0, tresca = 0;
+    long steps = 0, tresca = 0, continued = 0;
     int components = 0;
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -265,7 +265,7 @@ void Transitions(benchmark::State& state) {
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = smoothing = worst_step = 0.0;
-        tresca = 0;
+        tresca = continued = 0;
         for (long i = 0; i < steps; ++i) {
             const auto t1 = std::chrono::steady_clock::now();
             factorizations += st.step().factorizations;
@@ -273,6 +273,7 @@ void Transitions(benchmark::State& state) {
             newton += st.last_solve().newton_iterations;
             smoothing += st.last_solve().smoothing_iterations;
             if (st.last_solve().fell_back) ++tresca;
+            if (st.last_solve().continuation_steps > 0) ++continued;
         }
         total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         components = s.num_components();
@@ -282,6 +283,7 @@ void Transitions(benchmark::State& state) {
     state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
     state.counters["newton_per_step"] = newton / static_cast<double>(steps);
     state.counters["smooth_per_step"] = smoothing / static_cast<double>(steps);
+    state.counters["continued_steps"] = static_cast<double>(continued);  // steps that needed the continuation
     state.counters["fell_back_steps"] = static_cast<double>(tresca);  // answers of the Tresca fixed point (or the dense solver)
     state.counters["worst_step_s"] = worst_step;
 }
@@ -289,6 +291,7 @@ BENCHMARK(Transitions)
     ->ArgNames({"el", "graduated", "transition", "ms"})
     ->Args({100, 1, 0, 100})->Args({100, 1, 1, 100})
     ->Args({100, 0, 0, 300})->Args({100, 0, 1, 300})
+    ->Args({100, 1, 4, 100})->Args({100, 0, 4, 300})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -109,6 +109,8 @@ struct SolveResult {
                                ///< solve of a set of modes: a factorisation, an update or a cached one)
     int smoothing_iterations = 0;  ///< sparse path: iterations of the smoothing Newton method (each one sparse LU
                                    ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
+    int continuation_steps = 0;  ///< sparse path: sub-steps of the continuation on the offsets (transitions no
+                                 ///< Newton method settles from the step's start)
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not
 };
@@ -168,7 +170,9 @@ struct SparseContactProblem {
 /// that stalls, by a smoothing Newton method (the natural map with every max(0, .)
 /// smoothed, the smoothing driven to zero with the residual; one sparse LU of its
 /// Jacobian per iteration, SolveResult::smoothing_iterations; its modes are confirmed the
-/// same way). If all that fails, a problem of at most 4000 rows is
+/// same way), and if that stalls too, by a continuation on the offsets d from the step's start
+/// (the start's forces solve the problem with offsets d0; d0 -> d in sub-steps, each solved
+/// from the last by the passes or the semismooth method; SolveResult::continuation_steps). If all that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message.
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
@@ -183,11 +187,12 @@ struct SparseContactProblem {
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class TransitionMethod {
     newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
-                 ///< Newton method; if that fails, the Tresca fixed point (default)
+                 ///< Newton method; then the continuation on the offsets; then the Tresca fixed point (default)
     semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
                  ///< smoothing method (kept for comparison, BENCHMARKS.md)
     smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
     tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
+    continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
 };
 
 struct SparsePathTuning {
