@@ -165,7 +165,9 @@ struct SparseContactProblem {
 /// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
 /// both paths reach the same solution. Before the Tresca fixed point, a transition is
 /// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
-/// pairs change mode per iteration, one linear solve of a set of modes each; its final
+/// pairs change mode per iteration, one linear solve of a set of modes each; it starts from
+/// the last answer extrapolated linearly from the two before, when the warm start p is this
+/// solver's last answer, so a solve's answer may depend on the solves before it; its final
 /// modes are confirmed by the active-set passes, SolveResult::newton_iterations), and if
 /// that stalls, by a smoothing Newton method (the natural map with every max(0, .)
 /// smoothed, the smoothing driven to zero with the residual; one sparse LU of its
