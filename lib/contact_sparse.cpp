@@ -1404,9 +1404,9 @@ struct SparseContactSolver::Impl {
     /// the semismooth Newton method from the solution at a; h doubles after a success and
     /// halves after a failure. The answer at a = 1 solves the step's own problem (the same
     /// passes confirm it), so continuation changes the way, not the result.
-    /// Measured (BENCHMARKS.md): on 10 identical leaves x 100 elements it settles every
-    /// transition both Newton methods gave up on, in 2-6 sub-steps, where the Tresca fixed
-    /// point had cost up to 3,621 factorisations. It does not help where the step starts
+    /// Measured (BENCHMARKS.md): on 10 identical leaves x 100 elements it settled every
+    /// transition both Newton methods gave up on (5 of 300 steps), in 2-4 sub-steps each,
+    /// where the Tresca fixed point had cost up to 3,621 factorisations. It does not help where the step starts
     /// from rest with every pair at zero force and zero gap (10 identical leaves x 400): the
     /// problem is then positively homogeneous in a but for the clamps' preload, so the
     /// first sub-step is as hard as the whole step however short.
@@ -1536,11 +1536,12 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
         // 2a. A transition the passes do not settle: the semismooth Newton method on the
         //     natural map from the previous step's forces, extrapolated (p_newton; for the
-        //     first step: the stepper's start), then the active-set passes from its modes (one pass, normally: they
-        //     re-solve its last set of modes and find no violation, so the answer is the exact
-        //     solver's linear solution of those modes). If it fails, the smoothing Newton
-        //     method from the same start, then the passes from its modes; if that fails, the
-        //     continuation on the offsets (continuation()).
+        //     first step: the stepper's start), then the active-set passes from its modes
+        //     (one pass, normally: they re-solve its last set of modes and find no violation,
+        //     so the answer is the exact solver's linear solution of those modes). If it
+        //     fails, the smoothing Newton method from its best iterate (then from the step's
+        //     start), then the passes from its modes; if that fails too, the continuation on
+        //     the offsets (continuation()).
         const TransitionMethod tm = im.tuning.transition;
         if (!r.converged && tm != TransitionMethod::tresca && (m >= im.tuning.newton_min_rows || im.tuning.newton_first)) {
             const Eigen::VectorXd p_passes = p;
@@ -1562,7 +1563,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
                 if (im.smoothing_newton(problem.d, p, z, r))
                     r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
             }
-            // then the continuation on the offsets from the step's start (2-6 sub-steps where the
+            // then the continuation on the offsets from the step's start (2-4 sub-steps where the
             // Newton methods stall from it, measured on 10 identical leaves x 100 elements)
             if (!r.converged && (tm == TransitionMethod::newton || tm == TransitionMethod::continuation)) {
                 p = p_start;
