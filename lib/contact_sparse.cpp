@@ -446,9 +446,13 @@ struct SparseContactSolver::Impl {
     }
 
     /// s = G z - d for z = K^-1 (b + G^T p).
+    Eigen::VectorXd positions(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& p,
+                              Eigen::VectorXd& z) {
+        z = k_llt.solve(b + Gt * p);
+        return Grow * z - d;
+    }
     Eigen::VectorXd positions_of(const SparseContactProblem& pr, const Eigen::VectorXd& p, Eigen::VectorXd& z) {
-        z = k_llt.solve(pr.b + G.transpose() * p);
-        return G * z - pr.d;
+        return positions(pr.b, pr.d, p, z);
     }
 
     /// Solves the linear problem of the current modes for load b and offsets d into p and
@@ -1422,8 +1426,7 @@ struct SparseContactSolver::Impl {
                 p[c.row_t] = std::clamp(p[c.row_t], -limit, limit);
             }
         }
-        z = k_llt.solve(b + Gt * p);
-        Eigen::VectorXd sc = Grow * z - d;
+        Eigen::VectorXd sc = positions(b, d, p, z);
         for (int k = 0; k < np; ++k) {
             const ContactPair& c = laws.pairs[k];
             if (c.row_n >= 0)
@@ -1522,21 +1525,13 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     im.updates = 0;
     bool singular = false;
     const Eigen::VectorXd p_start = p;
-    // the semismooth Newton method's start: the previous step's forces extrapolated linearly
-    // from the two solves before, when the warm start is the last solve's answer (measured,
-    // 10 x 100 friction: 14.4 -> 9.5 Newton iterations per step on the graduated spring,
-    // 14.2 -> 11.1 on identical leaves, BENCHMARKS.md); the passes keep the previous modes
-    // (modes read from the extrapolation cost more: 27.7 iterations per step)
-    Eigen::VectorXd p_newton = p_start;
-    if (im.previous_p.size() == m && im.last_p.size() == m && p == im.last_p)
-        p_newton = 2.0 * im.last_p - im.previous_p;
     try {
         // 1. From the previous step's modes: most steps end here in one pass.
         if (!im.tuning.newton_first)
             r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
         // 2a. A transition the passes do not settle: the semismooth Newton method on the
-        //     natural map from the previous step's forces, extrapolated (p_newton; for the
-        //     first step: the stepper's start), then the active-set passes from its modes
+        //     natural map from the previous step's forces, extrapolated (for the first
+        //     step: the stepper's start), then the active-set passes from its modes
         //     (one pass, normally: they re-solve its last set of modes and find no violation,
         //     so the answer is the exact solver's linear solution of those modes). If it
         //     fails, the smoothing Newton method from its best iterate (then from the step's
@@ -1547,7 +1542,14 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             const Eigen::VectorXd p_passes = p;
             const std::vector<signed char> nmode_passes = im.modes.nmode, tmode_passes = im.modes.tmode;
             if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
-                p = p_newton;
+                // the start: the previous step's forces extrapolated linearly from the two solves
+                // before, when the warm start is the last solve's answer (measured, 10 x 100
+                // friction: 14.4 -> 9.5 Newton iterations per step on the graduated spring, 14.2 ->
+                // 11.1 on identical leaves, BENCHMARKS.md); the passes above keep the previous
+                // modes (modes read from the extrapolation cost more: 27.7 iterations per step)
+                const bool extrapolate =
+                    im.previous_p.size() == m && im.last_p.size() == m && p_start == im.last_p;
+                p = extrapolate ? Eigen::VectorXd(2.0 * im.last_p - im.previous_p) : p_start;
                 im.s = im.positions_of(problem, p, z);
                 if (im.semismooth_newton(problem.b, problem.d, p, z, r))
                     r.converged = im.passes(problem.b, problem.d, p, z, im.options.max_active_set_iterations, r);
