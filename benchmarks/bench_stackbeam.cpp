@@ -247,7 +247,9 @@ ModelSpec graduated_stack(int elements, int leaves) {
 /// The sparse path's transition methods on friction runs of 10 leaves (closed-form mode,
 /// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
 /// transition (0 newton: semismooth, smoothing, then continuation; 1 semismooth only; 3 Tresca
-/// only; 4 continuation only: TransitionMethod's values), simulated time in ms.
+/// only: box QPs by pivoting, then the interior-point method where pivoting does not settle;
+/// 4 continuation only: TransitionMethod's values), simulated time in ms, box QP method of the
+/// Tresca fixed point (BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only).
 void Transitions(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : stack(PaperCase::friction, elements, 10);
@@ -262,6 +264,7 @@ void Transitions(benchmark::State& state) {
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
         so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
+        so.sparse_tuning.box_qp = static_cast<BoxQpMethod>(state.range(4));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = smoothing = worst_step = 0.0;
@@ -288,10 +291,11 @@ void Transitions(benchmark::State& state) {
     state.counters["worst_step_s"] = worst_step;
 }
 BENCHMARK(Transitions)
-    ->ArgNames({"el", "graduated", "transition", "ms"})
-    ->Args({100, 1, 0, 100})->Args({100, 1, 1, 100})
-    ->Args({100, 0, 0, 300})->Args({100, 0, 1, 300})
-    ->Args({100, 1, 4, 100})->Args({100, 0, 4, 300})
+    ->ArgNames({"el", "graduated", "transition", "ms", "box"})
+    ->Args({100, 1, 0, 100, 0})->Args({100, 1, 1, 100, 0})
+    ->Args({100, 0, 0, 300, 0})->Args({100, 0, 1, 300, 0})
+    ->Args({100, 1, 4, 100, 0})->Args({100, 0, 4, 300, 0})
+    ->Args({100, 1, 3, 5, 0})->Args({100, 1, 3, 5, 2})->Args({100, 0, 3, 20, 0})->Args({100, 0, 3, 20, 2})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -44,8 +44,12 @@
 //    max_active_set_iterations passes, a Tresca fixed point (friction limits frozen: a
 //    box-constrained convex QP) whose working set gives the modes of a final Coulomb
 //    solve. The box QP is solved by block principal pivoting (a few factorisations)
-//    and, if that stalls, by the dense solver's monotone primal active-set method (one
-//    working-set change per iteration, cannot cycle), each step a sparse solve.
+//    and, if that stalls (50 passes), by a primal-dual interior-point method (box_qp_ipm:
+//    Mehrotra's predictor-corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration,
+//    15-45 iterations on every box QP measured, however degenerate; its working set is read
+//    from the iterate and its bounded forces put on their bounds), and if that fails, by the
+//    dense solver's monotone primal active-set method (one working-set change per iteration,
+//    cannot cycle), each step a sparse solve.
 //    Before that Tresca fixed point (SparsePathTuning::transition = newton, the default):
 //    a semismooth Newton method on the natural map of the contact laws (paper eq. 8; the
 //    natural map is zero exactly where eq. 10's error vector is), semismooth_newton: each
@@ -162,6 +166,11 @@ constexpr double kContinuationMinStep = 1.0 / 256;  // smallest continuation sub
 constexpr int kSmoothStall = 15;  // iterations without a 10 % fall of the natural residual
 // cached columns K^-1 g_i^T: at most this many doubles (80 MB)
 constexpr double kColumnCacheDoubles = 1e7;
+// interior-point method on the box QP (Impl::box_qp_ipm): iteration limit; proximal Sigma of
+// rows without bounds and floor of every Sigma, as a fraction of W_ii (the Newton systems stay
+// within ~1e8 of K's conditioning; s is recomputed exactly, so this only slows convergence)
+constexpr int kIpmIterations = 100;
+constexpr double kIpmRegularisation = 1e-8;
 constexpr double kAccept = 1e-3;    // as in the dense solver: threshold kAccept x tolerance
 
 /// diag(G K^-1 G^T) [m/N], the compliance of each contact row alone (it scales force
@@ -392,6 +401,11 @@ struct SparseContactSolver::Impl {
     // the solutions of the last two solves (the semismooth Newton method's start is their
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
+    // interior-point method on the box QP (box_qp_ipm): LDL^T of K + G^T Sigma^-1 G, its
+    // ordering made once per (K, G)
+    Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ipm_ldlt;
+    bool ipm_analysed = false;
+    Eigen::Index ipm_nnz = 0;
 
     void reset_structure(const SparseContactProblem& pr) {
         pr.validate();
@@ -401,6 +415,7 @@ struct SparseContactSolver::Impl {
         G.makeCompressed();
         k_llt.compute(K);
         if (k_llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
+        ipm_analysed = false;
         const int m = pr.size();
         diag = selected_compliance_diagonal(K, G, k_llt);
         g_norm_inf = 0.0;
@@ -951,6 +966,207 @@ struct SparseContactSolver::Impl {
             [&](const Eigen::VectorXd& x) { return count_violations(d, x, z); });
     }
 
+    /// The box QP of box_qp_bpp by a primal-dual interior-point method (Mehrotra's
+    /// predictor-corrector): its iteration count hardly depends on how many bounds change
+    /// or how degenerate they are (pairs with force and gap both ~0), where block principal
+    /// pivoting and the primal method may need one factorisation per working-set change.
+    ///   min 1/2 x^T W x + q^T x,  lower <= x <= upper,  W = G K^-1 G^T, q = G K^-1 b - d;
+    /// the gradient is s = W x + q = G z - d [m], z = K^-1 (b + G^T x). KKT conditions with
+    /// multipliers yl, yu >= 0 [m] and gaps gl = x - lower, gu = upper - x [N]:
+    ///   s - yl + yu = 0,   gl yl = 0,   gu yu = 0.
+    /// Each iteration solves the Newton system (W + Sigma) dx = h, Sigma = yl / gl + yu / gu
+    /// [m/N], without W:  (K + G^T Sigma^-1 G) dz = G^T Sigma^-1 h,  dx = Sigma^-1 (h - G dz)
+    /// (one sparse LDL^T of the same pattern each iteration; the predictor and corrector
+    /// share it). s is recomputed exactly from z at every iterate, so the Newton systems'
+    /// round-off (Sigma spans many decades near the end) only slows it, never biases it.
+    /// Rows without bounds (bilateral) carry a proximal Sigma = kIpmRegularisation x W_ii.
+    /// End: the working set read from the iterate (at a bound where the multiplier exceeds
+    /// the gap, both in metres), the bounded variables put exactly on their bounds, z and s
+    /// recomputed, and the box QP's natural residual (in metres, as box_qp_bpp's test) below
+    /// `tolerance` in every row: the answer is then the QP's to the same test as the
+    /// pivoting methods'. Returns false after kIpmIterations or on a failed factorisation.
+    bool box_qp_ipm(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& lower,
+                    const Eigen::VectorXd& upper, Eigen::VectorXd& x, Eigen::VectorXd& z,
+                    std::vector<signed char>& at_bound, double tolerance, SolveResult& r) {
+        const int m = static_cast<int>(x.size());
+        std::vector<signed char> kind(m);  // 0 free, 1 lower only, 2 upper only, 3 both, 4 fixed
+        double fscale = 0.0;               // force scale [N]
+        for (int i = 0; i < m; ++i) {
+            const bool hl = std::isfinite(lower[i]), hu = std::isfinite(upper[i]);
+            kind[i] = hl && hu ? (lower[i] == upper[i] ? 4 : 3) : hl ? 1 : hu ? 2 : 0;
+            if (hl) fscale = std::max(fscale, std::abs(lower[i]));
+            if (hu) fscale = std::max(fscale, std::abs(upper[i]));
+            fscale = std::max(fscale, std::abs(x[i]));
+        }
+        if (!(fscale > 0.0)) fscale = 1.0;
+        // start: x strictly inside its box, multipliers from s at that x (at least a floor)
+        for (int i = 0; i < m; ++i) {
+            switch (kind[i]) {
+                case 4: x[i] = lower[i]; break;
+                case 3: {
+                    const double w = upper[i] - lower[i];
+                    x[i] = std::clamp(x[i], lower[i] + 0.1 * w, upper[i] - 0.1 * w);
+                    break;
+                }
+                case 1: x[i] = std::max(x[i], lower[i] + 1e-2 * fscale); break;
+                case 2: x[i] = std::min(x[i], upper[i] - 1e-2 * fscale); break;
+                default: break;
+            }
+        }
+        Eigen::VectorXd sx = positions(b, d, x, z);
+        const double yfloor = std::max(1e-2 * sx.lpNorm<Eigen::Infinity>(), tolerance);
+        Eigen::VectorXd yl = Eigen::VectorXd::Zero(m), yu = Eigen::VectorXd::Zero(m);
+        for (int i = 0; i < m; ++i) {
+            if (kind[i] == 1 || kind[i] == 3) yl[i] = std::max(sx[i], yfloor);
+            if (kind[i] == 2 || kind[i] == 3) yu[i] = std::max(-sx[i], yfloor);
+        }
+        // the gaps are iterated themselves (not x - bound: that cancels to 0 or below near a bound)
+        Eigen::VectorXd gl = Eigen::VectorXd::Zero(m), gu = Eigen::VectorXd::Zero(m);
+        for (int i = 0; i < m; ++i) {
+            if (kind[i] == 1 || kind[i] == 3) gl[i] = x[i] - lower[i];
+            if (kind[i] == 2 || kind[i] == 3) gu[i] = upper[i] - x[i];
+        }
+        auto gap_l = [&](int i) { return gl[i]; };
+        auto gap_u = [&](int i) { return gu[i]; };
+        auto bounded = [&](int i, bool up) { return up ? (kind[i] == 2 || kind[i] == 3) : (kind[i] == 1 || kind[i] == 3); };
+        Eigen::VectorXd rd(m), sig(m), winv(m), h(m), dx(m), dyl(m), dyu(m), dxa(m), dyla(m), dyua(m), zc;
+        // the Newton system on the stiffness's pattern plus G^T G (every row, so the pattern
+        // stays and its ordering is made once per call)
+        auto newton = [&](const Eigen::VectorXd& hh, Eigen::VectorXd& ddx) {
+            ddx = winv.cwiseProduct(hh - Grow * ipm_ldlt.solve(Gt * winv.cwiseProduct(hh)));
+        };
+        // largest step keeping the gaps and multipliers positive (fraction to the boundary)
+        auto max_step = [&](const Eigen::VectorXd& ddx, const Eigen::VectorXd& ddl, const Eigen::VectorXd& ddu) {
+            double a = 1.0;
+            for (int i = 0; i < m; ++i) {
+                if (bounded(i, false)) {
+                    if (ddx[i] < 0.0) a = std::min(a, -gap_l(i) / ddx[i]);
+                    if (ddl[i] < 0.0) a = std::min(a, -yl[i] / ddl[i]);
+                }
+                if (bounded(i, true)) {
+                    if (ddx[i] > 0.0) a = std::min(a, gap_u(i) / ddx[i]);
+                    if (ddu[i] < 0.0) a = std::min(a, -yu[i] / ddu[i]);
+                }
+            }
+            return a;
+        };
+        // the multipliers' changes for a given dx and complementarity targets rl, ru
+        auto multipliers = [&](const Eigen::VectorXd& ddx, const Eigen::VectorXd& rl, const Eigen::VectorXd& ru,
+                               Eigen::VectorXd& ddl, Eigen::VectorXd& ddu) {
+            ddl.setZero(m);
+            ddu.setZero(m);
+            for (int i = 0; i < m; ++i) {
+                if (bounded(i, false)) ddl[i] = (rl[i] - yl[i] * ddx[i]) / gap_l(i);
+                if (bounded(i, true)) ddu[i] = (ru[i] + yu[i] * ddx[i]) / gap_u(i);
+            }
+        };
+        Eigen::VectorXd rl(m), ru(m);
+        for (int it = 0; it < kIpmIterations; ++it) {
+            // residuals: stationarity [m], complementarity [m^2] (gap x W_ii x multiplier)
+            rd = sx - yl + yu;
+            double comp = 0.0, comp_max = 0.0, rd_max = 0.0;
+            int nb = 0;
+            for (int i = 0; i < m; ++i) {
+                if (kind[i] == 4) {
+                    rd[i] = 0.0;
+                    continue;
+                }
+                rd_max = std::max(rd_max, std::abs(rd[i]));
+                if (bounded(i, false)) {
+                    comp += gap_l(i) * yl[i];
+                    comp_max = std::max(comp_max, gap_l(i) * yl[i] * diag[i]);
+                    ++nb;
+                }
+                if (bounded(i, true)) {
+                    comp += gap_u(i) * yu[i];
+                    comp_max = std::max(comp_max, gap_u(i) * yu[i] * diag[i]);
+                    ++nb;
+                }
+            }
+            // close enough to try the working set it points at (each row's error ~ sqrt(gap W y))
+            if (rd_max < 0.1 * tolerance && comp_max < 1e-2 * tolerance * tolerance) {
+                at_bound.assign(m, 0);
+                Eigen::VectorXd xs = x;
+                for (int i = 0; i < m; ++i) {
+                    if (kind[i] == 4) at_bound[i] = +1;
+                    else if (bounded(i, false) && yl[i] > diag[i] * gap_l(i)) at_bound[i] = -1;
+                    else if (bounded(i, true) && yu[i] > diag[i] * gap_u(i)) at_bound[i] = +1;
+                    if (at_bound[i] != 0) xs[i] = at_bound[i] < 0 ? lower[i] : upper[i];
+                }
+                const Eigen::VectorXd ss = positions(b, d, xs, zc);
+                double worst = 0.0;
+                for (int i = 0; i < m; ++i) {
+                    double v = 0.0;
+                    if (at_bound[i] == 0) v = std::max({std::abs(ss[i]), (lower[i] - xs[i]) * diag[i], (xs[i] - upper[i]) * diag[i]});
+                    else if (lower[i] < upper[i]) v = at_bound[i] < 0 ? -ss[i] : ss[i];
+                    worst = std::max(worst, v);
+                }
+                if (worst <= tolerance && xs.allFinite()) {
+                    x = xs;
+                    z = zc;
+                    return true;
+                }
+            }
+            ++r.iterations;
+            ++r.factorizations;
+            const double mu = nb > 0 ? comp / nb : 0.0;
+            for (int i = 0; i < m; ++i) {
+                double si = 0.0;
+                if (bounded(i, false)) si += yl[i] / gap_l(i);
+                if (bounded(i, true)) si += yu[i] / gap_u(i);
+                if (kind[i] == 0) si = kIpmRegularisation * diag[i];
+                winv[i] = kind[i] == 4 ? 0.0 : 1.0 / std::max(si, kIpmRegularisation * diag[i]);
+            }
+            SpMat M = K + SpMat(Gt * winv.asDiagonal() * Grow);
+            if (!ipm_analysed || M.nonZeros() != ipm_nnz) {
+                ipm_ldlt.analyzePattern(M);
+                ipm_analysed = true;
+                ipm_nnz = M.nonZeros();
+            }
+            ipm_ldlt.factorize(M);
+            if (ipm_ldlt.info() != Eigen::Success) return false;
+            // predictor (affine scaling: complementarity targets 0)
+            for (int i = 0; i < m; ++i) {
+                rl[i] = bounded(i, false) ? -gap_l(i) * yl[i] : 0.0;
+                ru[i] = bounded(i, true) ? -gap_u(i) * yu[i] : 0.0;
+                h[i] = kind[i] == 4 ? 0.0 : -rd[i] + (bounded(i, false) ? rl[i] / gap_l(i) : 0.0) -
+                                                (bounded(i, true) ? ru[i] / gap_u(i) : 0.0);
+            }
+            newton(h, dxa);
+            multipliers(dxa, rl, ru, dyla, dyua);
+            const double aa = max_step(dxa, dyla, dyua);
+            double comp_aff = 0.0;
+            for (int i = 0; i < m; ++i) {
+                if (bounded(i, false)) comp_aff += (gap_l(i) + aa * dxa[i]) * (yl[i] + aa * dyla[i]);
+                if (bounded(i, true)) comp_aff += (gap_u(i) - aa * dxa[i]) * (yu[i] + aa * dyua[i]);
+            }
+            const double mu_aff = nb > 0 ? comp_aff / nb : 0.0;
+            const double sigma = mu > 0.0 ? std::pow(std::clamp(mu_aff / mu, 0.0, 1.0), 3) : 0.0;
+            // corrector: centring sigma mu and the predictor's second-order term
+            for (int i = 0; i < m; ++i) {
+                rl[i] = bounded(i, false) ? sigma * mu - gap_l(i) * yl[i] - dxa[i] * dyla[i] : 0.0;
+                ru[i] = bounded(i, true) ? sigma * mu - gap_u(i) * yu[i] + dxa[i] * dyua[i] : 0.0;
+                h[i] = kind[i] == 4 ? 0.0 : -rd[i] + (bounded(i, false) ? rl[i] / gap_l(i) : 0.0) -
+                                                (bounded(i, true) ? ru[i] / gap_u(i) : 0.0);
+            }
+            newton(h, dx);
+            multipliers(dx, rl, ru, dyl, dyu);
+            const double a = std::min(1.0, 0.995 * max_step(dx, dyl, dyu));
+            if (!(a > 0.0) || !dx.allFinite()) return false;
+            x += a * dx;
+            gl += a * dx;
+            gu -= a * dx;
+            yl += a * dyl;
+            yu += a * dyu;
+            for (int i = 0; i < m; ++i) {  // keep strictly inside (round-off of the step)
+                if (bounded(i, false)) yl[i] = std::max(yl[i], 0.0);
+                if (bounded(i, true)) yu[i] = std::max(yu[i], 0.0);
+            }
+            sx = positions(b, d, x, z);
+        }
+        return false;
+    }
+
     /// The same box-constrained QP by block principal pivoting (Judice & Pires): every
     /// violated bound or multiplier switches at once while their number falls, then
     /// Murty's least-index rule (finite: the QP's matrix W is symmetric positive definite).
@@ -1020,13 +1236,29 @@ struct SparseContactSolver::Impl {
         const bool settled = detail::tresca_fixed_point(
             modes, laws, n, p, accept, kTrescaIterations,
             [&](const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<signed char>& at_bound) {
-                // block principal pivoting first (few factorisations); the monotone primal method
-                // (one factorisation per working-set change, cannot cycle) if it does not settle
+                // block principal pivoting first (few factorisations where it settles: the
+                // small problems); if it does not settle in kBoxPasses passes, the interior-point
+                // method (15-45 iterations on every box QP measured, however degenerate; 10
+                // identical leaves x 100 from rest: 34 instead of 50 factorisations per step with
+                // the Tresca fixed point alone, BENCHMARKS.md); the
+                // monotone primal method (one factorisation per working-set change, cannot cycle)
+                // if neither does
                 const std::vector<signed char> start = at_bound;
                 const Eigen::VectorXd p_start = p;
+                auto restart = [&] {
+                    at_bound = start;
+                    p = p_start;
+                };
+                if (tuning.box_qp == BoxQpMethod::interior_point) {
+                    if (box_qp_ipm(b, d, lower, upper, p, z, at_bound, accept, r)) return true;
+                    restart();
+                }
                 if (box_qp_bpp(b, d, lower, upper, p, z, at_bound, accept, kBoxPasses, r)) return true;
-                at_bound = start;
-                p = p_start;
+                restart();
+                if (tuning.box_qp == BoxQpMethod::pivoting) {
+                    if (box_qp_ipm(b, d, lower, upper, p, z, at_bound, accept, r)) return true;
+                    restart();
+                }
                 return box_qp(b, d, lower, upper, p, z, at_bound, accept, 50 * (n + 1), r);
             },
             [&](int row) { return diag[row]; },

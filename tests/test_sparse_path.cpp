@@ -400,6 +400,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
                          TransitionMethod method = TransitionMethod::newton) {
     const bool smoothing = method == TransitionMethod::smoothing;
     const bool continuation = method == TransitionMethod::continuation;
+    const bool tresca = method == TransitionMethod::tresca;  // with the interior-point method on every box QP
     const System sys(Model::build(spec));
     SimulationOptions so;
     so.solver.tolerance_m = kTol;
@@ -413,6 +414,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
     SparsePathTuning tuning;
     tuning.newton_first = true;
     tuning.transition = method;
+    if (tresca) tuning.box_qp = BoxQpMethod::interior_point;
     SparseContactSolver newton(so.solver, tuning);
     const auto dense_solver = make_solver(so.solver);
     Eigen::VectorXd pn = Eigen::VectorXd::Zero(problems.front().size()), pd = pn, z;
@@ -422,7 +424,10 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
         const SolveResult rn = newton.solve(pr, pn, z);
         BOOST_TEST(rn.converged);
         BOOST_TEST(!rn.fell_back);  // the Newton method's answer, not the Tresca fixed point's or the dense one's
-        const int its = smoothing ? rn.smoothing_iterations : continuation ? rn.continuation_steps : rn.newton_iterations;
+        const int its = smoothing      ? rn.smoothing_iterations
+                        : continuation ? rn.continuation_steps
+                        : tresca       ? rn.iterations  // interior-point iterations and passes
+                                       : rn.newton_iterations;
         newton_iterations += its;
         factorizations += rn.factorizations;
         if (its > 0) ++transitions;
@@ -435,7 +440,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
         worst_natural = std::max(worst_natural, natural_map(dense, pn, s).norm());
         BOOST_TEST(error_vector(dense, pn, s).norm() < kTol);  // eq. 10: v = 0 to the tolerance
     }
-    BOOST_TEST_MESSAGE((smoothing ? "smoothing Newton: " : continuation ? "continuation: " : "semismooth Newton: ")
+    BOOST_TEST_MESSAGE((smoothing ? "smoothing Newton: " : continuation ? "continuation: " : tresca ? "interior-point Tresca: " : "semismooth Newton: ")
                        << newton_iterations << (continuation ? " sub-steps in " : " iterations in ") << transitions
                                              << " solves that needed it, " << factorizations
                                              << " factorisations; max force difference to the dense exact solver "
@@ -500,6 +505,25 @@ BOOST_AUTO_TEST_CASE(continuation_equals_dense_exact_on_a_finer_friction_stack) 
     PaperExampleOptions o;
     o.elements_per_half_leaf = 160;
     newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::continuation);
+}
+
+BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_the_paper_friction_case) {
+    // The Tresca fixed point alone (TransitionMethod::tresca, from the warm start at every
+    // step) with every box QP solved by the interior-point method (BoxQpMethod::interior_point): its
+    // working set, read from the iterate, gives the modes, and the passes then solve those
+    // modes exactly, so the answer is again the linear solution of the dense solver's modes
+    // (a wrong working set would show as a different mode: >= 1e-6): the round-off bound of
+    // the Newton methods' tests, 1e-9 relative (kRel).
+    newton_equals_dense(paper_example(PaperCase::friction), 300, kRel, TransitionMethod::tresca);
+}
+
+BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_a_finer_friction_stack) {
+    // 3 x 160 from rest, 20 steps (the degenerate transition: pairs with force and gap both
+    // ~0, where pivoting changes few rows per factorisation), interior-point box QPs;
+    // tolerance as for the Newton methods on this stack (cond(W) ~ 64x the example's).
+    PaperExampleOptions o;
+    o.elements_per_half_leaf = 160;
+    newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::tresca);
 }
 
 BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {

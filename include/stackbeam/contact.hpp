@@ -161,7 +161,8 @@ struct SparseContactProblem {
 /// LU once per set of modes and reused while the modes stay (few held rows: the dense
 /// Schur complement on K's Cholesky factor instead; near the last LU's held set: a
 /// low-rank update of it; see SparsePathTuning). The mode switching and the
-/// handling of transitions (Tresca fixed point on a box QP, then the coupled Coulomb
+/// handling of transitions (Tresca fixed point on a box QP, solved by block principal
+/// pivoting and, where that does not settle, by an interior-point method; then the coupled Coulomb
 /// problem) are those of the exact solver (the same mode code, lib/active_set.hpp), so
 /// both paths reach the same solution. Before the Tresca fixed point, a transition is
 /// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
@@ -197,6 +198,19 @@ enum class TransitionMethod {
     continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
 };
 
+/// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
+/// limits frozen): min 1/2 p^T W p + q^T p over lower <= p <= upper, with W = G K^-1 G^T
+/// never formed.
+enum class BoxQpMethod {
+    pivoting,        ///< block principal pivoting (a few sparse solves where it settles); where it does not
+                     ///< settle in 50 passes, a primal-dual interior-point method (Mehrotra's predictor-
+                     ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
+                     ///< read from the iterate); then the monotone primal active-set method (default)
+    interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
+    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
+                     ///< (kept for comparison, BENCHMARKS.md)
+};
+
 struct SparsePathTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
@@ -210,6 +224,9 @@ struct SparsePathTuning {
     /// Tests: every solve starts with the semismooth Newton method from the warm start (no
     /// active-set passes from the previous modes first), so its answers can be checked alone.
     bool newton_first = false;
+    /// How the Tresca fixed point's box QPs are solved (all end at the same working-set test,
+    /// so their answers agree to round-off).
+    BoxQpMethod box_qp = BoxQpMethod::pivoting;
 };
 
 class SparseContactSolver {
