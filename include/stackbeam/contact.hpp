@@ -98,11 +98,13 @@ struct SolverOptions {
 struct SolveResult {
     bool converged = false;
     int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact; sparse path:
-                               ///< also the semismooth Newton iterations, counted in newton_iterations too)
+                               ///< also the semismooth Newton iterations, counted in newton_iterations too,
+                               ///< and the box QPs' pivoting passes and interior-point iterations)
     double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
     double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
     int factorizations = 0;    ///< factorisations done in this solve (exact solver; sparse path: sparse LU
-                               ///< of the saddle-point system or dense LU of the held rows' Schur complement)
+                               ///< of the saddle-point system or dense LU of the held rows' Schur complement,
+                               ///< and one sparse LDL^T per interior-point iteration on a box QP)
     int updates = 0;           ///< sparse path: sets of modes solved by a low-rank update of the last
                                ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
     int newton_iterations = 0; ///< sparse path: iterations of the semismooth Newton method (each one linear
