@@ -966,6 +966,18 @@ struct SparseContactSolver::Impl {
             [&](const Eigen::VectorXd& x) { return count_violations(d, x, z); });
     }
 
+    /// The box QP's optimality test of row i in metres, for a working set whose held rows
+    /// (at_bound 0) the solve satisfies exactly (s_i = 0): a held force outside its box
+    /// (times W_ii), or a force at a bound whose gradient s_i pushes it into the box.
+    /// box_qp_bpp stops when no row exceeds its tolerance; box_qp_ipm also checks |s_i| of
+    /// the held rows, which its iterate satisfies only approximately.
+    double box_row_violation(int i, const std::vector<signed char>& at_bound, const Eigen::VectorXd& x,
+                             const Eigen::VectorXd& s, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper) const {
+        if (at_bound[i] == 0) return std::max(lower[i] - x[i], x[i] - upper[i]) * diag[i];
+        if (lower[i] < upper[i]) return at_bound[i] < 0 ? -s[i] : s[i];
+        return 0.0;
+    }
+
     /// The box QP of box_qp_bpp by a primal-dual interior-point method (Mehrotra's
     /// predictor-corrector): its iteration count hardly depends on how many bounds change
     /// or how degenerate they are (pairs with force and gap both ~0), where block principal
@@ -1013,23 +1025,24 @@ struct SparseContactSolver::Impl {
                 default: break;
             }
         }
+        auto bounded = [&](int i, bool up) { return up ? (kind[i] == 2 || kind[i] == 3) : (kind[i] == 1 || kind[i] == 3); };
         Eigen::VectorXd sx = positions(b, d, x, z);
         const double yfloor = std::max(1e-2 * sx.lpNorm<Eigen::Infinity>(), tolerance);
+        // multipliers yl, yu and gaps gl, gu; the gaps are iterated themselves (not x - bound:
+        // that cancels to 0 or below near a bound)
         Eigen::VectorXd yl = Eigen::VectorXd::Zero(m), yu = Eigen::VectorXd::Zero(m);
-        for (int i = 0; i < m; ++i) {
-            if (kind[i] == 1 || kind[i] == 3) yl[i] = std::max(sx[i], yfloor);
-            if (kind[i] == 2 || kind[i] == 3) yu[i] = std::max(-sx[i], yfloor);
-        }
-        // the gaps are iterated themselves (not x - bound: that cancels to 0 or below near a bound)
         Eigen::VectorXd gl = Eigen::VectorXd::Zero(m), gu = Eigen::VectorXd::Zero(m);
         for (int i = 0; i < m; ++i) {
-            if (kind[i] == 1 || kind[i] == 3) gl[i] = x[i] - lower[i];
-            if (kind[i] == 2 || kind[i] == 3) gu[i] = upper[i] - x[i];
+            if (bounded(i, false)) {
+                yl[i] = std::max(sx[i], yfloor);
+                gl[i] = x[i] - lower[i];
+            }
+            if (bounded(i, true)) {
+                yu[i] = std::max(-sx[i], yfloor);
+                gu[i] = upper[i] - x[i];
+            }
         }
-        auto gap_l = [&](int i) { return gl[i]; };
-        auto gap_u = [&](int i) { return gu[i]; };
-        auto bounded = [&](int i, bool up) { return up ? (kind[i] == 2 || kind[i] == 3) : (kind[i] == 1 || kind[i] == 3); };
-        Eigen::VectorXd rd(m), sig(m), winv(m), h(m), dx(m), dyl(m), dyu(m), dxa(m), dyla(m), dyua(m), zc;
+        Eigen::VectorXd rd(m), winv(m), h(m), dx(m), dyl(m), dyu(m), dxa(m), dyla(m), dyua(m), zc;
         // the Newton system on the stiffness's pattern plus G^T G (every row, so the pattern
         // stays and its ordering is made once per call)
         auto newton = [&](const Eigen::VectorXd& hh, Eigen::VectorXd& ddx) {
@@ -1040,11 +1053,11 @@ struct SparseContactSolver::Impl {
             double a = 1.0;
             for (int i = 0; i < m; ++i) {
                 if (bounded(i, false)) {
-                    if (ddx[i] < 0.0) a = std::min(a, -gap_l(i) / ddx[i]);
+                    if (ddx[i] < 0.0) a = std::min(a, -gl[i] / ddx[i]);
                     if (ddl[i] < 0.0) a = std::min(a, -yl[i] / ddl[i]);
                 }
                 if (bounded(i, true)) {
-                    if (ddx[i] > 0.0) a = std::min(a, gap_u(i) / ddx[i]);
+                    if (ddx[i] > 0.0) a = std::min(a, gu[i] / ddx[i]);
                     if (ddu[i] < 0.0) a = std::min(a, -yu[i] / ddu[i]);
                 }
             }
@@ -1056,11 +1069,17 @@ struct SparseContactSolver::Impl {
             ddl.setZero(m);
             ddu.setZero(m);
             for (int i = 0; i < m; ++i) {
-                if (bounded(i, false)) ddl[i] = (rl[i] - yl[i] * ddx[i]) / gap_l(i);
-                if (bounded(i, true)) ddu[i] = (ru[i] + yu[i] * ddx[i]) / gap_u(i);
+                if (bounded(i, false)) ddl[i] = (rl[i] - yl[i] * ddx[i]) / gl[i];
+                if (bounded(i, true)) ddu[i] = (ru[i] + yu[i] * ddx[i]) / gu[i];
             }
         };
         Eigen::VectorXd rl(m), ru(m);
+        // the Newton system's right-hand side h = -rd + rl / gl - ru / gu for complementarity targets rl, ru
+        auto newton_rhs = [&] {
+            for (int i = 0; i < m; ++i)
+                h[i] = kind[i] == 4 ? 0.0 : -rd[i] + (bounded(i, false) ? rl[i] / gl[i] : 0.0) -
+                                                (bounded(i, true) ? ru[i] / gu[i] : 0.0);
+        };
         for (int it = 0; it < kIpmIterations; ++it) {
             // residuals: stationarity [m], complementarity [m^2] (gap x W_ii x multiplier)
             rd = sx - yl + yu;
@@ -1073,13 +1092,13 @@ struct SparseContactSolver::Impl {
                 }
                 rd_max = std::max(rd_max, std::abs(rd[i]));
                 if (bounded(i, false)) {
-                    comp += gap_l(i) * yl[i];
-                    comp_max = std::max(comp_max, gap_l(i) * yl[i] * diag[i]);
+                    comp += gl[i] * yl[i];
+                    comp_max = std::max(comp_max, gl[i] * yl[i] * diag[i]);
                     ++nb;
                 }
                 if (bounded(i, true)) {
-                    comp += gap_u(i) * yu[i];
-                    comp_max = std::max(comp_max, gap_u(i) * yu[i] * diag[i]);
+                    comp += gu[i] * yu[i];
+                    comp_max = std::max(comp_max, gu[i] * yu[i] * diag[i]);
                     ++nb;
                 }
             }
@@ -1089,17 +1108,15 @@ struct SparseContactSolver::Impl {
                 Eigen::VectorXd xs = x;
                 for (int i = 0; i < m; ++i) {
                     if (kind[i] == 4) at_bound[i] = +1;
-                    else if (bounded(i, false) && yl[i] > diag[i] * gap_l(i)) at_bound[i] = -1;
-                    else if (bounded(i, true) && yu[i] > diag[i] * gap_u(i)) at_bound[i] = +1;
+                    else if (bounded(i, false) && yl[i] > diag[i] * gl[i]) at_bound[i] = -1;
+                    else if (bounded(i, true) && yu[i] > diag[i] * gu[i]) at_bound[i] = +1;
                     if (at_bound[i] != 0) xs[i] = at_bound[i] < 0 ? lower[i] : upper[i];
                 }
                 const Eigen::VectorXd ss = positions(b, d, xs, zc);
                 double worst = 0.0;
                 for (int i = 0; i < m; ++i) {
-                    double v = 0.0;
-                    if (at_bound[i] == 0) v = std::max({std::abs(ss[i]), (lower[i] - xs[i]) * diag[i], (xs[i] - upper[i]) * diag[i]});
-                    else if (lower[i] < upper[i]) v = at_bound[i] < 0 ? -ss[i] : ss[i];
-                    worst = std::max(worst, v);
+                    const double v = box_row_violation(i, at_bound, xs, ss, lower, upper);
+                    worst = std::max(worst, at_bound[i] == 0 ? std::max(std::abs(ss[i]), v) : v);
                 }
                 if (worst <= tolerance && xs.allFinite()) {
                     x = xs;
@@ -1112,9 +1129,8 @@ struct SparseContactSolver::Impl {
             const double mu = nb > 0 ? comp / nb : 0.0;
             for (int i = 0; i < m; ++i) {
                 double si = 0.0;
-                if (bounded(i, false)) si += yl[i] / gap_l(i);
-                if (bounded(i, true)) si += yu[i] / gap_u(i);
-                if (kind[i] == 0) si = kIpmRegularisation * diag[i];
+                if (bounded(i, false)) si += yl[i] / gl[i];
+                if (bounded(i, true)) si += yu[i] / gu[i];  // free rows: 0, raised to the proximal floor
                 winv[i] = kind[i] == 4 ? 0.0 : 1.0 / std::max(si, kIpmRegularisation * diag[i]);
             }
             SpMat M = K + SpMat(Gt * winv.asDiagonal() * Grow);
@@ -1127,28 +1143,26 @@ struct SparseContactSolver::Impl {
             if (ipm_ldlt.info() != Eigen::Success) return false;
             // predictor (affine scaling: complementarity targets 0)
             for (int i = 0; i < m; ++i) {
-                rl[i] = bounded(i, false) ? -gap_l(i) * yl[i] : 0.0;
-                ru[i] = bounded(i, true) ? -gap_u(i) * yu[i] : 0.0;
-                h[i] = kind[i] == 4 ? 0.0 : -rd[i] + (bounded(i, false) ? rl[i] / gap_l(i) : 0.0) -
-                                                (bounded(i, true) ? ru[i] / gap_u(i) : 0.0);
+                rl[i] = bounded(i, false) ? -gl[i] * yl[i] : 0.0;
+                ru[i] = bounded(i, true) ? -gu[i] * yu[i] : 0.0;
             }
+            newton_rhs();
             newton(h, dxa);
             multipliers(dxa, rl, ru, dyla, dyua);
             const double aa = max_step(dxa, dyla, dyua);
             double comp_aff = 0.0;
             for (int i = 0; i < m; ++i) {
-                if (bounded(i, false)) comp_aff += (gap_l(i) + aa * dxa[i]) * (yl[i] + aa * dyla[i]);
-                if (bounded(i, true)) comp_aff += (gap_u(i) - aa * dxa[i]) * (yu[i] + aa * dyua[i]);
+                if (bounded(i, false)) comp_aff += (gl[i] + aa * dxa[i]) * (yl[i] + aa * dyla[i]);
+                if (bounded(i, true)) comp_aff += (gu[i] - aa * dxa[i]) * (yu[i] + aa * dyua[i]);
             }
             const double mu_aff = nb > 0 ? comp_aff / nb : 0.0;
             const double sigma = mu > 0.0 ? std::pow(std::clamp(mu_aff / mu, 0.0, 1.0), 3) : 0.0;
             // corrector: centring sigma mu and the predictor's second-order term
             for (int i = 0; i < m; ++i) {
-                rl[i] = bounded(i, false) ? sigma * mu - gap_l(i) * yl[i] - dxa[i] * dyla[i] : 0.0;
-                ru[i] = bounded(i, true) ? sigma * mu - gap_u(i) * yu[i] + dxa[i] * dyua[i] : 0.0;
-                h[i] = kind[i] == 4 ? 0.0 : -rd[i] + (bounded(i, false) ? rl[i] / gap_l(i) : 0.0) -
-                                                (bounded(i, true) ? ru[i] / gap_u(i) : 0.0);
+                rl[i] = bounded(i, false) ? sigma * mu - gl[i] * yl[i] - dxa[i] * dyla[i] : 0.0;
+                ru[i] = bounded(i, true) ? sigma * mu - gu[i] * yu[i] + dxa[i] * dyua[i] : 0.0;
             }
+            newton_rhs();
             newton(h, dx);
             multipliers(dx, rl, ru, dyl, dyu);
             const double a = std::min(1.0, 0.995 * max_step(dx, dyl, dyu));
@@ -1158,7 +1172,7 @@ struct SparseContactSolver::Impl {
             gu -= a * dx;
             yl += a * dyl;
             yu += a * dyu;
-            for (int i = 0; i < m; ++i) {  // keep strictly inside (round-off of the step)
+            for (int i = 0; i < m; ++i) {  // multipliers stay >= 0 (round-off of the step)
                 if (bounded(i, false)) yl[i] = std::max(yl[i], 0.0);
                 if (bounded(i, true)) yu[i] = std::max(yu[i], 0.0);
             }
@@ -1198,12 +1212,8 @@ struct SparseContactSolver::Impl {
             r.factorizations += solve_held(qp, key, b, d, x, z);
             const Eigen::VectorXd sx = Grow * z - d;
             viol.clear();
-            for (int i = 0; i < m; ++i) {
-                double v = 0.0;
-                if (at_bound[i] == 0) v = std::max(lower[i] - x[i], x[i] - upper[i]) * diag[i];
-                else if (lower[i] < upper[i]) v = at_bound[i] < 0 ? -sx[i] : sx[i];
-                if (v > tolerance) viol.push_back(i);
-            }
+            for (int i = 0; i < m; ++i)
+                if (box_row_violation(i, at_bound, x, sx, lower, upper) > tolerance) viol.push_back(i);
             const int nv = static_cast<int>(viol.size());
             if (nv == 0) return true;
             bool single = false;
