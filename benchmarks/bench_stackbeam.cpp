@@ -249,12 +249,14 @@ ModelSpec graduated_stack(int elements, int leaves) {
 /// transition (0 newton: semismooth, smoothing, then continuation; 1 semismooth only; 3 Tresca
 /// only: box QPs by pivoting, then the interior-point method where pivoting does not settle;
 /// 4 continuation only: TransitionMethod's values), simulated time in ms, box QP method of the
-/// Tresca fixed point (BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only).
+/// Tresca fixed point (BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only),
+/// Anderson depth of the fixed point on the friction limits (SolverOptions::tresca_anderson_depth;
+/// 0 the plain fixed point, 8 the default).
 void Transitions(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : stack(PaperCase::friction, elements, 10);
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
-    double total = 0.0, factorizations = 0.0, newton = 0.0, smoothing = 0.0, worst_step = 0.0;
+    double total = 0.0, factorizations = 0.0, newton = 0.0, smoothing = 0.0, passes = 0.0, worst_step = 0.0;
     long steps = 0, tresca = 0, continued = 0;
     int components = 0;
     for (auto _ : state) {
@@ -265,9 +267,10 @@ void Transitions(benchmark::State& state) {
         so.contact_path = ContactPath::sparse;
         so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
         so.sparse_tuning.box_qp = static_cast<BoxQpMethod>(state.range(4));
+        so.solver.tresca_anderson_depth = static_cast<int>(state.range(5));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
-        factorizations = newton = smoothing = worst_step = 0.0;
+        factorizations = newton = smoothing = passes = worst_step = 0.0;
         tresca = continued = 0;
         for (long i = 0; i < steps; ++i) {
             const auto t1 = std::chrono::steady_clock::now();
@@ -275,6 +278,7 @@ void Transitions(benchmark::State& state) {
             worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
             newton += st.last_solve().newton_iterations;
             smoothing += st.last_solve().smoothing_iterations;
+            passes += st.last_solve().tresca_iterations;
             if (st.last_solve().fell_back) ++tresca;
             if (st.last_solve().continuation_steps > 0) ++continued;
         }
@@ -286,16 +290,19 @@ void Transitions(benchmark::State& state) {
     state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
     state.counters["newton_per_step"] = newton / static_cast<double>(steps);
     state.counters["smooth_per_step"] = smoothing / static_cast<double>(steps);
+    state.counters["tresca_per_step"] = passes / static_cast<double>(steps);  // fixed-point passes (box QPs)
     state.counters["continued_steps"] = static_cast<double>(continued);  // steps that needed the continuation
     state.counters["fell_back_steps"] = static_cast<double>(tresca);  // answers of the Tresca fixed point (or the dense solver)
     state.counters["worst_step_s"] = worst_step;
 }
 BENCHMARK(Transitions)
-    ->ArgNames({"el", "graduated", "transition", "ms", "box"})
-    ->Args({100, 1, 0, 100, 0})->Args({100, 1, 1, 100, 0})
-    ->Args({100, 0, 0, 300, 0})->Args({100, 0, 1, 300, 0})
-    ->Args({100, 1, 4, 100, 0})->Args({100, 0, 4, 300, 0})
-    ->Args({100, 1, 3, 5, 0})->Args({100, 1, 3, 5, 2})->Args({100, 0, 3, 20, 0})->Args({100, 0, 3, 20, 2})
+    ->ArgNames({"el", "graduated", "transition", "ms", "box", "depth"})
+    ->Args({100, 1, 0, 100, 0, 8})->Args({100, 1, 1, 100, 0, 8})
+    ->Args({100, 0, 0, 300, 0, 8})->Args({100, 0, 1, 300, 0, 8})
+    ->Args({100, 1, 4, 100, 0, 8})->Args({100, 0, 4, 300, 0, 8})
+    ->Args({100, 1, 3, 5, 0, 8})->Args({100, 1, 3, 5, 2, 8})->Args({100, 0, 3, 20, 0, 8})->Args({100, 0, 3, 20, 2, 8})
+    ->Args({100, 1, 3, 30, 0, 0})->Args({100, 1, 3, 30, 0, 8})->Args({100, 1, 3, 100, 0, 8})
+    ->Args({100, 0, 3, 100, 0, 0})->Args({100, 0, 3, 100, 0, 8})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -119,8 +119,9 @@ private:
         const int n = pr.size();
         const double accept = kAccept * options_.tolerance_m;
         return detail::tresca_fixed_point(
-            modes_, pr, n, p, accept, kTrescaIterations,
+            modes_, pr, n, p, accept, kTrescaIterations, options_.tresca_anderson_depth,
             [&](const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<signed char>& at_bound) {
+                ++r.tresca_iterations;
                 const BoxQpResult b = solve_box_qp(pr.W, pr.q, lower, upper, p, at_bound, accept, 50 * (n + 1));
                 r.iterations += b.iterations;
                 r.factorizations += b.factorizations;
@@ -185,6 +186,9 @@ private:
 }  // namespace
 
 std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& o) {
+    if (o.tresca_anderson_depth < 0 || o.tresca_anderson_depth > 50)
+        throw InputError("solver.tresca_anderson_depth",
+                         "value " + std::to_string(o.tresca_anderson_depth) + " must be in 0..50 (0: no acceleration)");
     if (o.max_active_set_iterations < 1)
         throw InputError("solver.max_active_set_iterations",
                          "value " + std::to_string(o.max_active_set_iterations) + " must be >= 1");

@@ -1244,7 +1244,7 @@ struct SparseContactSolver::Impl {
         const double accept = kAccept * options.tolerance_m;
         bool s_current = false;  // s = G z - d of the final z, made once when needed
         const bool settled = detail::tresca_fixed_point(
-            modes, laws, n, p, accept, kTrescaIterations,
+            modes, laws, n, p, accept, kTrescaIterations, options.tresca_anderson_depth,
             [&](const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<signed char>& at_bound) {
                 // block principal pivoting first (few factorisations where it settles: the
                 // small problems); if it does not settle in kBoxPasses passes, the interior-point
@@ -1253,6 +1253,7 @@ struct SparseContactSolver::Impl {
                 // the Tresca fixed point alone, BENCHMARKS.md); the
                 // monotone primal method (one factorisation per working-set change, cannot cycle)
                 // if neither does
+                ++r.tresca_iterations;
                 const std::vector<signed char> start = at_bound;
                 const Eigen::VectorXd p_start = p;
                 auto restart = [&] {
@@ -1855,6 +1856,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         SolveResult d = make_solver(im.options)->solve(dense, p);
         r.iterations += d.iterations;
         r.factorizations += d.factorizations;
+        r.tresca_iterations += d.tresca_iterations;
         r.fell_back = true;
         r.converged = d.converged;
         if (!d.converged)

@@ -526,6 +526,88 @@ BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_a_finer_frictio
     newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::tresca);
 }
 
+BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
+    // 10 graduated leaves x 100 elements per half leaf (1,080 rows; leaf k shorter by
+    // 8 % of L per leaf, free ends, clamps at 0.2 and 0.3 m: the benchmark's graduated
+    // stack), 25 steps from rest recorded from a default sparse run (semismooth Newton at
+    // the transitions), replayed with the Tresca fixed point alone (TransitionMethod::tresca)
+    // at the default Anderson depth. Without the acceleration (depth 0) its 100 passes do
+    // not settle on steps 19-24 of this replay, and the dense fallback's Gauss-Seidel ends
+    // them just under the tolerance, 2.4 minutes for the 25 steps (measured; too slow for a
+    // test). Checked here:
+    // - every step settles (at most kMaxPasses passes; 13 measured, 10 on step 19, where the
+    //   plain fixed point first stalls; steps 20-24 then settle by the passes alone) and
+    //   satisfies the contact conditions on the dense problem: natural map below the
+    //   tolerance, an independent check of the solver's own report;
+    // - from step 6 on, the forces are the default transition's to round-off (both are the
+    //   linear solution of the same modes; cond(W) ~ elements^2, 1e-7 relative as the finer
+    //   stacks above; a different mode gives >= 1e-6). Steps 0-5 are the transition from
+    //   rest, where this stack's incremental problem has more than one solution: on steps 1
+    //   and 5 both methods end with natural maps ~1e-17 m yet forces 0.7 and 1.9 N apart
+    //   (measured), so there only the contact conditions are checked.
+    constexpr int kMaxPasses = 30;
+    ModelSpec spec = paper_example(PaperCase::friction, PaperExampleOptions{100});
+    while (spec.leaves.size() < 10) {
+        spec.leaves.push_back(spec.leaves.back());
+        spec.interfaces.push_back(spec.interfaces.back());
+    }
+    const double L = spec.leaves[0].length_m;
+    for (std::size_t k = 1; k < spec.leaves.size(); ++k) {
+        auto& leaf = spec.leaves[k];
+        leaf.length_m = L * (1.0 - 0.72 * static_cast<double>(k) / 9.0);
+        leaf.x_start_m = 0.5 * (L - leaf.length_m);
+        leaf.left_support = leaf.right_support = SupportKind::free;
+    }
+    spec.clamps = {{0.2, 1000.0}, {0.3, 1000.0}};
+    const System sys(Model::build(spec));
+    SimulationOptions so;
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper st(sys, so);
+    std::vector<SparseContactProblem> problems;
+    std::vector<Eigen::VectorXd> reference;
+    for (int i = 0; i < 25; ++i) {
+        st.step();
+        problems.push_back(st.last_sparse_problem());
+        reference.push_back(st.contact_forces());
+    }
+    SparsePathTuning tresca;
+    tresca.transition = TransitionMethod::tresca;
+    SparseContactSolver solver(so.solver, tresca);
+    BOOST_TEST(so.solver.tresca_anderson_depth > 0);
+    Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
+    double scale = 0.0, diff = 0.0, worst_natural = 0.0;
+    int passes = 0, most = 0, late = 0;
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+        const SolveResult r = solver.solve(problems[i], p, z);
+        BOOST_TEST(r.converged);
+        passes += r.tresca_iterations;
+        most = std::max(most, r.tresca_iterations);
+        if (r.tresca_iterations == 0) continue;  // the passes from the previous modes settled it
+        const ContactProblem dense = problems[i].to_dense();
+        const Eigen::VectorXd s = dense.W * p + dense.q;
+        worst_natural = std::max(worst_natural, natural_map(dense, p, s).norm());
+        if (i < 6) continue;
+        ++late;
+        BOOST_TEST(!r.fell_back);  // the passes confirmed the fixed point's modes
+        scale = std::max(scale, reference[i].lpNorm<Eigen::Infinity>());
+        diff = std::max(diff, (p - reference[i]).lpNorm<Eigen::Infinity>());
+    }
+    BOOST_TEST_MESSAGE("accelerated Tresca fixed point, graduated 10 x 100: " << passes << " passes in 25 steps (most "
+                                                                             << most << "), worst natural map " << worst_natural
+                                                                             << " m; from step 6 (" << late << " steps) max "
+                                                                             << "force difference to the default transition "
+                                                                             << diff / scale);
+    BOOST_TEST(late > 0);  // the hard steps did reach the fixed point
+    BOOST_TEST(most <= kMaxPasses);
+    BOOST_CHECK_SMALL(worst_natural, so.solver.tolerance_m);
+    BOOST_CHECK_SMALL(diff / scale, 1e-7);
+    SolverOptions bad;
+    bad.tresca_anderson_depth = -1;
+    BOOST_CHECK_THROW(SparseContactSolver(bad, tresca), InputError);
+    bad.tresca_anderson_depth = 51;
+    BOOST_CHECK_THROW(make_solver(bad), InputError);
+}
+
 BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {
     // 10 identical leaves x 20 elements (342 rows), friction, 20 steps from rest: the
     // degenerate transition the semismooth Newton method is for (the default sparse

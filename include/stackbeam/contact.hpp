@@ -92,6 +92,10 @@ struct SolverOptions {
     double alpha_fraction = 0.9;      ///< paper / block_jacobi: alpha as a fraction of the stability bound 2/lambda_max(E W)
     int max_active_set_iterations = 3;    ///< exact solver: active-set passes from the given modes before it
                                           ///< turns to the Tresca fixed point (and again after it)
+    int tresca_anderson_depth = 8;        ///< exact solver (dense and sparse path): Anderson acceleration depth of
+                                          ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
+                                          ///< fixed point (BENCHMARKS.md: 8 is the smallest depth that settles the
+                                          ///< graduated 10 x 400 first step)
 };
 
 /// What a solve reports. A solve that does not converge says so; it never passes silently.
@@ -113,6 +117,8 @@ struct SolveResult {
                                    ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
     int continuation_steps = 0;  ///< sparse path: sub-steps of the continuation on the offsets (transitions no
                                  ///< Newton method settles from the step's start)
+    int tresca_iterations = 0;   ///< exact solver: passes of the Tresca fixed point on the friction limits (box
+                                 ///< QPs solved; SolverOptions::tresca_anderson_depth), where it ran
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
     std::string message;       ///< why it did not converge, when it did not
 };
