@@ -668,6 +668,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.ev_tolerance = ev.tolerance_m;
     s.gap_margin = std::max(kMotionMargin, 10.0 * ev.tolerance_m / s.L_ref);
     ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
+    ev.tresca_anderson_depth = s.opt.solver.tresca_anderson_depth;
     s.ev_solver = make_solver(ev);
 
     // witness slots, as the massless mode

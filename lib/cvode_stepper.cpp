@@ -670,6 +670,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     ev.tolerance_m = 1e-10 * s.L_ref;
     s.ev_tolerance = ev.tolerance_m;
     ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
+    ev.tresca_anderson_depth = s.opt.solver.tresca_anderson_depth;
     s.ev_solver = make_solver(ev);
 
     // Gravity: the static equilibrium under R's weight first (as the closed-form mode):
