@@ -314,8 +314,8 @@ bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::
     Eigen::VectorXd g = tau;
     for (int it = 0; it < max_iterations; ++it) {
         for (int k = 0; k < np; ++k) {
+            if (!limited[k]) continue;
             const auto& c = pr.pairs[k];
-            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
             const double limit = c.friction_coefficient * tau[k];
             lower[c.row_t] = -limit;
             upper[c.row_t] = limit;
@@ -331,13 +331,13 @@ bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::
             mixer.next(scale_m, g, tau);
             continue;
         }
-        tau = g;
-        // modes from the working set; slip forces put at the limit of the final tau
+        // modes from the working set; slip forces put at the limit of the final tau, g
+        // (the normal forces of the last box QP; setting p's tangential rows leaves them)
         for (int k = 0; k < np; ++k) {
             const auto& c = pr.pairs[k];
             if (c.row_n >= 0 && ModeSet::unilateral(c)) modes.nmode[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
-            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-            const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+            if (!limited[k]) continue;
+            const double limit = c.friction_coefficient * g[k];
             if (limit <= 0.0) {
                 modes.tmode[k] = FREE;
                 p[c.row_t] = 0.0;
