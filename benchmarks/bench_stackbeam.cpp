@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/errors.hpp"
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/simulation.hpp"
 
@@ -303,6 +304,69 @@ BENCHMARK(Transitions)
     ->Args({100, 1, 3, 5, 0, 8})->Args({100, 1, 3, 5, 2, 8})->Args({100, 0, 3, 20, 0, 8})->Args({100, 0, 3, 20, 2, 8})
     ->Args({100, 1, 3, 30, 0, 0})->Args({100, 1, 3, 30, 0, 8})->Args({100, 1, 3, 100, 0, 8})
     ->Args({100, 0, 3, 100, 0, 0})->Args({100, 0, 3, 100, 0, 8})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+
+/// The friction-mesh ratio kappa = mu (t_i + t_i+1) / (2 h) (model.hpp) against the exact
+/// solver's fixed point on the friction limits: the graduated 10-leaf spring above with every
+/// interface's mu set to args[1] / 10000, closed-form mode, dt = 1 ms, from rest. args:
+/// elements per half leaf, mu x 1e4, transition (TransitionMethod: 3 the Tresca fixed point
+/// only, 0 the default chain), simulated time in ms, Anderson depth (0: the plain fixed
+/// point). A step that fails ends the run (failed_at_step, 0 when none failed); the figures
+/// are over the steps made.
+void FrictionMeshRatioRuns(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    ModelSpec spec = graduated_stack(elements, 10);
+    for (auto& f : spec.interfaces) f.friction_coefficient = 1e-4 * static_cast<double>(state.range(1));
+    const double t_sim = 1e-3 * static_cast<double>(state.range(3));
+    double total = 0.0, passes = 0.0, most_passes = 0.0, kappa = 0.0, worst_step = 0.0;
+    long steps = 0, failed_at = 0, fell_back = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const Model model = Model::build(spec);
+        kappa = friction_mesh_ratio(model).ratio;
+        const System s(model);
+        SimulationOptions so;
+        so.t_end_s = t_sim;
+        so.contact_path = ContactPath::sparse;
+        so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
+        so.solver.tresca_anderson_depth = static_cast<int>(state.range(4));
+        ClosedFormStepper st(s, so);
+        const long n = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
+        passes = most_passes = worst_step = 0.0;
+        steps = failed_at = fell_back = 0;
+        for (long i = 0; i < n; ++i) {
+            const auto t1 = std::chrono::steady_clock::now();
+            try {
+                st.step();
+            } catch (const SolverError&) {
+                failed_at = i + 1;
+                break;
+            }
+            ++steps;
+            worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+            passes += st.last_solve().tresca_iterations;
+            most_passes = std::max(most_passes, static_cast<double>(st.last_solve().tresca_iterations));
+            if (st.last_solve().fell_back) ++fell_back;
+        }
+        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    state.counters["kappa"] = kappa;
+    state.counters["failed_at_step"] = static_cast<double>(failed_at);
+    state.counters["steps"] = static_cast<double>(steps);
+    state.counters["s_per_sim_s"] = steps > 0 ? total / (1e-3 * static_cast<double>(steps)) : 0.0;
+    state.counters["tresca_per_step"] = steps > 0 ? passes / static_cast<double>(steps) : 0.0;
+    state.counters["most_tresca_in_a_step"] = most_passes;
+    state.counters["fell_back_steps"] = static_cast<double>(fell_back);  // answers the passes did not confirm
+    state.counters["worst_step_s"] = worst_step;
+}
+BENCHMARK(FrictionMeshRatioRuns)
+    ->ArgNames({"el", "mu_e4", "transition", "ms", "depth"})
+    // 10 x 100 (h = 2.5 mm): kappa 0.25, 0.5, 1, 2, plain fixed point
+    ->Args({100, 1250, 3, 25, 0})->Args({100, 2500, 3, 25, 0})->Args({100, 5000, 3, 25, 0})->Args({100, 10000, 3, 5, 0})
+    // 10 x 400 (h = 0.625 mm): kappa 0.5, 1, 2, plain fixed point
+    ->Args({400, 625, 3, 6, 0})->Args({400, 1250, 3, 6, 0})->Args({400, 2500, 3, 6, 0})
+    // 10 x 400, the default chain at kappa 0.5 and 0.8
+    ->Args({400, 625, 0, 100, 8})->Args({400, 1000, 0, 100, 8})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -340,6 +340,8 @@ int run_simulate(const SimulateArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const stackbeam::Model model = stackbeam::Model::build(spec);
     const stackbeam::System system(model);
+    if (const std::string advice = stackbeam::friction_mesh_advice(model); !advice.empty())
+        std::cerr << "stackbeam: note: " << advice << "\n";
     const stackbeam::ContactPath path = stackbeam::choose_contact_path(system, options);
 
     // --- run, streaming rows to FILE.partial ----------------------------------------

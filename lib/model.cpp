@@ -299,4 +299,41 @@ Model Model::build(ModelSpec spec) {
     return m;
 }
 
+FrictionMeshRatio friction_mesh_ratio(const Model& model) {
+    const ModelSpec& spec = model.spec();
+    const double tol = model.x_tolerance_m();
+    FrictionMeshRatio best;
+    for (int i = 0; i < static_cast<int>(spec.interfaces.size()); ++i) {
+        const InterfaceSpec& f = spec.interfaces[i];
+        if (f.law != InterfaceLaw::coulomb || f.friction_coefficient <= 0.0) continue;
+        std::vector<double> x;
+        for (const PairSpec& c : model.candidate_pairs())
+            if (c.interface_index == i) x.push_back(c.x_m);
+        std::sort(x.begin(), x.end());
+        double h = std::numeric_limits<double>::infinity();
+        for (std::size_t j = 1; j < x.size(); ++j)
+            if (x[j] - x[j - 1] > tol) h = std::min(h, x[j] - x[j - 1]);
+        if (!std::isfinite(h)) continue;  // fewer than two pairs: no neighbour to trade forces with
+        const double arm_m = 0.5 * (spec.leaves[i].height_m + spec.leaves[i + 1].height_m);
+        const double kappa = f.friction_coefficient * arm_m / h;
+        if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m};
+    }
+    return best;
+}
+
+std::string friction_mesh_advice(const Model& model) {
+    const FrictionMeshRatio r = friction_mesh_ratio(model);
+    if (r.ratio < 1.0) return {};
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is %.3g on interface %d (pair spacing h = %.4g m): "
+                  "from about 1 on, the incremental Coulomb problem of this mesh can have several solutions and the "
+                  "exact solver's fixed point on the friction limits settles slowly or not at all (BENCHMARKS.md); "
+                  "pairs spaced more than %.4g m apart there (mesh.element_length_m) or a mu below %.4g bring it "
+                  "below 1",
+                  r.ratio, r.interface_index, r.pair_spacing_m, r.spacing_for_one_m,
+                  model.spec().interfaces[r.interface_index].friction_coefficient / r.ratio);
+    return buf;
+}
+
 }  // namespace stackbeam

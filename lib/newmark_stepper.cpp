@@ -301,10 +301,14 @@ const StepRecord& NewmarkStepper::step() {
         solve_ = sparse_solver_->solve(sparse_problem_, p_, z1);
     }
     ++step_;
-    if (!solve_.converged && options_.stop_on_nonconvergence)
+    if (!solve_.converged && options_.stop_on_nonconvergence) {
+        // on a mesh whose friction-mesh ratio is 1 or more, say so: that is the likely cause
+        const std::string advice = friction_mesh_advice(system_.model());
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
-                              format_value(step_ * dt) + " s: " + solve_.message,
+                              format_value(step_ * dt) + " s: " + solve_.message +
+                              (advice.empty() ? std::string() : "; " + advice),
                           step_, step_ * dt, solve_.residual_m);
+    }
     // The contact forces' work over the step (newmark_stepper.hpp): p1^T G (z1 - z0) with
     // massive leaves, (p0 + p1)^T G (z1 - z0) / 2 with massless ones. Friction on the
     // tangential components; the rest (normal components, bonds) is the impact loss.

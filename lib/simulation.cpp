@@ -439,10 +439,14 @@ const StepRecord& ClosedFormStepper::step() {
         solve_ = sparse_solver_->solve(sparse_problem_, p_, z_, step_ > 0);  // K, G constant over the run
     }
     ++step_;
-    if (!solve_.converged && options_.stop_on_nonconvergence)
+    if (!solve_.converged && options_.stop_on_nonconvergence) {
+        // on a mesh whose friction-mesh ratio is 1 or more, say so: that is the likely cause
+        const std::string advice = friction_mesh_advice(system_.model());
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
-                              format_value(step_ * dt) + " s: " + solve_.message,
+                              format_value(step_ * dt) + " s: " + solve_.message +
+                              (advice.empty() ? std::string() : "; " + advice),
                           step_, step_ * dt, solve_.residual_m);
+    }
     const double cp1 = c.dot(p_);  // c^T p at t + dt [N]
     double w1 = 0.0, wd1 = 0.0;
     if (rig_) {

@@ -154,4 +154,38 @@ private:
 const char* to_string(SupportKind kind);
 const char* to_string(PairKind kind);
 
+/// The friction-mesh ratio of a model: how strongly a change of the friction forces
+/// moves the normal forces of neighbouring contact pairs, per Coulomb interface
+///
+///     kappa_i = mu_i (t_i + t_i+1) / (2 h_i),
+///
+/// t_i, t_i+1 the thicknesses of the leaves above and below [m], h_i the shortest
+/// spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
+/// Why: a change dT of a pair's tangential force acts at the interface, t/2 off each
+/// leaf's axis, so it puts a moment dT (t_i + t_i+1)/2 on the two leaves. Where a
+/// contact zone ends (a leaf tip, the edge of a closed zone) only the couple of the
+/// nearest pairs, arm h, answers it: dN ~ dT (t_i + t_i+1)/(2 h), and with dT = mu dN
+/// (a slipping pair's force follows its limit) the limits-to-normal-forces map has a
+/// gain of order kappa. Measured on graduated 10-leaf springs (BENCHMARKS.md, section
+/// "Friction-mesh ratio"), the exact solvers' plain fixed point on the friction limits
+/// settles in 5-9 passes at kappa 0.25-0.5, in 13-19 or not within 100 at 1, and
+/// not at all at 2 or more; at 1 the incremental problem was seen to have two
+/// solutions (graduated 10 x 100, mu = 0.5). This is a property of the
+/// node-to-node discretisation with Coulomb's law, not of a solver: refining the mesh
+/// of a frictional stack raises kappa (paper example, 5 mm leaves, mu = 0.5: kappa =
+/// 0.2 at its 20 elements per half leaf, 1 at 100, 4 at 400).
+struct FrictionMeshRatio {
+    double ratio = 0.0;           ///< the largest kappa over the Coulomb interfaces [-] (0: no friction)
+    int interface_index = -1;     ///< the interface where it is largest (-1: none with friction)
+    double pair_spacing_m = 0.0;  ///< h of that interface [m]
+    double spacing_for_one_m = 0.0;  ///< mu (t_i + t_i+1)/2 there: the pair spacing at which kappa = 1 [m]
+};
+
+/// kappa of every Coulomb interface with mu > 0 and two or more pairs; the largest.
+FrictionMeshRatio friction_mesh_ratio(const Model& model);
+
+/// When kappa >= 1: one sentence naming the interface, kappa, h and the spacing or mu
+/// that bring kappa below 1 (for error messages and notes); otherwise empty.
+std::string friction_mesh_advice(const Model& model);
+
 }  // namespace stackbeam
