@@ -41,6 +41,7 @@
 #include "cvode_modes.hpp"
 #include "cvode_inertia.hpp"
 #include "stackbeam/errors.hpp"
+#include "mesh_note.hpp"
 #include "step_record.hpp"
 #include "tied_shape.hpp"
 
@@ -292,7 +293,8 @@ struct CvodeModalStepper::Impl {
             iters_since += res.iterations;
             if (!res.converged)
                 throw SolverError("cvode mode (leaf inertia): the contact iteration deciding the modes at t = " +
-                                      format_value(t) + " s (" + cause + ") did not converge: " + res.message,
+                                      format_value(t) + " s (" + cause + ") did not converge: " + res.message +
+                                      mesh_note(sys.model()),
                                   stats.steps, t, res.residual_m);
             modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
             // A slipping pair slips against its slip rate: where the new modes' rate at

@@ -19,6 +19,7 @@
 #include "cvode_modes.hpp"
 #include "step_record.hpp"
 #include "stackbeam/errors.hpp"
+#include "mesh_note.hpp"
 
 namespace stackbeam {
 namespace {
@@ -291,7 +292,7 @@ struct CvodeStepper::Impl {
             iters_since += res.iterations;
             if (!res.converged)
                 throw SolverError("cvode mode: the contact iteration deciding the modes at t = " + format_value(t) +
-                                      " s (" + cause + ") did not converge: " + res.message,
+                                      " s (" + cause + ") did not converge: " + res.message + detail::mesh_note(sys.model()),
                                   stats.steps, t, res.residual_m);
             detail::modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
         }

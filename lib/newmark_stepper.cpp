@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "stackbeam/errors.hpp"
+#include "mesh_note.hpp"
 #include "step_record.hpp"
 #include "tied_shape.hpp"
 
@@ -302,11 +303,8 @@ const StepRecord& NewmarkStepper::step() {
     }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
-        // on a mesh whose friction-mesh ratio is 1 or more, say so: that is the likely cause
-        const std::string advice = friction_mesh_advice(system_.model());
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
-                              format_value(step_ * dt) + " s: " + solve_.message +
-                              (advice.empty() ? std::string() : "; " + advice),
+                              format_value(step_ * dt) + " s: " + solve_.message + detail::mesh_note(system_.model()),
                           step_, step_ * dt, solve_.residual_m);
     }
     // The contact forces' work over the step (newmark_stepper.hpp): p1^T G (z1 - z0) with

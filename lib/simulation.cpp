@@ -8,6 +8,7 @@
 #include "stackbeam/errors.hpp"
 #include "cvode_inertia.hpp"
 #include "stackbeam/newmark_stepper.hpp"
+#include "mesh_note.hpp"
 #include "step_record.hpp"
 
 namespace stackbeam {
@@ -440,11 +441,8 @@ const StepRecord& ClosedFormStepper::step() {
     }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
-        // on a mesh whose friction-mesh ratio is 1 or more, say so: that is the likely cause
-        const std::string advice = friction_mesh_advice(system_.model());
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
-                              format_value(step_ * dt) + " s: " + solve_.message +
-                              (advice.empty() ? std::string() : "; " + advice),
+                              format_value(step_ * dt) + " s: " + solve_.message + detail::mesh_note(system_.model()),
                           step_, step_ * dt, solve_.residual_m);
     }
     const double cp1 = c.dot(p_);  // c^T p at t + dt [N]
