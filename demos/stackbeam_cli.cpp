@@ -478,6 +478,11 @@ int run_simulate(const SimulateArgs& a) {
         j["solver"] = stackbeam::to_string(options.solver.kind);
         j["dt_s"] = options.dt_s;
         j["t_end_s"] = options.t_end_s;
+        const stackbeam::FrictionMeshRatio kappa = stackbeam::friction_mesh_ratio(model);
+        j["friction_mesh_ratio"] = {{"kappa", kappa.ratio},
+                                    {"interface", kappa.interface_index},
+                                    {"pair_spacing_m", kappa.pair_spacing_m},
+                                    {"spacing_for_kappa_one_m", kappa.spacing_for_one_m}};
         j["loading"] = {{"kind", stackbeam::to_string(options.loading.kind)},
                         {"gravity_m_per_s2", options.loading.gravity_m_per_s2},
                         {"period_s", options.loading.period_s()}};

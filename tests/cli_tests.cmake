@@ -270,3 +270,18 @@ stackbeam_cli_test(NAME cli_base_cvode
 stackbeam_cli_test(NAME cli_plot
                    ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
                    EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)
+
+# The friction-mesh ratio kappa = mu (t_i + t_i+1) / (2 h) (model.hpp): in the summary
+# (paper example: 0.5 x 5 mm / 12.5 mm = 0.2), and named in the note before the run and in
+# the error of a step that fails on a mesh with kappa >= 1 (200 elements per half leaf:
+# kappa = 2; the paper's iteration held to one iteration cannot settle the first step).
+stackbeam_cli_test(NAME cli_friction_mesh_ratio_summary
+                   ARGS simulate --case friction --t-end 0.005 --quiet --out ${_cli_out_dir}/cli_k.csv
+                        --summary ${_cli_out_dir}/cli_k.json
+                   EXPECT_RC 0 OUT ${_cli_out_dir}/cli_k.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_k.json JSON_PATH "friction_mesh_ratio|kappa" JSON_RANGE "0.199999|0.200001")
+stackbeam_cli_test(NAME cli_friction_mesh_ratio_failure
+                   ARGS simulate --case friction --elements 200 --t-end 0.002 --solver paper --max-iterations 1
+                        --out ${_cli_out_dir}/cli_k2.csv
+                   EXPECT_RC 3 EXPECT_TEXT "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is 2 on interface 0"
+                   OUT ${_cli_out_dir}/cli_k2.csv)
