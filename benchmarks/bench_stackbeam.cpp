@@ -304,6 +304,8 @@ BENCHMARK(Transitions)
     ->Args({100, 1, 3, 5, 0, 8})->Args({100, 1, 3, 5, 2, 8})->Args({100, 0, 3, 20, 0, 8})->Args({100, 0, 3, 20, 2, 8})
     ->Args({100, 1, 3, 30, 0, 0})->Args({100, 1, 3, 30, 0, 8})->Args({100, 1, 3, 100, 0, 8})
     ->Args({100, 0, 3, 100, 0, 0})->Args({100, 0, 3, 100, 0, 8})
+    // 50 elements per half leaf: friction-mesh ratio 0.5 with mu = 0.5 (FrictionMeshRatioRuns below)
+    ->Args({50, 1, 0, 300, 0, 8})->Args({50, 0, 0, 300, 0, 8})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 /// The friction-mesh ratio kappa = mu (t_i + t_i+1) / (2 h) (model.hpp) against the exact
@@ -367,6 +369,8 @@ BENCHMARK(FrictionMeshRatioRuns)
     ->Args({400, 625, 3, 6, 0})->Args({400, 1250, 3, 6, 0})->Args({400, 2500, 3, 6, 0})
     // 10 x 400, the default chain at kappa 0.5 and 0.8
     ->Args({400, 625, 0, 100, 8})->Args({400, 1000, 0, 100, 8})
+    // the paper's mu = 0.5 at kappa = 0.5: 50 elements per half leaf, the default chain
+    ->Args({50, 5000, 0, 300, 8})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
