@@ -168,7 +168,7 @@ const char* to_string(PairKind kind);
 /// (a slipping pair's force follows its limit) the limits-to-normal-forces map has a
 /// gain of order kappa. Measured on graduated 10-leaf springs (BENCHMARKS.md, section
 /// "Friction-mesh ratio"), the exact solvers' plain fixed point on the friction limits
-/// settles in 5-9 passes at kappa 0.25-0.5, in 13-19 or not within 100 at 1, and
+/// settles in at most 8-9 passes at kappa 0.25-0.5, in up to 24 or not within 100 at 1, and
 /// not at all at 2 or more; at 1 the incremental problem was seen to have two
 /// solutions (graduated 10 x 100, mu = 0.5). This is a property of the
 /// node-to-node discretisation with Coulomb's law, not of a solver: refining the mesh
