@@ -7,7 +7,7 @@
 //    median microseconds per step, iterations and factorisations per step.
 //  - WholeRun: a whole closed-form run (model build, condensation, stepping).
 //  - Scaling: closed-form runs on finer meshes and more leaves (the paper's leaf
-//    repeated: stack(), below), dense and sparse contact path, bonded and friction
+//    repeated: paper_stack(), tests/test_support.hpp), dense and sparse contact path, bonded and friction
 //    case. Counters: set-up (model, condensation, stepper) and wall time per
 //    simulated second (set-up + stepping, scaled from the simulated time), contact
 //    components, factorisations per step, semismooth Newton iterations per step (sparse
@@ -31,6 +31,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/simulation.hpp"
+#include "test_support.hpp"  // the many-leaf stacks (tests/)
 
 using namespace stackbeam;
 
@@ -98,16 +99,11 @@ void WholeRun(benchmark::State& state, PaperCase c, double t_end) {
     }
 }
 
-/// The paper's example with its leaf repeated: `leaves` identical leaves (pinned ends,
-/// the same interfaces and clamps), `elements` elements per half leaf.
-ModelSpec stack(PaperCase c, int elements, int leaves) {
-    ModelSpec spec = paper_example(c, PaperExampleOptions{elements});
-    while (static_cast<int>(spec.leaves.size()) < leaves) {
-        spec.leaves.push_back(spec.leaves.back());
-        spec.interfaces.push_back(spec.interfaces.back());
-    }
-    return spec;
-}
+// The many-leaf stacks, shared with the tests (tests/test_support.hpp): paper_stack (the
+// paper's example with its leaf repeated: identical pinned leaves, the same interfaces and
+// clamps) and graduated_stack (leaves shortened downwards, free ends, two clamps).
+using testing::graduated_stack;
+using testing::paper_stack;
 
 /// args: elements per half leaf, leaves, case (0 bonded, 1 friction, 2 frictionless), path (0 dense, 1 sparse),
 /// simulated time in ms.
@@ -118,7 +114,7 @@ void Scaling(benchmark::State& state) {
                                                                                        : PaperCase::frictionless;
     const ContactPath path = state.range(3) == 0 ? ContactPath::dense : ContactPath::sparse;
     const double t_sim = 1e-3 * static_cast<double>(state.range(4));
-    const ModelSpec spec = stack(c, elements, leaves);
+    const ModelSpec spec = paper_stack(c, elements, leaves);
     double setup = 0.0, total = 0.0, factorizations = 0.0, newton = 0.0, first_step = 0.0;
     int components = 0;
     long steps = 0;
@@ -229,21 +225,6 @@ BENCHMARK(Scaling)
     ->Args({100, 10, 1, 1, 20})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
-/// A graduated 10-leaf spring from the paper's leaf: the main leaf pinned at both ends,
-/// leaf k below it shorter by 8 % of L per leaf (0.5 m down to 0.14 m), centred, free
-/// ends; two clamps of 1000 N at x = 0.2 and 0.3 m (inside every leaf), mu = 0.5.
-ModelSpec graduated_stack(int elements, int leaves) {
-    ModelSpec spec = stack(PaperCase::friction, elements, leaves);
-    const double L = spec.leaves[0].length_m;
-    for (int k = 1; k < leaves; ++k) {
-        auto& leaf = spec.leaves[static_cast<std::size_t>(k)];
-        leaf.length_m = L * (1.0 - 0.72 * k / (leaves - 1));
-        leaf.x_start_m = 0.5 * (L - leaf.length_m);
-        leaf.left_support = leaf.right_support = SupportKind::free;
-    }
-    spec.clamps = {{0.2, 1000.0}, {0.3, 1000.0}};
-    return spec;
-}
 
 /// The sparse path's transition methods on friction runs of 10 leaves (closed-form mode,
 /// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
@@ -255,7 +236,7 @@ ModelSpec graduated_stack(int elements, int leaves) {
 /// 0 the plain fixed point, 8 the default).
 void Transitions(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
-    const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : stack(PaperCase::friction, elements, 10);
+    const ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : paper_stack(PaperCase::friction, elements, 10);
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
     double total = 0.0, factorizations = 0.0, newton = 0.0, smoothing = 0.0, passes = 0.0, worst_step = 0.0;
     long steps = 0, tresca = 0, continued = 0;

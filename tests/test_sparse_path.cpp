@@ -11,6 +11,7 @@
 #include "stackbeam/paper_example.hpp"
 #include "stackbeam/simulation.hpp"
 #include "stackbeam/system.hpp"
+#include "test_support.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -107,32 +108,6 @@ void compare_paths(const ModelSpec& spec, double dt, int steps, double tol, bool
 // tolerance 1e-10 m: far below the physics (amplitudes ~ 2e-2 m), so the modes are
 // settled well inside their thresholds and both paths see the same transitions.
 constexpr double kTol = 1e-10;
-
-/// The paper's friction case with `leaves` identical leaves of `elements` per half leaf
-/// (the benchmark's stack()).
-ModelSpec identical_stack(int elements, int leaves) {
-    ModelSpec spec = paper_example(PaperCase::friction, PaperExampleOptions{elements});
-    while (static_cast<int>(spec.leaves.size()) < leaves) {
-        spec.leaves.push_back(spec.leaves.back());
-        spec.interfaces.push_back(spec.interfaces.back());
-    }
-    return spec;
-}
-
-/// A graduated spring (the benchmark's graduated_stack()): leaf k shorter by 72 % of L
-/// x k / (leaves - 1), centred, free ends; clamps at 0.2 and 0.3 m, 1000 N.
-ModelSpec graduated_stack(int elements, int leaves) {
-    ModelSpec spec = identical_stack(elements, leaves);
-    const double L = spec.leaves[0].length_m;
-    for (int k = 1; k < leaves; ++k) {
-        auto& leaf = spec.leaves[static_cast<std::size_t>(k)];
-        leaf.length_m = L * (1.0 - 0.72 * k / (leaves - 1));
-        leaf.x_start_m = 0.5 * (L - leaf.length_m);
-        leaf.left_support = leaf.right_support = SupportKind::free;
-    }
-    spec.clamps = {{0.2, 1000.0}, {0.3, 1000.0}};
-    return spec;
-}
 
 }  // namespace
 
@@ -572,7 +547,7 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
     //   and 5 both methods end with natural maps ~1e-17 m yet forces 0.7 and 1.9 N apart
     //   (measured), so there only the contact conditions are checked.
     constexpr int kMaxPasses = 30;
-    const System sys(Model::build(graduated_stack(100, 10)));
+    const System sys(Model::build(testing::graduated_stack(100, 10)));
     SimulationOptions so;
     so.contact_path = ContactPath::sparse;
     ClosedFormStepper st(sys, so);
@@ -625,7 +600,7 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_ten_leaf_friction_stack) {
     // 10 identical leaves x 20 elements (342 rows), friction, 20 steps from rest: the
     // degenerate transition the semismooth Newton method is for (the default sparse
     // path: passes from the previous modes, then Newton). Tolerance as the finer stack.
-    compare_paths(identical_stack(20, 10), 1e-3, 20, kTol, true, TauRule::current, 1e-7);
+    compare_paths(testing::paper_stack(PaperCase::friction, 20, 10), 1e-3, 20, kTol, true, TauRule::current, 1e-7);
 }
 
 BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {

@@ -1,6 +1,7 @@
 #pragma once
-// Helpers shared by the physics tests: runs of the paper example and
-// measurements on time series (period from zero crossings, peaks).
+// Helpers shared by the physics tests (and the benchmarks' stacks): runs of the paper
+// example, the many-leaf stacks built from its leaf, and measurements on time series
+// (period from zero crossings, peaks).
 #include <cmath>
 #include <vector>
 
@@ -21,6 +22,33 @@ inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_
     so.solver.kind = solver;
     so.solver.tolerance_m = tol_m;
     return simulate(s, so);
+}
+
+/// The paper example's case `c` with `leaves` identical leaves of `elements` per half
+/// leaf (its last leaf and interface repeated below).
+inline ModelSpec paper_stack(PaperCase c, int elements, int leaves) {
+    ModelSpec spec = paper_example(c, PaperExampleOptions{elements});
+    while (static_cast<int>(spec.leaves.size()) < leaves) {
+        spec.leaves.push_back(spec.leaves.back());
+        spec.interfaces.push_back(spec.interfaces.back());
+    }
+    return spec;
+}
+
+/// A graduated spring from the paper's leaf (friction case, mu = 0.5): the main leaf pinned
+/// at both ends, leaf k below it shorter by 72 % of L x k / (leaves - 1) (0.5 m down to
+/// 0.14 m), centred, free ends; two clamps of 1000 N at x = 0.2 and 0.3 m (inside every leaf).
+inline ModelSpec graduated_stack(int elements, int leaves) {
+    ModelSpec spec = paper_stack(PaperCase::friction, elements, leaves);
+    const double L = spec.leaves[0].length_m;
+    for (int k = 1; k < leaves; ++k) {
+        auto& leaf = spec.leaves[static_cast<std::size_t>(k)];
+        leaf.length_m = L * (1.0 - 0.72 * k / (leaves - 1));
+        leaf.x_start_m = 0.5 * (L - leaf.length_m);
+        leaf.left_support = leaf.right_support = SupportKind::free;
+    }
+    spec.clamps = {{0.2, 1000.0}, {0.3, 1000.0}};
+    return spec;
 }
 
 /// Times [s] where w crosses zero upwards, by linear interpolation between steps.
