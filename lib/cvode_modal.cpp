@@ -661,17 +661,12 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.chk_problem.q = Eigen::VectorXd::Zero(s.m);
     s.ev_problem = s.chk_problem;
     s.chk_solver = make_solver(s.opt.solver);
-    SolverOptions ev;
-    ev.kind = SolverKind::exact;
     // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual
     // compliance (its entries are far smaller than C''s: most of the leaves'
     // flexibility is in the retained modes)
-    ev.tolerance_m = 1e-9 * s.F_ref * s.W.diagonal().maxCoeff();
-    s.ev_tolerance = ev.tolerance_m;
-    s.gap_margin = std::max(kMotionMargin, 10.0 * ev.tolerance_m / s.L_ref);
-    ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
-    ev.tresca_anderson_depth = s.opt.solver.tresca_anderson_depth;
-    s.ev_solver = make_solver(ev);
+    s.ev_tolerance = 1e-9 * s.F_ref * s.W.diagonal().maxCoeff();
+    s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
+    s.ev_solver = make_solver(event_solver_options(s.opt.solver, s.ev_tolerance));
 
     // witness slots, as the massless mode
     for (int kk = 0; kk < s.np; ++kk) {

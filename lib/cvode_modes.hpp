@@ -8,6 +8,7 @@
 #include <cvode/cvode.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -32,6 +33,18 @@ constexpr double kMotionMargin = 1e-12;
 constexpr double kLookahead = 1e-7;
 /// At most this many events at one instant before the run is declared chattering.
 constexpr int kMaxEventsAtOneTime = 200;
+
+/// The options of the event solver that decides the modes at an event: the exact solver
+/// at `tolerance_m` (each stepper's own, from its scales), with the user's active-set
+/// passes (at least 3) and Anderson depth of the Tresca fixed point.
+inline SolverOptions event_solver_options(const SolverOptions& user, double tolerance_m) {
+    SolverOptions ev;
+    ev.kind = SolverKind::exact;
+    ev.tolerance_m = tolerance_m;
+    ev.max_active_set_iterations = std::max(3, user.max_active_set_iterations);
+    ev.tresca_anderson_depth = user.tresca_anderson_depth;
+    return ev;
+}
 
 /// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).
 inline std::string cvode_flag_name(long flag) {

@@ -664,15 +664,10 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.chk_problem.q = Eigen::VectorXd::Zero(s.n);  // sized: ModeSet::linearize takes n from it
     s.ev_problem = s.chk_problem;
     s.chk_solver = make_solver(s.opt.solver);
-    SolverOptions ev;
-    ev.kind = SolverKind::exact;
     // ||v|| of an exact active-set answer is LU round-off, ~cond(C') 1e-16 L_ref ~ 1e-11 L_ref;
     // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
-    ev.tolerance_m = 1e-10 * s.L_ref;
-    s.ev_tolerance = ev.tolerance_m;
-    ev.max_active_set_iterations = std::max(3, s.opt.solver.max_active_set_iterations);
-    ev.tresca_anderson_depth = s.opt.solver.tresca_anderson_depth;
-    s.ev_solver = make_solver(ev);
+    s.ev_tolerance = 1e-10 * s.L_ref;
+    s.ev_solver = make_solver(detail::event_solver_options(s.opt.solver, s.ev_tolerance));
 
     // Gravity: the static equilibrium under R's weight first (as the closed-form mode):
     // k w - c^T p = -m g, s = C'p + c w - d, then the non-stuck pairs re-anchored.
