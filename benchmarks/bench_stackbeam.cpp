@@ -27,10 +27,11 @@
 #include <memory>
 #include <vector>
 
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/simulation.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/simulation.hpp"
 #include "test_support.hpp"  // the many-leaf stacks (tests/)
 
 using namespace stackbeam;

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "stackbeam/cvode_stepper.hpp"
-#include "stackbeam/paper_example.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/model/paper_example.hpp"
 
 using namespace stackbeam;
 

@@ -44,15 +44,15 @@
 #include <vector>
 
 #include "gnuplot.hpp"
-#include "stackbeam/csv.hpp"
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/io/csv.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/hysteresis.hpp"
-#include "stackbeam/modal.hpp"
-#include "stackbeam/model.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/simulation.hpp"
-#include "stackbeam/system.hpp"
+#include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/fe/modal.hpp"
+#include "stackbeam/model/model.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/simulation.hpp"
+#include "stackbeam/fe/system.hpp"
 
 namespace fs = std::filesystem;
 using stackbeam::Mode;

@@ -25,7 +25,7 @@ endfunction()
 # 1. install
 file(REMOVE_RECURSE "${PREFIX}" "${CONSUMER_BUILD}")
 run_step("cmake --install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${PREFIX}")
-foreach(f include/stackbeam/model.hpp include/stackbeam/scenario.hpp)
+foreach(f include/stackbeam/model/model.hpp include/stackbeam/io/scenario.hpp)
   if(NOT EXISTS "${PREFIX}/${f}")
     message(FATAL_ERROR "the install has no ${f}")
   endif()

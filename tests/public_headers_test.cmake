@@ -10,7 +10,7 @@ foreach(h IN LISTS headers)
   file(STRINGS "${h}" includes REGEX "^[ \t]*#[ \t]*include")
   foreach(line IN LISTS includes)
     # the dependencies' include directories (<cvode/cvode.h>, <sundials/...>, <toml.hpp>);
-    # the project's own "stackbeam/cvode_stepper.hpp" is not one of them
+    # the project's own "stackbeam/time/cvode_stepper.hpp" is not one of them
     if(line MATCHES "[<\"](sundials|cvode|nvector|sunlinsol|sunmatrix|sunnonlinsol|arkode|ida|kinsol)/" OR
        line MATCHES "[<\"]toml(11)?[/.]")
       string(APPEND leaks "  ${h}: ${line}\n")

@@ -5,10 +5,11 @@
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 
-#include "stackbeam/contact.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/simulation.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/simulation.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <map>
 
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "test_support.hpp"
 

@@ -1,4 +1,4 @@
-// Mode cvode with leaf inertia, first part (lib/cvode_inertia.hpp, docs/inertia.md): the
+// Mode cvode with leaf inertia, first part (lib/time/cvode/cvode_inertia.hpp, docs/inertia.md): the
 // bonded and frictionless stacks with steel leaves, a stiff linear ODE integrated by BDF
 // (order <= 2) in the held stack's modal coordinates. Checked against the eigen-solve, the Newmark
 // reference as its dt -> 0, and the energy balance against rtol.
@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/modal.hpp"
+#include "stackbeam/fe/modal.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;

@@ -1,4 +1,4 @@
-// Mode cvode with leaf inertia on a stack with friction (lib/cvode_modal.cpp,
+// Mode cvode with leaf inertia on a stack with friction (lib/time/cvode/cvode_modal.cpp,
 // docs/inertia.md): the stack's modes up to a cut carry the inertia, the modes above it
 // respond quasi-statically (a massless contact layer), and the events are those of the
 // massless cvode mode. Checked against the massless mode as the density falls, against
@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;

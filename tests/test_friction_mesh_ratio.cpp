@@ -8,10 +8,11 @@
 #include <boost/test/unit_test.hpp>
 #include <string>
 
+#include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/simulation.hpp"
-#include "stackbeam/system.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/simulation.hpp"
+#include "stackbeam/fe/system.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

@@ -5,8 +5,8 @@
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 
-#include "stackbeam/simulation.hpp"
-#include "stackbeam/system.hpp"
+#include "stackbeam/time/simulation.hpp"
+#include "stackbeam/fe/system.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

@@ -8,8 +8,8 @@
 #include <cmath>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/modal.hpp"
-#include "stackbeam/newmark_stepper.hpp"
+#include "stackbeam/fe/modal.hpp"
+#include "stackbeam/time/newmark_stepper.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;

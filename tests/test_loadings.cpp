@@ -8,9 +8,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stackbeam/cvode_stepper.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "stackbeam/hysteresis.hpp"
+#include "stackbeam/post/hysteresis.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;

@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/modal.hpp"
-#include "stackbeam/paper_example.hpp"
+#include "stackbeam/fe/modal.hpp"
+#include "stackbeam/model/paper_example.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

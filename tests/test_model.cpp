@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/system.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/fe/system.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/scenario.hpp"
-#include "stackbeam/simulation.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/time/simulation.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

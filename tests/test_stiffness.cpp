@@ -4,8 +4,8 @@
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/system.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/fe/system.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;

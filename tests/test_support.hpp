@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/simulation.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/simulation.hpp"
 
 namespace stackbeam::testing {
 

@@ -1,9 +1,9 @@
 #include <cstdio>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/paper_example.hpp"
-#include "stackbeam/scenario.hpp"
-#include "stackbeam/simulation.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/time/simulation.hpp"
 
 int main(int argc, char** argv) try {
     stackbeam::Scenario run;  // a scenario file if one is given, else the built-in example

@@ -1,0 +1,271 @@
+#pragma once
+/// @file contact.hpp
+/// The per-step frictional contact problem as a value, and the solvers that
+/// take it. A test can build a ContactProblem by hand; every solver has the same
+/// signature and returns a SolveResult (converged, iterations, residual).
+///
+/// The problem (paper section 3, its sign convention: conventions.hpp):
+///   s = W p + q                      relative surface positions (eq. 6 and 7)
+///   p_n <= 0, s_n <= 0, p_n s_n = 0  unilateral normal (eq. 8); bilateral at clamps and bonds: s_n = 0
+///   |p_t| <= mu tau;  s_t = 0 if |p_t| < mu tau;  s_t = -beta p_t, beta > 0, if |p_t| = mu tau  (eq. 8)
+///   tau = |p_n| (coulomb pair) or max(0, F_c - p_n) (clamp pair); bonded pairs: s = 0.
+/// The error vector v (eq. 9) is zero exactly at a solution (eq. 10); ||v||_2 [m]
+/// is the solver-independent residual every solver reports.
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "stackbeam/model/model.hpp"
+
+namespace stackbeam {
+
+/// One contact pair of the problem: its law and which rows of W/q/p are its
+/// normal and tangential components (-1: the component is absent, e.g. fixed by a support).
+struct ContactPair {
+    PairKind kind = PairKind::coulomb;
+    double friction_coefficient = 0.0;  ///< mu [-]
+    double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
+    int row_n = -1;                     ///< row of the normal component, or -1
+    int row_t = -1;                     ///< row of the tangential component, or -1
+};
+
+/// How tau in the friction limit mu*tau is taken (paper, after eq. 17).
+enum class TauRule {
+    current,        ///< tau from the current normal force p_n^j: Coulomb exactly
+    previous_step,  ///< tau from the converged previous step (the paper's fallback)
+};
+
+/// The per-step contact problem: s = W p + q with the pair laws.
+struct ContactProblem {
+    Eigen::MatrixXd W;                 ///< compliance [m/N], symmetric positive definite
+    Eigen::VectorXd q;                 ///< free term [m]: s when p = 0
+    std::vector<ContactPair> pairs;    ///< the pairs and their rows
+    TauRule tau_rule = TauRule::current;
+    Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (used with TauRule::previous_step)
+
+    int size() const { return static_cast<int>(q.size()); }
+    /// Throws InputError if the sizes, rows or laws are inconsistent.
+    void validate() const;
+};
+
+/// State of a pair at a solution.
+enum class PairState { stick, slip, open };
+const char* to_string(PairState state);
+
+/// tau [N] of pair `k` for the force vector p, by the problem's tau rule.
+double friction_normal_force(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+
+/// The paper's error vector v (eq. 9) for forces p and relative positions s = W p + q.
+Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+
+/// Solver-independent residual [m]: the natural map of the contact laws, scaled to
+/// metres by the diagonal of W. Per component, with w = W_kk:
+///   unilateral normal  w (p_n - min(0, p_n - s_n / w))
+///   tangential         w (p_t - clamp(p_t - s_t / w, -mu tau, mu tau))
+///   bilateral / bonded s
+/// It is zero exactly at a solution and, unlike eq. 9's v, also sees forces outside
+/// the admissible set (tension in an open pair, friction above the limit).
+Eigen::VectorXd natural_map(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+
+/// State of pair k at (p, s). A pair whose normal force is zero and may open is
+/// open; a tangential force at the friction limit (relative 1e-9) is slip; bonded pairs stick.
+PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+
+/// The available solvers.
+enum class SolverKind {
+    paper,        ///< eq. 17 with E = I and constant alpha (the faithful reference; slow)
+    accelerated,  ///< eq. 17 with E = per-pair 2x2 block inverse of W, Gauss-Seidel sweeps (Lee 1989 style)
+    exact,        ///< active-set direct solver, factorisation reused while the modes stay (default)
+    block_jacobi, ///< eq. 17 with E = per-pair 2x2 block inverse of W, applied to all pairs at once
+};
+const char* to_string(SolverKind kind);
+/// Parses "paper" | "accelerated" | "block-jacobi" | "exact"; throws InputError naming `field`.
+SolverKind parse_solver_kind(const std::string& text, const std::string& field);
+
+struct SolverOptions {
+    SolverKind kind = SolverKind::exact;
+    double tolerance_m = 2e-6;        ///< stop when ||v||_2 < tolerance_m [m] (paper: 2e-6)
+    int max_iterations = 200000;      ///< iteration limit of the iterative solvers
+    double alpha = 0.0;               ///< paper / block_jacobi: alpha; 0 = alpha_fraction * 2 / lambda_max(E W)
+    double alpha_fraction = 0.9;      ///< paper / block_jacobi: alpha as a fraction of the stability bound 2/lambda_max(E W)
+    int max_active_set_iterations = 3;    ///< exact solver: active-set passes from the given modes before it
+                                          ///< turns to the Tresca fixed point (and again after it)
+    int tresca_anderson_depth = 8;        ///< exact solver (dense and sparse path): Anderson acceleration depth of
+                                          ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
+                                          ///< fixed point (BENCHMARKS.md: of 3, 5 and 8 only 8 settles the graduated
+                                          ///< 10 x 400 first step; 3 needs 6-23 % fewer factorisations at 10 x 100)
+};
+
+/// What a solve reports. A solve that does not converge says so; it never passes silently.
+struct SolveResult {
+    bool converged = false;
+    int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact; sparse path:
+                               ///< also the semismooth Newton iterations, counted in newton_iterations too,
+                               ///< and the box QPs' pivoting passes and interior-point iterations)
+    double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
+    double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
+    int factorizations = 0;    ///< factorisations done in this solve (exact solver; sparse path: sparse LU
+                               ///< of the saddle-point system or dense LU of the held rows' Schur complement,
+                               ///< and one sparse LDL^T per interior-point iteration on a box QP)
+    int updates = 0;           ///< sparse path: sets of modes solved by a low-rank update of the last
+                               ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
+    int newton_iterations = 0; ///< sparse path: iterations of the semismooth Newton method (each one linear
+                               ///< solve of a set of modes: a factorisation, an update or a cached one)
+    int smoothing_iterations = 0;  ///< sparse path: iterations of the smoothing Newton method (each one sparse LU
+                                   ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
+    int continuation_steps = 0;  ///< sparse path: sub-steps of the continuation on the offsets (transitions no
+                                 ///< Newton method settles from the step's start)
+    int tresca_iterations = 0;   ///< exact solver: passes of the Tresca fixed point on the friction limits (box
+                                 ///< QPs solved; SolverOptions::tresca_anderson_depth), where it ran
+    bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
+    std::string message;       ///< why it did not converge, when it did not
+};
+
+/// A contact solver. It may keep data derived from W between calls (factorisations,
+/// eigenvalues): it notices when W changes.
+class ContactSolver {
+public:
+    virtual ~ContactSolver() = default;
+    /// Solves `problem`; p is the warm start on entry and the forces [N] on exit.
+    virtual SolveResult solve(const ContactProblem& problem, Eigen::VectorXd& p) = 0;
+    virtual SolverKind kind() const = 0;
+};
+
+/// Creates the solver named in `options`. Throws InputError for bad options.
+std::unique_ptr<ContactSolver> make_solver(const SolverOptions& options);
+
+/// The per-step contact problem on the sparse stiffness (the "sparse path"):
+///     K z = b + G^T p,    s = G z - d,
+/// with the pair laws of ContactProblem (the same pairs, rows and tau rule). z are
+/// displacements, K a sparse symmetric positive definite stiffness, G the contact
+/// rows. Eliminating z gives the dense problem s = W p + q of ContactProblem with
+///     W = G K^-1 G^T,  q = G K^-1 b - d     (to_dense()),
+/// so both have the same solution; this form never builds the dense W (its cost
+/// grows with the number of elements, not with its square or cube).
+struct SparseContactProblem {
+    Eigen::SparseMatrix<double> K;     ///< stiffness, n x n, symmetric positive definite (both triangles stored)
+    Eigen::SparseMatrix<double> G;     ///< contact rows [-], m x n
+    Eigen::VectorXd b;                 ///< load with p = 0, n entries
+    Eigen::VectorXd d;                 ///< offsets [m], m entries (normal gaps, tangential anchors)
+    std::vector<ContactPair> pairs;    ///< the pairs and their rows (rows of G)
+    TauRule tau_rule = TauRule::current;
+    Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (TauRule::previous_step)
+
+    int size() const { return static_cast<int>(d.size()); }
+    /// Throws InputError if the sizes, rows or laws are inconsistent.
+    void validate() const;
+    /// The equivalent dense problem (W = G K^-1 G^T, q = G K^-1 b - d): m solves and
+    /// m^2 doubles; for tests and for the sparse solver's last-resort fallback.
+    ContactProblem to_dense() const;
+};
+
+/// The active-set method of SolverKind::exact on a SparseContactProblem. Per set of
+/// modes the conditions are linear, so the solve is one sparse saddle-point system
+///     [ K                       -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
+///     [ G_S                      0                  ] [p_S] = [d_S      ]
+/// (S: rows held by s = 0; slip rows carry p_t = e_t + D p_n), factorised by a sparse
+/// LU once per set of modes and reused while the modes stay (few held rows: the dense
+/// Schur complement on K's Cholesky factor instead; near the last LU's held set: a
+/// low-rank update of it; see SparsePathTuning). The mode switching and the
+/// handling of transitions (Tresca fixed point on a box QP, solved by block principal
+/// pivoting and, where that does not settle, by an interior-point method; then the coupled Coulomb
+/// problem) are those of the exact solver (the same mode code, lib/contact/active_set.hpp), so
+/// both paths reach the same solution. Before the Tresca fixed point, a transition is
+/// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
+/// pairs change mode per iteration, one linear solve of a set of modes each; it starts from
+/// the last answer extrapolated linearly from the two before, when the warm start p is this
+/// solver's last answer, so a solve's answer may depend on the solves before it; its final
+/// modes are confirmed by the active-set passes, SolveResult::newton_iterations), and if
+/// that stalls, by a smoothing Newton method (the natural map with every max(0, .)
+/// smoothed, the smoothing driven to zero with the residual; one sparse LU of its
+/// Jacobian per iteration, SolveResult::smoothing_iterations; its modes are confirmed the
+/// same way), and if that stalls too, by a continuation on the offsets d from the step's start
+/// (the start's forces solve the problem with offsets d0; d0 -> d in sub-steps, each solved
+/// from the last by the passes or the semismooth method; SolveResult::continuation_steps). If all that fails, a problem of at most 4000 rows is
+/// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
+/// one returns converged = false with a message.
+/// How SparseContactSolver solves the linear problem of a set of modes (the defaults
+/// are the measured choices, BENCHMARKS.md; tests set them to force each way):
+///  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on
+///    a Cholesky factor of K made once per run (columns K^-1 g_i^T cached per row);
+///  - more: a sparse LU of the saddle-point system, and a set of modes without slip
+///    coupling that differs from the last LU's held set in at most `max_border_rows`
+///    rows is solved by bordering that LU (low-rank update: a solve per changed row and
+///    a small dense LU) instead of a new factorisation.
+/// How the sparse path solves a transition that the active-set passes from the previous
+/// modes do not settle (SparseContactSolver::solve, step 2).
+enum class TransitionMethod {
+    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
+                 ///< Newton method; then the continuation on the offsets; then the Tresca fixed point (default)
+    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
+                 ///< smoothing method (kept for comparison, BENCHMARKS.md)
+    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
+    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
+    continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
+};
+
+/// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
+/// limits frozen): min 1/2 p^T W p + q^T p over lower <= p <= upper, with W = G K^-1 G^T
+/// never formed.
+enum class BoxQpMethod {
+    pivoting,        ///< block principal pivoting (a few sparse solves where it settles); where it does not
+                     ///< settle in 50 passes, a primal-dual interior-point method (Mehrotra's predictor-
+                     ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
+                     ///< read from the iterate); then the monotone primal active-set method (default)
+    interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
+    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
+                     ///< (kept for comparison, BENCHMARKS.md)
+};
+
+struct SparsePathTuning {
+    int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
+    int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+    TransitionMethod transition = TransitionMethod::newton;
+    /// >= 0: the Newton method is tried on problems of at least this many contact rows (smaller
+    /// ones, e.g. the paper example's 76, settle quickly by the passes and the Tresca fixed
+    /// point, and keep exactly the answers they had: their near-degenerate pairs may settle in
+    /// another of the modes within the threshold, e.g. 1.03e-9 J against 0.70e-9 J of
+    /// energy-balance round-off on the paper example with steel leaves)
+    int newton_min_rows = 200;
+    /// Tests: every solve starts with the semismooth Newton method from the warm start (no
+    /// active-set passes from the previous modes first), so its answers can be checked alone.
+    bool newton_first = false;
+    /// How the Tresca fixed point's box QPs are solved (all end at the same working-set test,
+    /// so their answers agree to round-off).
+    BoxQpMethod box_qp = BoxQpMethod::pivoting;
+};
+
+class SparseContactSolver {
+public:
+    /// options.kind must be SolverKind::exact; throws InputError otherwise (and for a
+    /// negative tuning field, naming it).
+    explicit SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning = {});
+    ~SparseContactSolver();
+    SparseContactSolver(const SparseContactSolver&) = delete;
+    SparseContactSolver& operator=(const SparseContactSolver&) = delete;
+
+    /// Solves `problem`; p is the warm start on entry and the forces [N] on exit; z the
+    /// displacements on exit. It keeps its factorisations while K and G stay the same:
+    /// it compares them with the previous call's (O(nnz)), unless the caller passes
+    /// `structure_unchanged` = true, a promise that K, G and the pairs are those of the
+    /// previous call on this solver (the closed-form stepper's are constant over a run;
+    /// at 10 leaves x 400 elements the comparison was a quarter of a step's cost).
+    SolveResult solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                      bool structure_unchanged = false);
+    /// s = G z - d at the last solution [m].
+    const Eigen::VectorXd& relative_positions() const;
+    /// Diagonal of W = G K^-1 G^T [m/N] (computed once per K, G: it scales the force
+    /// violations to metres as in the dense solver).
+    const Eigen::VectorXd& compliance_diagonal() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Largest eigenvalue of a symmetric matrix [same units as W].
+double largest_eigenvalue(const Eigen::MatrixXd& W);
+
+}  // namespace stackbeam

@@ -1,0 +1,104 @@
+#pragma once
+/// @file system.hpp
+/// Derived data of a Model (Pinocchio's "data"): the finite-element stiffness of
+/// the leaves, the constraints (supports, the rigid body's seat, symmetry), and
+/// the condensation to the contact surface points of the paper (eqs. 1-6, A3).
+///
+/// Reduced coordinates z = [z_r; w]: z_r the free beam DOFs, w the rigid body's
+/// displacement (+y). With massless leaves, for contact forces p and w given,
+///     s = C' p + c w - d                  (eq. 6 with eq. 12 eliminated: u = C'p + (A/a) w)
+///     f = k w - c^T p                     (force of R on the stack, +y; eq. 12: w = A^T p + a f)
+/// C' = G_r K_rr^-1 G_r^T is the compliance with R held (eq. A3, SPD), k = 1/a the
+/// stiffness at R with no contact force, c = A/a the relative surface motion
+/// per unit w. All of it on the meshed part (half the spring on the half model).
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <memory>
+#include <vector>
+
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/model/model.hpp"
+
+namespace stackbeam {
+
+class System {
+public:
+    /// Assembles and condenses. Throws InputError when the stack is not
+    /// restrained with R held (a leaf or the seat free to move as a rigid body).
+    explicit System(const Model& model);
+
+    const Model& model() const noexcept { return model_; }
+
+    /// The contact pairs kept (components a support or the seat already fixes are
+    /// dropped), with their rows in C', c and the gaps.
+    const std::vector<ContactPair>& pairs() const noexcept { return pairs_; }
+    /// For each kept pair, its index in model().candidate_pairs().
+    const std::vector<int>& pair_candidates() const noexcept { return pair_candidate_; }
+    /// The candidate-pair record of kept pair k (interface, node, x).
+    const PairSpec& pair_spec(int k) const { return model_.candidate_pairs()[pair_candidate_[k]]; }
+    int num_components() const noexcept { return static_cast<int>(gaps_.size()); }
+    /// d_n per row for normal rows (the initial gap) and 0 for tangential rows [m].
+    const Eigen::VectorXd& initial_offsets_m() const noexcept { return gaps_; }
+    /// Compliance of the contact points with R held, C' [m/N] (eq. A3). Dense,
+    /// num_components()^2 doubles: built on the first call (one sparse solve per
+    /// contact row), not by the constructor, so that a large model run on the sparse
+    /// contact path (simulation.hpp, ContactPath) never pays for it. Thread-safe.
+    const Eigen::MatrixXd& compliance_held() const;
+    /// Whether compliance_held() has been built (for tests of the sparse path).
+    bool compliance_held_built() const noexcept;
+    /// Contact rows on the reduced DOFs, G [-] (num_components() x num_reduced_dofs(),
+    /// w last): s = G z - d for reduced displacements z (paper eq. 1 and 7).
+    const Eigen::SparseMatrix<double>& contact_rows() const noexcept { return G_; }
+    /// c = A/a: relative surface displacement per unit w with p = 0 [-].
+    const Eigen::VectorXd& coupling() const noexcept { return c_; }
+    /// k = 1/a: stiffness at R of the meshed part with p = 0 [N/m].
+    double stiffness_n_per_m() const noexcept { return k_; }
+    /// Mass carried by the meshed part [kg] (half of R on the half model).
+    double mass_kg() const noexcept { return mass_; }
+    /// Whole-spring stiffness at R with every kept contact component tied [N/m]
+    /// (the bonded stiffness on a bonded model): factor * (k + c^T C'^-1 c).
+    double tied_stiffness_n_per_m() const;
+    /// Whole-spring stiffness at R with every contact force zero [N/m].
+    double free_stiffness_n_per_m() const noexcept { return model_.whole_spring_factor() * k_; }
+    /// Index in pairs() of the probe pair, or -1.
+    int probe_pair() const noexcept { return probe_; }
+
+    /// Number of reduced degrees of freedom (including w, the last).
+    int num_reduced_dofs() const noexcept { return static_cast<int>(K_red_.rows()); }
+    /// Reduced stiffness P^T K P [N/m, N, N m per unit DOF], w last.
+    const Eigen::SparseMatrix<double>& stiffness_reduced() const noexcept { return K_red_; }
+    /// Reduced mass P^T M P [kg, kg m^2 per unit DOF], w last: the leaves' consistent
+    /// mass matrices (density from the model; 0 = massless, the paper) plus the rigid
+    /// body's mass on w (the meshed part's share: half on the half model).
+    Eigen::SparseMatrix<double> mass_reduced() const;
+    /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
+    /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
+    Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;
+    /// Displacements (u, v, theta) of every leaf node [m, m, rad] for contact forces p
+    /// and rigid-body displacement w: index 3*node_dof(leaf, node) + {0,1,2}.
+    Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
+    /// Offset of (leaf, node) in leaf_displacements() / 3, or -1 if the leaf has no such node.
+    int node_dof(int leaf, int node) const;
+
+private:
+    Model model_;
+    std::vector<ContactPair> pairs_;
+    std::vector<int> pair_candidate_;
+    Eigen::VectorXd gaps_;
+    struct LazyCompliance;                          // C', built once on demand
+    std::shared_ptr<LazyCompliance> C_held_;        // shared by copies (same model, same C')
+    Eigen::SparseMatrix<double> G_;                 // contact rows x reduced DOFs (w last)
+    Eigen::VectorXd c_;
+    double k_ = 0.0;
+    double mass_ = 0.0;
+    int probe_ = -1;
+    std::vector<int> node_offset_;         // per leaf: first full node index minus first_node
+    int num_full_ = 0;
+    Eigen::SparseMatrix<double> P_;        // full DOFs <- reduced DOFs
+    Eigen::SparseMatrix<double> K_red_;
+    Eigen::SparseMatrix<double> Gr_;       // contact rows x free DOFs (w excluded)
+    Eigen::SparseMatrix<double> Krw_col_;  // K_rw as a sparse column
+    Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> Krr_llt_;
+};
+
+}  // namespace stackbeam

@@ -1,0 +1,50 @@
+#pragma once
+/// @file scenario.hpp
+/// Scenario files: a whole run (the stack, the loading, the integrator and the
+/// outputs) described in a TOML file, e.g. scenarios/paper_friction.toml. The
+/// format is documented in scenarios/README.md.
+///
+/// Every key is checked: an unknown key, a wrong type, a missing required field
+/// or a value out of range throws InputError whose field() is the key's path in
+/// the file, e.g. "leaves[2].height_m", and whose message gives the value, what is
+/// allowed and where it is (file:line:column). The parser prints nothing, and the
+/// TOML library it uses is not part of this interface.
+#include <string>
+
+#include "stackbeam/model/model.hpp"
+#include "stackbeam/time/simulation.hpp"
+
+namespace stackbeam {
+
+/// Where a run writes its results. Empty: not given in the file. Relative paths
+/// are relative to the working directory (like command-line paths), not to the file.
+struct ScenarioOutputs {
+    std::string csv_path;     ///< `[outputs] csv_path`: the per-step records (CSV)
+    std::string events_path;  ///< `[outputs] events_path`: the event log (mode cvode), optional
+    std::string summary_path; ///< `[outputs] summary_path`: the JSON summary, optional
+    std::string pairs_path;   ///< `[outputs] pairs_path`: every pair at every output time (CSV), optional
+    std::string plot_prefix;  ///< `[outputs] plot_prefix`: PNG figures PREFIX_*.png (gnuplot), optional
+};
+
+/// A parsed, validated scenario.
+struct Scenario {
+    std::string source;        ///< the file name (or the name given to parse_scenario)
+    std::string description;   ///< free text (`description`), may be empty
+    ModelSpec model;           ///< the stack; Model::build(model) succeeds (checked by the parser)
+    /// The integrator and the loading (`simulation.loading`, from `[loading]`; the initial
+    /// conditions go to model.rigid_body); validate() succeeds (checked by the parser).
+    SimulationOptions simulation;
+    ScenarioOutputs outputs;
+};
+
+/// Parses scenario TOML `text`; `source_name` names it in messages. Builds the
+/// model once to validate it (Model::build) and validates the options
+/// (SimulationOptions::validate), translating their field names into the file's
+/// key paths. Throws InputError on any problem.
+Scenario parse_scenario(const std::string& text, const std::string& source_name);
+
+/// Reads and parses the scenario file at `path`. Throws InputError (field: the
+/// path) if it cannot be read, and as parse_scenario otherwise.
+Scenario load_scenario(const std::string& path);
+
+}  // namespace stackbeam

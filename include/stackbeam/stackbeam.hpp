@@ -1,0 +1,26 @@
+#pragma once
+/// @file stackbeam.hpp
+/// The whole public API in one include. The headers follow the data flow:
+///   model/    the spring as the user describes it (leaves, interfaces, clamps, body),
+///             the paper's example, the loadings
+///   fe/       the finite-element system built from it (stiffness, contact rows, mass)
+///             and its natural frequencies
+///   contact/  the per-step frictional contact problem and its solvers
+///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
+///   io/       scenario files (TOML) and CSV output
+///   post/     hysteresis-loop figures of a run
+#include "stackbeam/conventions.hpp"
+#include "stackbeam/errors.hpp"
+#include "stackbeam/model/model.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/model/loading.hpp"
+#include "stackbeam/fe/system.hpp"
+#include "stackbeam/fe/modal.hpp"
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/time/newmark_stepper.hpp"
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/io/csv.hpp"
+#include "stackbeam/post/hysteresis.hpp"

@@ -1,0 +1,91 @@
+#pragma once
+/// @file closed_form_stepper.hpp
+/// Mode closed-form: the paper's step for the rigid body on the massless stack.
+///
+/// Mode "closed-form" is the paper's reference scheme (section 4): the contact
+/// forces vary linearly over a step (eq. 14), so the motion of R has the exact
+/// solution (eq. 16)
+///     w(t') = k1 sin(omega t') + k2 cos(omega t') + [F(t) + (F(t+dt) - F(t)) (t'-t)/dt] / k,
+/// with omega = sqrt(k/m), F = c^T p the force of the contact forces on R. Hence
+///     w(t+dt) = w_free + (gamma/k) c^T p(t+dt),   gamma = 1 - sin(omega dt)/(omega dt),
+/// and the contact problem at t+dt is s = W p + q with
+///     W = C' + (gamma/k) c c^T  (constant for a fixed dt),  q = c w_free - d,
+/// which the chosen solver resolves (the paper's 8-step algorithm with the
+/// paper solver: steps 3-8 are its iteration on this problem).
+#include <memory>
+#include <vector>
+
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/fe/system.hpp"
+#include "stackbeam/time/simulation.hpp"
+
+namespace stackbeam {
+
+/// The paper's closed-form stepping (mode "closed-form").
+///
+/// On the sparse path (ContactPath) the same step is posed on the reduced stiffness
+/// instead of on W (SparseContactProblem, K z = b + G^T p, s = G z - d): eq. 16's
+/// w(t+dt) = w_free + (gamma/k) c^T p makes the rigid body a spring on w,
+///     K_aug = K + k_R e_w e_w^T,  k_R = k (1 - gamma) / gamma,   b = (k/gamma) w_free e_w,
+/// which is exact: eliminating z gives W = G K_aug^-1 G^T = C' + (gamma/k) c c^T and
+/// q = c w_free - d (the w row reads (k + k_R) w = (k/gamma) w_free + c^T p, and
+/// k + k_R = k/gamma). So both paths solve the same problem, to round-off.
+class ClosedFormStepper {
+public:
+    ClosedFormStepper(const System& system, const SimulationOptions& options);
+
+    /// Advances one step of dt. Throws SolverError (step, time, residual) if the
+    /// contact solve fails and options.stop_on_nonconvergence.
+    const StepRecord& step();
+    const StepRecord& current() const noexcept { return record_; }
+    long step_index() const noexcept { return step_; }
+
+    /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
+    const Eigen::VectorXd& contact_forces() const noexcept { return p_; }
+    /// Relative surface positions s + d [m] per row (normal: approach, tangential: slip position).
+    const Eigen::VectorXd& relative_positions() const noexcept { return rel_; }
+    /// Tangential anchors d_t and normal gaps d_n [m] per row.
+    const Eigen::VectorXd& anchors() const noexcept { return d_; }
+    /// State of each pair of system().pairs().
+    std::vector<PairState> pair_states() const;
+    /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
+    /// On the sparse path W and q are empty (the pairs and tau rule are set): see last_sparse_problem().
+    const ContactProblem& last_problem() const noexcept { return problem_; }
+    /// The sparse contact problem of the last step (sparse path; empty on the dense path).
+    const SparseContactProblem& last_sparse_problem() const noexcept { return sparse_problem_; }
+    /// The path this stepper uses (never automatic).
+    ContactPath contact_path() const noexcept { return path_; }
+    /// Reduced displacements z of the leaves [m, rad] at the current step (sparse path; empty on the dense path).
+    const Eigen::VectorXd& reduced_displacements() const noexcept { return z_; }
+    const SolveResult& last_solve() const noexcept { return solve_; }
+    const System& system() const noexcept { return system_; }
+    double omega_rad_per_s() const noexcept { return omega_; }
+
+private:
+    const System& system_;
+    SimulationOptions options_;
+    ContactPath path_ = ContactPath::dense;
+    std::unique_ptr<ContactSolver> solver_;
+    std::unique_ptr<SparseContactSolver> sparse_solver_;
+    ContactProblem problem_;
+    SparseContactProblem sparse_problem_;
+    Eigen::VectorXd z_;
+    int w_dof_ = -1;
+    double k_r_ = 0.0;  // sparse path: the rigid body's spring k_R [N/m] in K_aug
+    SolveResult solve_;
+    Eigen::VectorXd p_, d_, rel_;
+    double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
+    double omega_ = 0.0, cos_ = 1.0, sin_ = 0.0, gamma_ = 0.0;
+    double e0_ = 0.0, dissipated_ = 0.0;
+    long step_ = 0;
+    StepRecord record_;
+    // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
+    // external work [J, whole spring], and for the rig and the sparse path R's column of
+    // K (K_rw) and of G.
+    bool rig_ = false;
+    double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
+    Eigen::VectorXd krw_, gw_;
+    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
+};
+
+}  // namespace stackbeam

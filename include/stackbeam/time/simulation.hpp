@@ -1,0 +1,158 @@
+#pragma once
+/// @file simulation.hpp
+/// The simulation's options, its per-record results (StepRecord, PairRecord) and
+/// simulate(), which runs a model in one of the modes (Mode) from t = 0 to t_end.
+/// The steppers of the modes: closed_form_stepper.hpp, cvode_stepper.hpp,
+/// newmark_stepper.hpp.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/model/loading.hpp"
+#include "stackbeam/fe/system.hpp"
+
+namespace stackbeam {
+
+/// Whole-spring values at the end of a step (also on the half model). SI units.
+struct StepRecord {
+    double t_s = 0.0;                   ///< time [s]
+    double w_m = 0.0;                   ///< displacement of R [m] (+y; the initial velocity's direction in the example)
+    double w_dot_m_per_s = 0.0;         ///< velocity of R [m/s]
+    double force_on_mass_n = 0.0;       ///< m * d2w/dt2 = -(force of R on the stack) [N]
+    double probe_friction_force_n = 0.0;///< tangential contact force p_t at the probe pair [N] (0 if it has none; NaN: no probe)
+    int contact_iterations = 0;         ///< solver iterations of this step
+    int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
+    double kinetic_energy_j = 0.0;      ///< kinetic energy [J]: m w_dot^2 / 2, plus the leaves' v^T M v / 2 in mode newmark
+    double strain_energy_j = 0.0;       ///< elastic energy of the leaves [J]
+    double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
+    double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
+    double contact_residual_m = 0.0;    ///< ||v||_2 (eq. 9) at the converged forces [m]
+    int factorizations = 0;             ///< dense factorisations of the step (exact solver)
+    // Loadings (loading.hpp); all zero under the paper's initial conditions.
+    double spring_force_n = 0.0;        ///< force of R on the stack, +y: k w - c^T p, whole spring [N]
+                                        ///< (the force the rig's load cell reads; the loop is spring_force vs w)
+    double external_force_n = 0.0;      ///< load on R besides the stack: applied force - weight - m y_b'' [N];
+                                        ///< prescribed displacement: the rig's force on the spring (= spring_force_n)
+    double base_displacement_m = 0.0;   ///< y_b of the supports [m] (base excitation): R's absolute displacement is w + y_b
+    double external_work_j = 0.0;       ///< work of the external loads since t = 0 [J]; the balance is
+                                        ///< E(0) + external work - (kinetic + strain + dissipated)
+    double leaf_kinetic_energy_j = 0.0; ///< the leaves' share of kinetic_energy_j [J] (0 with massless leaves)
+    double impact_loss_j = 0.0;         ///< cumulative energy lost at contact closures net of openings [J]
+                                        ///< (mode newmark: the normal contact work, newmark_stepper.hpp)
+};
+
+/// Column names of StepRecord in CSV order.
+std::vector<std::string> step_record_columns();
+/// Values of a record in the order of step_record_columns().
+std::vector<double> step_record_values(const StepRecord& r);
+
+/// The integrators.
+enum class Mode {
+    closed_form,  ///< the paper's closed-form step (eq. 16), fixed dt: the reference (massless leaves)
+    cvode,        ///< SUNDIALS CVODE between events, root-finding on every contact transition (massless leaves)
+    newmark,      ///< leaves with mass: average-acceleration Newmark, fixed dt (newmark_stepper.hpp)
+};
+const char* to_string(Mode m);
+Mode parse_mode(const std::string& text, const std::string& field);
+
+/// How the closed-form stepper poses the per-step contact problem.
+enum class ContactPath {
+    automatic,  ///< dense for small problems, sparse for large ones (see choose_contact_path)
+    dense,      ///< ContactProblem: the dense W = C' + (gamma/k) c c^T (O(m^2) memory, O(m^3) set-up); every solver
+    sparse,     ///< SparseContactProblem on the banded stiffness, near-linear in the elements; exact solver only
+};
+const char* to_string(ContactPath path);
+/// Parses "auto" | "dense" | "sparse"; throws InputError naming `field`.
+ContactPath parse_contact_path(const std::string& text, const std::string& field);
+
+/// ContactPath::automatic takes the sparse path from this many contact components
+/// (rows of the contact problem) on, with the exact solver. Measured (BENCHMARKS.md,
+/// friction case, the costliest): at 636 rows both paths take the same time per step,
+/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
+/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
+/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
+constexpr int kSparsePathMinComponents = 1000;
+
+/// Options of mode "cvode" (see cvode_stepper.hpp).
+struct CvodeOptions {
+    double rtol = 1e-8;          ///< CVODE relative tolerance [-]
+    double atol_m = 1e-12;       ///< absolute tolerance on w [m]; on w_dot it is atol_m * omega, on the
+                                 ///< dissipated energy atol_m * k * (amplitude scale) (see cvode_stepper.cpp)
+    double max_step_s = 0.0;     ///< largest internal step [s]; 0 = no limit
+    bool root_finding = true;    ///< locate transitions by CVODE root-finding (false: only the per-step
+                                 ///< contact check finds them, by bisection; for testing that safety net)
+    long max_steps = 10000000;   ///< limit on CVODE's internal steps over the whole run
+    double modal_cutoff_rad_per_s = 0.0;  ///< leaf inertia with friction only: the stack's modes up to this
+                                          ///< circular frequency carry the inertia, those above respond
+                                          ///< quasi-statically [rad/s]; 0 = 10 x the stack's first
+                                          ///< frequency (docs/inertia.md)
+};
+
+struct SimulationOptions {
+    Mode mode = Mode::closed_form;
+    double dt_s = 1e-3;        ///< time step [s] (paper: 1e-3); in mode cvode the output interval
+    CvodeOptions cvode;        ///< mode cvode only
+    double t_end_s = 0.6;      ///< end time [s]
+    Loading loading;           ///< how the spring is loaded (loading.hpp); default: the paper's initial conditions
+    SolverOptions solver;      ///< contact solver and its tolerance (paper: ||v|| < 2e-6 m)
+    TauRule tau_rule = TauRule::current;
+    /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
+    ContactPath contact_path = ContactPath::automatic;
+    /// Sparse path only: how its exact solver solves the linear problems and the transitions
+    /// (contact.hpp; the defaults are the measured choices, BENCHMARKS.md).
+    SparsePathTuning sparse_tuning;
+    /// Throw SolverError when a step's contact solve does not converge (default);
+    /// if false the step is kept and flagged by its residual.
+    bool stop_on_nonconvergence = true;
+    /// Mode newmark with massive leaves: the normal restitution coefficient e [-] of the
+    /// impact law, 0 <= e <= 1. A normal component that closes in a step leaves it with
+    /// its relative velocity reversed to -e times its approach velocity at the step's
+    /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
+    /// ends with relative velocity 0. Docs: docs/inertia.md.
+    double restitution = 0.0;
+    /// Throws InputError naming the option when a value is out of range.
+    void validate() const;
+};
+
+/// The contact path `options.contact_path` resolves to on `system`: automatic gives
+/// sparse when the solver is exact and system.num_components() >= kSparsePathMinComponents,
+/// dense otherwise. Throws InputError for the sparse path with a solver other than exact.
+ContactPath choose_contact_path(const System& system, const SimulationOptions& options);
+
+/// Throws InputError when the model's initial conditions contradict the loading
+/// (a prescribed displacement fixes w(0) and w'(0) itself).
+void require_loading_fits(const ModelSpec& model, const Loading& loading);
+
+/// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
+/// with a density > 0 would be silently ignored there: this throws InputError naming
+/// it (leaves[i].density_kg_per_m3) instead. modal.hpp uses the density.
+void require_massless_leaves(const System& system, Mode mode);
+
+struct RunReport;  // cvode_stepper.hpp
+
+/// One contact pair at one time (simulate's per-pair output; meshed part, signs of
+/// conventions.hpp).
+struct PairRecord {
+    int pair = 0;             ///< index in System::pairs()
+    int interface_index = 0;  ///< interface i: leaf i above, leaf i+1 below
+    double x_m = 0.0;         ///< position along the leaves [m]
+    PairState state = PairState::open;
+    double p_n_n = 0.0;       ///< normal force [N], < 0 compression (0 when the pair has no normal row)
+    double p_t_n = 0.0;       ///< tangential (friction) force on the upper leaf, +x [N] (0: no tangential row)
+    double gap_m = 0.0;       ///< normal gap d_n - approach [m]: > 0 open, 0 closed (0: no normal row)
+    double slip_m = 0.0;      ///< tangential displacement of the upper surface relative to the lower, +x [m]
+};
+/// Receives the pairs at each record's time (t [s], one entry per System::pairs()).
+using PairObserver = std::function<void(double t_s, const std::vector<PairRecord>&)>;
+
+/// Runs from t = 0 to options.t_end_s in options.mode; the first record is the
+/// initial state, then one per dt_s (a step of the closed-form mode, an output time
+/// of the cvode mode). `on_step` (optional) sees every record as it is made;
+/// `report` (optional) receives the counters and, in mode cvode, the event log;
+/// `on_pairs` (optional) sees every pair at every record's time.
+std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
+                                 const std::function<void(const StepRecord&)>& on_step = {},
+                                 RunReport* report = nullptr, const PairObserver& on_pairs = {});
+
+}  // namespace stackbeam

@@ -1,0 +1,361 @@
+#pragma once
+// Internal: the modes of the active-set contact solvers, shared by the dense `exact`
+// solver (contact/exact.cpp) and the sparse path (contact/sparse/sparse_solver.cpp), so that both
+// take the same decisions from the same numbers.
+//
+// Every pair component is in one mode: a normal component is closed (s_n = 0) or
+// open (p_n = 0); a tangential one sticks (s_t = 0), slips with its force at the
+// limit (p_t = sigma mu tau, sigma = +-1, tau affine in the pair's own p_n) or is
+// free (p_t = 0: open pair, mu = 0, clamp pulled apart past its preload). For a set
+// of modes the contact problem is linear. What is path-specific is only how that
+// linear problem is solved and how s = W p + q is evaluated: this file needs s and
+// the diagonal of W, never W itself.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "stackbeam/contact/contact.hpp"
+
+namespace stackbeam::detail {
+
+enum : signed char { NONE = 0, CLOSED = 1, OPEN = 2 };
+enum : signed char { STICK = 1, SLIP_POS = 2, SLIP_NEG = 3, FREE = 4 };
+
+/// The linear problem of a set of modes: the rows held by "s = 0" (S, in pair order),
+/// the forces the modes fix (e, zero on S), and the slip rows whose force is affine in
+/// their pair's normal unknown: p_t = e_t + coef * p_n.
+struct ModeLinearization {
+    std::vector<int> S;
+    Eigen::VectorXd e;
+    std::vector<std::pair<int, int>> coupled;  // (tangential row, normal row)
+    std::vector<double> coef;                  // dp_t / dp_n
+};
+
+class ModeSet {
+public:
+    std::vector<signed char> nmode, tmode;
+
+    static bool unilateral(const ContactPair& c) { return c.kind == PairKind::coulomb; }
+
+    std::vector<signed char> key() const {
+        std::vector<signed char> k(nmode);
+        k.insert(k.end(), tmode.begin(), tmode.end());
+        return k;
+    }
+
+    void make_consistent(const ContactProblem& pr, int k) {
+        const auto& c = pr.pairs[k];
+        if (c.row_t < 0 || c.kind == PairKind::bonded) return;
+        const bool closed = c.row_n >= 0 ? nmode[k] == CLOSED : !unilateral(c);
+        if (c.friction_coefficient == 0.0) {
+            tmode[k] = FREE;
+        } else if (unilateral(c)) {
+            if (!closed) tmode[k] = FREE;
+            else if (tmode[k] == FREE) tmode[k] = STICK;
+        }
+    }
+
+    /// Modes read from forces p and relative positions s0 = W p + q.
+    void init(const ContactProblem& pr, const Eigen::VectorXd& p, const Eigen::VectorXd& s0) {
+        const int np = static_cast<int>(pr.pairs.size());
+        nmode.assign(np, NONE);
+        tmode.assign(np, NONE);
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0)
+                nmode[k] = (!unilateral(c) || p[c.row_n] < 0.0 || s0[c.row_n] >= 0.0) ? CLOSED : OPEN;
+            if (c.row_t >= 0) {
+                if (c.kind == PairKind::bonded) {
+                    tmode[k] = STICK;
+                } else {
+                    const double limit = c.friction_coefficient * friction_normal_force(pr, k, p);
+                    const double pt = p[c.row_t];
+                    tmode[k] = (limit > 0.0 && std::abs(pt) >= limit * (1.0 - 1e-9)) ? (pt > 0 ? SLIP_POS : SLIP_NEG) : STICK;
+                }
+                make_consistent(pr, k);
+            }
+        }
+    }
+
+    /// The linear problem of the current modes.
+    void linearize(const ContactProblem& pr, ModeLinearization& lin) const {
+        const int n = pr.size();
+        const int np = static_cast<int>(pr.pairs.size());
+        const bool prev = pr.tau_rule == TauRule::previous_step;
+        lin.e.setZero(n);
+        lin.coupled.clear();
+        lin.coef.clear();
+        lin.S.clear();
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && nmode[k] == CLOSED) lin.S.push_back(c.row_n);
+            if (c.row_t >= 0 && tmode[k] == STICK) lin.S.push_back(c.row_t);
+        }
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t < 0 || (tmode[k] != SLIP_POS && tmode[k] != SLIP_NEG)) continue;
+            const double sigma = tmode[k] == SLIP_POS ? 1.0 : -1.0;
+            const double mu = c.friction_coefficient;
+            if (prev) {
+                lin.e[c.row_t] = sigma * mu * pr.tau_previous_n[k];
+            } else if (c.kind == PairKind::clamp) {  // p_t = sigma mu (F_c - p_n)
+                lin.e[c.row_t] = sigma * mu * c.preload_n;
+                if (c.row_n >= 0) {
+                    lin.coupled.emplace_back(c.row_t, c.row_n);
+                    lin.coef.push_back(-sigma * mu);
+                }
+            } else {  // coulomb: p_t = sigma mu (-p_n)
+                lin.coupled.emplace_back(c.row_t, c.row_n);
+                lin.coef.push_back(-sigma * mu);
+            }
+        }
+    }
+
+    /// Slip rows: p_t = sigma mu tau(p_n), written with the same formula as the friction limit.
+    void put_slip_forces(const ContactProblem& pr, Eigen::VectorXd& p) const {
+        for (int k = 0; k < static_cast<int>(pr.pairs.size()); ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_t >= 0 && (tmode[k] == SLIP_POS || tmode[k] == SLIP_NEG))
+                p[c.row_t] = (tmode[k] == SLIP_POS ? 1.0 : -1.0) * c.friction_coefficient * friction_normal_force(pr, k, p);
+        }
+    }
+
+    /// Finds the modes whose inequality fails at (p, s) (kept for apply_switches); returns
+    /// their number. Every violation is measured in metres: a gap error directly, a force
+    /// error by the motion it would cause, force x W_kk (`diag` is the diagonal of W). A
+    /// mode is wrong when its violation exceeds `threshold_m`: near-degenerate components
+    /// (p and s both ~0, common where identical leaves just touch) then cannot ping-pong.
+    int count_violations(const ContactProblem& pr, const Eigen::VectorXd& p, const Eigen::VectorXd& s,
+                         const Eigen::VectorXd& diag, double threshold_m) {
+        const double ts = threshold_m;
+        const int np = static_cast<int>(pr.pairs.size());
+        sw_.clear();
+        auto add = [&](int k, bool normal, signed char to, double size_m) {
+            if (size_m > ts) sw_.push_back({k, normal, to, size_m});
+        };
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            const double Wn = c.row_n >= 0 ? diag[c.row_n] : 0.0;
+            const double Wt = c.row_t >= 0 ? diag[c.row_t] : 0.0;
+            if (c.row_n >= 0 && unilateral(c)) {
+                const double pn = p[c.row_n], sn = s[c.row_n];
+                if (nmode[k] == CLOSED) add(k, true, OPEN, pn * Wn);
+                if (nmode[k] == OPEN) add(k, true, CLOSED, sn);
+            }
+            if (c.row_t < 0 || c.kind == PairKind::bonded || c.friction_coefficient == 0.0) continue;
+            if (unilateral(c) && tmode[k] == FREE) continue;  // follows the normal mode
+            const double mu = c.friction_coefficient;
+            const double pt = p[c.row_t], st = s[c.row_t];
+            const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0;
+            const double release_m = (c.kind == PairKind::clamp && pr.tau_rule == TauRule::current)
+                                         ? mu * (pn - c.preload_n) * Wt  // friction lost past the preload
+                                         : -1.0;
+            const double limit = mu * friction_normal_force(pr, k, p);
+            switch (tmode[k]) {
+                case STICK:
+                    if (release_m > ts) add(k, false, FREE, release_m);
+                    else add(k, false, pt > 0 ? SLIP_POS : SLIP_NEG, (std::abs(pt) - limit) * Wt);
+                    break;
+                case SLIP_POS:
+                case SLIP_NEG: {
+                    const double sigma = tmode[k] == SLIP_POS ? 1.0 : -1.0;
+                    if (release_m > ts) add(k, false, FREE, release_m);
+                    else add(k, false, STICK, sigma * st);
+                    break;
+                }
+                case FREE:  // a clamp that carried no friction
+                    if (c.kind == PairKind::clamp) add(k, false, STICK, -release_m);
+                    break;
+                default: break;
+            }
+        }
+        return static_cast<int>(sw_.size());
+    }
+
+    /// Switches the violated modes found by count_violations: all, or only the first.
+    void apply_switches(const ContactProblem& pr, bool single) {
+        // Contact status first, friction second: while a normal mode is wrong, the
+        // tangential verdicts rest on wrong normal forces.
+        if (std::any_of(sw_.begin(), sw_.end(), [](const Switch& x) { return x.normal; }))
+            sw_.erase(std::remove_if(sw_.begin(), sw_.end(), [](const Switch& x) { return !x.normal; }), sw_.end());
+        if (single) sw_.resize(1);
+        for (const auto& x : sw_) {
+            if (x.normal) nmode[x.k] = x.to;
+            else tmode[x.k] = x.to;
+            if (x.normal && x.to == CLOSED && pr.pairs[x.k].row_t >= 0) tmode[x.k] = STICK;
+            make_consistent(pr, x.k);
+        }
+    }
+
+private:
+    struct Switch { int k; bool normal; signed char to; double size; };
+    std::vector<Switch> sw_;
+};
+
+/// Active-set passes from the current modes; true when no mode is violated.
+/// Block principal pivoting (Judice & Pires): switch every violated mode while the
+/// number of violations falls; when it has not fallen for `budget_passes` passes,
+/// switch only the first violated one (Murty's least-index rule, finite for P-matrices).
+/// `solve_modes(p)` solves the linear problem of the modes into p and returns the
+/// number of factorisations it made; `violations(p)` returns modes.count_violations(...).
+template <class SolveModes, class Violations>
+bool active_set_passes(ModeSet& modes, const ContactProblem& pr, Eigen::VectorXd& p, int max_passes,
+                       int budget_passes, SolveResult& r, SolveModes solve_modes, Violations violations) {
+    int best = std::numeric_limits<int>::max(), budget = budget_passes;
+    bool single = false;
+    for (int pass = 1; pass <= max_passes; ++pass) {
+        ++r.iterations;
+        r.factorizations += solve_modes(p);
+        const int v = violations(p);
+        if (v == 0) return true;
+        if (v < best) {
+            best = v;
+            budget = budget_passes;
+            single = false;
+        } else if (budget > 0) {
+            --budget;
+        } else {
+            single = true;
+        }
+        modes.apply_switches(pr, single);
+    }
+    return false;
+}
+
+/// Anderson acceleration (type II) of a fixed point x = g(x) on the friction limits,
+/// in the scaled variables y = scale * x [m] (entries with scale 0 take x = g, unmixed).
+/// next(scale, g, x): given g(x) at the current x, replaces x by the next iterate,
+///     y+ = g_y - dG gamma,  gamma = argmin || f - dF gamma ||_2,  f = g_y - y,
+/// over the last `depth` differences dF, dG, then projects on x >= 0 (limits are forces).
+class AndersonMixer {
+public:
+    AndersonMixer(int n, int depth) : depth_(depth), dF_(n, depth), dG_(n, depth) {}
+
+    void next(const Eigen::VectorXd& scale, const Eigen::VectorXd& g, Eigen::VectorXd& x) {
+        const Eigen::Index n = x.size();
+        Eigen::VectorXd gy(n), f(n);
+        for (Eigen::Index k = 0; k < n; ++k) {
+            gy[k] = scale[k] != 0.0 ? scale[k] * g[k] : 0.0;
+            f[k] = scale[k] != 0.0 ? gy[k] - scale[k] * x[k] : 0.0;
+        }
+        Eigen::VectorXd y = gy;
+        if (depth_ > 0 && f_.size() == n) {
+            const int slot = count_ % depth_;  // ring buffer of the last `depth` differences
+            dF_.col(slot) = f - f_;
+            dG_.col(slot) = gy - g_;
+            ++count_;
+            const int m = std::min(count_, depth_);
+            const Eigen::VectorXd gamma = dF_.leftCols(m).colPivHouseholderQr().solve(f);
+            if (gamma.allFinite()) y -= dG_.leftCols(m) * gamma;
+        }
+        const bool mixed = count_ > 0;
+        f_ = f;
+        g_ = gy;
+        for (Eigen::Index k = 0; k < n; ++k)
+            x[k] = mixed && scale[k] != 0.0 ? std::max(0.0, y[k] / scale[k]) : g[k];
+    }
+
+private:
+    int depth_;
+    int count_ = 0;
+    Eigen::MatrixXd dF_, dG_;  // differences of f and of g_y [m], one column per iteration
+    Eigen::VectorXd f_, g_;    // the last f and g_y
+};
+
+/// The Tresca fixed point of the exact solvers (dense and sparse): each pass solves
+/// the problem with the friction limits frozen, a box-constrained convex QP (unilateral
+/// normals in (-inf, 0], held at 0 when open; tangential rows in [-mu tau, mu tau],
+/// held at their bound while slipping); the limits are updated from its normal forces
+/// until they settle to `accept` (in metres: the change of mu tau times W's diagonal);
+/// its final working set then gives the modes, and slip forces are put at the limit of
+/// the final tau. Returns true when the limits settled within `max_iterations` passes.
+///
+/// The limits are updated by Anderson acceleration of depth `anderson_depth` (0: the plain
+/// fixed point tau <- tau(p)). The map from limits to normal forces is piecewise affine
+/// (affine while the box QP's working set stays); on fine meshes its contraction factor
+/// nears 1 (neighbouring pairs' normal forces are nearly interchangeable), and the plain
+/// update creeps or oscillates there: graduated 10 leaves x 100 elements, steps that ran all
+/// 100 passes unsettled now settle in 10-13 (BENCHMARKS.md). The mixing works on the
+/// limits in metres, y = mu tau W_tt (the measure `accept` uses), and is projected on tau >= 0.
+///   Anderson, J. ACM 12 (1965); Walker & Ni, SIAM J. Numer. Anal. 49 (2011), type II.
+///   box_solve(lower, upper, at_bound) -> bool   solves the box QP into p (the path's
+///                                                own start, factorisations, counters)
+///   diagonal(row) -> W_row,row [m/N]
+///   tangential_s(row) -> s_row at the final p   (only where a box of zero width, tau = 0
+///                                                in the last QP, held a force without a sign)
+template <class BoxSolve, class Diagonal, class TangentialS>
+bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::VectorXd& p, double accept,
+                        int max_iterations, int anderson_depth, BoxSolve box_solve, Diagonal diagonal,
+                        TangentialS tangential_s) {
+    const int np = static_cast<int>(pr.pairs.size());
+    const double inf = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -inf), upper = Eigen::VectorXd::Constant(n, inf);
+    std::vector<signed char> at_bound(n, 0);
+    for (int k = 0; k < np; ++k) {
+        const auto& c = pr.pairs[k];
+        if (c.row_n >= 0 && ModeSet::unilateral(c)) {
+            upper[c.row_n] = 0.0;
+            if (modes.nmode[k] == OPEN) at_bound[c.row_n] = +1;
+        }
+        if (c.row_t >= 0 && (modes.tmode[k] == SLIP_POS || modes.tmode[k] == SLIP_NEG))
+            at_bound[c.row_t] = modes.tmode[k] == SLIP_POS ? +1 : -1;
+    }
+    Eigen::VectorXd tau(np), scale_m = Eigen::VectorXd::Zero(np);  // scale_m = mu W_tt [m/N]
+    std::vector<char> limited(np, 0);  // pairs with a friction limit (a tangential row, not bonded)
+    for (int k = 0; k < np; ++k) {
+        const auto& c = pr.pairs[k];
+        tau[k] = friction_normal_force(pr, k, p);
+        limited[k] = c.row_t >= 0 && c.kind != PairKind::bonded;
+        if (limited[k]) scale_m[k] = c.friction_coefficient * diagonal(c.row_t);
+    }
+    AndersonMixer mixer(np, anderson_depth);
+    Eigen::VectorXd g = tau;
+    for (int it = 0; it < max_iterations; ++it) {
+        for (int k = 0; k < np; ++k) {
+            if (!limited[k]) continue;
+            const auto& c = pr.pairs[k];
+            const double limit = c.friction_coefficient * tau[k];
+            lower[c.row_t] = -limit;
+            upper[c.row_t] = limit;
+        }
+        if (!box_solve(lower, upper, at_bound)) return false;
+        double change_m = 0.0;
+        for (int k = 0; k < np; ++k) {
+            if (!limited[k]) continue;
+            g[k] = friction_normal_force(pr, k, p);
+            change_m = std::max(change_m, scale_m[k] * std::abs(g[k] - tau[k]));
+        }
+        if (change_m > accept) {
+            mixer.next(scale_m, g, tau);
+            continue;
+        }
+        // modes from the working set; slip forces put at the limit of the final tau, g
+        // (the normal forces of the last box QP; setting p's tangential rows leaves them)
+        for (int k = 0; k < np; ++k) {
+            const auto& c = pr.pairs[k];
+            if (c.row_n >= 0 && ModeSet::unilateral(c)) modes.nmode[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
+            if (!limited[k]) continue;
+            const double limit = c.friction_coefficient * g[k];
+            if (limit <= 0.0) {
+                modes.tmode[k] = FREE;
+                p[c.row_t] = 0.0;
+            } else if (at_bound[c.row_t] != 0) {
+                // slip against the motion; a box that had zero width (tau was 0 in the
+                // last QP) held the force without a sign: take it from s_t.
+                const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t]
+                                                                          : (tangential_s(c.row_t) > 0.0 ? -1 : +1);
+                modes.tmode[k] = sigma > 0 ? SLIP_POS : SLIP_NEG;
+                p[c.row_t] = sigma * limit;
+            } else {
+                modes.tmode[k] = STICK;
+            }
+            modes.make_consistent(pr, k);
+        }
+        return true;
+    }
+    return false;
+}
+
+}  // namespace stackbeam::detail

@@ -1,0 +1,267 @@
+// Finite elements of the leaves, constraints, and the condensation of the
+// paper's eqs. (1)-(6) and (A3). See system.hpp for the formulation.
+#include "stackbeam/fe/system.hpp"
+
+#include <cmath>
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <string>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+struct System::LazyCompliance {
+    std::once_flag once;
+    std::atomic<bool> built{false};
+    Eigen::MatrixXd C;
+};
+
+namespace {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+/// Bernoulli-Euler 2-node element, DOFs (u1, v1, th1, u2, v2, th2): axial EA/L
+/// and bending EI/L^3 [12 6L -12 6L; 6L 4L^2 -6L 2L^2; ...], exact for end loads.
+void add_element(Triplets& t, int a, int b, double EA, double EI, double L) {
+    const int d[6] = {3 * a, 3 * a + 1, 3 * a + 2, 3 * b, 3 * b + 1, 3 * b + 2};
+    double k[6][6] = {};
+    k[0][0] = k[3][3] = EA / L;
+    k[0][3] = k[3][0] = -EA / L;
+    const double c = EI / (L * L * L);
+    const double kb[4][4] = {{12 * c, 6 * L * c, -12 * c, 6 * L * c},
+                             {6 * L * c, 4 * L * L * c, -6 * L * c, 2 * L * L * c},
+                             {-12 * c, -6 * L * c, 12 * c, -6 * L * c},
+                             {6 * L * c, 2 * L * L * c, -6 * L * c, 4 * L * L * c}};
+    const int bi[4] = {1, 2, 4, 5};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) k[bi[i]][bi[j]] = kb[i][j];
+    for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j)
+            if (k[i][j] != 0.0) t.emplace_back(d[i], d[j], k[i][j]);
+}
+
+}  // namespace
+
+int System::node_dof(int leaf, int node) const {
+    if (!model_.leaf_has_node(leaf, node)) return -1;
+    return node_offset_[leaf] + node;
+}
+
+System::System(const Model& model) : model_(model) {
+    const auto& spec = model_.spec();
+    const int nleaf = static_cast<int>(spec.leaves.size());
+    const auto& xs = model_.nodes_x();
+    const bool half = spec.symmetry == Symmetry::half;
+    const double tol = model_.x_tolerance_m();
+    const int attach = model_.attachment_node();
+    const auto& tied = model_.tied_leaves();
+    const auto& yc = model_.centroid_heights_m();
+
+    // --- full DOF numbering: leaf by leaf, 3 per node ---------------------------
+    node_offset_.resize(nleaf);
+    int nfull_nodes = 0;
+    for (int l = 0; l < nleaf; ++l) {
+        node_offset_[l] = nfull_nodes - model_.first_node(l);
+        nfull_nodes += model_.last_node(l) - model_.first_node(l) + 1;
+    }
+    num_full_ = 3 * nfull_nodes;
+
+    Triplets kt;
+    for (int l = 0; l < nleaf; ++l) {
+        const auto& leaf = spec.leaves[l];
+        const double EA = leaf.youngs_modulus_pa * leaf.width_m * leaf.height_m;
+        const double EI = leaf.youngs_modulus_pa * leaf.width_m * std::pow(leaf.height_m, 3) / 12.0;
+        for (int j = model_.first_node(l); j < model_.last_node(l); ++j)
+            add_element(kt, node_dof(l, j), node_dof(l, j + 1), EA, EI, xs[j + 1] - xs[j]);
+    }
+    Eigen::SparseMatrix<double> K(num_full_, num_full_);
+    K.setFromTriplets(kt.begin(), kt.end());
+
+    // --- constraints: each full DOF = sum of coef * master ------------------------
+    // kind per full dof: -1 fixed, -2 seat w, -3 seat theta, -4 seat axial (-y theta_R), >=0 own master
+    const bool seat_rotates = !half;
+    std::vector<int> role(num_full_, 0);
+    for (int l = 0; l < nleaf; ++l) {
+        const auto& leaf = spec.leaves[l];
+        const bool is_tied = std::find(tied.begin(), tied.end(), l) != tied.end();
+        for (int j = model_.first_node(l); j <= model_.last_node(l); ++j) {
+            const int b = 3 * node_dof(l, j);
+            auto support = [&](SupportKind s) {
+                if (s == SupportKind::pinned) role[b + 1] = -1;
+                if (s == SupportKind::fixed) role[b] = role[b + 1] = role[b + 2] = -1;
+            };
+            const bool left_end = std::abs(xs[j] - leaf.x_start_m) <= tol;
+            const bool right_end = std::abs(xs[j] - (leaf.x_start_m + leaf.length_m)) <= tol;
+            if (left_end) support(leaf.left_support);
+            if (right_end) support(leaf.right_support);
+            if (j == attach && is_tied) {
+                if ((left_end && leaf.left_support != SupportKind::free) ||
+                    (right_end && leaf.right_support != SupportKind::free))
+                    throw InputError("rigid_body.x_m", "value " + format_value(spec.rigid_body.x_m) +
+                                                           " is at a supported end of leaves[" + std::to_string(l) +
+                                                           "]: the rigid body must be free to move");
+                role[b + 1] = -2;
+                role[b + 2] = seat_rotates ? -3 : -1;
+                role[b] = seat_rotates ? -4 : -1;
+            }
+            if (half && j == attach) {  // symmetry plane: u = 0, theta = 0
+                role[b] = -1;
+                role[b + 2] = -1;
+            }
+        }
+    }
+    // masters: node-major order for a narrow band, then theta_R, then w
+    int nm = 0;
+    std::vector<int> master(num_full_, -1);
+    for (int j = 0; j < static_cast<int>(xs.size()); ++j)
+        for (int l = 0; l < nleaf; ++l) {
+            if (!model_.leaf_has_node(l, j)) continue;
+            for (int d = 0; d < 3; ++d)
+                if (role[3 * node_dof(l, j) + d] == 0) master[3 * node_dof(l, j) + d] = nm++;
+        }
+    const int theta_master = seat_rotates ? nm++ : -1;
+    const int w_master = nm++;
+    Triplets pt;
+    for (int l = 0; l < nleaf; ++l)
+        for (int j = model_.first_node(l); j <= model_.last_node(l); ++j)
+            for (int d = 0; d < 3; ++d) {
+                const int i = 3 * node_dof(l, j) + d;
+                switch (role[i]) {
+                    case 0: pt.emplace_back(i, master[i], 1.0); break;
+                    case -2: pt.emplace_back(i, w_master, 1.0); break;
+                    case -3: pt.emplace_back(i, theta_master, 1.0); break;
+                    case -4: if (yc[l] != 0.0) pt.emplace_back(i, theta_master, -yc[l]); break;
+                    default: break;
+                }
+            }
+    P_.resize(num_full_, nm);
+    P_.setFromTriplets(pt.begin(), pt.end());
+    K_red_ = (P_.transpose() * K * P_).pruned();
+
+    // --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
+    const auto& cand = model_.candidate_pairs();
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P_;
+    Triplets gt;
+    std::vector<double> gaps;
+    int row = 0;
+    for (int ci = 0; ci < static_cast<int>(cand.size()); ++ci) {
+        const auto& cp = cand[ci];
+        const int a = cp.interface_index, b = a + 1;
+        const int da = 3 * node_dof(a, cp.node), db = 3 * node_dof(b, cp.node);
+        const double ha = spec.leaves[a].height_m, hb = spec.leaves[b].height_m;
+        // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
+        // On the reduced DOFs: each full DOF is at most one master times a coefficient (a row
+        // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
+        auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
+            std::vector<std::pair<int, double>> out;
+            for (const auto& [dof, g] : full)
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Prow, dof); it; ++it) {
+                    auto f = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == it.col(); });
+                    if (f == out.end()) out.emplace_back(static_cast<int>(it.col()), g * it.value());
+                    else f->second += g * it.value();
+                }
+            out.erase(std::remove_if(out.begin(), out.end(), [](const auto& e) { return std::abs(e.second) < 1e-12; }), out.end());
+            std::sort(out.begin(), out.end());
+            return out;
+        };
+        const auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
+        const auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        const bool has_n = !rn.empty();
+        bool has_t = !rt.empty();
+        // A friction pair whose normal motion a support or the seat fixes has no normal
+        // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
+        if (!has_n && cp.kind == PairKind::coulomb) has_t = false;
+        if (cp.kind != PairKind::bonded && cp.friction_coefficient == 0.0) has_t = false;  // mu = 0: p_t = 0
+        if (!has_n && !has_t) continue;
+        ContactPair p;
+        p.kind = cp.kind;
+        p.friction_coefficient = cp.friction_coefficient;
+        p.preload_n = cp.preload_n;
+        if (has_n) {
+            p.row_n = row++;
+            for (const auto& [col, v] : rn) gt.emplace_back(p.row_n, col, v);
+            gaps.push_back(cp.initial_gap_m);
+        }
+        if (has_t) {
+            p.row_t = row++;
+            for (const auto& [col, v] : rt) gt.emplace_back(p.row_t, col, v);
+            gaps.push_back(0.0);
+        }
+        if (ci == model_.probe_pair()) probe_ = static_cast<int>(pairs_.size());
+        pairs_.push_back(p);
+        pair_candidate_.push_back(ci);
+    }
+    gaps_ = Eigen::Map<Eigen::VectorXd>(gaps.data(), static_cast<Eigen::Index>(gaps.size()));
+    Eigen::SparseMatrix<double> G(row, nm);
+    G.setFromTriplets(gt.begin(), gt.end());
+
+    // --- condensation with R held ------------------------------------------------
+    const int nr = nm - 1;
+    const Eigen::SparseMatrix<double> Krr = K_red_.topLeftCorner(nr, nr);
+    Krw_col_ = K_red_.block(0, nr, nr, 1);
+    const double Kww = K_red_.coeff(nr, nr);
+    Krr_llt_.compute(Krr);
+    if (Krr_llt_.info() != Eigen::Success)
+        throw InputError("leaves", "the stack is not restrained with the rigid body held: some leaf (or the seat) can move "
+                                   "as a rigid body; give it supports or tie it to the rigid body (rigid_body.tied_leaves)");
+    Gr_ = G.leftCols(nr);
+    G_ = G;
+    const Eigen::VectorXd gw = Eigen::VectorXd(G.col(nr));
+    C_held_ = std::make_shared<LazyCompliance>();
+    const Eigen::VectorXd y = Krr_llt_.solve(Eigen::VectorXd(Krw_col_));
+    c_ = gw - Gr_ * y;
+    k_ = Kww - Eigen::VectorXd(Krw_col_).dot(y);
+    if (!(k_ > 0.0))
+        throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
+                                               " N/m): the rigid body must be carried by supported leaves");
+    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD), i.e.
+    // when G_r G_r^T is: checked by a sparse LDL^T of G_r G_r^T (the rows are local, so it is
+    // sparse and cheap) rather than by factorising the dense C', which is built only on demand.
+    // A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
+    // are 1 and h/2, so an independent set of rows stays far above that).
+    if (row > 0) {
+        const Eigen::SparseMatrix<double> GGt = Gr_ * Gr_.transpose();
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
+        const double scale = GGt.diagonal().maxCoeff();
+        if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
+            throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
+    }
+    mass_ = spec.rigid_body.mass_kg / model_.whole_spring_factor();
+}
+
+const Eigen::MatrixXd& System::compliance_held() const {
+    std::call_once(C_held_->once, [this] {
+        const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
+        Eigen::MatrixXd C = Gr_ * X;
+        C_held_->C = 0.5 * (C + C.transpose());
+        C_held_->built = true;
+    });
+    return C_held_->C;
+}
+
+bool System::compliance_held_built() const noexcept {
+    return C_held_->built;
+}
+
+double System::tied_stiffness_n_per_m() const {
+    if (c_.size() == 0) return free_stiffness_n_per_m();
+    const Eigen::VectorXd x = compliance_held().llt().solve(c_);
+    return model_.whole_spring_factor() * (k_ + c_.dot(x));
+}
+
+Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w) const {
+    const int nr = static_cast<int>(K_red_.rows()) - 1;
+    Eigen::VectorXd rhs = Gr_.transpose() * p - Eigen::VectorXd(Krw_col_) * w;
+    Eigen::VectorXd z(nr + 1);
+    z.head(nr) = Krr_llt_.solve(rhs);
+    z[nr] = w;
+    return z;
+}
+
+Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
+    return P_ * reduced_displacements(p, w);
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,588 @@
+// Scenario files (TOML, read with toml11): every key checked, errors name the
+// key's path in the file. Format: scenarios/README.md.
+#include "stackbeam/io/scenario.hpp"
+
+#include <toml.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+namespace {
+
+const char* type_name(const toml::value& v) {
+    switch (v.type()) {
+        case toml::value_t::boolean: return "a boolean";
+        case toml::value_t::integer: return "an integer";
+        case toml::value_t::floating: return "a float";
+        case toml::value_t::string: return "a string";
+        case toml::value_t::offset_datetime:
+        case toml::value_t::local_datetime:
+        case toml::value_t::local_date:
+        case toml::value_t::local_time: return "a date/time";
+        case toml::value_t::array: return "an array";
+        case toml::value_t::table: return "a table";
+        case toml::value_t::empty: return "empty";
+    }
+    return "unknown";
+}
+
+std::string join(const std::vector<std::string>& items) {
+    std::string out;
+    for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+    return out;
+}
+
+/// Shared state of one parse: the source name and where each key path is.
+class Context {
+public:
+    explicit Context(std::string source) : source_(std::move(source)) {}
+
+    std::string where(const toml::value& v) const {
+        const auto loc = v.location();
+        return source_ + ":" + std::to_string(loc.line()) + ":" + std::to_string(loc.column());
+    }
+    void remember(const std::string& path, const toml::value& v) { locations_[path] = where(v); }
+    /// Location of `path` or of its nearest remembered parent ("" if none).
+    std::string location_of(std::string path) const {
+        while (!path.empty()) {
+            const auto it = locations_.find(path);
+            if (it != locations_.end()) return it->second;
+            const auto cut = path.find_last_of(".[");
+            if (cut == std::string::npos) break;
+            path.erase(cut);
+        }
+        return source_;
+    }
+    [[noreturn]] void fail(const std::string& path, const std::string& message) const {
+        throw InputError(path, message + " (" + location_of(path) + ")");
+    }
+    const std::string& source() const noexcept { return source_; }
+
+private:
+    std::string source_;
+    std::map<std::string, std::string> locations_;
+};
+
+std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string element(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+/// A TOML table whose keys are all checked against a list of allowed keys.
+class Table {
+public:
+    Table(Context& ctx, const toml::value& v, std::string path, std::vector<std::string> allowed)
+        : ctx_(ctx), v_(v), path_(std::move(path)), allowed_(std::move(allowed)) {
+        if (!v.is_table())
+            ctx_.fail(path_.empty() ? "(top level)" : path_,
+                      std::string("is ") + type_name(v) + ": must be a table (keys " + join(allowed_) + ")");
+        if (!path_.empty()) ctx_.remember(path_, v);
+        std::vector<std::string> keys;
+        for (const auto& kv : v.as_table()) keys.push_back(kv.first);
+        std::sort(keys.begin(), keys.end());
+        for (const auto& k : keys) {
+            ctx_.remember(child(path_, k), v.as_table().at(k));
+            if (std::find(allowed_.begin(), allowed_.end(), k) == allowed_.end())
+                ctx_.fail(child(path_, k), "unknown key '" + k + "'" + (path_.empty() ? "" : " in " + path_) +
+                                               ": allowed keys are " + join(allowed_));
+        }
+    }
+
+    const std::string& path() const noexcept { return path_; }
+    Context& context() const noexcept { return ctx_; }
+    bool has(const std::string& key) const { return v_.as_table().count(key) > 0; }
+    const toml::value& at(const std::string& key) const { return v_.as_table().at(key); }
+
+    [[noreturn]] void missing(const std::string& key, const std::string& what) const {
+        ctx_.fail(child(path_, key), "required key is missing: " + what);
+    }
+
+    /// A number (an integer or a float); required unless a default is given.
+    double number(const std::string& key, const std::string& what, const double* fallback = nullptr) const {
+        if (!has(key)) {
+            if (fallback) return *fallback;
+            missing(key, what);
+        }
+        const auto& v = at(key);
+        if (v.is_floating()) return v.as_floating();
+        if (v.is_integer()) return static_cast<double>(v.as_integer());
+        wrong_type(key, v, "a number: " + what);
+    }
+    double number_or(const std::string& key, const std::string& what, double fallback) const {
+        return number(key, what, &fallback);
+    }
+
+    /// An integer in [lo, hi]; required unless a default is given.
+    long long integer(const std::string& key, const std::string& what, long long lo, long long hi,
+                      const long long* fallback = nullptr) const {
+        if (!has(key)) {
+            if (fallback) return *fallback;
+            missing(key, what);
+        }
+        const auto& v = at(key);
+        if (!v.is_integer()) wrong_type(key, v, "an integer: " + what);
+        const long long x = v.as_integer();
+        if (x < lo || x > hi)
+            ctx_.fail(child(path_, key), "value " + std::to_string(x) + " is not allowed: " + what);
+        return x;
+    }
+
+    std::string string(const std::string& key, const std::string& what, const std::string* fallback = nullptr) const {
+        if (!has(key)) {
+            if (fallback) return *fallback;
+            missing(key, what);
+        }
+        const auto& v = at(key);
+        if (!v.is_string()) wrong_type(key, v, "a string: " + what);
+        return v.as_string().str;
+    }
+    std::string string_or(const std::string& key, const std::string& what, const std::string& fallback) const {
+        return string(key, what, &fallback);
+    }
+
+    bool boolean_or(const std::string& key, const std::string& what, bool fallback) const {
+        if (!has(key)) return fallback;
+        const auto& v = at(key);
+        if (!v.is_boolean()) wrong_type(key, v, "a boolean (true or false): " + what);
+        return v.as_boolean();
+    }
+
+    /// An array of numbers; required.
+    std::vector<double> numbers(const std::string& key, const std::string& what) const {
+        if (!has(key)) missing(key, what);
+        const auto& v = at(key);
+        if (!v.is_array()) wrong_type(key, v, "an array of numbers: " + what);
+        std::vector<double> out;
+        const auto& a = v.as_array();
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            const std::string path = element(child(path_, key), i);
+            ctx_.remember(path, a[i]);
+            if (a[i].is_floating()) out.push_back(a[i].as_floating());
+            else if (a[i].is_integer()) out.push_back(static_cast<double>(a[i].as_integer()));
+            else ctx_.fail(path, std::string("has the wrong type, ") + type_name(a[i]) + ": must be a number: " + what);
+        }
+        return out;
+    }
+
+    /// A required sub-table (check has() first for an optional one).
+    Table table(const std::string& key, std::vector<std::string> allowed) const {
+        if (!has(key)) missing(key, "a table [" + child(path_, key) + "] with keys " + join(allowed));
+        return Table(ctx_, at(key), child(path_, key), std::move(allowed));
+    }
+
+    /// An array of tables ([[key]]); empty when absent and not required.
+    const toml::array* array(const std::string& key, const std::string& what, bool required) const {
+        if (!has(key)) {
+            if (required) missing(key, what);
+            return nullptr;
+        }
+        const auto& v = at(key);
+        if (!v.is_array()) wrong_type(key, v, "an array: " + what);
+        return &v.as_array();
+    }
+
+    [[noreturn]] void wrong_type(const std::string& key, const toml::value& v, const std::string& expected) const {
+        ctx_.fail(child(path_, key), std::string("has the wrong type, ") + type_name(v) + ": must be " + expected);
+    }
+
+private:
+    Context& ctx_;
+    const toml::value& v_;
+    std::string path_;
+    std::vector<std::string> allowed_;
+};
+
+/// A keyword value out of `choices` (text -> enum).
+template <class E>
+E choice(const Table& t, const std::string& key, const std::vector<std::pair<std::string, E>>& choices,
+         const E* fallback) {
+    std::vector<std::string> names;
+    for (const auto& c : choices) names.push_back("'" + c.first + "'");
+    const std::string what = "one of " + join(names);
+    if (!t.has(key) && fallback) return *fallback;
+    const std::string text = t.string(key, what);
+    for (const auto& c : choices)
+        if (c.first == text) return c.second;
+    t.context().fail(child(t.path(), key), "value '" + text + "' is not allowed: must be " + what);
+}
+
+// ---------------------------------------------------------------------------------------
+
+/// The file's key path of a field named by Model::build or SimulationOptions::validate.
+std::string file_path_of(const std::string& field) {
+    static const std::pair<const char*, const char*> exact[] = {
+        {"rigid_body.initial_displacement_m", "loading.initial_displacement_m"},
+        {"rigid_body.initial_velocity_m_per_s", "loading.initial_velocity_m_per_s"},
+        {"dt", "integrator.dt_s"},
+        {"t_end", "integrator.t_end_s"},
+        {"mode", "integrator.mode"},
+    };
+    for (const auto& [from, to] : exact)
+        if (field == from) return to;
+    static const std::pair<const char*, const char*> prefixes[] = {
+        {"solver.", "integrator.solver."},
+        {"cvode.", "integrator.cvode."},
+    };
+    for (const auto& [from, to] : prefixes) {
+        const std::string f = from;
+        if (field.compare(0, f.size(), f) == 0) return to + field.substr(f.size());
+    }
+    // "interfaces[i].leaves" (adjacent leaves do not overlap): the interface itself
+    const std::string suffix = ".leaves";
+    if (field.rfind("interfaces[", 0) == 0 && field.size() > suffix.size() &&
+        field.compare(field.size() - suffix.size(), suffix.size(), suffix) == 0)
+        return field.substr(0, field.size() - suffix.size());
+    return field;
+}
+
+/// Rethrows `e` (from the library's validation) with the file's key path and location.
+[[noreturn]] void rethrow_in_file(const Context& ctx, const InputError& e) {
+    const std::string prefix = e.field() + ": ";
+    std::string message = e.what();
+    if (message.rfind(prefix, 0) == 0) message = message.substr(prefix.size());
+    ctx.fail(file_path_of(e.field()), message);
+}
+
+
+const std::vector<std::pair<std::string, SupportKind>> kSupports = {
+    {"free", SupportKind::free}, {"pinned", SupportKind::pinned}, {"fixed", SupportKind::fixed}};
+
+void parse_leaves(const Table& top, ModelSpec& spec) {
+    const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
+    const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
+                                           "youngs_modulus_pa", "density_kg_per_m3", "left_support", "right_support"};
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        Table t(top.context(), (*arr)[i], element("leaves", i), keys);
+        LeafSpec l;
+        l.length_m = t.number("length_m", "the leaf length [m], > 0");
+        l.x_start_m = t.number_or("x_start_m", "x of the leaf's left end [m]", 0.0);
+        l.height_m = t.number("height_m", "the leaf thickness [m], > 0");
+        l.width_m = t.number("width_m", "the leaf width [m], > 0");
+        l.youngs_modulus_pa = t.number("youngs_modulus_pa", "Young's modulus [Pa], > 0");
+        l.density_kg_per_m3 = t.number_or("density_kg_per_m3", "density [kg/m^3], >= 0", 0.0);
+        const SupportKind free = SupportKind::free;
+        l.left_support = choice(t, "left_support", kSupports, &free);
+        l.right_support = choice(t, "right_support", kSupports, &free);
+        spec.leaves.push_back(l);
+    }
+}
+
+void parse_interfaces(const Table& top, ModelSpec& spec) {
+    const auto* arr = top.array("interfaces", "one [[interfaces]] table per pair of adjacent leaves", spec.leaves.size() > 1);
+    if (!arr) return;
+    enum class Law { coulomb, frictionless, bonded };
+    const std::vector<std::pair<std::string, Law>> laws = {
+        {"coulomb", Law::coulomb}, {"frictionless", Law::frictionless}, {"bonded", Law::bonded}};
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        Table t(top.context(), (*arr)[i], element("interfaces", i), {"law", "friction_coefficient", "initial_gap_m"});
+        InterfaceSpec f;
+        const Law law = choice<Law>(t, "law", laws, nullptr);
+        if (law == Law::coulomb) {
+            f.law = InterfaceLaw::coulomb;
+            f.friction_coefficient = t.number("friction_coefficient", "the Coulomb coefficient mu [-], >= 0 (law 'coulomb')");
+        } else {
+            if (t.has("friction_coefficient"))
+                t.context().fail(child(t.path(), "friction_coefficient"),
+                                 std::string("is not allowed with law '") + (law == Law::bonded ? "bonded" : "frictionless") +
+                                     "': only law 'coulomb' takes a friction coefficient");
+            f.law = law == Law::bonded ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
+            f.friction_coefficient = 0.0;
+        }
+        f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], >= 0", 0.0);
+        spec.interfaces.push_back(f);
+    }
+}
+
+void parse_clamps(const Table& top, ModelSpec& spec) {
+    const auto* arr = top.array("clamps", "[[clamps]] tables", false);
+    if (!arr) return;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        Table t(top.context(), (*arr)[i], element("clamps", i), {"x_m", "preload_n"});
+        ClampSpec c;
+        c.x_m = t.number("x_m", "the clamp position [m]");
+        c.preload_n = t.number_or("preload_n", "the clamp force [N], >= 0", 0.0);
+        spec.clamps.push_back(c);
+    }
+}
+
+void parse_rigid_body(const Table& top, ModelSpec& spec) {
+    const Table t = top.table("rigid_body", {"mass_kg", "x_m", "tied_leaves"});
+    spec.rigid_body.mass_kg = t.number("mass_kg", "the mass [kg], > 0");
+    spec.rigid_body.x_m = t.number("x_m", "the attachment position [m]");
+    if (t.has("tied_leaves")) {
+        const auto& v = t.at("tied_leaves");
+        if (!v.is_array()) t.wrong_type("tied_leaves", v, "an array of leaf indices");
+        const auto& arr = v.as_array();
+        for (std::size_t k = 0; k < arr.size(); ++k) {
+            const std::string path = element("rigid_body.tied_leaves", k);
+            t.context().remember(path, arr[k]);
+            if (!arr[k].is_integer())
+                t.context().fail(path, std::string("has the wrong type, ") + type_name(arr[k]) + ": must be an integer leaf index");
+            const long long x = arr[k].as_integer();
+            if (x < 0 || x >= static_cast<long long>(spec.leaves.size()))
+                t.context().fail(path, "value " + std::to_string(x) + " is not a leaf index: allowed 0.." +
+                                           std::to_string(static_cast<long long>(spec.leaves.size()) - 1));
+            spec.rigid_body.tied_leaves.push_back(static_cast<int>(x));
+        }
+    }
+}
+
+/// A time function `[loading.<key>]` (loading.hpp, TimeFunction); `unit` for messages.
+TimeFunction parse_time_function(const Table& parent, const std::string& key, const std::string& unit) {
+    const Table t = parent.table(key, {"shape", "mean", "amplitude", "frequency_hz", "phase_rad", "times_s", "values"});
+    using S = TimeFunction::Shape;
+    TimeFunction f;
+    f.shape = choice<S>(t, "shape",
+                        {{"constant", S::constant}, {"harmonic", S::harmonic}, {"triangle", S::triangle}, {"table", S::table}},
+                        nullptr);
+    auto only = [&](const std::string& k, bool allowed) {
+        if (t.has(k) && !allowed)
+            t.context().fail(child(t.path(), k), "is not used by shape '" + std::string(to_string(f.shape)) +
+                                                     "': remove it (constant: mean; harmonic, triangle: mean, amplitude, "
+                                                     "frequency_hz, phase_rad; table: times_s, values)");
+    };
+    const bool periodic = f.shape == S::harmonic || f.shape == S::triangle;
+    only("mean", f.shape != S::table);
+    only("amplitude", periodic);
+    only("frequency_hz", periodic);
+    only("phase_rad", periodic);
+    only("times_s", f.shape == S::table);
+    only("values", f.shape == S::table);
+    if (f.shape == S::constant) f.mean = t.number("mean", "the value [" + unit + "]");
+    if (periodic) {
+        f.mean = t.number_or("mean", "the offset [" + unit + "]", 0.0);
+        f.amplitude = t.number("amplitude", "the amplitude [" + unit + "], >= 0");
+        f.frequency_hz = t.number("frequency_hz", "the frequency [Hz], > 0");
+        f.phase_rad = t.number_or("phase_rad", "the phase [rad]", 0.0);
+    }
+    if (f.shape == S::table) {
+        f.times_s = t.numbers("times_s", "the times [s], strictly increasing");
+        f.values = t.numbers("values", "the values [" + unit + "], one per time");
+    }
+    return f;
+}
+
+Loading parse_loading(const Table& top, ModelSpec& spec) {
+    const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s", "gravity_m_per_s2",
+                                          "force_n", "displacement_m"});
+    Loading l;
+    l.kind = choice<LoadingKind>(t, "kind",
+                                 {{"initial-conditions", LoadingKind::initial_conditions},
+                                  {"applied-force", LoadingKind::applied_force},
+                                  {"prescribed-displacement", LoadingKind::prescribed_displacement},
+                                  {"base-excitation", LoadingKind::base_excitation}},
+                                 nullptr);
+    spec.rigid_body.initial_displacement_m = t.number_or("initial_displacement_m", "w(0) [m]", 0.0);
+    spec.rigid_body.initial_velocity_m_per_s = t.number_or("initial_velocity_m_per_s", "dw/dt(0) [m/s]", 0.0);
+    l.gravity_m_per_s2 = t.number_or("gravity_m_per_s2", "g [m/s^2], >= 0, acting in -y", 0.0);
+    const bool force = l.kind == LoadingKind::applied_force;
+    const bool disp = l.kind == LoadingKind::prescribed_displacement || l.kind == LoadingKind::base_excitation;
+    if (t.has("force_n") && !force)
+        t.context().fail("loading.force_n", "is only used with kind = 'applied-force' (kind is '" +
+                                                std::string(to_string(l.kind)) + "')");
+    if (t.has("displacement_m") && !disp)
+        t.context().fail("loading.displacement_m",
+                         "is only used with kind = 'prescribed-displacement' or 'base-excitation' (kind is '" +
+                             std::string(to_string(l.kind)) + "')");
+    if (force) l.force_n = parse_time_function(t, "force_n", "N");
+    if (disp) l.displacement_m = parse_time_function(t, "displacement_m", "m");
+    return l;
+}
+
+void parse_mesh(const Table& top, ModelSpec& spec) {
+    const Table t = top.table("mesh", {"element_length_m", "symmetry"});
+    spec.mesh.element_length_m = t.number("element_length_m", "the largest element length [m], > 0");
+    const Symmetry full = Symmetry::full;
+    spec.symmetry = choice<Symmetry>(t, "symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}}, &full);
+}
+
+void parse_probe(const Table& top, ModelSpec& spec) {
+    if (!top.has("probe")) return;
+    const Table t = top.table("probe", {"interface_index", "x_m"});
+    ProbeSpec p;
+    p.interface_index = static_cast<int>(t.integer("interface_index", "the interface index, 0.." +
+                                                                          std::to_string(static_cast<long long>(spec.leaves.size()) - 2),
+                                                   0, std::numeric_limits<int>::max()));
+    p.x_m = t.number("x_m", "the probe position [m]");
+    spec.probe = p;
+}
+
+void parse_integrator(const Table& top, SimulationOptions& o) {
+    const Table t = top.table("integrator", {"mode", "dt_s", "t_end_s", "tau_rule", "solver", "cvode", "restitution"});
+    const std::string mode = t.string("mode", "the time stepping mode");
+    try {
+        o.mode = parse_mode(mode, "integrator.mode");  // the message names this build's modes
+    } catch (const InputError& e) {
+        rethrow_in_file(t.context(), e);
+    }
+    o.dt_s = t.number("dt_s", "the time step (mode cvode: the output interval) [s], > 0");
+    o.t_end_s = t.number("t_end_s", "the end time [s], > 0");
+    o.restitution = t.number_or("restitution", "the impact law's restitution coefficient [-] (mode newmark, massive "
+                                               "leaves), 0 <= e <= 1", o.restitution);
+    if (!std::isfinite(o.restitution) || o.restitution < 0.0 || o.restitution > 1.0)
+        t.context().fail("integrator.restitution", "value " + format_value(o.restitution) +
+                                                       " is not allowed: must be in [0, 1] (0: perfectly inelastic, "
+                                                       "1: elastic)");
+    const TauRule current = TauRule::current;
+    o.tau_rule = choice<TauRule>(t, "tau_rule", {{"current", TauRule::current}, {"previous-step", TauRule::previous_step}},
+                                 &current);
+    if (t.has("solver")) {
+        const Table s = t.table("solver", {"kind", "tolerance_m", "max_iterations", "alpha_fraction"});
+        const std::string kind = s.string_or("kind", "the contact solver", to_string(o.solver.kind));
+        try {
+            o.solver.kind = parse_solver_kind(kind, "integrator.solver.kind");
+        } catch (const InputError& e) {
+            rethrow_in_file(t.context(), e);
+        }
+        o.solver.tolerance_m = s.number_or("tolerance_m", "the contact tolerance on ||v|| [m], > 0", o.solver.tolerance_m);
+        const long long max_iterations = o.solver.max_iterations;
+        o.solver.max_iterations = static_cast<int>(
+            s.integer("max_iterations", "an iteration limit >= 1", 1, std::numeric_limits<int>::max(), &max_iterations));
+        o.solver.alpha_fraction = s.number_or("alpha_fraction", "a fraction in (0, 1)", o.solver.alpha_fraction);
+        if (!(o.solver.alpha_fraction > 0.0 && o.solver.alpha_fraction < 1.0))
+            t.context().fail("integrator.solver.alpha_fraction",
+                             "value " + format_value(o.solver.alpha_fraction) +
+                                 " is not allowed: must be in (0, 1), a fraction of the stability bound");
+    }
+    if (t.has("cvode")) {
+        const Table c = t.table("cvode", {"rtol", "atol_m", "max_step_s", "root_finding", "max_steps",
+                                          "modal_cutoff_rad_per_s"});
+        auto& cv = o.cvode;
+        cv.rtol = c.number_or("rtol", "the relative tolerance [-], > 0", cv.rtol);
+        cv.atol_m = c.number_or("atol_m", "the absolute tolerance on w [m], > 0", cv.atol_m);
+        cv.max_step_s = c.number_or("max_step_s", "the largest internal step [s], >= 0 (0: no limit)", cv.max_step_s);
+        cv.root_finding = c.boolean_or("root_finding", "locate transitions by root-finding", cv.root_finding);
+        cv.modal_cutoff_rad_per_s = c.number_or("modal_cutoff_rad_per_s",
+                                                "the modal cut-off of leaf inertia with friction [rad/s], >= 0 "
+                                                "(0: 10 x the stack's first frequency)",
+                                                cv.modal_cutoff_rad_per_s);
+        if (!std::isfinite(cv.modal_cutoff_rad_per_s) || cv.modal_cutoff_rad_per_s < 0.0)
+            t.context().fail("integrator.cvode.modal_cutoff_rad_per_s",
+                             "value " + format_value(cv.modal_cutoff_rad_per_s) +
+                                 " is not allowed: must be finite and >= 0 [rad/s] (0: the default)");
+        const long long ms = cv.max_steps;
+        cv.max_steps = static_cast<long>(c.integer("max_steps", "a step limit >= 1", 1, std::numeric_limits<long>::max(), &ms));
+        auto positive = [&](const char* key, double v, const char* unit) {
+            if (!std::isfinite(v) || v <= 0.0)
+                t.context().fail(std::string("integrator.cvode.") + key,
+                                 "value " + format_value(v) + " is not allowed: must be finite and > 0 " + unit);
+        };
+        positive("rtol", cv.rtol, "[-]");
+        positive("atol_m", cv.atol_m, "[m]");
+        if (!std::isfinite(cv.max_step_s) || cv.max_step_s < 0.0)
+            t.context().fail("integrator.cvode.max_step_s", "value " + format_value(cv.max_step_s) +
+                                                                " is not allowed: must be finite and >= 0 [s] (0: no limit)");
+    }
+}
+
+void parse_outputs(const Table& top, ScenarioOutputs& out) {
+    if (!top.has("outputs")) return;
+    const Table t = top.table("outputs", {"csv_path", "events_path", "summary_path", "pairs_path", "plot_prefix"});
+    auto path = [&](const char* key, const char* what) {
+        if (!t.has(key)) return std::string();
+        const std::string p = t.string(key, what);
+        if (p.empty()) t.context().fail(child("outputs", key), "is empty: must be a file name (" + std::string(what) + ")");
+        return p;
+    };
+    out.csv_path = path("csv_path", "the per-step CSV");
+    out.events_path = path("events_path", "the event log");
+    out.summary_path = path("summary_path", "the JSON summary");
+    out.pairs_path = path("pairs_path", "the per-pair CSV");
+    out.plot_prefix = path("plot_prefix", "the prefix of the PNG figures");
+}
+
+/// The TOML parser recurses into nested arrays and inline tables, so a file of
+/// thousands of '[' would overflow the stack: refuse nesting deeper than a scenario
+/// ever needs before parsing. Scans brackets outside strings and comments.
+void check_nesting(const std::string& text, const std::string& source_name) {
+    constexpr int kMaxDepth = 32;
+    int depth = 0, line = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '\n') {
+            ++line;
+        } else if (c == '#') {
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+        } else if (c == '"' || c == '\'') {
+            const bool multi = text.compare(i, 3, std::string(3, c)) == 0;
+            const std::string close = multi ? std::string(3, c) : std::string(1, c);
+            i += close.size();
+            while (i < text.size() && text.compare(i, close.size(), close) != 0) {
+                if (c == '"' && text[i] == '\\') ++i;  // an escape in a basic string
+                else if (text[i] == '\n') {
+                    ++line;
+                    if (!multi) break;  // an unterminated string: the parser reports it
+                }
+                ++i;
+            }
+            i += close.size() - 1;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxDepth)
+                throw InputError(source_name, "TOML syntax error: arrays or tables nested deeper than " +
+                                                  std::to_string(kMaxDepth) + " levels at line " + std::to_string(line));
+        } else if (c == ']' || c == '}') {
+            depth = std::max(0, depth - 1);
+        }
+    }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::string& source_name) {
+    Context ctx(source_name);
+    check_nesting(text, source_name);
+    toml::value root;
+    try {
+        std::istringstream in(text);
+        root = toml::parse(in, source_name);
+    } catch (const toml::syntax_error& e) {
+        throw InputError(source_name, std::string("TOML syntax error:\n") + e.what());
+    } catch (const std::exception& e) {
+        throw InputError(source_name, std::string("cannot parse as TOML: ") + e.what());
+    }
+
+    Scenario s;
+    s.source = source_name;
+    const Table top(ctx, root, "",
+                    {"description", "leaves", "interfaces", "clamps", "rigid_body", "loading", "mesh", "probe",
+                     "integrator", "outputs"});
+    s.description = top.string_or("description", "free text", "");
+    parse_leaves(top, s.model);
+    parse_interfaces(top, s.model);
+    parse_clamps(top, s.model);
+    parse_rigid_body(top, s.model);
+    const Loading loading = parse_loading(top, s.model);
+    parse_mesh(top, s.model);
+    parse_probe(top, s.model);
+    parse_integrator(top, s.simulation);
+    s.simulation.loading = loading;
+    parse_outputs(top, s.outputs);
+
+    try {
+        Model::build(s.model);
+        s.simulation.validate();
+        require_loading_fits(s.model, s.simulation.loading);
+    } catch (const InputError& e) {
+        rethrow_in_file(ctx, e);
+    }
+    return s;
+}
+
+Scenario load_scenario(const std::string& path) {
+    std::ifstream in(path, std::ios::in | std::ios::binary);
+    if (!in) throw InputError(path, "cannot open the scenario file for reading");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw InputError(path, "cannot read the scenario file");
+    return parse_scenario(text.str(), path);
+}
+
+}  // namespace stackbeam

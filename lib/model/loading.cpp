@@ -1,0 +1,240 @@
+// Loadings of a run (loading.hpp): time functions, their validation and the
+// external force on the rigid body.
+#include "stackbeam/model/loading.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+/// Fractional part of x in [0, 1).
+double frac(double x) { return x - std::floor(x); }
+
+/// Index i of the table interval [t_i, t_i+1] holding t (t inside the table).
+std::size_t interval(const std::vector<double>& ts, double t) {
+    const auto it = std::upper_bound(ts.begin(), ts.end(), t);
+    const std::size_t i = static_cast<std::size_t>(it - ts.begin());
+    return std::min(i == 0 ? 0 : i - 1, ts.size() - 2);
+}
+
+void require_finite(const std::string& field, double v, const std::string& what) {
+    if (!std::isfinite(v)) throw InputError(field, "value " + format_value(v) + " is not allowed: " + what + " must be finite");
+}
+
+}  // namespace
+
+const char* to_string(TimeFunction::Shape shape) {
+    switch (shape) {
+        case TimeFunction::Shape::constant: return "constant";
+        case TimeFunction::Shape::harmonic: return "harmonic";
+        case TimeFunction::Shape::triangle: return "triangle";
+        case TimeFunction::Shape::table: return "table";
+    }
+    return "?";
+}
+
+const char* to_string(LoadingKind kind) {
+    switch (kind) {
+        case LoadingKind::initial_conditions: return "initial-conditions";
+        case LoadingKind::applied_force: return "applied-force";
+        case LoadingKind::prescribed_displacement: return "prescribed-displacement";
+        case LoadingKind::base_excitation: return "base-excitation";
+    }
+    return "?";
+}
+
+void TimeFunction::validate(const std::string& field, bool smooth) const {
+    require_finite(field + ".mean", mean, "the mean");
+    if (shape == Shape::harmonic || shape == Shape::triangle) {
+        if (!std::isfinite(amplitude) || amplitude < 0.0)
+            throw InputError(field + ".amplitude", "value " + format_value(amplitude) +
+                                                       " is not allowed: the amplitude must be finite and >= 0");
+        if (!std::isfinite(frequency_hz) || frequency_hz <= 0.0)
+            throw InputError(field + ".frequency_hz", "value " + format_value(frequency_hz) +
+                                                          " is not allowed: the frequency must be finite and > 0 [Hz]");
+        require_finite(field + ".phase_rad", phase_rad, "the phase");
+    }
+    if (shape == Shape::triangle && smooth)
+        throw InputError(field + ".shape", "value 'triangle' is not allowed here: a base displacement needs a "
+                                           "continuous acceleration (its inertial force); use harmonic or table");
+    if (shape == Shape::table) {
+        if (times_s.size() < 2)
+            throw InputError(field + ".times_s", "has " + std::to_string(times_s.size()) +
+                                                     " points: a table needs at least 2");
+        if (values.size() != times_s.size())
+            throw InputError(field + ".values", "has " + std::to_string(values.size()) + " values for " +
+                                                    std::to_string(times_s.size()) + " times: give one value per time");
+        for (std::size_t i = 0; i < times_s.size(); ++i) {
+            const std::string ti = field + ".times_s[" + std::to_string(i) + "]";
+            require_finite(ti, times_s[i], "a time");
+            require_finite(field + ".values[" + std::to_string(i) + "]", values[i], "a value");
+            if (i > 0 && !(times_s[i] > times_s[i - 1]))
+                throw InputError(ti, "value " + format_value(times_s[i]) + " is not allowed: the times must increase "
+                                     "strictly (previous " + format_value(times_s[i - 1]) + ")");
+        }
+    }
+}
+
+void TimeFunction::prepare(bool smooth) {
+    spline_m2.clear();
+    if (shape != Shape::table || !smooth) return;
+    // Clamped cubic spline (zero slope at both ends): tridiagonal system for the
+    // second derivatives M_i, solved by the Thomas algorithm.
+    const std::size_t n = times_s.size();
+    std::vector<double> a(n, 0.0), b(n, 0.0), c(n, 0.0), r(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double hl = i > 0 ? times_s[i] - times_s[i - 1] : 0.0;
+        const double hr = i + 1 < n ? times_s[i + 1] - times_s[i] : 0.0;
+        const double sl = i > 0 ? (values[i] - values[i - 1]) / hl : 0.0;      // slope 0 before the first point
+        const double sr = i + 1 < n ? (values[i + 1] - values[i]) / hr : 0.0;  // and after the last
+        a[i] = hl;
+        b[i] = 2.0 * (hl + hr);
+        c[i] = hr;
+        r[i] = 6.0 * (sr - sl);
+    }
+    for (std::size_t i = 1; i < n; ++i) {
+        const double m = a[i] / b[i - 1];
+        b[i] -= m * c[i - 1];
+        r[i] -= m * r[i - 1];
+    }
+    spline_m2.assign(n, 0.0);
+    spline_m2[n - 1] = r[n - 1] / b[n - 1];
+    for (std::size_t i = n - 1; i-- > 0;) spline_m2[i] = (r[i] - c[i] * spline_m2[i + 1]) / b[i];
+}
+
+double TimeFunction::value(double t) const {
+    switch (shape) {
+        case Shape::constant: return mean;
+        case Shape::harmonic: return mean + amplitude * std::sin(kTwoPi * frequency_hz * t + phase_rad);
+        case Shape::triangle: {
+            const double x = frac(frequency_hz * t + phase_rad / kTwoPi);
+            const double tri = x < 0.25 ? 4.0 * x : x < 0.75 ? 2.0 - 4.0 * x : 4.0 * x - 4.0;
+            return mean + amplitude * tri;
+        }
+        case Shape::table: {
+            if (t <= times_s.front()) return values.front();
+            if (t >= times_s.back()) return values.back();
+            const std::size_t i = interval(times_s, t);
+            const double h = times_s[i + 1] - times_s[i], A = times_s[i + 1] - t, B = t - times_s[i];
+            if (spline_m2.empty()) return (values[i] * A + values[i + 1] * B) / h;
+            const double Mi = spline_m2[i], Mj = spline_m2[i + 1];
+            return Mi * A * A * A / (6 * h) + Mj * B * B * B / (6 * h) + (values[i] / h - Mi * h / 6) * A +
+                   (values[i + 1] / h - Mj * h / 6) * B;
+        }
+    }
+    return 0.0;
+}
+
+double TimeFunction::derivative(double t) const {
+    switch (shape) {
+        case Shape::constant: return 0.0;
+        case Shape::harmonic:
+            return amplitude * kTwoPi * frequency_hz * std::cos(kTwoPi * frequency_hz * t + phase_rad);
+        case Shape::triangle: {
+            const double x = frac(frequency_hz * t + phase_rad / kTwoPi);
+            return (x < 0.25 || x >= 0.75 ? 4.0 : -4.0) * amplitude * frequency_hz;
+        }
+        case Shape::table: {
+            if (t < times_s.front() || t >= times_s.back()) return 0.0;
+            const std::size_t i = interval(times_s, t);
+            const double h = times_s[i + 1] - times_s[i], A = times_s[i + 1] - t, B = t - times_s[i];
+            if (spline_m2.empty()) return (values[i + 1] - values[i]) / h;
+            const double Mi = spline_m2[i], Mj = spline_m2[i + 1];
+            return -Mi * A * A / (2 * h) + Mj * B * B / (2 * h) - (values[i] / h - Mi * h / 6) +
+                   (values[i + 1] / h - Mj * h / 6);
+        }
+    }
+    return 0.0;
+}
+
+double TimeFunction::second_derivative(double t) const {
+    switch (shape) {
+        case Shape::constant:
+        case Shape::triangle: return 0.0;  // triangle: impulses at the turning points (refused where it matters)
+        case Shape::harmonic: {
+            const double om = kTwoPi * frequency_hz;
+            return -amplitude * om * om * std::sin(om * t + phase_rad);
+        }
+        case Shape::table: {
+            if (spline_m2.empty() || t < times_s.front() || t > times_s.back()) return 0.0;
+            const std::size_t i = interval(times_s, t);
+            const double h = times_s[i + 1] - times_s[i], A = times_s[i + 1] - t, B = t - times_s[i];
+            return (spline_m2[i] * A + spline_m2[i + 1] * B) / h;
+        }
+    }
+    return 0.0;
+}
+
+double TimeFunction::period_s() const {
+    return (shape == Shape::harmonic || shape == Shape::triangle) && frequency_hz > 0.0 ? 1.0 / frequency_hz : 0.0;
+}
+
+void Loading::validate() const {
+    if (!std::isfinite(gravity_m_per_s2) || gravity_m_per_s2 < 0.0)
+        throw InputError("loading.gravity_m_per_s2", "value " + format_value(gravity_m_per_s2) +
+                                                         " is not allowed: g must be finite and >= 0 [m/s^2] (it acts in -y)");
+    switch (kind) {
+        case LoadingKind::initial_conditions: break;
+        case LoadingKind::applied_force: force_n.validate("loading.force_n", false); break;
+        case LoadingKind::prescribed_displacement:
+            displacement_m.validate("loading.displacement_m", false);
+            if (gravity_m_per_s2 != 0.0)
+                throw InputError("loading.gravity_m_per_s2",
+                                 "value " + format_value(gravity_m_per_s2) +
+                                     " is not allowed with a prescribed displacement: the rig holds R, so its weight "
+                                     "does not load the spring (give 0, or shift the displacement's mean)");
+            break;
+        case LoadingKind::base_excitation: displacement_m.validate("loading.displacement_m", true); break;
+    }
+}
+
+void Loading::prepare() {
+    validate();
+    force_n.prepare(false);
+    displacement_m.prepare(kind == LoadingKind::base_excitation);
+}
+
+double Loading::external_force_n(double t, double mass_kg) const {
+    if (kind == LoadingKind::prescribed_displacement) return 0.0;  // the rig's force is a result
+    double F = -mass_kg * gravity_m_per_s2;
+    if (kind == LoadingKind::applied_force) F += force_n.value(t);
+    if (kind == LoadingKind::base_excitation) F -= mass_kg * displacement_m.second_derivative(t);
+    return F;
+}
+
+double Loading::base_displacement_m(double t) const {
+    return kind == LoadingKind::base_excitation ? displacement_m.value(t) : 0.0;
+}
+
+double Loading::base_velocity_m_per_s(double t) const {
+    return kind == LoadingKind::base_excitation ? displacement_m.derivative(t) : 0.0;
+}
+
+void require_initial_conditions_only(const Loading& loading, const std::string& context) {
+    if (loading.kind != LoadingKind::initial_conditions)
+        throw InputError("loading.kind", std::string("value '") + to_string(loading.kind) + "' is not available in " +
+                                             context + " yet (leaves with mass): only 'initial-conditions'; "
+                                             "use massless leaves (modes closed-form, cvode) for this loading");
+    if (loading.gravity_m_per_s2 != 0.0)
+        throw InputError("loading.gravity_m_per_s2", "value " + format_value(loading.gravity_m_per_s2) +
+                                                         " is not available in " + context +
+                                                         " yet (leaves with mass): give 0, or use massless leaves");
+}
+
+double Loading::period_s() const {
+    switch (kind) {
+        case LoadingKind::applied_force: return force_n.period_s();
+        case LoadingKind::prescribed_displacement:
+        case LoadingKind::base_excitation: return displacement_m.period_s();
+        case LoadingKind::initial_conditions: break;
+    }
+    return 0.0;
+}
+
+}  // namespace stackbeam

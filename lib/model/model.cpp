@@ -1,0 +1,339 @@
+#include "stackbeam/model/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+std::string format_value(double value) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.10g", value);
+    return buf;
+}
+
+const char* to_string(SupportKind kind) {
+    switch (kind) {
+        case SupportKind::free: return "free";
+        case SupportKind::pinned: return "pinned";
+        case SupportKind::fixed: return "fixed";
+    }
+    return "?";
+}
+
+const char* to_string(PairKind kind) {
+    switch (kind) {
+        case PairKind::bonded: return "bonded";
+        case PairKind::coulomb: return "coulomb";
+        case PairKind::clamp: return "clamp";
+    }
+    return "?";
+}
+
+namespace {
+
+std::string idx(const char* array, std::size_t i, const char* field) {
+    std::ostringstream os;
+    os << array << '[' << i << "]." << field;
+    return os.str();
+}
+
+void require_positive(const std::string& field, double value, const char* unit) {
+    if (!std::isfinite(value) || value <= 0.0)
+        throw InputError(field, "value " + format_value(value) + " is not allowed: must be finite and > 0 " + unit);
+}
+
+void require_nonnegative(const std::string& field, double value, const char* unit) {
+    if (!std::isfinite(value) || value < 0.0)
+        throw InputError(field, "value " + format_value(value) + " is not allowed: must be finite and >= 0 " + unit);
+}
+
+void require_finite(const std::string& field, double value) {
+    if (!std::isfinite(value))
+        throw InputError(field, "value " + format_value(value) + " is not allowed: must be finite");
+}
+
+double leaf_end(const LeafSpec& leaf) { return leaf.x_start_m + leaf.length_m; }
+
+}  // namespace
+
+bool Model::leaf_has_node(int leaf, int node) const {
+    return node >= first_node_[leaf] && node <= last_node_[leaf];
+}
+
+Model Model::build(ModelSpec spec) {
+    Model m;
+    const auto& leaves = spec.leaves;
+    if (leaves.empty()) throw InputError("leaves", "the stack has no leaf: at least 1 is required");
+
+    // --- leaves -----------------------------------------------------------
+    double x_min = std::numeric_limits<double>::infinity();
+    double x_max = -x_min;
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        const auto& l = leaves[i];
+        require_positive(idx("leaves", i, "length_m"), l.length_m, "[m]");
+        require_finite(idx("leaves", i, "x_start_m"), l.x_start_m);
+        require_positive(idx("leaves", i, "height_m"), l.height_m, "[m]");
+        require_positive(idx("leaves", i, "width_m"), l.width_m, "[m]");
+        require_positive(idx("leaves", i, "youngs_modulus_pa"), l.youngs_modulus_pa, "[Pa]");
+        require_nonnegative(idx("leaves", i, "density_kg_per_m3"), l.density_kg_per_m3, "[kg/m^3]");
+        x_min = std::min(x_min, l.x_start_m);
+        x_max = std::max(x_max, leaf_end(l));
+    }
+    const double extent = x_max - x_min;
+    const double tol = 1e-9 * std::max(extent, std::abs(x_max));
+    m.x_tol_ = tol;
+
+    // --- interfaces -------------------------------------------------------
+    if (spec.interfaces.size() != leaves.size() - 1)
+        throw InputError("interfaces", "has " + std::to_string(spec.interfaces.size()) +
+                                           " entries: a stack of " + std::to_string(leaves.size()) +
+                                           " leaves needs exactly " + std::to_string(leaves.size() - 1));
+    for (std::size_t i = 0; i < spec.interfaces.size(); ++i) {
+        const auto& f = spec.interfaces[i];
+        require_nonnegative(idx("interfaces", i, "friction_coefficient"), f.friction_coefficient, "[-]");
+        require_nonnegative(idx("interfaces", i, "initial_gap_m"), f.initial_gap_m, "[m]");
+        const double lo = std::max(leaves[i].x_start_m, leaves[i + 1].x_start_m);
+        const double hi = std::min(leaf_end(leaves[i]), leaf_end(leaves[i + 1]));
+        if (hi - lo <= tol)
+            throw InputError(idx("interfaces", i, "leaves"),
+                             "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) +
+                                 "] do not overlap along x: adjacent leaves must touch over a positive length");
+    }
+
+    // --- rigid body -------------------------------------------------------
+    auto& rb = spec.rigid_body;
+    require_positive("rigid_body.mass_kg", rb.mass_kg, "[kg]");
+    require_finite("rigid_body.x_m", rb.x_m);
+    require_finite("rigid_body.initial_displacement_m", rb.initial_displacement_m);
+    require_finite("rigid_body.initial_velocity_m_per_s", rb.initial_velocity_m_per_s);
+    auto present = [&](std::size_t leaf, double x) {
+        return x >= leaves[leaf].x_start_m - tol && x <= leaf_end(leaves[leaf]) + tol;
+    };
+    if (rb.tied_leaves.empty()) {
+        for (std::size_t i = 0; i < leaves.size(); ++i)
+            if (present(i, rb.x_m)) m.tied_.push_back(static_cast<int>(i));
+        if (m.tied_.empty())
+            throw InputError("rigid_body.x_m", "value " + format_value(rb.x_m) +
+                                                   " is off every leaf: the attachment must lie on a leaf");
+    } else {
+        for (std::size_t k = 0; k < rb.tied_leaves.size(); ++k) {
+            const int leaf = rb.tied_leaves[k];
+            const std::string field = "rigid_body.tied_leaves[" + std::to_string(k) + "]";
+            if (leaf < 0 || leaf >= static_cast<int>(leaves.size()))
+                throw InputError(field, "value " + std::to_string(leaf) + " is not a leaf index: allowed 0.." +
+                                            std::to_string(leaves.size() - 1));
+            if (!present(leaf, rb.x_m))
+                throw InputError(field, "leaf " + std::to_string(leaf) + " does not reach the attachment x = " +
+                                            format_value(rb.x_m) + " m");
+            if (std::find(m.tied_.begin(), m.tied_.end(), leaf) != m.tied_.end())
+                throw InputError(field, "leaf " + std::to_string(leaf) + " is listed twice");
+            m.tied_.push_back(leaf);
+        }
+        std::sort(m.tied_.begin(), m.tied_.end());
+    }
+
+    // --- clamps -----------------------------------------------------------
+    for (std::size_t c = 0; c < spec.clamps.size(); ++c) {
+        const auto& cl = spec.clamps[c];
+        require_finite(idx("clamps", c, "x_m"), cl.x_m);
+        require_nonnegative(idx("clamps", c, "preload_n"), cl.preload_n, "[N]");
+        bool crosses = false;
+        for (std::size_t i = 0; i + 1 < leaves.size(); ++i) crosses = crosses || (present(i, cl.x_m) && present(i + 1, cl.x_m));
+        if (!crosses)
+            throw InputError(idx("clamps", c, "x_m"), "value " + format_value(cl.x_m) +
+                                                          " crosses no interface: a clamp must lie where two adjacent leaves overlap");
+        for (std::size_t d = 0; d < c; ++d)
+            if (std::abs(spec.clamps[d].x_m - cl.x_m) <= tol)
+                throw InputError(idx("clamps", c, "x_m"), "value " + format_value(cl.x_m) + " duplicates clamps[" +
+                                                              std::to_string(d) + "]: clamps must be at distinct positions");
+    }
+
+    // --- mesh -------------------------------------------------------------
+    require_positive("mesh.element_length_m", spec.mesh.element_length_m, "[m]");
+    if (extent / spec.mesh.element_length_m > 1e6)
+        throw InputError("mesh.element_length_m", "value " + format_value(spec.mesh.element_length_m) +
+                                                      " gives more than 1e6 elements along the stack: use a longer element");
+
+    // --- symmetry ---------------------------------------------------------
+    const bool half = spec.symmetry == Symmetry::half;
+    if (half) {
+        const double xr = rb.x_m;
+        for (std::size_t i = 0; i < leaves.size(); ++i) {
+            const auto& l = leaves[i];
+            if (std::abs(l.x_start_m + 0.5 * l.length_m - xr) > tol)
+                throw InputError(idx("leaves", i, "x_start_m"),
+                                 "the half model needs every leaf centred on the attachment x = " + format_value(xr) +
+                                     " m; this leaf's centre is at " + format_value(l.x_start_m + 0.5 * l.length_m) + " m");
+            if (l.left_support != l.right_support)
+                throw InputError(idx("leaves", i, "right_support"), "the half model needs equal supports at both ends");
+        }
+        if (m.tied_.size() != leaves.size())
+            throw InputError("rigid_body.tied_leaves", "the half model needs the seat to tie every leaf");
+        for (std::size_t c = 0; c < spec.clamps.size(); ++c) {
+            const auto& cl = spec.clamps[c];
+            if (std::abs(cl.x_m - xr) <= tol) continue;
+            const bool mirrored = std::any_of(spec.clamps.begin(), spec.clamps.end(), [&](const ClampSpec& o) {
+                return std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol && o.preload_n == cl.preload_n;
+            });
+            if (!mirrored)
+                throw InputError(idx("clamps", c, "x_m"), "the half model needs each clamp mirrored about x = " +
+                                                              format_value(xr) + " m with the same preload");
+        }
+    }
+    const double x_hi = half ? rb.x_m : x_max;
+
+    // --- probe ------------------------------------------------------------
+    if (spec.probe) {
+        const auto& pr = *spec.probe;
+        if (pr.interface_index < 0 || pr.interface_index + 1 >= static_cast<int>(leaves.size()))
+            throw InputError("probe.interface_index", "value " + std::to_string(pr.interface_index) +
+                                                          " is not an interface: allowed 0.." +
+                                                          std::to_string(static_cast<int>(leaves.size()) - 2));
+        require_finite("probe.x_m", pr.x_m);
+        if (!present(pr.interface_index, pr.x_m) || !present(pr.interface_index + 1, pr.x_m) || pr.x_m > x_hi + tol)
+            throw InputError("probe.x_m", "value " + format_value(pr.x_m) + " is not on interface " +
+                                              std::to_string(pr.interface_index) + " (within the meshed region)");
+    }
+
+    // --- node grid ----------------------------------------------------------
+    std::vector<double> breaks;
+    for (const auto& l : leaves) {
+        breaks.push_back(l.x_start_m);
+        breaks.push_back(leaf_end(l));
+    }
+    for (const auto& cl : spec.clamps) breaks.push_back(cl.x_m);
+    breaks.push_back(rb.x_m);
+    if (spec.probe) breaks.push_back(spec.probe->x_m);
+    std::sort(breaks.begin(), breaks.end());
+    std::vector<double> uniq;
+    for (double b : breaks) {
+        if (b > x_hi + tol) continue;
+        if (uniq.empty() || b - uniq.back() > tol) uniq.push_back(b);
+    }
+    if (half && std::abs(uniq.back() - rb.x_m) > tol) uniq.push_back(rb.x_m);
+    m.nodes_x_.push_back(uniq.front());
+    for (std::size_t s = 1; s < uniq.size(); ++s) {
+        const double a = uniq[s - 1], b = uniq[s];
+        const int n = std::max(1, static_cast<int>(std::ceil((b - a) / spec.mesh.element_length_m - 1e-6)));
+        for (int k = 1; k <= n; ++k) m.nodes_x_.push_back(k == n ? b : a + (b - a) * k / n);
+    }
+    auto node_at = [&](double x) {
+        const auto it = std::lower_bound(m.nodes_x_.begin(), m.nodes_x_.end(), x - tol);
+        return static_cast<int>(it - m.nodes_x_.begin());
+    };
+    const int nn = static_cast<int>(m.nodes_x_.size());
+    for (const auto& l : leaves) {
+        m.first_node_.push_back(node_at(l.x_start_m));
+        m.last_node_.push_back(std::min(nn - 1, node_at(leaf_end(l))));
+    }
+    m.attach_node_ = node_at(rb.x_m);
+
+    // --- centroid heights (y up, leaf 0 on top) ------------------------------
+    std::vector<double> yc(leaves.size());
+    double top = 0.0;
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        yc[i] = top - 0.5 * leaves[i].height_m;
+        top -= leaves[i].height_m + (i < spec.interfaces.size() ? spec.interfaces[i].initial_gap_m : 0.0);
+    }
+    const int t0 = m.tied_.front(), t1 = m.tied_.back();
+    const double mid = 0.5 * ((yc[t0] + 0.5 * leaves[t0].height_m) + (yc[t1] - 0.5 * leaves[t1].height_m));
+    for (auto& y : yc) y -= mid;
+    m.y_centroid_ = yc;
+
+    // --- candidate pairs ------------------------------------------------------
+    for (std::size_t i = 0; i + 1 < leaves.size(); ++i) {
+        const int lo = std::max(m.first_node_[i], m.first_node_[i + 1]);
+        const int hi = std::min(m.last_node_[i], m.last_node_[i + 1]);
+        for (int n = lo; n <= hi; ++n) {
+            PairSpec p;
+            p.interface_index = static_cast<int>(i);
+            p.node = n;
+            p.x_m = m.nodes_x_[n];
+            p.friction_coefficient = spec.interfaces[i].friction_coefficient;
+            p.initial_gap_m = spec.interfaces[i].initial_gap_m;
+            p.kind = PairKind::coulomb;
+            if (spec.interfaces[i].law == InterfaceLaw::bonded) {
+                p.kind = PairKind::bonded;
+                p.friction_coefficient = 0.0;
+            } else {
+                for (const auto& cl : spec.clamps)
+                    if (std::abs(cl.x_m - p.x_m) <= tol) {
+                        p.kind = PairKind::clamp;
+                        p.preload_n = cl.preload_n;
+                    }
+            }
+            if (p.kind == PairKind::clamp && p.initial_gap_m > 0.0)
+                throw InputError(idx("interfaces", i, "initial_gap_m"),
+                                 "value " + format_value(p.initial_gap_m) +
+                                     " is not allowed where a clamp crosses the interface: a clamp closes the gap (use 0)");
+            m.pairs_.push_back(p);
+        }
+    }
+
+    // --- probe pair -------------------------------------------------------------
+    ProbeSpec probe;
+    bool have_probe = false;
+    if (spec.probe) {
+        probe = *spec.probe;
+        have_probe = true;
+    } else if (leaves.size() > 1) {
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& cl : spec.clamps)
+            if (present(0, cl.x_m) && present(1, cl.x_m) && cl.x_m < best && cl.x_m <= x_hi + tol) best = cl.x_m;
+        if (std::isfinite(best)) {
+            probe = ProbeSpec{0, best};
+            have_probe = true;
+        }
+    }
+    if (have_probe) {
+        const int n = node_at(probe.x_m);
+        for (std::size_t k = 0; k < m.pairs_.size(); ++k)
+            if (m.pairs_[k].interface_index == probe.interface_index && m.pairs_[k].node == n) m.probe_pair_ = static_cast<int>(k);
+    }
+    m.spec_ = std::move(spec);
+    return m;
+}
+
+FrictionMeshRatio friction_mesh_ratio(const Model& model) {
+    const ModelSpec& spec = model.spec();
+    const double tol = model.x_tolerance_m();
+    FrictionMeshRatio best;
+    for (int i = 0; i < static_cast<int>(spec.interfaces.size()); ++i) {
+        const InterfaceSpec& f = spec.interfaces[i];
+        if (f.law != InterfaceLaw::coulomb || f.friction_coefficient <= 0.0) continue;
+        std::vector<double> x;
+        for (const PairSpec& c : model.candidate_pairs())
+            if (c.interface_index == i) x.push_back(c.x_m);
+        std::sort(x.begin(), x.end());
+        double h = std::numeric_limits<double>::infinity();
+        for (std::size_t j = 1; j < x.size(); ++j)
+            if (x[j] - x[j - 1] > tol) h = std::min(h, x[j] - x[j - 1]);
+        if (!std::isfinite(h)) continue;  // fewer than two pairs: no neighbour to trade forces with
+        const double arm_m = 0.5 * (spec.leaves[i].height_m + spec.leaves[i + 1].height_m);
+        const double kappa = f.friction_coefficient * arm_m / h;
+        if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m};
+    }
+    return best;
+}
+
+std::string friction_mesh_advice(const Model& model) {
+    const FrictionMeshRatio r = friction_mesh_ratio(model);
+    if (r.ratio < 1.0) return {};
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is %.3g on interface %d (pair spacing h = %.4g m): "
+                  "from about 1 on, the incremental Coulomb problem of this mesh can have several solutions and the "
+                  "exact solver's fixed point on the friction limits settles slowly or not at all (BENCHMARKS.md); "
+                  "pairs spaced more than %.4g m apart there (mesh.element_length_m) or a mu below %.4g bring it "
+                  "below 1",
+                  r.ratio, r.interface_index, r.pair_spacing_m, r.spacing_for_one_m,
+                  model.spec().interfaces[r.interface_index].friction_coefficient / r.ratio);
+    return buf;
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,280 @@
+// The paper's closed-form step (eqs. 14-16) and its 8-step algorithm (mode closed-form).
+#include "stackbeam/time/closed_form_stepper.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "stackbeam/errors.hpp"
+#include "model/mesh_note.hpp"
+#include "time/step_record.hpp"
+
+namespace stackbeam {
+
+ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
+    : system_(system), options_(options) {
+    options_.validate();
+    require_massless_leaves(system_, Mode::closed_form);
+    options_.loading.prepare();
+    const Loading& load = options_.loading;
+    rig_ = load.kind == LoadingKind::prescribed_displacement;
+    require_loading_fits(system_.model().spec(), load);
+    path_ = choose_contact_path(system_, options_);
+    const int n = system_.num_components();
+    const double k = system_.stiffness_n_per_m();
+    const double m = system_.mass_kg();
+    f_ = system_.model().whole_spring_factor();
+    m_whole_ = system_.model().spec().rigid_body.mass_kg;
+    omega_ = std::sqrt(k / m);
+    const double x = omega_ * options_.dt_s;
+    cos_ = std::cos(x);
+    sin_ = std::sin(x);
+    // gamma = 1 - sin(x)/x, by its series where the subtraction would cancel
+    gamma_ = x < 1e-3 ? x * x / 6.0 - x * x * x * x / 120.0 : 1.0 - sin_ / x;
+
+    problem_.pairs = system_.pairs();
+    problem_.tau_rule = options_.tau_rule;
+    problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
+    const auto& c = system_.coupling();
+    d_ = system_.initial_offsets_m();
+    p_ = Eigen::VectorXd::Zero(n);
+    const auto& rb = system_.model().spec().rigid_body;
+    const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+    const int nz = static_cast<int>(K.rows());
+    w_dof_ = nz - 1;
+    if (path_ == ContactPath::sparse) {
+        krw_ = Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1));
+        gw_ = Eigen::VectorXd(G.col(w_dof_));
+    }
+
+    // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
+    //    from the unloaded stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
+    w_ = 0.0;
+    if (load.gravity_m_per_s2 > 0.0) {
+        const double Fs = -m * load.gravity_m_per_s2;  // R's weight on the meshed part [N]
+        const std::string what = "static equilibrium under gravity";
+        if (path_ == ContactPath::dense) {
+            auto solver = make_solver(options_.solver);
+            const detail::StaticState st = detail::static_equilibrium_dense(system_, problem_, Fs, *solver, p_, d_, what);
+            w_ = st.w_m;
+            solve_ = st.solve;
+        } else {
+            SparseContactProblem st;
+            st.K = K;
+            st.G = G;
+            st.b = Eigen::VectorXd::Zero(nz);
+            st.b[w_dof_] = Fs;
+            st.d = d_;
+            st.pairs = problem_.pairs;
+            st.tau_rule = problem_.tau_rule;
+            st.tau_previous_n = problem_.tau_previous_n;
+            SparseContactSolver solver(options_.solver, options_.sparse_tuning);
+            solve_ = solver.solve(st, p_, z_);
+            if (n > 0 && !solve_.converged) throw SolverError(what + ": " + solve_.message, 0, 0.0, solve_.residual_m);
+            w_ = z_[w_dof_];
+            detail::reanchor(problem_, p_, Eigen::VectorXd(G * z_), d_);
+        }
+    }
+    // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
+    //    relative to the supports, whose velocity the initial absolute velocity excludes).
+    double w_start = w_ + rb.initial_displacement_m;
+    wd_ = rb.initial_velocity_m_per_s - load.base_velocity_m_per_s(0.0);
+    if (rig_) {
+        w_start = load.displacement_m.value(0.0);
+        wd_ = load.displacement_m.derivative(0.0);
+    }
+
+    if (path_ == ContactPath::dense) {
+        solver_ = make_solver(options_.solver);
+        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
+            problem_.W = system_.compliance_held();
+            problem_.q = c * w_start - d_;
+            solve_ = solver_->solve(problem_, p_);
+            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+        }
+        w_ = w_start;
+        // The rig holds R: each step is quasi-static with R held (W = C'); otherwise eq. 16.
+        problem_.W = rig_ ? system_.compliance_held()
+                          : Eigen::MatrixXd(system_.compliance_held() + (gamma_ / k) * c * c.transpose());
+        problem_.q = Eigen::VectorXd::Zero(n);
+        rel_ = system_.compliance_held() * p_ + c * w_;
+    } else {
+        // Sparse path (see simulation.hpp): K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma,
+        // with 1 - gamma = sin(x)/x taken directly (no cancellation for small x).
+        if (!(sin_ > 0.0) && !rig_)
+            throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
+                                       " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
+        const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
+        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
+        if (z_.size() == 0) z_ = system_.reduced_displacements(p_, w_);
+        SparseContactProblem held;  // R held at w: the problem on z_r
+        held.K = K.topLeftCorner(w_dof_, w_dof_);
+        held.G = G.leftCols(w_dof_);
+        held.pairs = problem_.pairs;
+        held.tau_rule = problem_.tau_rule;
+        held.tau_previous_n = problem_.tau_previous_n;
+        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
+            held.b = -krw_ * w_start;
+            held.d = d_ - gw_ * w_start;
+            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
+            Eigen::VectorXd zr;
+            solve_ = initial.solve(held, p_, zr);
+            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+            z_.head(w_dof_) = zr;
+            z_[w_dof_] = w_start;
+        }
+        w_ = w_start;
+        if (rig_) {
+            sparse_problem_ = std::move(held);
+        } else {
+            Eigen::SparseMatrix<double> Kaug = K;
+            k_r_ = k * one_minus_gamma / gamma_;
+            Kaug.coeffRef(w_dof_, w_dof_) += k_r_;
+            Kaug.makeCompressed();
+            sparse_problem_.K = std::move(Kaug);
+            sparse_problem_.G = G;
+            sparse_problem_.b = Eigen::VectorXd::Zero(nz);
+            sparse_problem_.pairs = problem_.pairs;
+            sparse_problem_.tau_rule = problem_.tau_rule;
+            sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        }
+        sparse_problem_.d = d_;
+        rel_ = G * z_;
+    }
+    fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
+    fill_record(0, 0);
+    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
+    record_.energy_balance_error_j = 0.0;
+}
+
+void ClosedFormStepper::fill_record(int iterations, int factorizations, double strain_j) {
+    const double f = f_;
+    const double k = system_.stiffness_n_per_m();
+    // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp); the
+    // sparse path has z itself and never builds C'. step() passes the sparse path's U
+    // (strain_j >= 0), which it has without a product with K.
+    const double strain = strain_j >= 0.0 ? strain_j
+                          : path_ == ContactPath::dense
+                              ? 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_)
+                              : 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
+    detail::LoadState load;
+    load.external_work_j = wext_;
+    load.base_displacement_m = options_.loading.base_displacement_m(t_);
+    if (rig_) {
+        load.prescribed = true;
+        load.force_on_mass_n = m_whole_ * options_.loading.displacement_m.second_derivative(t_);
+        load.external_force_n = f * (k * w_ - (p_.size() > 0 ? system_.coupling().dot(p_) : 0.0));
+    } else {
+        load.external_force_n = f * fe_;
+    }
+    detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, load, record_);
+    record_.t_s = t_;
+    record_.contact_iterations = iterations;
+    record_.factorizations = factorizations;
+    record_.contact_residual_m = solve_.residual_m;
+}
+
+std::vector<PairState> ClosedFormStepper::pair_states() const {
+    std::vector<PairState> s(problem_.pairs.size());
+    for (std::size_t k = 0; k < s.size(); ++k) s[k] = pair_state(problem_, static_cast<int>(k), p_);
+    return s;
+}
+
+const StepRecord& ClosedFormStepper::step() {
+    const double k = system_.stiffness_n_per_m();
+    const double dt = options_.dt_s;
+    const auto& c = system_.coupling();
+    const Loading& load = options_.loading;
+    const double t1 = (step_ + 1) * dt;
+    const double w0 = w_;
+    const double cp0 = c.dot(p_);  // c^T p at t [N]
+    const double kin0 = 0.5 * m_whole_ * wd_ * wd_;
+    double w_next = 0.0, fe1 = 0.0, F0 = 0.0;
+    if (rig_) {
+        // The rig: w(t+dt) prescribed, the contact problem quasi-static with R held there.
+        w_next = load.displacement_m.value(t1);
+        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
+    } else {
+        // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
+        // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
+        fe1 = load.external_force_n(t1, m_whole_) / f_;
+        F0 = cp0 + fe_;
+        w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
+        // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
+        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
+    }
+    if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
+    const Eigen::VectorXd p0 = p_;
+    if (path_ == ContactPath::dense) {
+        solve_ = solver_->solve(problem_, p_);
+    } else if (rig_) {
+        sparse_problem_.b = -krw_ * w_next;
+        sparse_problem_.d = d_ - gw_ * w_next;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        Eigen::VectorXd zr = z_.head(w_dof_);
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, zr, step_ > 0);  // the held K, G constant over the run
+        z_.head(w_dof_) = zr;
+        z_[w_dof_] = w_next;
+    } else {
+        sparse_problem_.b[w_dof_] = k / gamma_ * w_next;
+        sparse_problem_.d = d_;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, z_, step_ > 0);  // K, G constant over the run
+    }
+    ++step_;
+    if (!solve_.converged && options_.stop_on_nonconvergence) {
+        throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
+                              format_value(step_ * dt) + " s: " + solve_.message + detail::mesh_note(system_.model()),
+                          step_, step_ * dt, solve_.residual_m);
+    }
+    const double cp1 = c.dot(p_);  // c^T p at t + dt [N]
+    double w1 = 0.0, wd1 = 0.0;
+    if (rig_) {
+        w1 = w_next;
+        wd1 = load.displacement_m.derivative(t1);
+    } else {
+        const double F1 = cp1 + fe1;
+        w1 = w_next + gamma_ * cp1 / k;
+        wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
+    }
+    // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
+    // G z on the sparse path: the solver's s = G z - d at the solution, plus d (the rig's
+    // held problem is posed on z_r with d - G_w w: add R's part G_w w back)
+    Eigen::VectorXd rel1;
+    if (path_ == ContactPath::dense) rel1 = problem_.W * p_ + problem_.q + d_;
+    else if (rig_) rel1 = sparse_solver_->relative_positions() + sparse_problem_.d + gw_ * w_next;
+    else rel1 = sparse_solver_->relative_positions() + sparse_problem_.d;
+    double work = 0.0;
+    for (const auto& pr : problem_.pairs)
+        if (pr.row_t >= 0 && pr.kind != PairKind::bonded)
+            work += 0.5 * (p0[pr.row_t] + p_[pr.row_t]) * (rel1[pr.row_t] - rel_[pr.row_t]);
+    dissipated_ -= f_ * work;
+    // External work, trapezoidal: the loading's force on R over dw (exact for a constant
+    // force); the rig: its force on the spring over dw plus the kinetic energy it gives R.
+    if (rig_) {
+        const double spring0 = f_ * (k * w0 - cp0), spring1 = f_ * (k * w1 - cp1);
+        wext_ += 0.5 * (spring0 + spring1) * (w1 - w0) + 0.5 * m_whole_ * wd1 * wd1 - kin0;
+    } else {
+        wext_ += 0.5 * f_ * (fe_ + fe1) * (w1 - w0);
+        fe_ = fe1;
+    }
+    rel_ = rel1;
+    w_ = w1;
+    wd_ = wd1;
+    t_ = step_ * dt;
+    detail::reanchor(problem_, p_, rel_, d_);
+    // Sparse path: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
+    // (the solved system, K_aug = K + k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2,
+    // with G z = rel_ (made above). b_w w and k_R w^2 are each about 1/gamma times U
+    // (~1e2-1e3 at dt = 1 ms): the difference loses that factor of round-off, 1e-13 relative.
+    // (The rig's held problem is another system: fill_record takes z^T K z there.)
+    double strain = -1.0;
+    if (path_ == ContactPath::sparse && !rig_) {
+        const double zw = z_[w_dof_];
+        strain = 0.5 * f_ * (sparse_problem_.b[w_dof_] * zw + p_.dot(rel_) - k_r_ * zw * zw);
+    }
+    fill_record(solve_.iterations, solve_.factorizations, strain);
+    return record_;
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,302 @@
+// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/inertia.md).
+#include "time/cvode/cvode_inertia.hpp"
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_band.h>
+#include <sunmatrix/sunmatrix_band.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <cmath>
+#include <string>
+
+#include "stackbeam/errors.hpp"
+#include "time/step_record.hpp"
+#include "fe/tied_shape.hpp"
+
+namespace stackbeam::detail {
+
+bool has_leaf_mass(const System& system) {
+    for (const auto& leaf : system.model().spec().leaves)
+        if (leaf.density_kg_per_m3 != 0.0) return true;
+    return false;
+}
+
+bool has_mode_changes(const System& system) {
+    for (const auto& pr : system.pairs())
+        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0) return true;
+    return false;
+}
+
+struct CvodeInertiaStepper::Impl {
+    Impl(const System& system, const SimulationOptions& options) : sys(system), opt(options) {}
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
+    const System& sys;
+    SimulationOptions opt;
+    int n = 0, r = 0;
+    Eigen::SparseMatrix<double> K, M;
+    std::vector<int> held;     // the held contact rows (bonded: both; mu = 0: the normal one)
+    Eigen::MatrixXd Gd;        // the held contact rows of G, dense [-]
+    Eigen::VectorXd dC;        // their offsets [m]
+    double F_ref = 1.0;        // force scale of the release check [N]
+    Eigen::MatrixXd N;         // orthonormal basis of null(G), n x r
+    Eigen::VectorXd zp;        // particular solution of G z = d [m]
+    Eigen::MatrixXd Phi;       // mass-normalised modes of (N^T K N, N^T M N): q = Phi xi
+    Eigen::VectorXd om;        // their circular frequencies [rad/s]
+    Eigen::MatrixXd NPhi;      // N Phi: z = z_p + NPhi xi
+    Eigen::VectorXd g;         // modal load -Phi^T N^T K z_p
+    Eigen::LDLT<Eigen::MatrixXd> GGt;  // G G^T, for the contact forces
+    ContactProblem laws;       // the pairs (for the record's pair states)
+    double e0 = 0.0;
+    long out_index = 0, num_out = 0;
+    StepRecord rec;
+    CvodeStats st;
+
+    SUNContext ctx = nullptr;
+    N_Vector y = nullptr, atol = nullptr;
+    SUNMatrix J = nullptr;
+    SUNLinearSolver LS = nullptr;
+    void* cv = nullptr;
+
+    ~Impl() {
+        if (cv) CVodeFree(&cv);
+        if (LS) SUNLinSolFree(LS);
+        if (J) SUNMatDestroy(J);
+        if (y) N_VDestroy(y);
+        if (atol) N_VDestroy(atol);
+        if (ctx) SUNContext_Free(&ctx);
+    }
+
+    void check(int flag, const char* what) const {
+        if (flag < 0)
+            throw SolverError(std::string("cvode mode (leaf inertia): ") + what + " failed with flag " +
+                                  std::to_string(flag),
+                              out_index, out_index * opt.dt_s, 0.0);
+    }
+
+    // State in energy-norm modal coordinates, interleaved: y[2i] = om_i xi_i, y[2i+1] = xi_i'
+    // (1/2 sum y^2 is the energy of the motion about z_p): y[2i]' = om_i y[2i+1],
+    // y[2i+1]' = -om_i y[2i] + g_i. The Jacobian is constant and block diagonal (band 1, 1).
+    static int rhs(realtype, N_Vector yv, N_Vector ydot, void* data) {
+        const auto* s = static_cast<const Impl*>(data);
+        const double* Y = N_VGetArrayPointer(yv);
+        double* D = N_VGetArrayPointer(ydot);
+        for (int i = 0; i < s->r; ++i) {
+            D[2 * i] = s->om[i] * Y[2 * i + 1];
+            D[2 * i + 1] = -s->om[i] * Y[2 * i] + s->g[i];
+        }
+        return 0;
+    }
+
+    static int jac(realtype, N_Vector, N_Vector, SUNMatrix Jm, void* data, N_Vector, N_Vector, N_Vector) {
+        const auto* s = static_cast<const Impl*>(data);
+        SUNMatZero(Jm);
+        for (int i = 0; i < s->r; ++i) {
+            SM_ELEMENT_B(Jm, 2 * i, 2 * i + 1) = s->om[i];
+            SM_ELEMENT_B(Jm, 2 * i + 1, 2 * i) = -s->om[i];
+        }
+        return 0;
+    }
+
+    /// Modal coordinates xi, xi' of the state.
+    void modal(Eigen::VectorXd& xi, Eigen::VectorXd& xid) const {
+        const double* Y = N_VGetArrayPointer(y);
+        xi.resize(r);
+        xid.resize(r);
+        for (int i = 0; i < r; ++i) {
+            xi[i] = Y[2 * i] / om[i];
+            xid[i] = Y[2 * i + 1];
+        }
+    }
+
+    void fill(double t) {
+        Eigen::VectorXd xi, xid;
+        modal(xi, xid);
+        const Eigen::VectorXd z = zp + NPhi * xi;
+        const Eigen::VectorXd v = NPhi * xid;
+        const Eigen::VectorXd a = NPhi * Eigen::VectorXd(g - om.cwiseProduct(om).cwiseProduct(xi));
+        // the held components' forces: G^T p = M a + K z (least squares: exact on range(G^T))
+        const Eigen::VectorXd pC = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(M * a + K * z)))
+                                                 : Eigen::VectorXd();
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(sys.num_components());
+        for (int k = 0; k < static_cast<int>(held.size()); ++k) p[held[k]] = pC[k];
+        // a held unilateral pair must stay compressed (p_n <= 0): a release is an event,
+        // not built yet with massive leaves
+        for (const auto& pr : laws.pairs)
+            if (pr.kind == PairKind::coulomb && pr.row_n >= 0 && p[pr.row_n] > 1e-6 * F_ref)
+                throw SolverError("cvode mode (leaf inertia): a frictionless pair goes into tension (p_n = " +
+                                      format_value(p[pr.row_n]) + " N) at t = " + format_value(t) +
+                                      " s: contact events between massive leaves are not built yet, use mode newmark",
+                                  out_index, t, 0.0);
+        const double f = sys.model().whole_spring_factor();
+        const double strain = 0.5 * f * z.dot(K * z);
+        fill_state(sys, laws, p, z[n - 1], v[n - 1], strain, 0.0, e0, LoadState{}, rec);
+        const double kinetic = 0.5 * f * v.dot(M * v);
+        rec.leaf_kinetic_energy_j = kinetic - rec.kinetic_energy_j;
+        rec.kinetic_energy_j = kinetic;
+        rec.impact_loss_j = 0.0;
+        rec.force_on_mass_n = sys.model().spec().rigid_body.mass_kg * a[n - 1];
+        rec.energy_balance_error_j = e0 - (rec.kinetic_energy_j + rec.strain_energy_j);
+        rec.t_s = t;
+        rec.contact_iterations = 0;
+        rec.factorizations = 0;
+        rec.contact_residual_m = (Gd * z - dC).norm();
+    }
+};
+
+CvodeInertiaStepper::~CvodeInertiaStepper() = default;
+
+CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationOptions& options)
+    : impl_(std::make_unique<Impl>(system, options)) {
+    Impl& s = *impl_;
+    s.opt.validate();
+    require_uniform_leaf_mass(system, "cvode");
+    require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
+    const auto& pairs = system.pairs();
+    for (std::size_t j = 0; j < pairs.size(); ++j) {
+        const auto& pr = pairs[j];
+        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0)
+            throw InputError("mode", std::string("value 'cvode' with leaves of density > 0 handles bonded and frictionless "
+                                                 "stacks only so far (pair ") + std::to_string(j) + " is " +
+                                         to_string(pr.kind) + " with mu = " + format_value(pr.friction_coefficient) +
+                                         ": contact events between massive leaves are not built yet): use mode newmark");
+        if (pr.row_n >= 0) s.held.push_back(pr.row_n);
+        if (pr.row_t >= 0 && pr.kind == PairKind::bonded) s.held.push_back(pr.row_t);
+    }
+    s.K = system.stiffness_reduced();
+    s.M = system.mass_reduced();
+    s.n = static_cast<int>(s.K.rows());
+    const int m = static_cast<int>(s.held.size());
+    {
+        const Eigen::MatrixXd Gall(system.contact_rows());
+        s.Gd.resize(m, s.n);
+        s.dC.resize(m);
+        for (int k = 0; k < m; ++k) {
+            s.Gd.row(k) = Gall.row(s.held[k]);
+            s.dC[k] = system.initial_offsets_m()[s.held[k]];
+        }
+    }
+    s.laws.pairs = pairs;
+    s.laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    // null(G) from a QR of G^T: its last n - rank columns of Q
+    const Eigen::VectorXd& d = s.dC;
+    if (m > 0) {
+        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s.Gd.transpose());
+        const int rank = static_cast<int>(qr.rank());
+        s.r = s.n - rank;
+        const Eigen::MatrixXd Q = qr.householderQ();
+        s.N = Q.rightCols(s.r);
+        s.GGt.compute(s.Gd * s.Gd.transpose());
+        s.zp = s.Gd.transpose() * s.GGt.solve(d);
+    } else {  // no contact pair: every DOF free
+        s.r = s.n;
+        s.N = Eigen::MatrixXd::Identity(s.n, s.n);
+        s.zp = Eigen::VectorXd::Zero(s.n);
+    }
+    if (s.r < 1) throw InputError("mode", "value 'cvode' with leaf inertia: the held stack has no free motion");
+    const Eigen::MatrixXd Mt = s.N.transpose() * (s.M * s.N);
+    const Eigen::MatrixXd Kt = s.N.transpose() * (s.K * s.N);
+    if (Eigen::LLT<Eigen::MatrixXd>(Mt).info() != Eigen::Success)
+        throw InputError("leaves[].density_kg_per_m3", "mode cvode with leaf inertia needs every leaf massive (> 0)");
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kt, Mt);
+    if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() <= 0.0)
+        throw SolverError("cvode mode (leaf inertia): the modal analysis of the held stack failed", 0, 0.0, 0.0);
+    s.Phi = eig.eigenvectors();
+    s.om = eig.eigenvalues().cwiseSqrt();
+    s.g = -s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.K * s.zp));
+    s.NPhi = s.N * s.Phi;
+
+    // initial state: the tied static shape at w(0), the tied shape per unit w times w'(0)
+    const auto& body = system.model().spec().rigid_body;
+    const Eigen::VectorXd z0 =
+        tied_shape(s.K, system.contact_rows(), s.held, body.initial_displacement_m, system.initial_offsets_m());
+    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s *
+                               tied_shape(s.K, system.contact_rows(), s.held, 1.0,
+                                          Eigen::VectorXd::Zero(system.num_components()));
+
+    s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create");
+    s.y = N_VNew_Serial(2 * s.r, s.ctx);
+    s.atol = N_VNew_Serial(2 * s.r, s.ctx);
+    if (!s.y || !s.atol) throw SolverError("cvode mode (leaf inertia): N_VNew_Serial failed", 0, 0.0, 0.0);
+    {
+        // xi = Phi^T Mt q (Phi^T Mt Phi = I), q = N^T (z - z_p)
+        const Eigen::VectorXd xi = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * (z0 - s.zp)));
+        const Eigen::VectorXd xid = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * v0));
+        double* Y = N_VGetArrayPointer(s.y);
+        for (int i = 0; i < s.r; ++i) {
+            Y[2 * i] = s.om[i] * xi[i];
+            Y[2 * i + 1] = xid[i];
+        }
+    }
+    // atol, the same on every component (energy-norm units, sqrt(J) on the meshed part):
+    // rtol sqrt(2 E0), so that the error is controlled relative to the whole motion's
+    // energy (a leaf mode carrying 1e-8 of the energy is not resolved to rtol of its own
+    // amplitude: BDF damps it), and at least the user's atol on w as an energy-norm
+    // amplitude of the body's mode, sqrt(m) omega atol_m.
+    const double omega = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
+    s.F_ref = system.tied_stiffness_n_per_m() / system.model().whole_spring_factor() *
+              std::max(std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega, 1e-6);
+    const double e_meshed = 0.5 * N_VDotProd(s.y, s.y);
+    N_VConst(std::max(std::sqrt(system.mass_kg()) * omega * s.opt.cvode.atol_m,
+                      s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed)),
+             s.atol);
+
+    s.cv = CVodeCreate(CV_BDF, s.ctx);
+    if (!s.cv) throw SolverError("cvode mode (leaf inertia): CVodeCreate failed", 0, 0.0, 0.0);
+    s.check(CVodeInit(s.cv, &Impl::rhs, 0.0, s.y), "CVodeInit");
+    s.check(CVodeSVtolerances(s.cv, s.opt.cvode.rtol, s.atol), "CVodeSVtolerances");
+    s.check(CVodeSetUserData(s.cv, &s), "CVodeSetUserData");
+    s.check(CVodeSetMaxOrd(s.cv, 2), "CVodeSetMaxOrd");
+    s.check(CVodeSetMaxNumSteps(s.cv, 100000), "CVodeSetMaxNumSteps");
+    if (s.opt.cvode.max_step_s > 0.0) s.check(CVodeSetMaxStep(s.cv, s.opt.cvode.max_step_s), "CVodeSetMaxStep");
+    s.J = SUNBandMatrix(2 * s.r, 1, 1, s.ctx);
+    s.LS = SUNLinSol_Band(s.y, s.J, s.ctx);
+    if (!s.J || !s.LS) throw SolverError("cvode mode (leaf inertia): dense linear solver creation failed", 0, 0.0, 0.0);
+    s.check(CVodeSetLinearSolver(s.cv, s.LS, s.J), "CVodeSetLinearSolver");
+    s.check(CVodeSetJacFn(s.cv, &Impl::jac), "CVodeSetJacFn");
+
+    s.num_out = static_cast<long>(std::ceil(s.opt.t_end_s / s.opt.dt_s - 1e-9));
+    s.fill(0.0);
+    s.e0 = s.rec.kinetic_energy_j + s.rec.strain_energy_j;
+    s.rec.energy_balance_error_j = 0.0;
+}
+
+const StepRecord& CvodeInertiaStepper::advance() {
+    Impl& s = *impl_;
+    ++s.out_index;
+    const double tout = s.out_index * s.opt.dt_s;
+    realtype t = 0.0;
+    const int flag = CVode(s.cv, tout, s.y, &t, CV_NORMAL);
+    long steps = 0;
+    CVodeGetNumSteps(s.cv, &steps);
+    if (flag < 0) {
+        realtype h = 0.0;
+        CVodeGetLastStep(s.cv, &h);
+        throw SolverError("cvode mode (leaf inertia): CVode failed with flag " + std::to_string(flag) + " at t = " +
+                              format_value(t) + " s after " + std::to_string(steps) + " steps (last step " +
+                              format_value(h) + " s)",
+                          s.out_index, t, 0.0);
+    }
+    if (steps > s.opt.cvode.max_steps)
+        throw SolverError("cvode mode (leaf inertia): more than max_steps = " + std::to_string(s.opt.cvode.max_steps) +
+                              " steps by t = " + format_value(t) + " s",
+                          s.out_index, t, 0.0);
+    s.st.steps = steps;
+    long v = 0;
+    CVodeGetNumRhsEvals(s.cv, &v);
+    s.st.rhs_evaluations = v;
+    CVodeGetNumJacEvals(s.cv, &v);
+    s.st.jacobian_evaluations = v;
+    CVodeGetNumLinSolvSetups(s.cv, &v);
+    s.st.linear_setups = v;
+    s.fill(tout);
+    return s.rec;
+}
+
+const StepRecord& CvodeInertiaStepper::current() const noexcept { return impl_->rec; }
+const CvodeStats& CvodeInertiaStepper::stats() const noexcept { return impl_->st; }
+
+}  // namespace stackbeam::detail

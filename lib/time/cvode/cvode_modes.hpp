@@ -1,0 +1,122 @@
+#pragma once
+// Internal: the contact-mode bookkeeping shared by the two event-driven cvode steppers,
+// the massless one (cvode_stepper.cpp: R's displacement w drives the contact problem)
+// and the modal one with leaf inertia (cvode_modal.cpp: the retained modes q do). Both
+// use the witnesses of cvode_stepper.hpp with these margins, read modes from a contact
+// solution the same way, apply the transitions CVODE reports the same way and log them
+// under the same labels.
+#include <cvode/cvode.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "contact/active_set.hpp"
+#include "stackbeam/contact/contact.hpp"
+
+namespace stackbeam::detail {
+
+/// Every witness is positive by a margin (relative to its scale) while its mode
+/// holds, so that pairs that merely touch (p = s = 0 up to round-off) do not chatter.
+/// Forces come from an LU of the mode's conditions (cond(C') ~ 1e5: round-off
+/// ~1e-11 F_ref), so force witnesses get 1e-9: a friction limit or a contact
+/// release is passed by 1e-9 F_ref before it counts. Gaps and slip rates are
+/// products of C' with the forces (round-off ~1e-16 L_ref): 1e-12, so that a gap
+/// closing into penetration by 1e-12 L_ref makes a force jump of only ~1e-12 L_ref / C'_nn.
+constexpr double kForceMargin = 1e-9;
+constexpr double kMotionMargin = 1e-12;
+/// The look-ahead at an event moves the contact points by this fraction of L_ref:
+/// large against round-off (1e-16 L_ref), small against every margin that matters.
+constexpr double kLookahead = 1e-7;
+/// At most this many events at one instant before the run is declared chattering.
+constexpr int kMaxEventsAtOneTime = 200;
+
+/// The options of the event solver that decides the modes at an event: the exact solver
+/// at `tolerance_m` (each stepper's own, from its scales), with the user's active-set
+/// passes (at least 3) and Anderson depth of the Tresca fixed point.
+inline SolverOptions event_solver_options(const SolverOptions& user, double tolerance_m) {
+    SolverOptions ev;
+    ev.kind = SolverKind::exact;
+    ev.tolerance_m = tolerance_m;
+    ev.max_active_set_iterations = std::max(3, user.max_active_set_iterations);
+    ev.tresca_anderson_depth = user.tresca_anderson_depth;
+    return ev;
+}
+
+/// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).
+inline std::string cvode_flag_name(long flag) {
+    char* name = CVodeGetReturnFlagName(flag);
+    std::string out = name ? name : "unknown flag";
+    free(name);
+    return out;
+}
+
+/// Label of a pair's modes (nm, tm) for the event log.
+inline std::string mode_label(const ContactPair& cp, signed char nm, signed char tm) {
+    if (cp.kind == PairKind::bonded) return "bonded";
+    if (cp.kind == PairKind::coulomb && nm == OPEN) return "open";
+    switch (tm) {
+        case STICK: return "stick";
+        case SLIP_POS: return "slip+";
+        case SLIP_NEG: return "slip-";
+        case FREE: return cp.kind == PairKind::clamp ? "released" : "closed";
+        default: return cp.kind == PairKind::clamp ? "clamped" : "closed";
+    }
+}
+
+/// Modes of the contact solution p of `laws` (tau rule current): a unilateral pair with
+/// p_n >= -eps_f [N] is open; a friction force within 1e-9 of its limit slips.
+inline void modes_from_solution(const ContactProblem& laws, const Eigen::VectorXd& p, double eps_f,
+                                std::vector<signed char>& nm, std::vector<signed char>& tm) {
+    const int np = static_cast<int>(laws.pairs.size());
+    nm.assign(np, NONE);
+    tm.assign(np, NONE);
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = laws.pairs[kk];
+        bool open = false;
+        if (cp.row_n >= 0) {
+            open = cp.kind == PairKind::coulomb && p[cp.row_n] >= -eps_f;
+            nm[kk] = open ? OPEN : CLOSED;
+        } else if (cp.kind == PairKind::coulomb) {
+            open = true;  // no normal component: it carries no friction either
+        }
+        if (cp.row_t < 0) continue;
+        if (cp.kind == PairKind::bonded) {
+            tm[kk] = STICK;
+            continue;
+        }
+        const double limit = cp.friction_coefficient * friction_normal_force(laws, kk, p);
+        const double pt = p[cp.row_t];
+        if (open || cp.friction_coefficient == 0.0 || limit <= 0.0) tm[kk] = FREE;
+        else if (std::abs(pt) >= limit * (1.0 - 1e-9)) tm[kk] = pt > 0.0 ? SLIP_POS : SLIP_NEG;
+        else tm[kk] = STICK;
+    }
+}
+
+/// The transition a witness announces, applied to the pair's modes (nm, tm): the normal
+/// slot of a unilateral pair opens or closes it (closing: sticking if it has friction),
+/// that of a clamp releases or engages it; the tangential slot makes a stuck pair slip
+/// in the direction of its force p_t [N] and a slipping one stick.
+inline void apply_transition(const ContactPair& cp, bool normal_slot, double p_t, signed char& nm, signed char& tm) {
+    const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
+    if (normal_slot && cp.kind == PairKind::coulomb) {
+        if (nm == CLOSED) {
+            nm = OPEN;
+            if (cp.row_t >= 0) tm = FREE;
+        } else {
+            nm = CLOSED;
+            if (cp.row_t >= 0) tm = friction ? STICK : FREE;
+        }
+    } else if (normal_slot) {
+        tm = tm == FREE ? STICK : FREE;
+    } else if (tm == STICK) {
+        tm = p_t > 0.0 ? SLIP_POS : SLIP_NEG;
+    } else if (tm == SLIP_POS || tm == SLIP_NEG) {
+        tm = STICK;
+    }
+}
+
+}  // namespace stackbeam::detail

@@ -1,0 +1,346 @@
+// Mode "newmark": average-acceleration Newmark on the massive leaves with the paper's
+// contact problem at every step (newmark_stepper.hpp, docs/inertia.md).
+#include "stackbeam/time/newmark_stepper.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+#include "model/mesh_note.hpp"
+#include "time/step_record.hpp"
+#include "fe/tied_shape.hpp"
+
+namespace stackbeam {
+
+struct NewmarkStepper::Factor {
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
+};
+
+NewmarkStepper::~NewmarkStepper() = default;
+
+NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
+    : system_(system), options_(options), factor_(std::make_unique<Factor>()) {
+    options_.validate();
+    detail::require_uniform_leaf_mass(system_, "newmark");
+    require_initial_conditions_only(options_.loading, "mode newmark");
+    path_ = choose_contact_path(system_, options_);
+    const double dt = options_.dt_s;
+    const int m = system_.num_components();
+    K_ = system_.stiffness_reduced();
+    M_ = system_.mass_reduced();
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+    const int n = static_cast<int>(K_.rows());
+    const int w_dof = n - 1;
+    const auto& body = system_.model().spec().rigid_body;
+
+    problem_.pairs = system_.pairs();
+    problem_.tau_rule = options_.tau_rule;
+    problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
+    d_ = system_.initial_offsets_m();
+    p_ = Eigen::VectorXd::Zero(m);
+    const double w0 = body.initial_displacement_m;
+    const double wd0 = body.initial_velocity_m_per_s;
+
+    // Initial contact state with R held at w(0), as in the closed-form mode; the leaves
+    // start at that static shape.
+    if (w0 != 0.0 && m > 0) {
+        if (path_ == ContactPath::dense) {
+            ContactProblem held = problem_;
+            held.W = system_.compliance_held();
+            held.q = system_.coupling() * w0 - d_;
+            solve_ = make_solver(options_.solver)->solve(held, p_);
+        } else {
+            SparseContactProblem held;
+            held.K = K_.topLeftCorner(w_dof, w_dof);
+            held.G = G.leftCols(w_dof);
+            held.b = -Eigen::VectorXd(K_.block(0, w_dof, w_dof, 1)) * w0;
+            held.d = d_ - Eigen::VectorXd(G.col(w_dof)) * w0;
+            held.pairs = problem_.pairs;
+            held.tau_rule = problem_.tau_rule;
+            held.tau_previous_n = problem_.tau_previous_n;
+            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
+            Eigen::VectorXd zr;
+            solve_ = initial.solve(held, p_, zr);
+        }
+        if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
+    }
+    z_ = system_.reduced_displacements(p_, w0);
+    rel_ = G * z_;
+
+    // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.
+    massless_.assign(static_cast<std::size_t>(n), 0);
+    std::vector<int> massive;
+    for (int i = 0; i < n; ++i) {
+        if (M_.coeff(i, i) > 0.0) massive.push_back(i);
+        else massless_[i] = 1;
+    }
+
+    // Leaves all massive (contact between massive points: impacts, velocity projection) or
+    // all massless (the paper's statically condensed contact): a mix was refused above.
+    const auto& leaves = system_.model().spec().leaves;
+    massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
+    if (!massive_leaves_ && options_.restitution > 0.0)
+        throw InputError("restitution", "value " + format_value(options_.restitution) +
+                                            " is not used with massless leaves (no impacts: the contact points are "
+                                            "condensed statically): give 0, or a leaf density > 0");
+
+    // Initial velocity: w'(0) times the static shape per unit w with the closed contact
+    // components tied (bilateral ones always; unilateral ones whose gap is closed; their
+    // tangential component too when it carries friction or is bonded).
+    v_ = Eigen::VectorXd::Zero(n);
+    if (wd0 != 0.0) {
+        std::vector<int> tied;
+        for (const auto& pr : problem_.pairs) {
+            bool closed = true;
+            if (pr.row_n >= 0) {
+                const bool bilateral = pr.kind != PairKind::coulomb;
+                closed = bilateral || rel_[pr.row_n] - d_[pr.row_n] > -1e-12;
+                if (closed) tied.push_back(pr.row_n);
+            }
+            if (closed && pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0))
+                tied.push_back(pr.row_t);
+        }
+        v_ = wd0 * detail::tied_shape(K_, G, tied, 1.0, Eigen::VectorXd::Zero(m));
+    }
+    // Initial acceleration from the equations of motion on the massive DOFs:
+    // M_SS a_S = (G^T p0 - K z0)_S (the massless rows of the residual are zero: static shape).
+    a_ = Eigen::VectorXd::Zero(n);
+    {
+        const Eigen::VectorXd r = Eigen::VectorXd(G.transpose() * p_) - K_ * z_;
+        const int ns = static_cast<int>(massive.size());
+        Eigen::SparseMatrix<double> S(ns, n);
+        std::vector<Eigen::Triplet<double>> st;
+        for (int i = 0; i < ns; ++i) st.emplace_back(i, massive[i], 1.0);
+        S.setFromTriplets(st.begin(), st.end());
+        const Eigen::SparseMatrix<double> Mss = S * M_ * S.transpose();
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mf(Mss);
+        if (mf.info() != Eigen::Success)
+            throw SolverError("newmark: the mass matrix of the massive DOFs is singular", 0, 0.0, 0.0);
+        a_ = S.transpose() * Eigen::VectorXd(mf.solve(S * r));
+    }
+    for (int i = 0; i < n; ++i)
+        if (massless_[i]) v_[i] = a_[i] = 0.0;
+
+    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
+    // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
+    if (massive_leaves_) {
+        factor_->mass.compute(M_);
+        if (factor_->mass.info() != Eigen::Success)
+            throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
+        if (m > 0 && path_ == ContactPath::dense) {
+            Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
+            const Eigen::MatrixXd A = G * Z_;
+            A_ = 0.5 * (A + A.transpose());
+        }
+    }
+
+    // K_eff = K + 4 M / dt^2, factorised once. The contact force enters the step as
+    // kappa G^T p1: kappa = 1 (massless leaves: the trapezoidal rule) or 2 (massive leaves:
+    // the contact impulse over the step is dt p1, newmark_stepper.hpp).
+    const double kappa = massive_leaves_ ? 2.0 : 1.0;
+    Eigen::SparseMatrix<double> Keff = K_ + (4.0 / (dt * dt)) * M_;
+    Keff.makeCompressed();
+    factor_->llt.compute(Keff);
+    if (factor_->llt.info() != Eigen::Success)
+        throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
+    if (path_ == ContactPath::dense) {
+        solver_ = make_solver(options_.solver);
+        Y_ = kappa * factor_->llt.solve(Eigen::MatrixXd(G.transpose()));
+        const Eigen::MatrixXd W = G * Y_;
+        problem_.W = 0.5 * (W + W.transpose());
+        problem_.q = Eigen::VectorXd::Zero(m);
+    } else {
+        // (K_eff / kappa) z1 = r / kappa + G^T p1
+        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
+        sparse_problem_.K = (1.0 / kappa) * Keff;
+        sparse_problem_.G = G;
+        sparse_problem_.b = Eigen::VectorXd::Zero(n);
+        sparse_problem_.d = d_;
+        sparse_problem_.pairs = problem_.pairs;
+        sparse_problem_.tau_rule = problem_.tau_rule;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+    }
+    solve_ = SolveResult{};
+    solve_.converged = true;
+    fill_record(0, 0);
+    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
+    record_.energy_balance_error_j = 0.0;
+}
+
+void NewmarkStepper::fill_record(int iterations, int factorizations) {
+    const double f = system_.model().whole_spring_factor();
+    const auto& body = system_.model().spec().rigid_body;
+    const int w_dof = static_cast<int>(z_.size()) - 1;
+    const double strain = 0.5 * f * z_.dot(K_ * z_);
+    detail::fill_state(system_, problem_, p_, z_[w_dof], v_[w_dof], strain, dissipated_, e0_, detail::LoadState{}, record_);
+    const double kinetic = 0.5 * f * v_.dot(M_ * v_);
+    const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
+    record_.kinetic_energy_j = kinetic;
+    record_.leaf_kinetic_energy_j = kinetic - body_kinetic;
+    record_.impact_loss_j = impact_loss_;
+    // R is attached to the w DOF: the force on it is m w''.
+    record_.force_on_mass_n = body.mass_kg * a_[w_dof];
+    record_.energy_balance_error_j =
+        e0_ - (record_.kinetic_energy_j + record_.strain_energy_j + record_.dissipated_energy_j + impact_loss_);
+    record_.t_s = t_;
+    record_.contact_iterations = iterations;
+    record_.factorizations = factorizations;
+    record_.contact_residual_m = solve_.residual_m;
+}
+
+double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0) {
+    // The held components at t1: normal rows of closed pairs (compressed, or bilateral),
+    // tangential rows of sticking and bonded pairs. Their relative velocity is set to zero
+    // by the impulse G_C^T l that changes the kinetic energy least (M-orthogonal projection):
+    //     (G_C M^-1 G_C^T) l = G_C v,   v <- v - M^-1 G_C^T l,
+    // the inelastic impact law (restitution 0); the kinetic energy it removes,
+    // 1/2 (v- - v+)^T M (v- - v+) >= 0, is returned [J, whole spring].
+    std::vector<int> held;
+    for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
+        const auto& pr = problem_.pairs[j];
+        const PairState st = pair_state(problem_, static_cast<int>(j), p_);
+        if (pr.row_n >= 0 && (pr.kind != PairKind::coulomb || p_[pr.row_n] < 0.0)) held.push_back(pr.row_n);
+        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || st == PairState::stick) &&
+            (pr.row_n < 0 || pr.kind != PairKind::coulomb || p_[pr.row_n] < 0.0))
+            held.push_back(pr.row_t);
+    }
+    if (held.empty()) return 0.0;
+    const int nh = static_cast<int>(held.size());
+    // Restitution e (SimulationOptions::restitution): a unilateral normal component closed
+    // at t1 that was open at t0 (p0_n = 0) and approaching (s_n' = (G v0)_n > 0) leaves
+    // with G_n v+ = b_n = -e (G v0)_n; every other held component with 0. The impulse
+    // solves (G_C M^-1 G_C^T) l = G_C v - b and the kinetic energy removed is
+    // 1/2 l^T (G_C v + b) = (1 - e^2) times the e = 0 loss of the closing rows.
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(nh);
+    const double e = options_.restitution;
+    if (e > 0.0) {
+        for (int i = 0; i < nh; ++i) {
+            const int row = held[i];
+            for (const auto& pr : problem_.pairs) {
+                if (pr.row_n != row || pr.kind != PairKind::coulomb) continue;
+                if (p0[row] == 0.0 && gv0[row] > 0.0) b[i] = -e * gv0[row];
+            }
+        }
+    }
+    if (path_ == ContactPath::sparse) {
+        // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
+        const int n = static_cast<int>(v_.size());
+        if (held != held_) {
+            std::vector<Eigen::Triplet<double>> t;
+            for (int col = 0; col < M_.outerSize(); ++col)
+                for (Eigen::SparseMatrix<double>::InnerIterator it(M_, col); it; ++it)
+                    t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+            const Eigen::SparseMatrix<double, Eigen::RowMajor> Gr = system_.contact_rows();
+            for (int i = 0; i < nh; ++i)
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Gr, held[i]); it; ++it) {
+                    t.emplace_back(n + i, static_cast<int>(it.col()), it.value());
+                    t.emplace_back(static_cast<int>(it.col()), n + i, it.value());
+                }
+            Eigen::SparseMatrix<double> S(n + nh, n + nh);
+            S.setFromTriplets(t.begin(), t.end());
+            S.makeCompressed();
+            factor_->saddle.compute(S);
+            if (factor_->saddle.info() != Eigen::Success)
+                throw SolverError("newmark: the impact projection's matrix is singular at step " + std::to_string(step_),
+                                  step_, step_ * options_.dt_s, 0.0);
+            held_ = held;
+        }
+        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
+        rhs.head(n) = M_ * v_;
+        rhs.tail(nh) = b;
+        const Eigen::VectorXd x = factor_->saddle.solve(rhs);
+        const Eigen::VectorXd dv = v_ - x.head(n);
+        v_ = x.head(n);
+        if (e == 0.0) return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
+        // M dv = G_C^T l: l^T (G_C v + b) = dv^T M (2 v - dv) = dv^T M v + ... (kinetic energy change)
+        const Eigen::VectorXd vold = v_ + dv;
+        return 0.5 * system_.model().whole_spring_factor() * (vold.dot(M_ * vold) - v_.dot(M_ * v_));
+    }
+    const Eigen::VectorXd gv = system_.contact_rows() * v_;
+    if (held != held_) {  // factorise A_hh once per held set
+        Eigen::MatrixXd Ahh(nh, nh);
+        for (int i = 0; i < nh; ++i)
+            for (int k = 0; k < nh; ++k) Ahh(i, k) = A_(held[i], held[k]);
+        held_factor_.compute(Ahh);
+        held_ = held;
+    }
+    Eigen::VectorXd rhs(nh);
+    for (int i = 0; i < nh; ++i) rhs[i] = gv[held[i]];
+    const Eigen::VectorXd l = held_factor_.solve(Eigen::VectorXd(rhs - b));
+    Eigen::VectorXd dv = Eigen::VectorXd::Zero(v_.size());
+    for (int i = 0; i < nh; ++i) dv += Z_.col(held[i]) * l[i];
+    v_ -= dv;
+    // 1/2 l^T (G_C v + b) (= 1/2 dv^T M dv = 1/2 l^T A_hh l when b = 0; dv = M^-1 G_C^T l)
+    return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
+}
+
+const StepRecord& NewmarkStepper::step() {
+    const double dt = options_.dt_s;
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+    // r: the step's load with p1 = 0 (newmark_stepper.hpp). Massive leaves: the elastic force
+    // by the trapezoidal rule, the contact impulse implicit; massless: Newmark as printed.
+    const double kappa = massive_leaves_ ? 2.0 : 1.0;
+    const Eigen::VectorXd r = massive_leaves_
+                                  ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
+                                  : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
+    if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
+    const Eigen::VectorXd p0 = p_;
+    const Eigen::VectorXd gv0 = massive_leaves_ && options_.restitution > 0.0 ? Eigen::VectorXd(G * v_) : Eigen::VectorXd();
+    Eigen::VectorXd z1;
+    if (path_ == ContactPath::dense) {
+        const Eigen::VectorXd u = factor_->llt.solve(r);
+        problem_.q = G * u - d_;
+        solve_ = solver_->solve(problem_, p_);
+        z1 = u + Y_ * p_;
+    } else {
+        sparse_problem_.b = r / kappa;
+        sparse_problem_.d = d_;
+        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, z1);
+    }
+    ++step_;
+    if (!solve_.converged && options_.stop_on_nonconvergence) {
+        throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
+                              format_value(step_ * dt) + " s: " + solve_.message + detail::mesh_note(system_.model()),
+                          step_, step_ * dt, solve_.residual_m);
+    }
+    // The contact forces' work over the step (newmark_stepper.hpp): p1^T G (z1 - z0) with
+    // massive leaves, (p0 + p1)^T G (z1 - z0) / 2 with massless ones. Friction on the
+    // tangential components; the rest (normal components, bonds) is the impact loss.
+    const Eigen::VectorXd rel1 = G * z1;
+    const Eigen::VectorXd pbar = massive_leaves_ ? Eigen::VectorXd(p_) : Eigen::VectorXd(0.5 * (p0 + p_));
+    double friction_work = 0.0, other_work = 0.0;
+    for (const auto& pr : problem_.pairs) {
+        if (pr.row_t >= 0) {
+            const double wk = pbar[pr.row_t] * (rel1[pr.row_t] - rel_[pr.row_t]);
+            (pr.kind == PairKind::bonded ? other_work : friction_work) += wk;
+        }
+        if (pr.row_n >= 0) other_work += pbar[pr.row_n] * (rel1[pr.row_n] - rel_[pr.row_n]);
+    }
+    const double f = system_.model().whole_spring_factor();
+    dissipated_ -= f * friction_work;
+    impact_loss_ -= f * other_work;
+    // Newmark's update of v and a (beta = 1/4, gamma = 1/2): v1 = 2 (z1 - z0)/dt - v0.
+    if (massive_leaves_) {
+        v_ = (2.0 / dt) * (z1 - z_) - v_;
+        a_ = factor_->mass.solve(Eigen::VectorXd(G.transpose() * p_ - K_ * z1));  // M a1 = G^T p1 - K z1
+    } else {
+        const Eigen::VectorXd a1 = (4.0 / (dt * dt)) * (z1 - z_ - dt * v_) - a_;
+        v_ += 0.5 * dt * (a_ + a1);
+        a_ = a1;
+    }
+    z_ = std::move(z1);
+    for (int i = 0; i < static_cast<int>(z_.size()); ++i)
+        if (massless_[i]) v_[i] = a_[i] = 0.0;
+    rel_ = rel1;
+    if (massive_leaves_) impact_loss_ += project_velocities(p0, gv0);
+    t_ = step_ * dt;
+    detail::reanchor(problem_, p_, rel_, d_);  // paper, section 5
+    fill_record(solve_.iterations, solve_.factorizations);
+    return record_;
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,274 @@
+// Simulation options, the record columns and simulate(): the loop over the steppers.
+#include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/time/simulation.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/errors.hpp"
+#include "time/cvode/cvode_inertia.hpp"
+#include "stackbeam/time/newmark_stepper.hpp"
+#include "model/mesh_note.hpp"
+#include "time/step_record.hpp"
+
+namespace stackbeam {
+
+std::vector<std::string> step_record_columns() {
+    return {"t",           "w",              "w_dot",          "force_on_mass",     "probe_friction_force",
+            "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
+            "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
+            "spring_force", "external_force", "base_displacement", "external_work", "leaf_kinetic_energy",
+            "impact_loss"};
+}
+
+std::vector<double> step_record_values(const StepRecord& r) {
+    return {r.t_s,
+            r.w_m,
+            r.w_dot_m_per_s,
+            r.force_on_mass_n,
+            r.probe_friction_force_n,
+            static_cast<double>(r.contact_iterations),
+            static_cast<double>(r.n_stick),
+            static_cast<double>(r.n_slip),
+            static_cast<double>(r.n_open),
+            r.kinetic_energy_j,
+            r.strain_energy_j,
+            r.dissipated_energy_j,
+            r.energy_balance_error_j,
+            r.contact_residual_m,
+            static_cast<double>(r.factorizations),
+            r.spring_force_n,
+            r.external_force_n,
+            r.base_displacement_m,
+            r.external_work_j,
+            r.leaf_kinetic_energy_j,
+            r.impact_loss_j};
+}
+
+const char* to_string(Mode m) {
+    switch (m) {
+        case Mode::closed_form: return "closed-form";
+        case Mode::cvode: return "cvode";
+        case Mode::newmark: return "newmark";
+    }
+    return "?";
+}
+
+Mode parse_mode(const std::string& text, const std::string& field) {
+    if (text == "closed-form") return Mode::closed_form;
+    if (text == "cvode") return Mode::cvode;
+    if (text == "newmark") return Mode::newmark;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
+}
+
+const char* to_string(ContactPath path) {
+    switch (path) {
+        case ContactPath::automatic: return "auto";
+        case ContactPath::dense: return "dense";
+        case ContactPath::sparse: return "sparse";
+    }
+    return "?";
+}
+
+ContactPath parse_contact_path(const std::string& text, const std::string& field) {
+    if (text == "auto") return ContactPath::automatic;
+    if (text == "dense") return ContactPath::dense;
+    if (text == "sparse") return ContactPath::sparse;
+    throw InputError(field, "value '" + text + "' is not a contact path: allowed auto, dense, sparse");
+}
+
+ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {
+    const bool exact = options.solver.kind == SolverKind::exact;
+    switch (options.contact_path) {
+        case ContactPath::dense: return ContactPath::dense;
+        case ContactPath::sparse:
+            if (!exact)
+                throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
+                                                     to_string(options.solver.kind) + "')");
+            return ContactPath::sparse;
+        case ContactPath::automatic: break;
+    }
+    return exact && system.num_components() >= kSparsePathMinComponents ? ContactPath::sparse : ContactPath::dense;
+}
+
+void SimulationOptions::validate() const {
+    if (!std::isfinite(dt_s) || dt_s <= 0.0)
+        throw InputError("dt", "value " + format_value(dt_s) + " is not allowed: the time step must be finite and > 0 [s]");
+    if (!std::isfinite(t_end_s) || t_end_s <= 0.0)
+        throw InputError("t_end", "value " + format_value(t_end_s) + " is not allowed: the end time must be finite and > 0 [s]");
+    if (t_end_s / dt_s > 1e9)
+        throw InputError("dt", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end = " + format_value(t_end_s) + " s");
+    make_solver(solver);  // validates the solver options
+    loading.validate();
+    if (mode == Mode::cvode && loading.kind == LoadingKind::prescribed_displacement)
+        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode: with w(t) "
+                                         "imposed there is no equation of motion to integrate, each step is "
+                                         "quasi-static (use mode closed-form, whose step is then exact)");
+    if (mode == Mode::cvode) {
+        if (!std::isfinite(cvode.rtol) || cvode.rtol < 1e-14 || cvode.rtol > 1e-2)
+            throw InputError("rtol", "value " + format_value(cvode.rtol) +
+                                         " is not allowed: CVODE's relative tolerance must be in [1e-14, 1e-2]");
+        if (!std::isfinite(cvode.atol_m) || cvode.atol_m <= 0.0)
+            throw InputError("atol", "value " + format_value(cvode.atol_m) +
+                                         " is not allowed: the absolute tolerance on w must be finite and > 0 [m]");
+        if (!std::isfinite(cvode.max_step_s) || cvode.max_step_s < 0.0)
+            throw InputError("max_step", "value " + format_value(cvode.max_step_s) +
+                                             " is not allowed: the largest step must be finite and >= 0 (0: no limit) [s]");
+        if (!std::isfinite(cvode.modal_cutoff_rad_per_s) || cvode.modal_cutoff_rad_per_s < 0.0)
+            throw InputError("modal_cutoff", "value " + format_value(cvode.modal_cutoff_rad_per_s) +
+                                                 " is not allowed: the modal cut-off must be finite and >= 0 "
+                                                 "(0: the default) [rad/s]");
+        if (cvode.max_steps < 1)
+            throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
+    }
+    if (!std::isfinite(restitution) || restitution < 0.0 || restitution > 1.0)
+        throw InputError("restitution", "value " + format_value(restitution) +
+                                            " is not allowed: the restitution coefficient must be in [0, 1] "
+                                            "(0: perfectly inelastic impacts, 1: elastic)");
+    if (restitution > 0.0 && mode != Mode::newmark)
+        throw InputError("restitution", "value " + format_value(restitution) + " is not used by mode " + to_string(mode) +
+                                            ": only mode newmark with massive leaves has impacts (give 0)");
+    if (mode == Mode::cvode && contact_path == ContactPath::sparse)
+        throw InputError("contact_path", "value 'sparse' is not available in mode cvode: its mode sets are factorised "
+                                         "on the dense compliance C' (use auto or dense)");
+    if (contact_path == ContactPath::sparse && solver.kind != SolverKind::exact)
+        throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
+                                             to_string(solver.kind) + "')");
+}
+
+void require_massless_leaves(const System& system, Mode mode) {
+    const auto& leaves = system.model().spec().leaves;
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+        if (leaves[i].density_kg_per_m3 != 0.0)
+            throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
+                             "value " + format_value(leaves[i].density_kg_per_m3) + " is not used by mode " +
+                                 to_string(mode) + ", which treats the leaves as massless (the paper): give 0 "
+                                 "(mode newmark integrates the leaves' inertia)");
+}
+
+void require_loading_fits(const ModelSpec& model, const Loading& loading) {
+    const auto& rb = model.rigid_body;
+    if (loading.kind == LoadingKind::prescribed_displacement) {
+        if (rb.initial_displacement_m != 0.0)
+            throw InputError("rigid_body.initial_displacement_m",
+                             "value " + format_value(rb.initial_displacement_m) +
+                                 " is not allowed with a prescribed displacement: w(0) is the prescribed w(0) (give 0)");
+        if (rb.initial_velocity_m_per_s != 0.0)
+            throw InputError("rigid_body.initial_velocity_m_per_s",
+                             "value " + format_value(rb.initial_velocity_m_per_s) +
+                                 " is not allowed with a prescribed displacement: w'(0) is the prescribed one (give 0)");
+    }
+}
+
+namespace {
+
+/// The pairs at one time from the forces p and the relative positions rel = s + d.
+std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+                                     const Eigen::VectorXd& rel) {
+    std::vector<PairRecord> out(laws.pairs.size());
+    const Eigen::VectorXd& d0 = system.initial_offsets_m();
+    for (std::size_t k = 0; k < out.size(); ++k) {
+        const ContactPair& pr = laws.pairs[k];
+        const PairSpec& spec = system.pair_spec(static_cast<int>(k));
+        PairRecord& r = out[k];
+        r.pair = static_cast<int>(k);
+        r.interface_index = spec.interface_index;
+        r.x_m = spec.x_m;
+        r.state = pair_state(laws, static_cast<int>(k), p);
+        if (pr.row_n >= 0) {
+            r.p_n_n = p[pr.row_n];
+            r.gap_m = std::max(0.0, d0[pr.row_n] - rel[pr.row_n]);
+        }
+        if (pr.row_t >= 0) {
+            r.p_t_n = p[pr.row_t];
+            r.slip_m = rel[pr.row_t];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
+                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report,
+                                 const PairObserver& on_pairs) {
+    options.validate();
+    const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
+    std::vector<StepRecord> out;
+    out.reserve(static_cast<std::size_t>(n) + 1);
+    auto keep = [&](const StepRecord& r) {
+        out.push_back(r);
+        if (on_step) on_step(out.back());
+    };
+    RunReport rep;
+    rep.mode = options.mode;
+    // The event-driven cvode steppers: records, per-pair output (rel: the pairs'
+    // relative positions s + d at the output), counters and the event log.
+    ContactProblem cvode_laws;
+    cvode_laws.pairs = system.pairs();
+    cvode_laws.tau_rule = TauRule::current;
+    auto run_events = [&](auto& stepper, const auto& relative_positions) {
+        auto pairs_out = [&] {
+            if (on_pairs)
+                on_pairs(out.back().t_s, pair_records(system, cvode_laws, stepper.contact_forces(), relative_positions()));
+        };
+        keep(stepper.current());
+        pairs_out();
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.advance());
+            pairs_out();
+        }
+        rep.cvode = stepper.stats();
+        rep.events = stepper.events();
+        rep.steps = rep.cvode.steps;
+        rep.contact_iterations = rep.cvode.contact_iterations;
+        rep.factorizations = rep.cvode.mode_factorizations;
+    };
+    if (options.mode == Mode::cvode && detail::has_leaf_mass(system) && detail::has_mode_changes(system)) {
+        detail::CvodeModalStepper stepper(system, options);  // docs/inertia.md
+        run_events(stepper, [&] { return stepper.relative_positions(); });
+    } else if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
+        detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) keep(stepper.advance());
+        rep.cvode = stepper.stats();
+        rep.steps = rep.cvode.steps;
+    } else if (options.mode == Mode::cvode) {
+        CvodeStepper stepper(system, options);
+        run_events(stepper, [&] {
+            const Eigen::VectorXd& p = stepper.contact_forces();
+            return p.size() > 0 ? Eigen::VectorXd(system.compliance_held() * p + system.coupling() * out.back().w_m)
+                                : Eigen::VectorXd();
+        });
+    } else if (options.mode == Mode::newmark) {
+        NewmarkStepper stepper(system, options);
+        keep(stepper.current());
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.step());
+            rep.contact_iterations += out.back().contact_iterations;
+            rep.factorizations += out.back().factorizations;
+        }
+        rep.steps = n;
+    } else {
+        ClosedFormStepper stepper(system, options);
+        auto pairs_out = [&] {
+            if (on_pairs)
+                on_pairs(out.back().t_s, pair_records(system, stepper.last_problem(), stepper.contact_forces(),
+                                                      stepper.relative_positions()));
+        };
+        keep(stepper.current());
+        pairs_out();
+        for (long i = 0; i < n; ++i) {
+            keep(stepper.step());
+            pairs_out();
+            rep.contact_iterations += out.back().contact_iterations;
+            rep.factorizations += out.back().factorizations;
+        }
+        rep.steps = n;
+    }
+    if (report) *report = std::move(rep);
+    return out;
+}
+
+}  // namespace stackbeam

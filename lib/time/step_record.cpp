@@ -1,0 +1,80 @@
+// What the time-stepping modes share (step_record.hpp): the record's state part, the
+// anchors, the previous step's friction limits and the static equilibrium.
+#include "time/step_record.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+void detail::reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel,
+                      Eigen::VectorXd& d) {
+    for (std::size_t j = 0; j < laws.pairs.size(); ++j) {
+        const auto& pr = laws.pairs[j];
+        if (pr.row_t < 0 || pr.kind == PairKind::bonded) continue;
+        if (pair_state(laws, static_cast<int>(j), p) != PairState::stick) d[pr.row_t] = rel[pr.row_t];
+    }
+}
+
+void detail::set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p) {
+    for (int j = 0; j < static_cast<int>(problem.pairs.size()); ++j) {
+        const auto& pr = problem.pairs[j];
+        const double pn = pr.row_n >= 0 ? p[pr.row_n] : 0.0;
+        problem.tau_previous_n[j] = pr.kind == PairKind::clamp ? std::max(0.0, pr.preload_n - pn) : std::max(0.0, -pn);
+    }
+}
+
+detail::StaticState detail::static_equilibrium_dense(const System& system, const ContactProblem& laws, double force_n,
+                                                     ContactSolver& solver, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                                                     const std::string& what) {
+    const double k = system.stiffness_n_per_m();
+    const Eigen::VectorXd& c = system.coupling();
+    StaticState out;
+    if (system.num_components() > 0) {
+        ContactProblem st = laws;
+        st.W = system.compliance_held() + (1.0 / k) * c * c.transpose();
+        st.q = c * (force_n / k) - d;
+        out.solve = solver.solve(st, p);
+        if (!out.solve.converged) throw SolverError(what + ": " + out.solve.message, 0, 0.0, out.solve.residual_m);
+        reanchor(st, p, Eigen::VectorXd(st.W * p + st.q + d), d);
+    }
+    out.w_m = (force_n + (system.num_components() > 0 ? c.dot(p) : 0.0)) / k;
+    return out;
+}
+
+void detail::fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
+                        double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
+                        const LoadState& load, StepRecord& r) {
+    const double f = system.model().whole_spring_factor();
+    r.w_m = w_m;
+    r.w_dot_m_per_s = w_dot_m_per_s;
+    const double cp = p.size() > 0 ? system.coupling().dot(p) : 0.0;
+    r.spring_force_n = f * (system.stiffness_n_per_m() * w_m - cp);
+    r.external_force_n = load.external_force_n;
+    r.force_on_mass_n = load.prescribed ? load.force_on_mass_n : load.external_force_n - r.spring_force_n;
+    r.base_displacement_m = load.base_displacement_m;
+    r.external_work_j = load.external_work_j;
+    // The probe pair may carry no tangential component (mu = 0, or fixed by a support):
+    // its friction force is then zero. NaN only when the model has no probe at all.
+    const int probe = system.probe_pair();
+    const bool has_probe = system.model().probe_pair() >= 0;
+    r.probe_friction_force_n = !has_probe ? std::numeric_limits<double>::quiet_NaN()
+                               : (probe >= 0 && system.pairs()[probe].row_t >= 0) ? p[system.pairs()[probe].row_t]
+                                                                                   : 0.0;
+    r.n_stick = r.n_slip = r.n_open = 0;
+    for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+        const PairState s = pair_state(laws, k, p);
+        if (s == PairState::stick) ++r.n_stick;
+        else if (s == PairState::slip) ++r.n_slip;
+        else ++r.n_open;
+    }
+    r.kinetic_energy_j = 0.5 * system.model().spec().rigid_body.mass_kg * w_dot_m_per_s * w_dot_m_per_s;
+    r.strain_energy_j = strain_energy_j;
+    r.dissipated_energy_j = dissipated_energy_j;
+    r.energy_balance_error_j =
+        e0_j + load.external_work_j - (r.kinetic_energy_j + r.strain_energy_j + r.dissipated_energy_j);
+}
+
+}  // namespace stackbeam
