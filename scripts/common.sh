@@ -1,8 +1,8 @@
 # Shared by run-demo.sh and run-tests.sh (sourced, not run): installs the Debian
 # packages the project needs, if missing, and configures and builds it in build/.
 
-# The packages every build needs.
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+# The packages every build needs (pkgconf: the test of the installed stackbeam.pc).
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.
