@@ -12,7 +12,6 @@
 //   switches           the test-only switches (transition and box-QP methods, newton_first)
 //
 // Design (why a saddle-point system per set of modes):
-//
 //  - For a set of modes the contact conditions are linear: held rows (closed normal,
 //    stuck tangential, bonded) impose G_S z = d_S; slipping rows carry a force affine in
 //    their pair's normal force, p_t = e_t + D p_n; open / free rows carry p = e = 0.
@@ -105,7 +104,6 @@
 namespace stackbeam {
 
 using detail::sparse::SpMat;
-
 
 void SparseContactProblem::validate() const {
     const int n = static_cast<int>(K.rows());
