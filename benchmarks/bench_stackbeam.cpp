@@ -27,6 +27,7 @@
 #include <memory>
 #include <vector>
 
+#include "contact/sparse/switches.hpp"  // the sparse path's internal switches (lib/)
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
@@ -231,8 +232,8 @@ BENCHMARK(Scaling)
 /// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
 /// transition (0 newton: semismooth, smoothing, then continuation; 1 semismooth only; 3 Tresca
 /// only: box QPs by pivoting, then the interior-point method where pivoting does not settle;
-/// 4 continuation only: TransitionMethod's values), simulated time in ms, box QP method of the
-/// Tresca fixed point (BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only),
+/// 4 continuation only: detail::sparse::TransitionMethod's values), simulated time in ms, box QP method of the
+/// Tresca fixed point (detail::sparse::BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only),
 /// Anderson depth of the fixed point on the friction limits (SolverOptions::tresca_anderson_depth;
 /// 0 the plain fixed point, 8 the default).
 void Transitions(benchmark::State& state) {
@@ -248,8 +249,10 @@ void Transitions(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
-        so.sparse_tuning.box_qp = static_cast<BoxQpMethod>(state.range(4));
+        detail::sparse::Switches switches;
+        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
+        switches.box_qp = static_cast<detail::sparse::BoxQpMethod>(state.range(4));
+        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(5));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
@@ -293,7 +296,7 @@ BENCHMARK(Transitions)
 /// The friction-mesh ratio kappa = mu (t_i + t_i+1) / (2 h) (model.hpp) against the exact
 /// solver's fixed point on the friction limits: the graduated 10-leaf spring above with every
 /// interface's mu set to args[1] / 10000, closed-form mode, dt = 1 ms, from rest. args:
-/// elements per half leaf, mu x 1e4, transition (TransitionMethod: 3 the Tresca fixed point
+/// elements per half leaf, mu x 1e4, transition (detail::sparse::TransitionMethod: 3 the Tresca fixed point
 /// only, 0 the default chain), simulated time in ms, Anderson depth (0: the plain fixed
 /// point). A step that fails ends the run (failed_at_step, 0 when none failed); the figures
 /// are over the steps made.
@@ -312,7 +315,9 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        so.sparse_tuning.transition = static_cast<TransitionMethod>(state.range(2));
+        detail::sparse::Switches switches;
+        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
+        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(4));
         ClosedFormStepper st(s, so);
         const long n = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));

@@ -12,10 +12,13 @@
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/fe/system.hpp"
+#include "contact/sparse/switches.hpp"
+#include "fe/system_internal.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
+using stackbeam::detail::sparse::TransitionMethod;
 
 namespace stackbeam {
 std::ostream& operator<<(std::ostream& os, ContactPath p) { return os << to_string(p); }
@@ -73,7 +76,7 @@ void compare_paths(const ModelSpec& spec, double dt, int steps, double tol, bool
     const System sparse_sys(Model::build(spec));
     const Run d = run(dense_sys, ContactPath::dense, dt, steps, tol, rule);
     const Run s = run(sparse_sys, ContactPath::sparse, dt, steps, tol, rule);
-    BOOST_TEST(!sparse_sys.compliance_held_built());  // the sparse path never forms C'
+    BOOST_TEST(!detail::compliance_held_built(sparse_sys));  // the sparse path never forms C'
     BOOST_TEST_REQUIRE(d.records.size() == s.records.size());
     const double w_scale = max_abs(d.records, &StepRecord::w_m);
     const double v_scale = max_abs(d.records, &StepRecord::w_dot_m_per_s);
@@ -194,7 +197,7 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
     const System large(Model::build(paper_example(PaperCase::friction, o)));
     BOOST_TEST(large.num_components() >= kSparsePathMinComponents);
     BOOST_TEST(choose_contact_path(large, so) == ContactPath::sparse);
-    BOOST_TEST(!large.compliance_held_built());  // the constructor no longer builds C'
+    BOOST_TEST(!detail::compliance_held_built(large));  // the constructor no longer builds C'
     so.solver.kind = SolverKind::accelerated;    // only the exact solver has a sparse form
     BOOST_TEST(choose_contact_path(large, so) == ContactPath::dense);
     so.contact_path = ContactPath::sparse;
@@ -392,7 +395,7 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_finer_stack) {
 namespace {
 
 /// Replays the sparse problems of `steps` closed-form steps of `spec` (recorded from a
-/// sparse run) with the semismooth Newton method alone (SparsePathTuning::newton_first:
+/// sparse run) with the semismooth Newton method alone (detail::sparse::Switches::newton_first:
 /// every solve starts with it from the previous forces, the passes only confirm its
 /// modes) and with the dense exact solver on to_dense(), each warm-started from its own
 /// previous forces, and compares the forces step by step. Also checks the contact
@@ -413,11 +416,12 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
         st.step();
         problems.push_back(st.last_sparse_problem());
     }
-    SparsePathTuning tuning;
-    tuning.newton_first = true;
-    tuning.transition = method;
-    if (tresca) tuning.box_qp = BoxQpMethod::interior_point;
-    SparseContactSolver newton(so.solver, tuning);
+    detail::sparse::Switches switches;
+    switches.newton_first = true;
+    switches.transition = method;
+    if (tresca) switches.box_qp = detail::sparse::BoxQpMethod::interior_point;
+    const detail::sparse::ScopedSwitches scoped(switches);
+    SparseContactSolver newton(so.solver);
     const auto dense_solver = make_solver(so.solver);
     Eigen::VectorXd pn = Eigen::VectorXd::Zero(problems.front().size()), pd = pn, z;
     double scale = 0.0, diff = 0.0, worst_natural = 0.0;
@@ -559,9 +563,10 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
         problems.push_back(st.last_sparse_problem());
         reference.push_back(st.contact_forces());
     }
-    SparsePathTuning tresca;
+    detail::sparse::Switches tresca;
     tresca.transition = TransitionMethod::tresca;
-    SparseContactSolver solver(so.solver, tresca);
+    const detail::sparse::ScopedSwitches scoped(tresca);
+    SparseContactSolver solver(so.solver);
     BOOST_TEST(so.solver.tresca_anderson_depth > 0);
     Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
     double scale = 0.0, diff = 0.0, worst_natural = 0.0;
@@ -592,7 +597,7 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
     BOOST_CHECK_SMALL(diff / scale, 1e-7);
     SolverOptions bad;
     bad.tresca_anderson_depth = -1;
-    BOOST_CHECK_THROW(SparseContactSolver(bad, tresca), InputError);
+    BOOST_CHECK_THROW(SparseContactSolver{bad}, InputError);
     bad.tresca_anderson_depth = 51;
     BOOST_CHECK_THROW(make_solver(bad), InputError);
 }
@@ -623,8 +628,9 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
         st.step();
         problems.push_back(st.last_sparse_problem());
     }
-    auto replay = [&](const SparsePathTuning& tuning, int& newton) {
-        SparseContactSolver solver(so.solver, tuning);
+    auto replay = [&](const detail::sparse::Switches& switches, int& newton) {
+        const detail::sparse::ScopedSwitches scoped(switches);
+        SparseContactSolver solver(so.solver);
         std::vector<Eigen::VectorXd> out;
         Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
         newton = 0;
@@ -636,10 +642,10 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
         }
         return out;
     };
-    SparsePathTuning tresca;
+    detail::sparse::Switches tresca;
     tresca.transition = TransitionMethod::tresca;
     int n_default = 0, n_tresca = 0;
-    const auto a = replay(SparsePathTuning{}, n_default);
+    const auto a = replay(detail::sparse::Switches{}, n_default);
     const auto b = replay(tresca, n_tresca);
     double scale = 0.0, diff = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i) {

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <string>
 
+#include "fe/system_internal.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -241,8 +242,8 @@ const Eigen::MatrixXd& System::compliance_held() const {
     return C_held_->C;
 }
 
-bool System::compliance_held_built() const noexcept {
-    return C_held_->built;
+bool detail::compliance_held_built(const System& system) noexcept {
+    return system.C_held_->built;
 }
 
 double System::tied_stiffness_n_per_m() const {

@@ -173,7 +173,7 @@ struct SparseContactProblem {
 /// pivoting and, where that does not settle, by an interior-point method; then the coupled Coulomb
 /// problem) are those of the exact solver (the same mode code, lib/contact/active_set.hpp), so
 /// both paths reach the same solution. Before the Tresca fixed point, a transition is
-/// tried by a semismooth Newton method on the natural map (TransitionMethod::newton: many
+/// tried by a semismooth Newton method on the natural map (many
 /// pairs change mode per iteration, one linear solve of a set of modes each; it starts from
 /// the last answer extrapolated linearly from the two before, when the warm start p is this
 /// solver's last answer, so a solve's answer may depend on the solves before it; its final
@@ -185,56 +185,27 @@ struct SparseContactProblem {
 /// (the start's forces solve the problem with offsets d0; d0 -> d in sub-steps, each solved
 /// from the last by the passes or the semismooth method; SolveResult::continuation_steps). If all that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
-/// one returns converged = false with a message.
+/// one returns converged = false with a message. (The units: lib/contact/sparse/; tests force
+/// each transition and box-QP method alone through lib/contact/sparse/switches.hpp.)
+///
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
-/// are the measured choices, BENCHMARKS.md; tests set them to force each way):
+/// are the measured choices, BENCHMARKS.md; tests set them to force each way; the three
+/// fields are those a user may tune):
 ///  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on
 ///    a Cholesky factor of K made once per run (columns K^-1 g_i^T cached per row);
 ///  - more: a sparse LU of the saddle-point system, and a set of modes without slip
 ///    coupling that differs from the last LU's held set in at most `max_border_rows`
 ///    rows is solved by bordering that LU (low-rank update: a solve per changed row and
 ///    a small dense LU) instead of a new factorisation.
-/// How the sparse path solves a transition that the active-set passes from the previous
-/// modes do not settle (SparseContactSolver::solve, step 2).
-enum class TransitionMethod {
-    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
-                 ///< Newton method; then the continuation on the offsets; then the Tresca fixed point (default)
-    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
-                 ///< smoothing method (kept for comparison, BENCHMARKS.md)
-    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
-    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
-    continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
-};
-
-/// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
-/// limits frozen): min 1/2 p^T W p + q^T p over lower <= p <= upper, with W = G K^-1 G^T
-/// never formed.
-enum class BoxQpMethod {
-    pivoting,        ///< block principal pivoting (a few sparse solves where it settles); where it does not
-                     ///< settle in 50 passes, a primal-dual interior-point method (Mehrotra's predictor-
-                     ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
-                     ///< read from the iterate); then the monotone primal active-set method (default)
-    interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
-    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
-                     ///< (kept for comparison, BENCHMARKS.md)
-};
-
 struct SparsePathTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
-    TransitionMethod transition = TransitionMethod::newton;
     /// >= 0: the Newton method is tried on problems of at least this many contact rows (smaller
     /// ones, e.g. the paper example's 76, settle quickly by the passes and the Tresca fixed
     /// point, and keep exactly the answers they had: their near-degenerate pairs may settle in
     /// another of the modes within the threshold, e.g. 1.03e-9 J against 0.70e-9 J of
     /// energy-balance round-off on the paper example with steel leaves)
     int newton_min_rows = 200;
-    /// Tests: every solve starts with the semismooth Newton method from the warm start (no
-    /// active-set passes from the previous modes first), so its answers can be checked alone.
-    bool newton_first = false;
-    /// How the Tresca fixed point's box QPs are solved (all end at the same working-set test,
-    /// so their answers agree to round-off).
-    BoxQpMethod box_qp = BoxQpMethod::pivoting;
 };
 
 class SparseContactSolver {

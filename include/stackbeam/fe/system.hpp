@@ -21,6 +21,11 @@
 
 namespace stackbeam {
 
+class System;
+namespace detail {
+bool compliance_held_built(const System& system) noexcept;  // internal (lib/fe/system_internal.hpp)
+}
+
 class System {
 public:
     /// Assembles and condenses. Throws InputError when the stack is not
@@ -44,8 +49,6 @@ public:
     /// contact row), not by the constructor, so that a large model run on the sparse
     /// contact path (simulation.hpp, ContactPath) never pays for it. Thread-safe.
     const Eigen::MatrixXd& compliance_held() const;
-    /// Whether compliance_held() has been built (for tests of the sparse path).
-    bool compliance_held_built() const noexcept;
     /// Contact rows on the reduced DOFs, G [-] (num_components() x num_reduced_dofs(),
     /// w last): s = G z - d for reduced displacements z (paper eq. 1 and 7).
     const Eigen::SparseMatrix<double>& contact_rows() const noexcept { return G_; }
@@ -81,6 +84,7 @@ public:
     int node_dof(int leaf, int node) const;
 
 private:
+    friend bool detail::compliance_held_built(const System& system) noexcept;
     Model model_;
     std::vector<ContactPair> pairs_;
     std::vector<int> pair_candidate_;

@@ -1,0 +1,458 @@
+// The linear problem of a set of modes on the sparse stiffness (mode_solver.hpp).
+//
+// Why these ways:
+//  - The factorisation depends only on the modes; it is kept and reused while they stay,
+//    like the dense solver's LU. Within one set of modes the solution is affine in the
+//    right-hand side; on the closed-form stepper only b (the rigid body's load, one entry)
+//    changes from step to step, and e, d_S only when the modes or anchors do. So two
+//    back-solves per set of modes ({unit b entry} and {e, d_S}) are cached and a step whose
+//    modes stay costs O(n) (a linear combination, one product with G), not a back-solve.
+//  - The saddle-point system is not symmetric when a slip row is coupled to its normal
+//    force, and it is indefinite, so it is factorised by a sparse LU (COLAMD ordering: no
+//    extra package) when many rows are held (bonded and frictionless runs: thousands).
+//  - Few held rows (the usual situation of friction runs on identical leaves: most pairs
+//    open, the clamps held): the dense Schur complement of the held rows on K's Cholesky
+//    factor, a new set of modes costing the solves of the rows new to the column cache and
+//    a small dense LU.
+//  - Held sets near the last sparse LU's (e.g. the box QP's primal active-set iterations,
+//    one row per iteration): the LU bordered by the changed rows.
+#include "contact/sparse/mode_solver.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "contact/sparse/selected_inverse.hpp"
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam::detail::sparse {
+
+namespace {
+// cached columns K^-1 g_i^T: at most this many doubles (80 MB)
+constexpr double kColumnCacheDoubles = 1e7;
+}  // namespace
+
+void SparseStiffness::build(const SpMat& K_, const SpMat& G_) {
+    K = K_;
+    G = G_;
+    K.makeCompressed();
+    G.makeCompressed();
+    k_llt.compute(K);
+    if (k_llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
+    const int m = rows();
+    diag = selected_compliance_diagonal(K, G, k_llt);
+    g_norm_inf = 0.0;
+    const SpMat absG = G.cwiseAbs();
+    const Eigen::VectorXd row_sums = absG * Eigen::VectorXd::Ones(G.cols());
+    if (m > 0) g_norm_inf = row_sums.maxCoeff();
+    dz = K.diagonal().cwiseSqrt().cwiseInverse();
+    Gt_scaled = dz.asDiagonal() * SpMat(G.transpose());
+    Gt_scaled.makeCompressed();
+    Gt = SpMat(G.transpose());
+    Grow = G;
+    row_h.resize(m);
+    for (int i = 0; i < m; ++i) {
+        const double h = Gt_scaled.col(i).norm();
+        row_h[i] = h > 0.0 ? h : 1.0;
+    }
+}
+
+Eigen::VectorXd SparseStiffness::positions(const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                                           const Eigen::VectorXd& p, Eigen::VectorXd& z) const {
+    z = k_llt.solve(b + Gt * p);
+    return Grow * z - d;
+}
+
+double SparseStiffness::roundoff(const Eigen::VectorXd& d, const Eigen::VectorXd& z) const {
+    return 1e-13 * (d.lpNorm<Eigen::Infinity>() + g_norm_inf * z.lpNorm<Eigen::Infinity>());
+}
+
+void SparseStiffness::append_scaled_K(std::vector<Eigen::Triplet<double>>& t) const {
+    for (int j = 0; j < K.outerSize(); ++j)
+        for (SpMat::InnerIterator it(K, j); it; ++it)
+            t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
+}
+
+double SparseStiffness::row_dot(int r, const Eigen::VectorXd& v) const {
+    double sum = 0.0;
+    for (RowMat::InnerIterator it(Grow, r); it; ++it) sum += it.value() * v[it.col()];
+    return sum;
+}
+
+void ModeSolver::reset(const SpMat& K, const SpMat& G) {
+    st_.build(K, G);
+    const auto m = static_cast<std::size_t>(st_.rows());
+    lu_key_.clear();
+    lu_ok = false;
+    const_ok = false;
+    unit_dof = -1;
+    xcol.assign(m, Eigen::VectorXd());
+    xcol_count = 0;
+    bcol.assign(m, Eigen::VectorXd());
+    bcol_count = 0;
+    base_valid = false;
+    border_active = false;
+}
+
+/// The linear problem of `lin` (held rows S with s = 0, fixed forces e, slip coupling),
+/// factorised unless `key` names the current factorisation. Two ways, by the number of
+/// held rows:
+///  - up to tuning_.schur_max_rows: the Schur complement on the held rows, M p_S = d_S - G_S z0,
+///    M = G_S K^-1 (G_S^T + G_slip^T D) (dense, ms x ms, LU with partial pivoting, as the
+///    dense solver's W_SS), z = z0 + K^-1 G^T (E p_S), z0 = K^-1 (b + G^T e). K is
+///    factorised once per run (k_llt) and the columns K^-1 g_i^T are cached per row, so
+///    a change of the held set costs the solves of the rows new to the cache and a small
+///    dense LU, not a sparse factorisation of the whole saddle-point system. This is
+///    the friction case's usual situation: most pairs of identical leaves open, the
+///    clamps held (tens of rows out of thousands).
+///  - more held rows (bonded, frictionless, the first passes of a large transition):
+///    the sparse saddle-point LU below.
+/// Both cache the affine map of the load: (z, p_S) = (zc, pc) + b_w (zu, pu).
+int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
+                      const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    const int n = static_cast<int>(st_.K.rows()), m = static_cast<int>(d.size());
+    const auto& S = lin.S;
+    const int ms = static_cast<int>(S.size());
+    pos.assign(m, -1);
+    for (int i = 0; i < ms; ++i) pos[S[i]] = i;
+    int factorised = 0;
+    if (key != lu_key_ && try_border(lin)) {
+        ++updates_;
+        lu_key_ = key;
+        key_uses = 0;
+        const_ok = false;
+        unit_dof = -1;
+    } else if (key != lu_key_) {
+        border_active = false;
+        lu_schur = ms <= tuning_.schur_max_rows;
+        if (lu_schur) {
+            factor_schur(lin);
+        } else {
+            row_scale.resize(ms);
+            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / st_.row_h[S[i]];
+            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+            std::vector<Eigen::Triplet<double>> t;
+            t.reserve(static_cast<std::size_t>(st_.K.nonZeros() + 4 * st_.G.nonZeros()));
+            st_.append_scaled_K(t);
+            for (int i = 0; i < ms; ++i)
+                for (SpMat::InnerIterator it(st_.Gt_scaled, S[i]); it; ++it) {
+                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+                }
+            for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+                const int col = pos[lin.coupled[a].second];
+                if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+                for (SpMat::InnerIterator it(st_.Gt_scaled, lin.coupled[a].first); it; ++it)
+                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+            }
+            A.resize(n + ms, n + ms);
+            A.setFromTriplets(t.begin(), t.end());
+            A.makeCompressed();
+            lu.compute(A);
+            lu_ok = lu.info() == Eigen::Success;
+            base_valid = lu_ok && lin.coupled.empty();
+            base_S = S;
+            base_pos = pos;
+            for (auto& c : bcol) c.resize(0);
+            bcol_count = 0;
+        }
+        lu_key_ = key;
+        key_uses = 0;
+        const_ok = false;
+        unit_dof = -1;
+        factorised = 1;
+    }
+    if (!lu_ok) throw SingularModes{};
+    Eigen::VectorXd dS(ms);
+    for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
+    Eigen::VectorXd pS;
+    if (border_active) {
+        border_solve(lin, b, d, p, z);
+        return factorised;
+    }
+    if (++key_uses == 1) {
+        // first use of a factorisation (most active-set passes use it once): one solve
+        // with the whole load; the affine caches are made if it is used again
+        const Eigen::VectorXd f = b + st_.G.transpose() * lin.e;
+        if (lu_schur) {
+            schur_solve(lin, st_.k_llt.solve(f), dS, pS, z);
+        } else {
+            rhs.resize(n + ms);
+            rhs.head(n) = st_.dz.cwiseProduct(f);
+            rhs.tail(ms) = row_scale.cwiseProduct(dS);
+            x = refined_solve(rhs);
+            z = st_.dz.cwiseProduct(x.head(n));
+            pS = row_scale.cwiseProduct(x.tail(ms));
+        }
+        p = lin.e;
+        for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+        return factorised;
+    }
+    if (!const_ok || const_e != lin.e || const_dS != dS) {
+        if (lu_schur) {
+            schur_solve(lin, st_.k_llt.solve(st_.G.transpose() * lin.e), dS, pc, zc);
+        } else {  // right-hand side [Dz G^T e; R d_S]
+            rhs.resize(n + ms);
+            rhs.head(n) = st_.dz.cwiseProduct(st_.G.transpose() * lin.e);
+            rhs.tail(ms) = row_scale.cwiseProduct(dS);
+            x = refined_solve(rhs);
+            zc = st_.dz.cwiseProduct(x.head(n));
+            pc = row_scale.cwiseProduct(x.tail(ms));
+        }
+        const_e = lin.e;
+        const_dS = dS;
+        const_ok = true;
+    }
+    // b: one nonzero entry (the closed-form stepper's load on the rigid body) is a
+    // multiple of a cached unit solve; anything else is solved directly.
+    int nz = -1, count = 0;
+    for (int i = 0; i < n; ++i)
+        if (b[i] != 0.0) {
+            nz = i;
+            ++count;
+        }
+    if (count == 0) {
+        z = zc;
+        pS = pc;
+    } else if (count == 1) {
+        if (unit_dof != nz) {
+            load_solve(lin, Eigen::VectorXd::Unit(n, nz), pu, zu);
+            unit_dof = nz;
+        }
+        z = zc + b[nz] * zu;
+        pS = pc + b[nz] * pu;
+    } else {
+        Eigen::VectorXd pb, zb;
+        load_solve(lin, b, pb, zb);
+        z = zc + zb;
+        pS = pc + pb;
+    }
+    p = lin.e;
+    for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+        p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+    return factorised;
+}
+
+/// Low-rank updates of the sparse saddle-point LU (the "base", held set S0, no slip
+/// coupling) for a held set S near S0, without refactorising: the system of S is the
+/// base system bordered by one row and column per changed row,
+///     [A0 U; W^T 0] [x; y] = [f; g],
+///  - a row of S0 no longer held (its force fixed at e_i): U = the unit column of its
+///    multiplier's equation (y_i is the slack that frees that equation), W^T x picks
+///    its force unknown, g = e_i (scaled);
+///  - a held row not in S0: U = [-g_a Dz s_a; 0], W^T = [s_a g_a Dz, 0], g = s_a d_a,
+///    y its force (scaled by s_a = 1/||g_a Dz||).
+/// With Z = A0^-1 U (one base solve per changed row, cached while the base stays) the
+/// capacitance matrix C = -W^T Z (k x k, dense LU) gives y = C^-1 (g - W^T A0^-1 f)
+/// and x = A0^-1 f - Z y; one step of iterative refinement on the whole bordered
+/// system follows. This is what the box QP's primal active-set method needs: it
+/// changes one row per iteration (hundreds of iterations per box QP on 10 leaves x 400
+/// elements, each a 0.15-0.5 s sparse LU before). The base is refactorised when more
+/// than tuning_.max_border_rows rows differ.
+bool ModeSolver::try_border(const ModeLinearization& lin) {
+    const auto& S = lin.S;
+    if (tuning_.max_border_rows == 0 || !base_valid || !lin.coupled.empty() ||
+        static_cast<int>(S.size()) <= tuning_.schur_max_rows)
+        return false;
+    std::vector<int> rows;
+    for (int i : base_S)
+        if (pos[i] < 0) rows.push_back(i);
+    const int nr = static_cast<int>(rows.size());
+    if (nr > tuning_.max_border_rows) return false;
+    for (int i : S)
+        if (base_pos[i] < 0) rows.push_back(i);
+    if (static_cast<int>(rows.size()) > tuning_.max_border_rows) return false;
+    border_rows = std::move(rows);
+    border_nr = nr;
+    border_active = true;
+    lu_schur = false;
+    lu_ok = true;
+    return true;
+}
+
+/// Bordered solve of the current held set (see try_border) for load b and offsets d.
+void ModeSolver::border_solve(const ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                  Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    const int n = static_cast<int>(st_.K.rows());
+    const int ms0 = static_cast<int>(base_S.size());
+    const int k = static_cast<int>(border_rows.size());
+    auto scale_of = [&](int a) { return 1.0 / st_.row_h[a]; };
+    // U y added to v
+    auto add_U = [&](const Eigen::VectorXd& y, Eigen::VectorXd& v) {
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            if (j < border_nr) v[n + base_pos[i]] += y[j];
+            else v.head(n) -= (scale_of(i) * y[j]) * st_.Gt_scaled.col(i);
+        }
+    };
+    auto apply_Wt = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd out(k);
+        for (int j = 0; j < k; ++j) {
+            const int i = border_rows[static_cast<std::size_t>(j)];
+            out[j] = j < border_nr ? v[n + base_pos[i]] : scale_of(i) * st_.Gt_scaled.col(i).dot(v.head(n));
+        }
+        return out;
+    };
+    // columns A0^-1 U_j (cached per row while the base stays; at most 4 x max_border_rows
+    // of them, (n + ms0) doubles each: the cache is dropped past that)
+    if (bcol_count > 4 * static_cast<std::size_t>(tuning_.max_border_rows)) {
+        for (auto& c : bcol) c.resize(0);
+        bcol_count = 0;
+    }
+    Eigen::MatrixXd C(k, k);
+    for (int j = 0; j < k; ++j) {
+        const int i = border_rows[static_cast<std::size_t>(j)];
+        Eigen::VectorXd& col = bcol[static_cast<std::size_t>(i)];
+        if (col.size() == 0) {
+            Eigen::VectorXd u = Eigen::VectorXd::Zero(n + ms0);
+            if (j < border_nr) u[n + base_pos[i]] = 1.0;
+            else u.head(n) = -scale_of(i) * st_.Gt_scaled.col(i);
+            col = refined_solve(u);
+            ++bcol_count;
+        }
+        C.col(j) = -apply_Wt(col);
+    }
+    const Eigen::PartialPivLU<Eigen::MatrixXd> clu(C);
+    // right-hand side: forces of the freed base rows are unknowns held by the border
+    Eigen::VectorXd ep = lin.e;
+    for (int j = 0; j < border_nr; ++j) ep[border_rows[static_cast<std::size_t>(j)]] = 0.0;
+    Eigen::VectorXd f(n + ms0), g(k);
+    f.head(n) = st_.dz.cwiseProduct(b + st_.G.transpose() * ep);
+    for (int i = 0; i < ms0; ++i) f[n + i] = row_scale[i] * d[base_S[static_cast<std::size_t>(i)]];
+    for (int j = 0; j < k; ++j) {
+        const int i = border_rows[static_cast<std::size_t>(j)];
+        g[j] = j < border_nr ? lin.e[i] / row_scale[base_pos[i]] : scale_of(i) * d[i];
+    }
+    auto solve_bordered = [&](const Eigen::VectorXd& ff, const Eigen::VectorXd& gg, Eigen::VectorXd& xx,
+                              Eigen::VectorXd& yy) {
+        const Eigen::VectorXd h = refined_solve(ff);
+        yy = k > 0 ? Eigen::VectorXd(clu.solve(gg - apply_Wt(h))) : Eigen::VectorXd();
+        xx = h;
+        for (int j = 0; j < k; ++j) xx -= yy[j] * bcol[static_cast<std::size_t>(border_rows[static_cast<std::size_t>(j)])];
+    };
+    Eigen::VectorXd xx, yy, dx, dy;
+    solve_bordered(f, g, xx, yy);
+    {  // one step of iterative refinement on the bordered system
+        Eigen::VectorXd rf = f - A * xx;
+        Eigen::VectorXd uy = Eigen::VectorXd::Zero(n + ms0);
+        add_U(yy, uy);
+        rf -= uy;
+        const Eigen::VectorXd rg = g - apply_Wt(xx);
+        solve_bordered(rf, rg, dx, dy);
+        xx += dx;
+        yy += dy;
+    }
+    z = st_.dz.cwiseProduct(xx.head(n));
+    p = lin.e;
+    for (int i = 0; i < ms0; ++i) {
+        const int r = base_S[static_cast<std::size_t>(i)];
+        if (pos[r] >= 0) p[r] = row_scale[i] * xx[n + i];
+    }
+    for (int j = border_nr; j < k; ++j) {
+        const int i = border_rows[static_cast<std::size_t>(j)];
+        p[i] = scale_of(i) * yy[j];
+    }
+}
+
+/// (p_S, z) for load `f` alone (e = 0, d_S = 0) with the current factorisation.
+void ModeSolver::load_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS,
+                Eigen::VectorXd& zf) {
+    const int n = static_cast<int>(st_.K.rows()), ms = static_cast<int>(lin.S.size());
+    if (lu_schur) {
+        schur_solve(lin, st_.k_llt.solve(f), Eigen::VectorXd::Zero(ms), pS, zf);
+    } else {
+        rhs.setZero(n + ms);
+        rhs.head(n) = st_.dz.cwiseProduct(f);
+        x = refined_solve(rhs);
+        zf = st_.dz.cwiseProduct(x.head(n));
+        pS = row_scale.cwiseProduct(x.tail(ms));
+    }
+}
+
+/// Column K^-1 g_i^T of contact row i [m/N per unit force], cached (solved in blocks
+/// for the rows in `rows` not cached yet; the cache is dropped when it would exceed
+/// kColumnCacheDoubles).
+void ModeSolver::ensure_columns(const std::vector<int>& rows) {
+    const int n = static_cast<int>(st_.K.rows());
+    std::vector<int> missing;
+    for (int r : rows)
+        if (xcol[static_cast<std::size_t>(r)].size() == 0) missing.push_back(r);
+    if (missing.empty()) return;
+    if (static_cast<double>(xcol_count + missing.size()) * n > kColumnCacheDoubles) {
+        for (auto& c : xcol) c.resize(0);
+        xcol_count = 0;
+        missing.clear();
+        for (int r : rows) missing.push_back(r);
+    }
+    constexpr int kBlock = 32;
+    Eigen::MatrixXd Y;
+    for (std::size_t j0 = 0; j0 < missing.size(); j0 += kBlock) {
+        const int nb = static_cast<int>(std::min<std::size_t>(kBlock, missing.size() - j0));
+        Y.setZero(n, nb);
+        for (int c = 0; c < nb; ++c)
+            for (SpMat::InnerIterator it(st_.Gt, missing[j0 + static_cast<std::size_t>(c)]); it; ++it)
+                Y(it.row(), c) = it.value();
+        Y = st_.k_llt.solve(Y).eval();
+        for (int c = 0; c < nb; ++c) {
+            xcol[static_cast<std::size_t>(missing[j0 + static_cast<std::size_t>(c)])] = Y.col(c);
+            ++xcol_count;
+        }
+    }
+}
+
+/// The Schur complement M = G_S K^-1 (G_S^T + G_slip^T D) of the held rows, LU-factorised.
+void ModeSolver::factor_schur(const ModeLinearization& lin) {
+    const auto& S = lin.S;
+    const int ms = static_cast<int>(S.size());
+    std::vector<int> rows(S);
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+        if (pos[lin.coupled[a].second] >= 0) rows.push_back(lin.coupled[a].first);
+    ensure_columns(rows);
+    Eigen::MatrixXd M(ms, ms);
+    for (int c = 0; c < ms; ++c) {
+        const Eigen::VectorXd& xc = xcol[static_cast<std::size_t>(S[c])];
+        for (int r = 0; r < ms; ++r) M(r, c) = st_.row_dot(S[r], xc);
+    }
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+        const int c = pos[lin.coupled[a].second];
+        if (c < 0) continue;
+        const Eigen::VectorXd& xt = xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+        for (int r = 0; r < ms; ++r) M(r, c) += lin.coef[a] * st_.row_dot(S[r], xt);
+    }
+    dlu.compute(M);
+    // a singular set of modes (dependent held rows) is left to the caller, as with the sparse LU
+    lu_ok = ms == 0 || (M.allFinite() && dlu.rcond() > 1e-14);
+    Mschur = std::move(M);
+}
+
+/// Held-row solve with the Schur complement: p_S from M p_S = target - G_S z0 (one
+/// step of iterative refinement with M, as the sparse LU's solves get) and
+/// z = z0 + sum_S (p_S,c K^-1 g_c^T + coef p_S,c K^-1 g_t^T).
+void ModeSolver::schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
+                 Eigen::VectorXd& pS, Eigen::VectorXd& zout) {
+    const auto& S = lin.S;
+    const int ms = static_cast<int>(S.size());
+    zout = z0;
+    pS.setZero(ms);
+    if (ms == 0) return;
+    Eigen::VectorXd res(ms);
+    for (int r = 0; r < ms; ++r) res[r] = target[r] - st_.row_dot(S[r], z0);
+    pS = dlu.solve(res);
+    pS += dlu.solve(res - Mschur * pS);
+    for (int c = 0; c < ms; ++c) zout += pS[c] * xcol[static_cast<std::size_t>(S[c])];
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+        const int c = pos[lin.coupled[a].second];
+        if (c >= 0) zout += (lin.coef[a] * pS[c]) * xcol[static_cast<std::size_t>(lin.coupled[a].first)];
+    }
+}
+
+Eigen::VectorXd ModeSolver::refined_solve(const Eigen::VectorXd& r) {
+    Eigen::VectorXd y = lu.solve(r);
+    const Eigen::VectorXd res = r - A * y;
+    y += lu.solve(res);
+    return y;
+}
+
+}  // namespace stackbeam::detail::sparse

@@ -1,0 +1,133 @@
+#pragma once
+// Internal: the linear problem of a set of modes on the sparse stiffness (mode_solver.cpp).
+//
+// For a set of modes the contact conditions are linear: held rows (closed normal, stuck
+// tangential, bonded) impose G_S z = d_S; slipping rows carry a force affine in their
+// pair's normal force, p_t = e_t + D p_n; open / free rows carry p = e = 0. With z and p_S
+// as unknowns this is one sparse saddle-point system
+//     [ K     -G_S^T - G_slip^T D ] [z  ]   [b + G^T e]
+//     [ G_S    0                  ] [p_S] = [d_S      ]
+// (K [N/m per DOF unit] the stiffness, G [-] the contact rows, d [m] the offsets, p [N] the
+// contact forces, z the displacements). ModeSolver solves it three ways (the defaults are
+// the measured choices, BENCHMARKS.md):
+//  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on a
+//    Cholesky factor of K made once per (K, G), the columns K^-1 g_i^T cached per row;
+//  - more: a sparse LU of the saddle-point system (Eigen::SparseLU, COLAMD);
+//  - a held set without slip coupling within `max_border_rows` rows of the last LU's: that
+//    LU bordered by the changed rows (a low-rank update) instead of a new factorisation.
+// A factorisation is named by a key (the caller's modes, or a box QP's working set) and
+// reused while the key stays; within one key the solution is affine in the load b, and
+// the back-solves of that map are cached.
+#include <Eigen/Dense>
+#include <Eigen/SparseLU>
+#include <vector>
+
+#include "contact/active_set.hpp"
+#include "contact/sparse/common.hpp"
+
+namespace stackbeam::detail::sparse {
+
+/// The data of one (K, G), made once per structure: K's factor, W's diagonal, the scalings.
+struct SparseStiffness {
+    SpMat K, G;              ///< stiffness (n x n) and contact rows (m x n), compressed
+    SpMat Gt;                ///< G^T (columns: contact rows)
+    RowMat Grow;             ///< G, row-major
+    KCholesky k_llt;         ///< Cholesky factor of K
+    Eigen::VectorXd diag;    ///< diagonal of W = G K^-1 G^T [m/N] (selected_inverse.hpp)
+    double g_norm_inf = 0.0; ///< max row sum of |G|
+    Eigen::VectorXd dz;      ///< column scaling of z: diag(K)^-1/2
+    SpMat Gt_scaled;         ///< Dz G^T: column r is contact row r, scaled
+    Eigen::VectorXd row_h;   ///< ||G_i Dz|| per contact row (1 for an empty row): the row scaling
+
+    /// Factorises K (throws InputError("problem.K") if it is not positive definite) and
+    /// makes the rest. K and G must have matching sizes.
+    void build(const SpMat& K_, const SpMat& G_);
+    int dofs() const { return static_cast<int>(K.rows()); }
+    int rows() const { return static_cast<int>(G.rows()); }
+    /// s = G z - d [m] for z = K^-1 (b + G^T p).
+    Eigen::VectorXd positions(const Eigen::VectorXd& b, const Eigen::VectorXd& d, const Eigen::VectorXd& p,
+                              Eigen::VectorXd& z) const;
+    /// 1e-13 x (||d||_inf + ||G||_inf ||z||_inf) [m]: the round-off of s = G z - d.
+    double roundoff(const Eigen::VectorXd& d, const Eigen::VectorXd& z) const;
+    /// Appends Dz K Dz (the stiffness block of the scaled saddle-point systems) to t.
+    void append_scaled_K(std::vector<Eigen::Triplet<double>>& t) const;
+    /// g_r . v for a contact row r and a vector v of n entries.
+    double row_dot(int r, const Eigen::VectorXd& v) const;
+};
+
+/// The ways of ModeSolver (SparsePathTuning's fields of the same names).
+struct ModeSolverTuning {
+    int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
+    int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+};
+
+class ModeSolver {
+public:
+    explicit ModeSolver(const ModeSolverTuning& tuning = {}) : tuning_(tuning) {}
+
+    /// A new (K, G): factorises K, computes W's diagonal and drops every cache.
+    void reset(const SpMat& K, const SpMat& G);
+    const SparseStiffness& stiffness() const { return st_; }
+
+    /// Solves the linear problem of `lin` (held rows S with s = 0, fixed forces e, slip
+    /// coupling p_t = e_t + coef p_n) for load b and offsets d into p [N] (every row: the
+    /// held ones solved, the others e plus their coupling) and z. Reuses the factorisation
+    /// while `key` names it; returns 1 if it factorised (a sparse LU or the Schur
+    /// complement's dense LU), 0 otherwise (cached, or a bordered update: updates()).
+    /// Throws SingularModes if the held rows are dependent.
+    int solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
+              const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// Whether `key` names the current factorisation.
+    bool is_current(const std::vector<signed char>& key) const { return key == lu_key_; }
+    /// Forgets the current factorisation's key (after a singular solve).
+    void forget() { lu_key_.clear(); }
+    /// Solves by a bordered update since the last reset_updates().
+    int updates() const { return updates_; }
+    void reset_updates() { updates_ = 0; }
+
+private:
+    bool try_border(const ModeLinearization& lin);
+    void border_solve(const ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                      Eigen::VectorXd& p, Eigen::VectorXd& z);
+    void load_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS, Eigen::VectorXd& zf);
+    void ensure_columns(const std::vector<int>& rows);
+    void factor_schur(const ModeLinearization& lin);
+    void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
+                     Eigen::VectorXd& pS, Eigen::VectorXd& zout);
+    Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
+
+    ModeSolverTuning tuning_;
+    SparseStiffness st_;
+    int updates_ = 0;
+    // factorisation of the current key
+    std::vector<signed char> lu_key_;
+    Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> lu;
+    bool lu_ok = false;
+    std::vector<int> pos;                // row -> index in lin.S, or -1
+    Eigen::VectorXd row_scale;           // scaling of the held rows (1/||G_i Dz||)
+    SpMat A;                             // the scaled saddle-point matrix of the current key
+    // cached back-solves of the current factorisation
+    int unit_dof = -1;                   // (zu, pu) are for a unit load on this DOF
+    Eigen::VectorXd const_e, const_dS;   // (zc, pc) are for these e, d_S
+    bool const_ok = false;
+    Eigen::VectorXd x, rhs;
+    // the affine map of the load for the current factorisation: (z, p_S) = (zc, pc) + b_w (zu, pu)
+    Eigen::VectorXd zc, pc, zu, pu;
+    // Schur-complement way: the held rows' dense LU and the cached columns K^-1 g_i^T
+    bool lu_schur = false;
+    Eigen::MatrixXd Mschur;              // the Schur complement (for refinement)
+    Eigen::PartialPivLU<Eigen::MatrixXd> dlu;
+    std::vector<Eigen::VectorXd> xcol;   // per contact row; empty = not computed
+    std::size_t xcol_count = 0;
+    // low-rank updates of the sparse LU (try_border): the base's held set and the border
+    bool base_valid = false;
+    std::vector<int> base_S, base_pos;
+    bool border_active = false;
+    std::vector<int> border_rows;        // the freed base rows first (border_nr of them), then the added rows
+    int border_nr = 0;
+    std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
+    std::size_t bcol_count = 0;          // non-empty entries of bcol
+    int key_uses = 0;                    // solves with the current factorisation
+};
+
+}  // namespace stackbeam::detail::sparse

@@ -1,0 +1,71 @@
+#pragma once
+// Internal: the state the units of the sparse contact path share (sparse_path.cpp): the
+// mode solver of the current (K, G), the pair laws, the current modes and the active-set
+// passes on them, and the natural map of the contact laws. The box-QP methods
+// (box_qp_methods.hpp) and the transition methods (transitions.hpp) each take it with
+// one signature; SparseContactSolver (sparse_solver.cpp) orchestrates them.
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <vector>
+
+#include "contact/active_set.hpp"
+#include "contact/sparse/mode_solver.hpp"
+#include "contact/sparse/switches.hpp"
+#include "stackbeam/contact/contact.hpp"
+
+namespace stackbeam::detail::sparse {
+
+/// The right-hand side of one solve: K z = b + G^T p, s = G z - d.
+struct Step {
+    const Eigen::VectorXd& b;  ///< load with p = 0, one entry per DOF
+    const Eigen::VectorXd& d;  ///< offsets [m], one entry per contact row
+};
+
+struct SparsePath {
+    SolverOptions options;   ///< tolerance_m, max_active_set_iterations, tresca_anderson_depth
+    Switches switches;       ///< the test-only switches (switches.hpp)
+    ModeSolver solver;       ///< the linear problem of a set of modes on the current (K, G)
+    ContactProblem laws;     ///< pairs and tau rule; W empty, q zero (sizes only)
+    ModeSet modes;           ///< the current modes
+    Eigen::VectorXd s;       ///< s = G z - d [m] where the last unit left it (the solver's answer's at the end)
+    Eigen::VectorXd best_p;  ///< the semismooth Newton method's iterate of smallest ||F|| (its last run)
+    // workspaces made once per (K, G): the interior-point method's LDL^T of K + G^T Sigma^-1 G
+    // (its ordering) and the smoothing Newton method's Jacobian and LU (its ordering)
+    Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ipm_ldlt;
+    bool ipm_analysed = false;
+    Eigen::Index ipm_nnz = 0;
+    SpMat Js;
+    Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> js_lu;
+    bool js_analysed = false;
+
+    SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
+        : options(o), switches(sw), solver(tuning) {}
+
+    /// A new structure (K, G, pairs): validates `pr` (InputError), refactorises, forgets the modes.
+    void reset(const SparseContactProblem& pr);
+    const SparseStiffness& stiffness() const { return solver.stiffness(); }
+    const Eigen::VectorXd& diag() const { return solver.stiffness().diag; }
+
+    /// Solves the linear problem of the current modes for `step` into p and z; returns 1
+    /// if it factorised. Throws SingularModes.
+    int solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// Sets s = G z - d and returns the number of violated modes at (p, s) (threshold
+    /// kAccept x tolerance, or the round-off of s if larger).
+    int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z);
+    /// At most max_passes active-set passes from the current modes (active_set.hpp);
+    /// true when no mode is violated.
+    bool passes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, int max_passes, SolveResult& r);
+    /// The natural map F(p, s) of the contact laws per component in metres, and with
+    /// `set_modes` the modes of its generalised Jacobian at (p, s) (sparse_path.cpp).
+    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes);
+
+private:
+    // the linearisation of the modes solve_modes last solved (kept while they stay)
+    ModeLinearization lin_;
+    bool lin_ok_ = false;
+    std::vector<signed char> lin_nmode_, lin_tmode_, lin_key_;
+    TauRule lin_tau_rule_ = TauRule::current;
+};
+
+}  // namespace stackbeam::detail::sparse

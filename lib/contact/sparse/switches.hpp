@@ -1,0 +1,59 @@
+#pragma once
+// Internal: the sparse path's test-only and historical switches (SparseContactSolver).
+// They are not part of the public API: the defaults are the production method; tests and
+// the benchmark force each way through ScopedSwitches to check or measure it alone.
+namespace stackbeam::detail::sparse {
+
+/// How the sparse path solves a transition that the active-set passes from the previous
+/// modes do not settle (SparseContactSolver::solve, step 2).
+enum class TransitionMethod {
+    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
+                 ///< Newton method; then the continuation on the offsets; then the Tresca fixed point (default)
+    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
+                 ///< smoothing method (kept for comparison, BENCHMARKS.md)
+    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
+    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
+    continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
+};
+
+/// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
+/// limits frozen): min 1/2 p^T W p + q^T p over lower <= p <= upper, with W = G K^-1 G^T
+/// never formed. All end at the same working-set test, so their answers agree to round-off.
+enum class BoxQpMethod {
+    pivoting,        ///< block principal pivoting (a few sparse solves where it settles); where it does not
+                     ///< settle in 50 passes, a primal-dual interior-point method (Mehrotra's predictor-
+                     ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
+                     ///< read from the iterate); then the monotone primal active-set method (default)
+    interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
+    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
+                     ///< (kept for comparison, BENCHMARKS.md)
+};
+
+/// The switches of one SparseContactSolver (fixed at its construction).
+struct Switches {
+    TransitionMethod transition = TransitionMethod::newton;
+    BoxQpMethod box_qp = BoxQpMethod::pivoting;
+    /// Every solve starts with the transition method from the warm start (no active-set
+    /// passes from the previous modes first, and whatever the problem's size), so its
+    /// answers can be checked alone.
+    bool newton_first = false;
+};
+
+/// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
+/// or those of the innermost live ScopedSwitches.
+Switches current_switches();
+
+/// While alive, every SparseContactSolver constructed on this thread (directly, or by a
+/// stepper) takes `switches`; the previous ones are restored at the end of its scope.
+class ScopedSwitches {
+public:
+    explicit ScopedSwitches(const Switches& switches);
+    ~ScopedSwitches();
+    ScopedSwitches(const ScopedSwitches&) = delete;
+    ScopedSwitches& operator=(const ScopedSwitches&) = delete;
+
+private:
+    Switches saved_;
+};
+
+}  // namespace stackbeam::detail::sparse
