@@ -6,6 +6,7 @@
 #   # expect-field: leaves[2].height_m   the message must start with this field path
 #                                        ("stackbeam: error: leaves[2].height_m: ");
 #                                        @FILE@ stands for the file's own path (syntax errors)
+#                                        (also in expect-text: "(@FILE@:65:8)", where the key is)
 #   # expect-text: value -0.005 is not allowed    a part of the message (value, what is allowed)
 #   # expect-exit: 3                     the exit status (default 2, bad input; 3 is a solver failure)
 # and the checker asserts: that exit status (so no crash: a signal is no exit
@@ -36,6 +37,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
     message(FATAL_ERROR "${FILE} states no '# expect-field:' nor '# expect-text:' line")
   endif()
   string(REPLACE "@FILE@" "${FILE}" field "${field}")
+  string(REPLACE "@FILE@" "${FILE}" text "${text}")
 
   file(REMOVE "${OUT}" "${OUT}.partial")
   execute_process(COMMAND "${CLI}" simulate --scenario "${FILE}" --out "${OUT}"
