@@ -289,3 +289,19 @@ stackbeam_cli_test(NAME cli_friction_mesh_ratio_failure
                         --out ${_cli_out_dir}/cli_k2.csv
                    EXPECT_RC 3 EXPECT_TEXT "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is 2 on interface 0"
                    OUT ${_cli_out_dir}/cli_k2.csv)
+
+# Interruption (apps/cli/run.hpp): SIGTERM / SIGINT once the first rows are on disk; exit
+# status 143 / 130, the .partial files end on whole rows (every line the header's field
+# count; the pairs at the CSV's last time), the summary says "interrupted": true.
+find_program(_cli_bash bash)
+if(_cli_bash)
+  foreach(_sig_rc TERM:143 INT:130)
+    string(REPLACE ":" ";" _sig_rc "${_sig_rc}")
+    list(GET _sig_rc 0 _sig)
+    list(GET _sig_rc 1 _rc)
+    add_test(NAME cli_interrupt_sig${_sig}
+             COMMAND ${_cli_bash} ${CMAKE_CURRENT_LIST_DIR}/cli_interrupt_test.sh $<TARGET_FILE:stackbeam_cli> ${_sig} ${_rc}
+                     ${_cli_out_dir}/interrupt)
+    set_tests_properties(cli_interrupt_sig${_sig} PROPERTIES LABELS cli TIMEOUT 180)
+  endforeach()
+endif()
