@@ -43,8 +43,7 @@ namespace {
 
 using namespace stackbeam::cli;
 
-int run_simulate(const SimulateArgs& args) {
-    const RunRequest request = make_request(args);  // every argument checked before any work
+int run_request(const RunRequest& request) {
     const stackbeam::Model model = stackbeam::Model::build(request.spec);
     const stackbeam::System system(model);
     if (const std::string advice = stackbeam::friction_mesh_advice(model); !advice.empty())
@@ -67,6 +66,18 @@ int run_simulate(const SimulateArgs& args) {
         if (result.signal == 0) std::printf("summary                    %s\n", request.summary.c_str());
     }
     return result.signal != 0 ? 128 + result.signal : exit_ok;
+}
+
+
+int run_simulate(const SimulateArgs& args) {
+    const RunRequest request = make_request(args);  // every argument checked before any work
+    try {
+        return run_request(request);
+    } catch (const stackbeam::InputError& e) {
+        // found when the run starts: a scenario's value is named by its key and line
+        if (request.scenario && e.location().empty()) stackbeam::rethrow_in_scenario(*request.scenario, e);
+        throw;
+    }
 }
 
 }  // namespace

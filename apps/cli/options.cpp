@@ -153,7 +153,8 @@ RunRequest make_request(const SimulateArgs& a) {
     const bool density_given = a.given.count("--beam-density") > 0;
     if (!a.scenario.empty()) {
         // A scenario file; options given on the command line override its values.
-        const Scenario scenario = load_scenario(a.scenario);
+        r.scenario = load_scenario(a.scenario);
+        const Scenario& scenario = *r.scenario;
         r.spec = scenario.model;
         r.options = scenario.simulation;
         apply_given(a, r.options);

@@ -6,10 +6,12 @@
 #include <CLI/CLI.hpp>
 
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
 
+#include "stackbeam/io/scenario.hpp"
 #include "stackbeam/model/model.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -49,6 +51,7 @@ struct RunRequest {
     std::string out, events, summary, pairs, plot;  ///< files ("" = none); out is required
     std::string setup;                              ///< the summary's first line: the case or the scenario
     bool quiet = false;
+    std::optional<Scenario> scenario;  ///< the file read, for --scenario (its keys' locations)
 };
 
 /// Reads the arguments (and the scenario file): throws ArgumentError naming the flag,

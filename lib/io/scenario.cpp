@@ -46,7 +46,8 @@ std::string join(const std::vector<std::string>& items) {
 /// Shared state of one parse: the source name and where each key path is.
 class Context {
 public:
-    explicit Context(std::string source) : source_(std::move(source)) {}
+    explicit Context(std::string source, std::map<std::string, std::string> locations = {})
+        : source_(std::move(source)), locations_(std::move(locations)) {}
 
     std::string where(const toml::value& v) const {
         const auto loc = v.location();
@@ -65,9 +66,10 @@ public:
         return source_;
     }
     [[noreturn]] void fail(const std::string& path, const std::string& message) const {
-        throw InputError(path, message + " (" + location_of(path) + ")");
+        throw InputError(path, message, location_of(path));
     }
     const std::string& source() const noexcept { return source_; }
+    const std::map<std::string, std::string>& locations() const noexcept { return locations_; }
 
 private:
     std::string source_;
@@ -548,7 +550,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     } catch (const InputError& e) {
         rethrow_in_file(ctx, e);
     }
+    s.key_locations = ctx.locations();
     return s;
+}
+
+void rethrow_in_scenario(const Scenario& scenario, const InputError& e) {
+    rethrow_in_file(Context(scenario.source, scenario.key_locations), e);
 }
 
 Scenario load_scenario(const std::string& path) {
