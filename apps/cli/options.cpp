@@ -117,17 +117,18 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
                 ->type_name(type)
                 ->excludes(main);
     }
-    sim.add_option("--elements", a.elements, "--case: elements per half leaf")
+    sim.add_option("--elements", a.elements,
+                   "--case: elements per half leaf (default " +
+                       std::to_string(PaperExampleOptions{}.elements_per_half_leaf) + ")")
         ->type_name("N")
-        ->capture_default_str()
         ->excludes(scenario_opt);
     sim.add_flag("--full-model", a.full_model, "--case: mesh the whole spring instead of the symmetric half")
         ->excludes(scenario_opt);
     sim.add_option("--beam-density", a.beam_density,
                    "density of every leaf [kg/m^3] (file key leaves[i].density_kg_per_m3): 0 = massless leaves (the "
-                   "paper), > 0 = leaves with mass (mode newmark; mode cvode)")
-        ->type_name("KG_PER_M3")
-        ->capture_default_str();
+                   "paper), > 0 = leaves with mass (mode newmark; mode cvode) (default: the case's or the file's, "
+                   "0 in the paper cases)")
+        ->type_name("KG_PER_M3");
     sim.add_option("--out", a.out,
                    "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names "
                    "one (file key outputs.csv_path)")
@@ -174,16 +175,16 @@ RunRequest make_request(const SimulateArgs& a) {
         const PaperCase pcase = parse_paper_case(a.case_name, "--case");
         apply_given(a, r.options);  // over the library's defaults
         PaperExampleOptions example;
-        example.elements_per_half_leaf = parse_count("--elements", a.elements);
+        if (!a.elements.empty()) example.elements_per_half_leaf = parse_count("--elements", a.elements);
         example.symmetry = a.full_model ? Symmetry::full : Symmetry::half;
         if (r.out.empty()) throw ArgumentError("--out: an output file name is required");
         r.spec = paper_example(pcase, example);
-        for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
+        if (density_given)
+            for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         r.setup = std::string("case ") + to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                   " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }
-    if ((a.scenario.empty() || density_given) && r.options.mode == Mode::closed_form &&
-        parse_density(a.beam_density) > 0.0)
+    if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
         throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded and "
                             "frictionless stacks so far): mode closed-form treats the leaves as massless, the paper");
     if (r.options.mode != Mode::cvode && !r.events.empty())

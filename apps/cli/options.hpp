@@ -32,9 +32,9 @@ struct ArgumentError : std::runtime_error {
 struct SimulateArgs {
     std::string case_name;
     std::string scenario;
-    std::string elements = "20";
+    std::string elements;      ///< "" = the library's default (PaperExampleOptions)
     bool full_model = false;
-    std::string beam_density = "0";
+    std::string beam_density;  ///< "" = the leaves' own density (the case's: 0, massless)
     std::string out, events, summary, pairs, plot;
     bool quiet = false;
     std::map<std::string, std::string> table_text;  ///< flag (or alias) of the option table -> text
