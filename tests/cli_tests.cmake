@@ -238,6 +238,15 @@ stackbeam_cli_test(NAME cli_scenario_with_elements
 stackbeam_cli_test(NAME cli_scenario_bad_override
                    ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --dt nan --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "--dt: value 'nan' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+# A file's value that an override makes invalid is named by its key and line, a flag's by the flag.
+stackbeam_cli_test(NAME cli_scenario_value_by_key
+                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --mode cvode --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "rig_friction.toml:71:8: loading.kind: value 'prescribed-displacement' is not available in mode cvode"
+                   OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_scenario_override_by_flag
+                   ARGS simulate --scenario ${_scenarios}/paper_friction.toml --restitution 0.5 --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--restitution: value 0.5 is not used by mode closed-form"
+                   OUT ${_cli_out_dir}/cli_x.csv)
 stackbeam_cli_test(NAME cli_scenario_missing_file
                    ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x.csv)

@@ -76,20 +76,20 @@ void apply_given(const SimulateArgs& a, SimulationOptions& options) {
     }
 }
 
-/// Runs options.validate(); an InputError about a member is reported under the flag the
-/// user gave for it, else (a value from the scenario) under its key in `scenario`.
-void validate(const SimulateArgs& a, const SimulationOptions& options, const std::string& scenario) {
+/// Runs options.validate(); an InputError about an option is reported under the flag the
+/// user gave for it, else (a value from the scenario file) under its key and line in the file.
+void validate(const SimulateArgs& a, const SimulationOptions& options, const Scenario* scenario) {
     try {
         options.validate();
     } catch (const InputError& e) {
         const OptionSpec* spec = find_option_by_member(e.field());
+        const std::string flag = spec ? given_flag(a, *spec) : "";
+        if (flag.empty() && scenario) rethrow_in_scenario(*scenario, e);
         if (!spec) throw;
         const std::string prefix = e.field() + ": ";
         std::string message = e.what();
         if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
-        std::string name = given_flag(a, *spec);
-        if (name.empty()) name = scenario.empty() ? spec->flag : std::string(spec->key) + " (in " + scenario + ")";
-        throw ArgumentError(name + ": " + message);
+        throw ArgumentError((flag.empty() ? std::string(spec->flag) : flag) + ": " + message);
     }
 }
 
@@ -190,7 +190,7 @@ RunRequest make_request(const SimulateArgs& a) {
     if (r.options.mode != Mode::cvode && !r.events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
                             std::string(to_string(r.options.mode)) + ")");
-    validate(a, r.options, a.scenario);
+    validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }
 
