@@ -14,6 +14,7 @@ namespace stackbeam {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+static_assert(kSparsePathMinComponents == 1000, "the --contact-path help below states the threshold: update it");
 using T = OptionSpec::Type;
 
 std::string number_text(double v) {
