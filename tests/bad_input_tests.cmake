@@ -3,9 +3,11 @@
 # (bad_input.<name>), added at configure time (a new file re-runs the configure).
 #
 # Each file states what is expected in comment lines at its top:
-#   # expect-field: leaves[2].height_m   the message must start with this field path
-#                                        ("stackbeam: error: leaves[2].height_m: ");
+#   # expect-field: leaves[2].height_m   the message must name this field path first, after the
+#                                        key's place in the file ("stackbeam: error: FILE:LINE:COL:
+#                                        leaves[2].height_m: ", or without the place);
 #                                        @FILE@ stands for the file's own path (syntax errors)
+#                                        (also in expect-text: "(@FILE@:65:8)", where the key is)
 #   # expect-text: value -0.005 is not allowed    a part of the message (value, what is allowed)
 #   # expect-exit: 3                     the exit status (default 2, bad input; 3 is a solver failure)
 # and the checker asserts: that exit status (so no crash: a signal is no exit
@@ -36,6 +38,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
     message(FATAL_ERROR "${FILE} states no '# expect-field:' nor '# expect-text:' line")
   endif()
   string(REPLACE "@FILE@" "${FILE}" field "${field}")
+  string(REPLACE "@FILE@" "${FILE}" text "${text}")
 
   file(REMOVE "${OUT}" "${OUT}.partial")
   execute_process(COMMAND "${CLI}" simulate --scenario "${FILE}" --out "${OUT}"
@@ -46,9 +49,12 @@ if(CMAKE_SCRIPT_MODE_FILE)
     string(APPEND failures "exit status '${rc}', expected ${expect_rc}\n")
   endif()
   if(NOT field STREQUAL "")
-    string(FIND "${err}" "stackbeam: error: ${field}: " pos)
-    if(pos EQUAL -1)
-      string(APPEND failures "stderr does not name the field: no 'stackbeam: error: ${field}: '\n")
+    # "stackbeam: error: FIELD: ..." or, where the file has the key, "stackbeam: error: FILE:LINE:COL: FIELD: ..."
+    string(REGEX MATCH "stackbeam: error: [^\n]*" first_line "${err}")
+    string(FIND "${first_line}" "stackbeam: error: ${field}: " at_start)
+    string(FIND "${first_line}" ": ${field}: " after_place)
+    if(NOT at_start EQUAL 0 AND after_place EQUAL -1)
+      string(APPEND failures "stderr does not name the field: no 'stackbeam: error: [FILE:LINE:COL: ]${field}: '\n")
     endif()
   endif()
   if(NOT text STREQUAL "")

@@ -111,9 +111,13 @@ set(_cli_bad_cases
   "mode_unknown|--mode|rk4|--mode: value 'rk4'"
   "rtol_zero|--rtol|0|--rtol: value '0'"
   "rtol_nan|--rtol|nan|--rtol: value 'nan'"
-  "rtol_too_large|--rtol|0.5|--rtol: value 0.5 is not allowed"
+  "rtol_too_large|--rtol|0.5|--rtol: value '0.5' is not allowed: must be a number in [1e-14, 0.01]"
+  "rtol_one|--rtol|1|--rtol: value '1' is not allowed: must be a number in [1e-14, 0.01]"
   "atol_negative|--atol|-1e-9|--atol: value '-1e-9'"
-  "max_step_zero|--max-step|0|--max-step: value '0'"
+  "max_step_negative|--max-step|-1|--max-step: value '-1' is not allowed: must be a finite number >= 0 [s] (0: no limit)"
+  "tolerance_zero|--tolerance|0|--tolerance: value '0' is not allowed: must be a finite number > 0 [m]"
+  "max_iterations_fraction|--max-iterations|2.5|--max-iterations: value '2.5' is not an integer"
+  "tau_rule_unknown|--tau-rule|later|--tau-rule: value 'later' is not a tau rule"
   "events_without_cvode|--events|ev.csv|--events: the event log exists in mode cvode only"
   "contact_path_unknown|--contact-path|banded|--contact-path: value 'banded' is not a contact path: allowed auto, dense, sparse"
   "beam_density_negative|--beam-density|-7850|--beam-density: value '-7850' is not allowed: must be a finite number >= 0 [kg/m^3]"
@@ -234,6 +238,15 @@ stackbeam_cli_test(NAME cli_scenario_with_elements
 stackbeam_cli_test(NAME cli_scenario_bad_override
                    ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --dt nan --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "--dt: value 'nan' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+# A file's value that an override makes invalid is named by its key and line, a flag's by the flag.
+stackbeam_cli_test(NAME cli_scenario_value_by_key
+                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --mode cvode --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "rig_friction.toml:71:8: loading.kind: value 'prescribed-displacement' is not available in mode cvode"
+                   OUT ${_cli_out_dir}/cli_x.csv)
+stackbeam_cli_test(NAME cli_scenario_override_by_flag
+                   ARGS simulate --scenario ${_scenarios}/paper_friction.toml --restitution 0.5 --out ${_cli_out_dir}/cli_x.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--restitution: value 0.5 is not used by mode closed-form"
+                   OUT ${_cli_out_dir}/cli_x.csv)
 stackbeam_cli_test(NAME cli_scenario_missing_file
                    ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x.csv)
@@ -285,3 +298,19 @@ stackbeam_cli_test(NAME cli_friction_mesh_ratio_failure
                         --out ${_cli_out_dir}/cli_k2.csv
                    EXPECT_RC 3 EXPECT_TEXT "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is 2 on interface 0"
                    OUT ${_cli_out_dir}/cli_k2.csv)
+
+# Interruption (apps/cli/run.hpp): SIGTERM / SIGINT once the first rows are on disk; exit
+# status 143 / 130, the .partial files end on whole rows (every line the header's field
+# count; the pairs at the CSV's last time), the summary says "interrupted": true.
+find_program(_cli_bash bash)
+if(_cli_bash)
+  foreach(_sig_rc TERM:143 INT:130)
+    string(REPLACE ":" ";" _sig_rc "${_sig_rc}")
+    list(GET _sig_rc 0 _sig)
+    list(GET _sig_rc 1 _rc)
+    add_test(NAME cli_interrupt_sig${_sig}
+             COMMAND ${_cli_bash} ${CMAKE_CURRENT_LIST_DIR}/cli_interrupt_test.sh $<TARGET_FILE:stackbeam_cli> ${_sig} ${_rc}
+                     ${_cli_out_dir}/interrupt)
+    set_tests_properties(cli_interrupt_sig${_sig} PROPERTIES LABELS cli TIMEOUT 180)
+  endforeach()
+endif()

@@ -9,15 +9,24 @@
 namespace stackbeam {
 
 /// Bad input: a field of a model or option out of range, inconsistent geometry.
-/// `field()` is the path of the offending field, e.g. "leaves[2].height_m".
+/// `field()` is the path of the offending field, e.g. "leaves[2].height_m"; what() is
+/// "field: message", or "location: field: message" when the input has a place, e.g.
+/// "paper.toml:87:8: integrator.cvode.rtol: value 1 is not allowed: ..." (a scenario file).
 class InputError : public std::invalid_argument {
 public:
     InputError(std::string field, const std::string& message)
         : std::invalid_argument(field + ": " + message), field_(std::move(field)) {}
+    /// `location`: where the value is written, "file:line:column".
+    InputError(std::string field, const std::string& message, std::string location)
+        : std::invalid_argument(location + ": " + field + ": " + message),
+          field_(std::move(field)),
+          location_(std::move(location)) {}
     const std::string& field() const noexcept { return field_; }
+    const std::string& location() const noexcept { return location_; }  ///< "" if none
 
 private:
     std::string field_;
+    std::string location_;
 };
 
 /// A numerical procedure that did not reach its goal: a contact iteration that

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "stackbeam/errors.hpp"
+#include "stackbeam/time/option_table.hpp"
 
 namespace stackbeam {
 
@@ -45,7 +46,8 @@ std::string join(const std::vector<std::string>& items) {
 /// Shared state of one parse: the source name and where each key path is.
 class Context {
 public:
-    explicit Context(std::string source) : source_(std::move(source)) {}
+    explicit Context(std::string source, std::map<std::string, std::string> locations = {})
+        : source_(std::move(source)), locations_(std::move(locations)) {}
 
     std::string where(const toml::value& v) const {
         const auto loc = v.location();
@@ -64,9 +66,10 @@ public:
         return source_;
     }
     [[noreturn]] void fail(const std::string& path, const std::string& message) const {
-        throw InputError(path, message + " (" + location_of(path) + ")");
+        throw InputError(path, message, location_of(path));
     }
     const std::string& source() const noexcept { return source_; }
+    const std::map<std::string, std::string>& locations() const noexcept { return locations_; }
 
 private:
     std::string source_;
@@ -216,25 +219,19 @@ E choice(const Table& t, const std::string& key, const std::vector<std::pair<std
 
 // ---------------------------------------------------------------------------------------
 
-/// The file's key path of a field named by Model::build or SimulationOptions::validate.
+/// The file's key path of a field named by Model::build or SimulationOptions::validate:
+/// the option table's key for an option (option_table.hpp), else the model's path.
 std::string file_path_of(const std::string& field) {
+    if (const OptionSpec* spec = find_option_by_member(field)) return spec->key;
     static const std::pair<const char*, const char*> exact[] = {
         {"rigid_body.initial_displacement_m", "loading.initial_displacement_m"},
         {"rigid_body.initial_velocity_m_per_s", "loading.initial_velocity_m_per_s"},
-        {"dt", "integrator.dt_s"},
-        {"t_end", "integrator.t_end_s"},
-        {"mode", "integrator.mode"},
     };
     for (const auto& [from, to] : exact)
         if (field == from) return to;
-    static const std::pair<const char*, const char*> prefixes[] = {
-        {"solver.", "integrator.solver."},
-        {"cvode.", "integrator.cvode."},
-    };
-    for (const auto& [from, to] : prefixes) {
-        const std::string f = from;
-        if (field.compare(0, f.size(), f) == 0) return to + field.substr(f.size());
-    }
+    // the solver's options outside the table (SolverOptions::max_active_set_iterations ...)
+    const std::string solver = "solver.";
+    if (field.compare(0, solver.size(), solver) == 0) return "integrator." + field;
     // "interfaces[i].leaves" (adjacent leaves do not overlap): the interface itself
     const std::string suffix = ".leaves";
     if (field.rfind("interfaces[", 0) == 0 && field.size() > suffix.size() &&
@@ -415,72 +412,52 @@ void parse_probe(const Table& top, ModelSpec& spec) {
     spec.probe = p;
 }
 
+/// [integrator], [integrator.solver], [integrator.cvode]: the keys of the option table
+/// (option_table.hpp) under "integrator.", each checked by its row as it is read.
 void parse_integrator(const Table& top, SimulationOptions& o) {
-    const Table t = top.table("integrator", {"mode", "dt_s", "t_end_s", "tau_rule", "solver", "cvode", "restitution"});
-    const std::string mode = t.string("mode", "the time stepping mode");
-    try {
-        o.mode = parse_mode(mode, "integrator.mode");  // the message names this build's modes
-    } catch (const InputError& e) {
-        rethrow_in_file(t.context(), e);
+    const std::string prefix = "integrator.";
+    std::map<std::string, std::vector<std::string>> keys = {  // table path -> its allowed keys
+        {"integrator", {}}, {"integrator.solver", {}}, {"integrator.cvode", {"root_finding"}}};
+    for (const OptionSpec& spec : simulation_option_table()) {
+        const std::string key = spec.key;
+        if (key.compare(0, prefix.size(), prefix) != 0) continue;
+        const auto cut = key.find_last_of('.');
+        keys[key.substr(0, cut)].push_back(key.substr(cut + 1));
     }
-    o.dt_s = t.number("dt_s", "the time step (mode cvode: the output interval) [s], > 0");
-    o.t_end_s = t.number("t_end_s", "the end time [s], > 0");
-    o.restitution = t.number_or("restitution", "the impact law's restitution coefficient [-] (mode newmark, massive "
-                                               "leaves), 0 <= e <= 1", o.restitution);
-    if (!std::isfinite(o.restitution) || o.restitution < 0.0 || o.restitution > 1.0)
-        t.context().fail("integrator.restitution", "value " + format_value(o.restitution) +
-                                                       " is not allowed: must be in [0, 1] (0: perfectly inelastic, "
-                                                       "1: elastic)");
-    const TauRule current = TauRule::current;
-    o.tau_rule = choice<TauRule>(t, "tau_rule", {{"current", TauRule::current}, {"previous-step", TauRule::previous_step}},
-                                 &current);
-    if (t.has("solver")) {
-        const Table s = t.table("solver", {"kind", "tolerance_m", "max_iterations", "alpha_fraction"});
-        const std::string kind = s.string_or("kind", "the contact solver", to_string(o.solver.kind));
+    keys["integrator"].insert(keys["integrator"].end(), {"solver", "cvode"});
+    const Table t = top.table("integrator", keys["integrator"]);
+    for (const char* required : {"mode", "dt_s", "t_end_s"})
+        if (!t.has(required)) t.missing(required, find_option_by_member(required)->help);
+    std::map<std::string, Table> tables;
+    tables.emplace("integrator", t);
+    for (const char* sub : {"solver", "cvode"})
+        if (t.has(sub)) tables.emplace(prefix + sub, t.table(sub, keys[prefix + sub]));
+    for (const OptionSpec& spec : simulation_option_table()) {
+        const std::string key = spec.key;
+        if (key.compare(0, prefix.size(), prefix) != 0) continue;
+        const auto cut = key.find_last_of('.');
+        const auto table = tables.find(key.substr(0, cut));
+        const std::string leaf = key.substr(cut + 1);
+        if (table == tables.end() || !table->second.has(leaf)) continue;  // the default stays
+        const Table& in = table->second;
         try {
-            o.solver.kind = parse_solver_kind(kind, "integrator.solver.kind");
+            if (spec.type == OptionSpec::Type::keyword) {
+                spec.set_word(o, in.string(leaf, spec.allowed()), spec.member);
+                continue;
+            }
+            const double v = spec.type == OptionSpec::Type::integer
+                                 ? static_cast<double>(in.integer(leaf, spec.allowed(), std::numeric_limits<long long>::min(),
+                                                                  std::numeric_limits<long long>::max()))
+                                 : in.number(leaf, spec.allowed());
+            check_option(spec, v);
+            spec.set(o, v);
         } catch (const InputError& e) {
+            if (e.field() == spec.key) throw;  // from Table: already with the key and its location
             rethrow_in_file(t.context(), e);
         }
-        o.solver.tolerance_m = s.number_or("tolerance_m", "the contact tolerance on ||v|| [m], > 0", o.solver.tolerance_m);
-        const long long max_iterations = o.solver.max_iterations;
-        o.solver.max_iterations = static_cast<int>(
-            s.integer("max_iterations", "an iteration limit >= 1", 1, std::numeric_limits<int>::max(), &max_iterations));
-        o.solver.alpha_fraction = s.number_or("alpha_fraction", "a fraction in (0, 1)", o.solver.alpha_fraction);
-        if (!(o.solver.alpha_fraction > 0.0 && o.solver.alpha_fraction < 1.0))
-            t.context().fail("integrator.solver.alpha_fraction",
-                             "value " + format_value(o.solver.alpha_fraction) +
-                                 " is not allowed: must be in (0, 1), a fraction of the stability bound");
     }
-    if (t.has("cvode")) {
-        const Table c = t.table("cvode", {"rtol", "atol_m", "max_step_s", "root_finding", "max_steps",
-                                          "modal_cutoff_rad_per_s"});
-        auto& cv = o.cvode;
-        cv.rtol = c.number_or("rtol", "the relative tolerance [-], > 0", cv.rtol);
-        cv.atol_m = c.number_or("atol_m", "the absolute tolerance on w [m], > 0", cv.atol_m);
-        cv.max_step_s = c.number_or("max_step_s", "the largest internal step [s], >= 0 (0: no limit)", cv.max_step_s);
-        cv.root_finding = c.boolean_or("root_finding", "locate transitions by root-finding", cv.root_finding);
-        cv.modal_cutoff_rad_per_s = c.number_or("modal_cutoff_rad_per_s",
-                                                "the modal cut-off of leaf inertia with friction [rad/s], >= 0 "
-                                                "(0: 10 x the stack's first frequency)",
-                                                cv.modal_cutoff_rad_per_s);
-        if (!std::isfinite(cv.modal_cutoff_rad_per_s) || cv.modal_cutoff_rad_per_s < 0.0)
-            t.context().fail("integrator.cvode.modal_cutoff_rad_per_s",
-                             "value " + format_value(cv.modal_cutoff_rad_per_s) +
-                                 " is not allowed: must be finite and >= 0 [rad/s] (0: the default)");
-        const long long ms = cv.max_steps;
-        cv.max_steps = static_cast<long>(c.integer("max_steps", "a step limit >= 1", 1, std::numeric_limits<long>::max(), &ms));
-        auto positive = [&](const char* key, double v, const char* unit) {
-            if (!std::isfinite(v) || v <= 0.0)
-                t.context().fail(std::string("integrator.cvode.") + key,
-                                 "value " + format_value(v) + " is not allowed: must be finite and > 0 " + unit);
-        };
-        positive("rtol", cv.rtol, "[-]");
-        positive("atol_m", cv.atol_m, "[m]");
-        if (!std::isfinite(cv.max_step_s) || cv.max_step_s < 0.0)
-            t.context().fail("integrator.cvode.max_step_s", "value " + format_value(cv.max_step_s) +
-                                                                " is not allowed: must be finite and >= 0 [s] (0: no limit)");
-    }
+    if (const auto c = tables.find("integrator.cvode"); c != tables.end())
+        o.cvode.root_finding = c->second.boolean_or("root_finding", "locate transitions by root-finding", o.cvode.root_finding);
 }
 
 void parse_outputs(const Table& top, ScenarioOutputs& out) {
@@ -573,7 +550,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     } catch (const InputError& e) {
         rethrow_in_file(ctx, e);
     }
+    s.key_locations = ctx.locations();
     return s;
+}
+
+void rethrow_in_scenario(const Scenario& scenario, const InputError& e) {
+    rethrow_in_file(Context(scenario.source, scenario.key_locations), e);
 }
 
 Scenario load_scenario(const std::string& path) {

@@ -1,6 +1,7 @@
 // Simulation options, the record columns and simulate(): the loop over the steppers.
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/option_table.hpp"
 
 #include <cmath>
 #include <limits>
@@ -93,39 +94,17 @@ ContactPath choose_contact_path(const System& system, const SimulationOptions& o
 }
 
 void SimulationOptions::validate() const {
-    if (!std::isfinite(dt_s) || dt_s <= 0.0)
-        throw InputError("dt", "value " + format_value(dt_s) + " is not allowed: the time step must be finite and > 0 [s]");
-    if (!std::isfinite(t_end_s) || t_end_s <= 0.0)
-        throw InputError("t_end", "value " + format_value(t_end_s) + " is not allowed: the end time must be finite and > 0 [s]");
+    // Every number of the option table (option_table.hpp) in its range; field(): the member's path.
+    for (const OptionSpec& spec : simulation_option_table())
+        if (spec.type != OptionSpec::Type::keyword) check_option(spec, spec.get(*this));
     if (t_end_s / dt_s > 1e9)
-        throw InputError("dt", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end = " + format_value(t_end_s) + " s");
+        throw InputError("dt_s", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end_s = " + format_value(t_end_s) + " s");
     make_solver(solver);  // validates the solver options
     loading.validate();
     if (mode == Mode::cvode && loading.kind == LoadingKind::prescribed_displacement)
         throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode: with w(t) "
                                          "imposed there is no equation of motion to integrate, each step is "
                                          "quasi-static (use mode closed-form, whose step is then exact)");
-    if (mode == Mode::cvode) {
-        if (!std::isfinite(cvode.rtol) || cvode.rtol < 1e-14 || cvode.rtol > 1e-2)
-            throw InputError("rtol", "value " + format_value(cvode.rtol) +
-                                         " is not allowed: CVODE's relative tolerance must be in [1e-14, 1e-2]");
-        if (!std::isfinite(cvode.atol_m) || cvode.atol_m <= 0.0)
-            throw InputError("atol", "value " + format_value(cvode.atol_m) +
-                                         " is not allowed: the absolute tolerance on w must be finite and > 0 [m]");
-        if (!std::isfinite(cvode.max_step_s) || cvode.max_step_s < 0.0)
-            throw InputError("max_step", "value " + format_value(cvode.max_step_s) +
-                                             " is not allowed: the largest step must be finite and >= 0 (0: no limit) [s]");
-        if (!std::isfinite(cvode.modal_cutoff_rad_per_s) || cvode.modal_cutoff_rad_per_s < 0.0)
-            throw InputError("modal_cutoff", "value " + format_value(cvode.modal_cutoff_rad_per_s) +
-                                                 " is not allowed: the modal cut-off must be finite and >= 0 "
-                                                 "(0: the default) [rad/s]");
-        if (cvode.max_steps < 1)
-            throw InputError("max_steps", "value " + std::to_string(cvode.max_steps) + " must be >= 1");
-    }
-    if (!std::isfinite(restitution) || restitution < 0.0 || restitution > 1.0)
-        throw InputError("restitution", "value " + format_value(restitution) +
-                                            " is not allowed: the restitution coefficient must be in [0, 1] "
-                                            "(0: perfectly inelastic impacts, 1: elastic)");
     if (restitution > 0.0 && mode != Mode::newmark)
         throw InputError("restitution", "value " + format_value(restitution) + " is not used by mode " + to_string(mode) +
                                             ": only mode newmark with massive leaves has impacts (give 0)");

@@ -85,7 +85,7 @@ const char* to_string(SolverKind kind);
 SolverKind parse_solver_kind(const std::string& text, const std::string& field);
 
 struct SolverOptions {
-    SolverKind kind = SolverKind::exact;
+    SolverKind kind = SolverKind::exact;  ///< the default in every mode (SimulationOptions::solver)
     double tolerance_m = 2e-6;        ///< stop when ||v||_2 < tolerance_m [m] (paper: 2e-6)
     int max_iterations = 200000;      ///< iteration limit of the iterative solvers
     double alpha = 0.0;               ///< paper / block_jacobi: alpha; 0 = alpha_fraction * 2 / lambda_max(E W)

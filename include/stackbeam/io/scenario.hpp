@@ -9,8 +9,10 @@
 /// the file, e.g. "leaves[2].height_m", and whose message gives the value, what is
 /// allowed and where it is (file:line:column). The parser prints nothing, and the
 /// TOML library it uses is not part of this interface.
+#include <map>
 #include <string>
 
+#include "stackbeam/errors.hpp"
 #include "stackbeam/model/model.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -35,6 +37,8 @@ struct Scenario {
     /// conditions go to model.rigid_body); validate() succeeds (checked by the parser).
     SimulationOptions simulation;
     ScenarioOutputs outputs;
+    /// Where each key path of the file is written, "file:line:column" (for rethrow_in_scenario).
+    std::map<std::string, std::string> key_locations;
 };
 
 /// Parses scenario TOML `text`; `source_name` names it in messages. Builds the
@@ -42,6 +46,12 @@ struct Scenario {
 /// (SimulationOptions::validate), translating their field names into the file's
 /// key paths. Throws InputError on any problem.
 Scenario parse_scenario(const std::string& text, const std::string& source_name);
+
+/// Rethrows `e`, an InputError of the library about `scenario`'s model or options found
+/// after parsing (when the run starts: a leaf density a mode cannot use, a body on a leaf
+/// without stiffness), under the file's key path and with the key's location, as the
+/// parser reports its own errors.
+[[noreturn]] void rethrow_in_scenario(const Scenario& scenario, const InputError& e);
 
 /// Reads and parses the scenario file at `path`. Throws InputError (field: the
 /// path) if it cannot be read, and as parse_scenario otherwise.

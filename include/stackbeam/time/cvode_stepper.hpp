@@ -37,7 +37,7 @@
 /// jump is recorded in CvodeStats::max_force_jump_n); CVODE is then re-initialised.
 ///
 /// At every accepted CVODE step (CV_ONE_STEP) the configured contact solver
-/// (SolverOptions; the paper's projected iteration by default in this mode, eq. 17)
+/// (SimulationOptions::solver; exact by default, as in every mode)
 /// is run on the paper's incremental problem, warm-started at the mode solution:
 /// it must accept that solution, and every witness must still be positive. A
 /// disagreement is a missed event (two crossings inside one step, or a witness

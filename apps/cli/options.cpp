@@ -1,0 +1,197 @@
+// `stackbeam simulate`'s arguments -> ModelSpec + SimulationOptions + output files.
+#include "options.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/option_table.hpp"
+
+namespace stackbeam::cli {
+
+namespace {
+
+/// Parses all of `text` as a number for `spec` given as `flag`, or throws naming the flag,
+/// the text as written and what the option table allows.
+double parse_number(const OptionSpec& spec, const std::string& flag, const std::string& text) {
+    const std::string allowed = "must be " + spec.allowed();
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double value = std::strtod(begin, &end);
+    if (text.empty() || end == begin || *end != '\0')
+        throw ArgumentError(flag + ": value '" + text + "' is not a number: " + allowed);
+    if (errno == ERANGE && std::isfinite(value) && value != 0.0 && std::abs(value) < 1.0)  // a denormal
+        throw ArgumentError(flag + ": value '" + text + "' is out of range: " + allowed);
+    if (spec.type == OptionSpec::Type::integer && std::isfinite(value) && value != std::floor(value))
+        throw ArgumentError(flag + ": value '" + text + "' is not an integer: " + allowed);
+    if (!spec.allows(value)) throw ArgumentError(flag + ": value '" + text + "' is not allowed: " + allowed);
+    return value;
+}
+
+/// --elements: an integer >= 1.
+int parse_count(const std::string& flag, const std::string& text) {
+    const std::string allowed = "must be an integer >= 1";
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(begin, &end, 10);
+    if (text.empty() || end == begin || *end != '\0')
+        throw ArgumentError(flag + ": value '" + text + "' is not an integer: " + allowed);
+    if (errno == ERANGE || value < 1 || value > std::numeric_limits<int>::max())
+        throw ArgumentError(flag + ": value '" + text + "' is not allowed: " + allowed);
+    return static_cast<int>(value);
+}
+
+/// --beam-density: a finite density >= 0 [kg/m^3] (0: massless leaves, the paper).
+double parse_density(const std::string& text) {
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    const double value = std::strtod(begin, &end);
+    if (text.empty() || end == begin || *end != '\0' || !std::isfinite(value) || value < 0.0)
+        throw ArgumentError("--beam-density: value '" + text +
+                            "' is not allowed: must be a finite number >= 0 [kg/m^3] (0: massless leaves, the paper)");
+    return value;
+}
+
+/// The flag of `spec` the user gave ("" if neither its name nor its alias).
+std::string given_flag(const SimulateArgs& a, const OptionSpec& spec) {
+    if (a.given.count(spec.flag)) return spec.flag;
+    if (spec.alias[0] != '\0' && a.given.count(spec.alias)) return spec.alias;
+    return "";
+}
+
+/// Sets every option of the table given on the command line over `options`.
+void apply_given(const SimulateArgs& a, SimulationOptions& options) {
+    for (const OptionSpec& spec : simulation_option_table()) {
+        const std::string flag = given_flag(a, spec);
+        if (flag.empty()) continue;
+        const std::string& text = a.table_text.at(flag);
+        if (spec.type == OptionSpec::Type::keyword) spec.set_word(options, text, flag);  // InputError names the flag
+        else spec.set(options, parse_number(spec, flag, text));
+    }
+}
+
+/// Runs options.validate(); an InputError about an option is reported under the flag the
+/// user gave for it, else (a value from the scenario file) under its key and line in the file.
+void validate(const SimulateArgs& a, const SimulationOptions& options, const Scenario* scenario) {
+    try {
+        options.validate();
+    } catch (const InputError& e) {
+        const OptionSpec* spec = find_option_by_member(e.field());
+        const std::string flag = spec ? given_flag(a, *spec) : "";
+        if (flag.empty() && scenario) rethrow_in_scenario(*scenario, e);
+        if (!spec) throw;
+        const std::string prefix = e.field() + ": ";
+        std::string message = e.what();
+        if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
+        throw ArgumentError((flag.empty() ? std::string(spec->flag) : flag) + ": " + message);
+    }
+}
+
+}  // namespace
+
+void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
+    CLI::Option* case_opt =
+        sim.add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
+    CLI::Option* scenario_opt =
+        sim.add_option("--scenario", a.scenario,
+                       "a scenario file (TOML, scenarios/README.md) instead of --case; options given here override its values")
+            ->type_name("FILE.toml")
+            ->excludes(case_opt);
+    // The integrator's options: one row of the library's table each (option_table.hpp).
+    const SimulationOptions defaults;
+    for (const OptionSpec& spec : simulation_option_table()) {
+        std::string help = std::string(spec.help) + "; " + spec.allowed() + "; file key " + spec.key +
+                           " (default " + spec.value_text(defaults) + ")";
+        const std::string type = spec.type == OptionSpec::Type::keyword ? "WORD"
+                                 : spec.type == OptionSpec::Type::integer ? "N"
+                                                                          : "X";
+        CLI::Option* main = sim.add_option(spec.flag, a.table_text[spec.flag], help)->type_name(type);
+        if (spec.alias[0] != '\0')
+            sim.add_option(spec.alias, a.table_text[spec.alias], std::string("the old name of ") + spec.flag)
+                ->type_name(type)
+                ->excludes(main);
+    }
+    sim.add_option("--elements", a.elements,
+                   "--case: elements per half leaf (default " +
+                       std::to_string(PaperExampleOptions{}.elements_per_half_leaf) + ")")
+        ->type_name("N")
+        ->excludes(scenario_opt);
+    sim.add_flag("--full-model", a.full_model, "--case: mesh the whole spring instead of the symmetric half")
+        ->excludes(scenario_opt);
+    sim.add_option("--beam-density", a.beam_density,
+                   "density of every leaf [kg/m^3] (file key leaves[i].density_kg_per_m3): 0 = massless leaves (the "
+                   "paper), > 0 = leaves with mass (mode newmark; mode cvode) (default: the case's or the file's, "
+                   "0 in the paper cases)")
+        ->type_name("KG_PER_M3");
+    sim.add_option("--out", a.out,
+                   "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names "
+                   "one (file key outputs.csv_path)")
+        ->type_name("FILE.csv");
+    sim.add_option("--events", a.events, "cvode: write the event log to this CSV (file key outputs.events_path)")
+        ->type_name("FILE.csv");
+    sim.add_option("--summary", a.summary, "write a JSON summary (file key outputs.summary_path)")->type_name("FILE");
+    sim.add_option("--pairs", a.pairs, "write every contact pair at every output time (file key outputs.pairs_path)")
+        ->type_name("FILE");
+    sim.add_option("--plot", a.plot, "draw PNG figures with gnuplot: PREFIX_*.png (file key outputs.plot_prefix)")
+        ->type_name("PREFIX");
+    sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
+}
+
+RunRequest make_request(const SimulateArgs& a) {
+    RunRequest r;
+    r.out = a.out;
+    r.events = a.events;
+    r.summary = a.summary;
+    r.pairs = a.pairs;
+    r.plot = a.plot;
+    r.quiet = a.quiet;
+    const bool density_given = a.given.count("--beam-density") > 0;
+    if (!a.scenario.empty()) {
+        // A scenario file; options given on the command line override its values.
+        r.scenario = load_scenario(a.scenario);
+        const Scenario& scenario = *r.scenario;
+        r.spec = scenario.model;
+        r.options = scenario.simulation;
+        apply_given(a, r.options);
+        if (r.out.empty()) r.out = scenario.outputs.csv_path;
+        if (r.out.empty())
+            throw ArgumentError("--out: an output file name is required (none given, and " + a.scenario +
+                                " has no outputs.csv_path)");
+        if (r.events.empty()) r.events = scenario.outputs.events_path;
+        if (r.summary.empty()) r.summary = scenario.outputs.summary_path;
+        if (r.pairs.empty()) r.pairs = scenario.outputs.pairs_path;
+        if (r.plot.empty()) r.plot = scenario.outputs.plot_prefix;
+        if (density_given)
+            for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
+        r.setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
+    } else {
+        if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
+        const PaperCase pcase = parse_paper_case(a.case_name, "--case");
+        apply_given(a, r.options);  // over the library's defaults
+        PaperExampleOptions example;
+        if (!a.elements.empty()) example.elements_per_half_leaf = parse_count("--elements", a.elements);
+        example.symmetry = a.full_model ? Symmetry::full : Symmetry::half;
+        if (r.out.empty()) throw ArgumentError("--out: an output file name is required");
+        r.spec = paper_example(pcase, example);
+        if (density_given)
+            for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
+        r.setup = std::string("case ") + to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
+                  " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+    }
+    if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded and "
+                            "frictionless stacks so far): mode closed-form treats the leaves as massless, the paper");
+    if (r.options.mode != Mode::cvode && !r.events.empty())
+        throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
+                            std::string(to_string(r.options.mode)) + ")");
+    validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
+    return r;
+}
+
+}  // namespace stackbeam::cli

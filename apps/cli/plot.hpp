@@ -1,0 +1,13 @@
+#pragma once
+/// @file plot.hpp
+/// --plot: PNG figures of a run with gnuplot from its CSV.
+#include <string>
+#include <vector>
+
+namespace stackbeam::cli {
+
+/// Displacement, forces, friction force at the probe and the loop (spring force against
+/// w) as PREFIX_*.png. Returns the files written, or none and a note why in `note`.
+std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note);
+
+}  // namespace stackbeam::cli

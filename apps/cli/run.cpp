@@ -1,0 +1,186 @@
+// The run of `stackbeam simulate`: rows streamed to FILE.partial, progress, interruption.
+#include "run.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/io/csv.hpp"
+
+namespace stackbeam::cli {
+
+namespace {
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int signal) { g_stop_signal = signal; }
+
+/// Thrown from the per-record callback when a stop was asked for.
+struct Interrupted {};
+
+/// A file written as FILE.partial and renamed to FILE when the whole run succeeded.
+class PartialFile {
+public:
+    PartialFile(const std::string& path, const std::string& option) : path_(path), partial_(path + ".partial") {
+        if (path_.empty()) return;
+        stream_.open(partial_, std::ios::out | std::ios::trunc);
+        if (!stream_) throw ArgumentError(option + ": cannot open '" + partial_ + "' for writing");
+    }
+    bool active() const { return !path_.empty(); }
+    std::ofstream& stream() { return stream_; }
+    const std::string& partial() const { return partial_; }
+    /// Closes and renames; throws if writing failed.
+    void commit() {
+        if (!active()) return;
+        close();
+        if (std::rename(partial_.c_str(), path_.c_str()) != 0)
+            throw std::runtime_error("cannot rename '" + partial_ + "' to '" + path_ + "'");
+    }
+    /// Closes and keeps FILE.partial (an interrupted or failed run); throws if writing failed.
+    void close() {
+        if (!active()) return;
+        stream_.close();
+        if (stream_.fail()) throw std::runtime_error("writing '" + partial_ + "' failed");
+    }
+    /// Removes the partial file (bad input found before any result).
+    void discard() {
+        if (!active()) return;
+        stream_.close();
+        std::remove(partial_.c_str());
+    }
+
+private:
+    std::string path_, partial_;
+    std::ofstream stream_;
+};
+
+/// Progress on stderr when it is a terminal (and not --quiet): a line rewritten at
+/// most every 0.2 s wall time.
+class Progress {
+public:
+    Progress(bool enabled, double t_end_s) : enabled_(enabled && isatty(fileno(stderr)) != 0), t_end_(t_end_s) {}
+    void update(double t_s) {
+        if (!enabled_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (shown_ && now - last_ < std::chrono::milliseconds(200)) return;
+        last_ = now;
+        shown_ = true;
+        std::fprintf(stderr, "\rstackbeam: t = %.4g of %.4g s (%3.0f %%)", t_s, t_end_, 100.0 * t_s / t_end_);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (enabled_ && shown_) std::fprintf(stderr, "\r%60s\r", "");
+    }
+
+private:
+    bool enabled_;
+    double t_end_;
+    bool shown_ = false;
+    std::chrono::steady_clock::time_point last_;
+};
+
+}  // namespace
+
+void RunStats::add(const StepRecord& r) {
+    if (records == 0) {
+        first = r;
+        w_min_m = w_max_m = r.w_m;
+        force_min_n = force_max_n = r.spring_force_n;
+    }
+    last = r;
+    ++records;
+    contact_iterations += r.contact_iterations;
+    max_contact_iterations = std::max(max_contact_iterations, r.contact_iterations);
+    max_abs_balance_j = std::max(max_abs_balance_j, std::abs(r.energy_balance_error_j));
+    w_min_m = std::min(w_min_m, r.w_m);
+    w_max_m = std::max(w_max_m, r.w_m);
+    force_min_n = std::min(force_min_n, r.spring_force_n);
+    force_max_n = std::max(force_max_n, r.spring_force_n);
+}
+
+void install_interrupt_handlers() {
+    struct sigaction action {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = 0;
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
+
+RunResult run(const RunRequest& request, const System& system) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const SimulationOptions& options = request.options;
+    PartialFile csv(request.out, "--out");
+    PartialFile pairs_csv(request.pairs, "--pairs");
+    write_csv_header(csv.stream());
+    if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
+    pairs_csv.stream().precision(17);
+
+    RunResult result;
+    Progress progress(!request.quiet, options.t_end_s);
+    PairObserver on_pairs;
+    if (pairs_csv.active())
+        on_pairs = [&](double t, const std::vector<PairRecord>& prs) {
+            auto& o = pairs_csv.stream();
+            for (const auto& p : prs)
+                o << t << ',' << p.pair << ',' << p.interface_index << ',' << p.x_m << ',' << to_string(p.state) << ','
+                  << p.p_n_n << ',' << p.p_t_n << ',' << p.gap_m << ',' << p.slip_m << '\n';
+        };
+    // A record's pairs follow it (simulate calls on_pairs after on_step): stopping before
+    // a record is written leaves the CSV and the pairs at the same last whole record.
+    auto on_step = [&](const StepRecord& r) {
+        if (g_stop_signal != 0) throw Interrupted{};
+        write_csv_row(csv.stream(), r);
+        result.stats.add(r);
+        progress.update(r.t_s);
+    };
+    try {
+        result.records = simulate(system, options, on_step, &result.report, on_pairs);
+        progress.finish();
+    } catch (const Interrupted&) {
+        progress.finish();
+        result.signal = g_stop_signal;
+        csv.close();
+        pairs_csv.close();
+        result.csv_file = csv.partial();
+        if (pairs_csv.active()) result.pairs_file = pairs_csv.partial();
+        result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::cerr << "stackbeam: interrupted by signal " << result.signal << " at t = " << result.stats.last.t_s
+                  << " s; the rows up to it are in " << csv.partial() << "\n";
+        return result;
+    } catch (const InputError&) {
+        // bad input found when the run starts (e.g. an option the mode cannot use): no rows to keep
+        progress.finish();
+        csv.discard();
+        pairs_csv.discard();
+        throw;
+    } catch (...) {
+        progress.finish();
+        csv.stream().flush();
+        pairs_csv.stream().flush();
+        std::cerr << "stackbeam: note: " << request.out << " was not written; the rows up to the failure are in "
+                  << csv.partial() << "\n";
+        throw;
+    }
+    if (!request.events.empty()) {
+        PartialFile ev(request.events, "--events");
+        write_events_csv(ev.stream(), result.report.events);
+        ev.commit();
+        result.events_file = request.events;
+    }
+    csv.commit();
+    pairs_csv.commit();
+    result.csv_file = request.out;
+    result.pairs_file = request.pairs;
+    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return result;
+}
+
+}  // namespace stackbeam::cli
