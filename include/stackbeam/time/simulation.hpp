@@ -129,7 +129,7 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading);
 /// it (leaves[i].density_kg_per_m3) instead. modal.hpp uses the density.
 void require_massless_leaves(const System& system, Mode mode);
 
-struct RunReport;  // cvode_stepper.hpp
+struct RunReport;  // run_report.hpp
 
 /// One contact pair at one time (simulate's per-pair output; meshed part, signs of
 /// conventions.hpp).

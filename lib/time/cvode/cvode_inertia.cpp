@@ -50,6 +50,7 @@ struct CvodeInertiaStepper::Impl {
     Eigen::VectorXd g;         // modal load -Phi^T N^T K z_p
     Eigen::LDLT<Eigen::MatrixXd> GGt;  // G G^T, for the contact forces
     ContactProblem laws;       // the pairs (for the record's pair states)
+    Eigen::VectorXd p_out, rel_out;  // contact forces [N] and relative positions G z [m] (all rows) at the output
     double e0 = 0.0;
     long out_index = 0, num_out = 0;
     StepRecord rec;
@@ -123,6 +124,8 @@ struct CvodeInertiaStepper::Impl {
                                                  : Eigen::VectorXd();
         Eigen::VectorXd p = Eigen::VectorXd::Zero(sys.num_components());
         for (int k = 0; k < static_cast<int>(held.size()); ++k) p[held[k]] = pC[k];
+        p_out = p;
+        rel_out = sys.contact_rows() * z;
         // a held unilateral pair must stay compressed (p_n <= 0): a release is an event,
         // not built yet with massive leaves
         for (const auto& pr : laws.pairs)
@@ -298,5 +301,16 @@ const StepRecord& CvodeInertiaStepper::advance() {
 
 const StepRecord& CvodeInertiaStepper::current() const noexcept { return impl_->rec; }
 const CvodeStats& CvodeInertiaStepper::stats() const noexcept { return impl_->st; }
+long CvodeInertiaStepper::record_index() const noexcept { return impl_->out_index; }
+std::vector<PairRecord> CvodeInertiaStepper::pairs() const {
+    return pair_records(impl_->sys, impl_->laws, impl_->p_out, impl_->rel_out);
+}
+RunReport CvodeInertiaStepper::report() const {
+    RunReport rep;
+    rep.mode = Mode::cvode;
+    rep.cvode = impl_->st;
+    rep.steps = impl_->st.steps;
+    return rep;
+}
 
 }  // namespace stackbeam::detail

@@ -19,18 +19,22 @@
 
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam::detail {
 
-class CvodeInertiaStepper {
+class CvodeInertiaStepper final : public Stepper {
 public:
     CvodeInertiaStepper(const System& system, const SimulationOptions& options);
-    ~CvodeInertiaStepper();
-    CvodeInertiaStepper(const CvodeInertiaStepper&) = delete;
-    CvodeInertiaStepper& operator=(const CvodeInertiaStepper&) = delete;
+    ~CvodeInertiaStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance();
-    const StepRecord& current() const noexcept;
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output: the held components' forces, relative positions G z.
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps and counters (no contact iterations, no events: the modes never change).
+    RunReport report() const override;
     const CvodeStats& stats() const noexcept;
 
 private:
@@ -43,15 +47,18 @@ private:
 /// carry the inertia, the modes above it respond quasi-statically (residual
 /// flexibility), so the contact points are massless and the events are those of the
 /// massless cvode mode (cvode_modal.cpp, docs/inertia.md).
-class CvodeModalStepper {
+class CvodeModalStepper final : public Stepper {
 public:
     CvodeModalStepper(const System& system, const SimulationOptions& options);
-    ~CvodeModalStepper();
-    CvodeModalStepper(const CvodeModalStepper&) = delete;
-    CvodeModalStepper& operator=(const CvodeModalStepper&) = delete;
+    ~CvodeModalStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance();
-    const StepRecord& current() const noexcept;
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output (contact_forces(), relative_positions()).
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
+    RunReport report() const override;
     const CvodeStats& stats() const noexcept;
     /// Every mode transition, in time order (cause "start", "root" or "check").
     const std::vector<ContactEvent>& events() const noexcept;

@@ -729,6 +729,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     }
     Eigen::VectorXd p_rec, rel_rec;
     s.record = s.make_record(0.0, Y, p_rec, rel_rec);
+    s.iters_since = s.facts_since = 0;  // counted in the initial record (as the massless mode)
     s.e0 = s.record.kinetic_energy_j + s.record.strain_energy_j;
     s.record.energy_balance_error_j = 0.0;
     s.p_out = p_rec;
@@ -771,5 +772,10 @@ const CvodeStats& CvodeModalStepper::stats() const noexcept { return impl_->stat
 const std::vector<ContactEvent>& CvodeModalStepper::events() const noexcept { return impl_->events; }
 const Eigen::VectorXd& CvodeModalStepper::contact_forces() const noexcept { return impl_->p_out; }
 const Eigen::VectorXd& CvodeModalStepper::relative_positions() const noexcept { return impl_->rel_out; }
+long CvodeModalStepper::record_index() const noexcept { return impl_->out_index; }
+std::vector<PairRecord> CvodeModalStepper::pairs() const {
+    return pair_records(impl_->sys, impl_->chk_problem, impl_->p_out, impl_->rel_out);
+}
+RunReport CvodeModalStepper::report() const { return event_report(impl_->stats, impl_->events); }
 
 }  // namespace stackbeam::detail

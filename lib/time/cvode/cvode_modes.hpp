@@ -16,6 +16,7 @@
 
 #include "contact/active_set.hpp"
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/time/run_report.hpp"
 
 namespace stackbeam::detail {
 
@@ -44,6 +45,19 @@ inline SolverOptions event_solver_options(const SolverOptions& user, double tole
     ev.max_active_set_iterations = std::max(3, user.max_active_set_iterations);
     ev.tresca_anderson_depth = user.tresca_anderson_depth;
     return ev;
+}
+
+/// The report of an event-driven cvode stepper: CVODE's steps, the contact iterations
+/// and mode factorisations, its counters and the event log.
+inline RunReport event_report(const CvodeStats& stats, const std::vector<ContactEvent>& events) {
+    RunReport rep;
+    rep.mode = Mode::cvode;
+    rep.cvode = stats;
+    rep.events = events;
+    rep.steps = stats.steps;
+    rep.contact_iterations = stats.contact_iterations;
+    rep.factorizations = stats.mode_factorizations;
+    return rep;
 }
 
 /// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).

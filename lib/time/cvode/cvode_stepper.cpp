@@ -715,7 +715,13 @@ const StepRecord& CvodeStepper::advance() {
 
 const StepRecord& CvodeStepper::current() const noexcept { return impl_->record; }
 long CvodeStepper::num_outputs() const noexcept { return impl_->n_out; }
-long CvodeStepper::output_index() const noexcept { return impl_->out_index; }
+long CvodeStepper::record_index() const noexcept { return impl_->out_index; }
+std::vector<PairRecord> CvodeStepper::pairs() const {
+    const Impl& s = *impl_;
+    const Eigen::VectorXd rel = s.p_out.size() > 0 ? Eigen::VectorXd(s.C * s.p_out + s.c * s.record.w_m) : Eigen::VectorXd();
+    return detail::pair_records(s.sys, s.chk_problem, s.p_out, rel);
+}
+RunReport CvodeStepper::report() const { return detail::event_report(impl_->stats, impl_->events); }
 const Eigen::VectorXd& CvodeStepper::contact_forces() const noexcept { return impl_->p_out; }
 const std::vector<ContactEvent>& CvodeStepper::events() const noexcept { return impl_->events; }
 const CvodeStats& CvodeStepper::stats() const noexcept { return impl_->stats; }
