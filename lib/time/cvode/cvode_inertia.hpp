@@ -9,8 +9,10 @@
 //     (N^T M N) q'' + N^T K N q = -N^T K z_p,
 // a stiff linear ODE (leaf bending modes up to ~1e5..1e6 rad/s next to the 70 rad/s
 // body mode) integrated by CVODE's BDF at order <= 2 (higher orders are unstable on
-// the lightly damped oscillatory modes), Newton with a dense direct solver and the
-// analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N.
+// the lightly damped oscillatory modes), Newton with a direct solver and the
+// analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N; in the modal
+// coordinates of B it is block diagonal (2 x 2 blocks), so the direct solver is a band one
+// (half-bandwidths 1, 1).
 // Stacks with friction (pairs that may stick or slip) run CvodeModalStepper below;
 // called directly with one, this stepper refuses it (InputError naming `mode`).
 #include <Eigen/Dense>

@@ -21,11 +21,6 @@
 // newmark), at the price of the contact layer's high-frequency chatter.
 // The retained modes are resolved by the integrator (non-stiff up to omega_cut), so
 // CVODE runs Adams-Moulton with fixed-point iteration, as the massless mode.
-#include <cvode/cvode.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
@@ -40,6 +35,7 @@
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/cvode_inertia.hpp"
+#include "time/cvode/sundials.hpp"
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
 #include "time/step_record.hpp"
@@ -87,12 +83,7 @@ struct CvodeModalStepper::Impl {
     std::unique_ptr<ContactSolver> chk_solver, ev_solver;
     double ev_tolerance = 0.0;
 
-    SUNContext ctx = nullptr;
-    void* cv = nullptr;
-    N_Vector y = nullptr, ydky = nullptr, atol = nullptr;
-    SUNNonlinearSolver nls = nullptr;
-    std::string cv_error;
-    long base_steps = 0, base_rhs = 0, base_g = 0;
+    std::unique_ptr<CvodeSession> cvode;
 
     double t = 0.0, t_final = 0.0, dt = 0.0;
     long n_out = 0, out_index = 0;
@@ -107,23 +98,7 @@ struct CvodeModalStepper::Impl {
     std::vector<ContactEvent> events;
     CvodeStats stats;
 
-    ~Impl() {
-        if (cv) CVodeFree(&cv);
-        if (nls) SUNNonlinSolFree(nls);
-        if (y) N_VDestroy(y);
-        if (ydky) N_VDestroy(ydky);
-        if (atol) N_VDestroy(atol);
-        if (ctx) SUNContext_Free(&ctx);
-    }
-
     const std::vector<ContactPair>& pairs() const { return chk_problem.pairs; }
-
-    void check(int flag, const char* what) const {
-        if (flag < 0)
-            throw SolverError(std::string("cvode mode (leaf inertia): ") + what + " failed: " + cvode_flag_name(flag) +
-                                  (cv_error.empty() ? "" : " (" + cv_error + ")"),
-                              stats.steps, t, 0.0);
-    }
 
     // ---- modes ------------------------------------------------------------------
 
@@ -398,54 +373,12 @@ struct CvodeModalStepper::Impl {
         return 0;
     }
 
-    static void error_handler(int code, const char* module, const char* function, char* msg, void* user) {
-        auto* self = static_cast<Impl*>(user);
-        if (code > 0) return;
-        self->cv_error = std::string(module ? module : "") + "::" + (function ? function : "") + ": " + (msg ? msg : "");
-    }
-
-    void set_roots() {
-        if (!opt.cvode.root_finding || slots.empty()) return;
-        check(CVodeRootInit(cv, static_cast<int>(slots.size()), &Impl::roots), "CVodeRootInit");
-        std::vector<int> dir(slots.size(), -1);
-        check(CVodeSetRootDirection(cv, dir.data()), "CVodeSetRootDirection");
-        check(CVodeSetNoInactiveRootWarn(cv), "CVodeSetNoInactiveRootWarn");
-    }
-
-    void accumulate_counters() {
-        long v = 0;
-        CVodeGetNumSteps(cv, &v);
-        base_steps += v;
-        CVodeGetNumRhsEvals(cv, &v);
-        base_rhs += v;
-        if (opt.cvode.root_finding && !slots.empty()) {
-            CVodeGetNumGEvals(cv, &v);
-            base_g += v;
-        }
-    }
-
-    void update_stats() {
-        long v = 0;
-        CVodeGetNumSteps(cv, &v);
-        stats.steps = base_steps + v;
-        CVodeGetNumRhsEvals(cv, &v);
-        stats.rhs_evaluations = base_rhs + v;
-        if (opt.cvode.root_finding && !slots.empty()) {
-            CVodeGetNumGEvals(cv, &v);
-            stats.root_evaluations = base_g + v;
-        }
-    }
-
     void restart(double te) {
         const auto t0 = Clock::now();
-        accumulate_counters();
-        check(CVodeReInit(cv, te, y), "CVodeReInit");
-        check(CVodeSetStopTime(cv, t_final), "CVodeSetStopTime");
+        cvode->reinit(te);
         ++stats.restarts;
         stats.event_time_s += seconds_since(t0);
     }
-
-    Eigen::Map<Eigen::VectorXd> state(N_Vector v) const { return {N_VGetArrayPointer(v), nstate}; }
 
     // ---- records ----------------------------------------------------------------
 
@@ -484,9 +417,9 @@ struct CvodeModalStepper::Impl {
         long next = out_index + static_cast<long>(pending.size()) + 1;
         while (next <= n_out && output_time(next) <= upto) {
             const double tau = output_time(next);
-            check(CVodeGetDky(cv, tau, 0, ydky), "CVodeGetDky");
+            cvode->dense_output(tau);
             Output o;
-            o.rec = make_record(tau, state(ydky), o.p, o.rel);
+            o.rec = make_record(tau, cvode->ydky(), o.p, o.rel);
             iters_since = facts_since = 0;
             pending.push_back(std::move(o));
             ++next;
@@ -511,29 +444,19 @@ struct CvodeModalStepper::Impl {
         if (t >= t_final) return false;
         double tret = t;
         const auto t_cv = Clock::now();
-        const int flag = CVode(cv, t_final, y, &tret, CV_ONE_STEP);
+        const int flag = cvode->advance(t_final, CV_ONE_STEP, opt.cvode.max_steps, tret);
         stats.cvode_time_s += seconds_since(t_cv);
-        update_stats();
-        if (flag < 0) {
-            double h = 0.0;
-            CVodeGetLastStep(cv, &h);
-            throw SolverError("cvode mode (leaf inertia): CVODE failed (" + cvode_flag_name(flag) + ") at t = " +
-                                  format_value(tret) + " s after " + std::to_string(stats.steps) +
-                                  " steps, last step size " + format_value(h) + " s" +
-                                  (cv_error.empty() ? "" : ": " + cv_error),
-                              stats.steps, tret, 0.0);
-        }
-        if (stats.steps > opt.cvode.max_steps)
-            throw SolverError("cvode mode (leaf inertia): more than cvode.max_steps = " +
-                                  std::to_string(opt.cvode.max_steps) + " steps at t = " + format_value(tret) + " s",
-                              stats.steps, tret, 0.0);
-        auto Y = state(y);
+        const CvodeCounters& cc = cvode->counters();
+        stats.steps = cc.steps;
+        stats.rhs_evaluations = cc.rhs_evaluations;
+        stats.root_evaluations = cc.root_evaluations;
+        Eigen::VectorXd Y = cvode->y();
         if (flag == CV_ROOT_RETURN) {
             emit_until(tret);
             t = tret;
             note_event_time(tret);
             std::vector<int> found(slots.size(), 0);
-            check(CVodeGetRootInfo(cv, found.data()), "CVodeGetRootInfo");
+            cvode->root_info(found);
             decide_modes(Y.head(r), Y.segment(r, r), forces(Y.head(r)), "root", &found);
             restart(tret);
             return true;
@@ -565,22 +488,21 @@ struct CvodeModalStepper::Impl {
             reset_check_anchors(Y.head(r));
             return tret < t_final;
         }
-        double hlast = 0.0;
-        CVodeGetLastStep(cv, &hlast);
+        const double hlast = cvode->last_step();
         double lo = tret - hlast, hi = tret;
         const double tol_t = 1e-13 * std::max(1.0, std::abs(tret)) + 1e-9 * hlast;
         while (hi - lo > tol_t) {
             const double mid = 0.5 * (lo + hi);
-            check(CVodeGetDky(cv, mid, 0, ydky), "CVodeGetDky");
-            const auto Ym = state(ydky);
+            cvode->dense_output(mid);
+            const Eigen::VectorXd Ym = cvode->ydky();
             double rm = 0.0;
             if (modes_hold(Ym.head(r), Ym.segment(r, r), rm)) lo = mid;
             else hi = mid;
         }
-        check(CVodeGetDky(cv, hi, 0, ydky), "CVodeGetDky");
+        cvode->dense_output(hi);
+        Y = cvode->ydky();
         emit_until(hi);
-        Y = state(ydky);
-        state(y) = Y;
+        cvode->y() = Y;
         t = hi;
         ++stats.missed_events;
         note_event_time(hi);
@@ -691,12 +613,8 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.dt = s.opt.dt_s;
     s.n_out = static_cast<long>(std::ceil(s.opt.t_end_s / s.dt - 1e-9));
     s.t_final = static_cast<double>(s.n_out) * s.dt;
-    s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create");
-    s.y = N_VNew_Serial(s.nstate, s.ctx);
-    s.ydky = N_VNew_Serial(s.nstate, s.ctx);
-    s.atol = N_VNew_Serial(s.nstate, s.ctx);
-    if (!s.y || !s.ydky || !s.atol) throw SolverError("cvode mode (leaf inertia): N_VNew_Serial failed", 0, 0.0, 0.0);
-    auto Y = s.state(s.y);
+    s.cvode = std::make_unique<CvodeSession>("cvode mode (leaf inertia)", s.nstate);
+    auto Y = s.cvode->y();
     Y.head(s.r) = s.Phi.transpose() * (M * z0);
     Y.segment(s.r, s.r) = s.Phi.transpose() * (M * v0);
     Y[2 * s.r] = 0.0;
@@ -720,7 +638,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
                                 0.5 * Y.head(s.r).dot(s.om.cwiseProduct(s.om).cwiseProduct(Y.head(s.r)));
         const double a_e = std::max(std::sqrt(system.mass_kg()) * omega_t * s.opt.cvode.atol_m,
                                     s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed));
-        auto A = s.state(s.atol);
+        auto A = s.cvode->atol();
         for (int i = 0; i < s.r; ++i) {
             A[i] = a_e / s.om[i];  // q_i: energy-norm amplitude omega_i q_i
             A[s.r + i] = a_e;      // q_i'
@@ -735,18 +653,11 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.p_out = p_rec;
     s.rel_out = rel_rec;
 
-    s.cv = CVodeCreate(CV_ADAMS, s.ctx);
-    if (!s.cv) throw SolverError("cvode mode (leaf inertia): CVodeCreate failed", 0, 0.0, 0.0);
-    s.check(CVodeSetErrHandlerFn(s.cv, &Impl::error_handler, &s), "CVodeSetErrHandlerFn");
-    s.check(CVodeInit(s.cv, &Impl::rhs, 0.0, s.y), "CVodeInit");
-    s.check(CVodeSVtolerances(s.cv, s.opt.cvode.rtol, s.atol), "CVodeSVtolerances");
-    s.check(CVodeSetUserData(s.cv, &s), "CVodeSetUserData");
-    s.nls = SUNNonlinSol_FixedPoint(s.y, 0, s.ctx);
-    s.check(CVodeSetNonlinearSolver(s.cv, s.nls), "CVodeSetNonlinearSolver");
-    s.check(CVodeSetMaxNumSteps(s.cv, 1000000), "CVodeSetMaxNumSteps");
-    if (s.opt.cvode.max_step_s > 0.0) s.check(CVodeSetMaxStep(s.cv, s.opt.cvode.max_step_s), "CVodeSetMaxStep");
-    s.check(CVodeSetStopTime(s.cv, s.t_final), "CVodeSetStopTime");
-    s.set_roots();
+    s.cvode->create(CV_ADAMS, &Impl::rhs, &s, s.opt.cvode.rtol);
+    s.cvode->use_fixed_point();
+    s.cvode->set_limits(s.opt.cvode.max_step_s);
+    s.cvode->set_stop_time(s.t_final);
+    if (s.opt.cvode.root_finding && !s.slots.empty()) s.cvode->set_roots(static_cast<int>(s.slots.size()), &Impl::roots);
 }
 
 const StepRecord& CvodeModalStepper::advance() {

@@ -5,12 +5,9 @@
 // use the witnesses of cvode_stepper.hpp with these margins, read modes from a contact
 // solution the same way, apply the transitions CVODE reports the same way and log them
 // under the same labels.
-#include <cvode/cvode.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -58,14 +55,6 @@ inline RunReport event_report(const CvodeStats& stats, const std::vector<Contact
     rep.contact_iterations = stats.contact_iterations;
     rep.factorizations = stats.mode_factorizations;
     return rep;
-}
-
-/// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).
-inline std::string cvode_flag_name(long flag) {
-    char* name = CVodeGetReturnFlagName(flag);
-    std::string out = name ? name : "unknown flag";
-    free(name);
-    return out;
 }
 
 /// Label of a pair's modes (nm, tm) for the event log.

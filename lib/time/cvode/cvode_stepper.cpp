@@ -3,11 +3,6 @@
 // step. The physics and the witness functions are stated in cvode_stepper.hpp.
 #include "stackbeam/time/cvode_stepper.hpp"
 
-#include <cvode/cvode.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
-
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -17,6 +12,7 @@
 
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/sundials.hpp"
 #include "time/step_record.hpp"
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
@@ -77,12 +73,7 @@ struct CvodeStepper::Impl {
     std::vector<Slot> slots;
 
     // CVODE
-    SUNContext ctx = nullptr;
-    void* cv = nullptr;
-    N_Vector y = nullptr, ydky = nullptr, atol = nullptr;
-    SUNNonlinearSolver nls = nullptr;
-    std::string cv_error;
-    long base_steps = 0, base_rhs = 0, base_g = 0;  // counters before the last CVodeReInit
+    std::unique_ptr<detail::CvodeSession> cvode;
 
     double t = 0.0;        // time of the last accepted point
     double t_final = 0.0;
@@ -104,14 +95,6 @@ struct CvodeStepper::Impl {
     int events_at_this_time = 0;
 
     Impl(const System& s, const SimulationOptions& o) : sys(s), opt(o), C(s.compliance_held()) {}
-    ~Impl() {
-        if (cv) CVodeFree(&cv);
-        if (nls) SUNNonlinSolFree(nls);
-        if (y) N_VDestroy(y);
-        if (ydky) N_VDestroy(ydky);
-        if (atol) N_VDestroy(atol);
-        if (ctx) SUNContext_Free(&ctx);
-    }
 
     const std::vector<ContactPair>& pairs() const { return sys.pairs(); }
 
@@ -372,93 +355,37 @@ struct CvodeStepper::Impl {
         return 0;
     }
 
-    static void error_handler(int code, const char* module, const char* function, char* msg, void* user) {
-        auto* self = static_cast<Impl*>(user);
-        if (code > 0) return;  // warnings (e.g. about inactive roots) are not errors
-        self->cv_error = std::string(module ? module : "") + "::" + (function ? function : "") + ": " + (msg ? msg : "");
-    }
-
-    void check(int flag, const char* what) const {
-        if (flag < 0)
-            throw SolverError(std::string("cvode mode: ") + what + " failed: " + detail::cvode_flag_name(flag) +
-                                  (cv_error.empty() ? "" : " (" + cv_error + ")"),
-                              stats.steps, t, 0.0);
-    }
-
     void init_cvode(double w0, double wd0) {
-        check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
-        y = N_VNew_Serial(nstate, ctx);
-        ydky = N_VNew_Serial(nstate, ctx);
-        atol = N_VNew_Serial(nstate, ctx);
-        double* yy = N_VGetArrayPointer(y);
+        cvode = std::make_unique<detail::CvodeSession>("cvode mode", nstate);
+        auto yy = cvode->y();
         yy[0] = w0;
         yy[1] = wd0;
-        yy[2] = 0.0;
-        if (nstate > 3) yy[3] = 0.0;
-        double* at = N_VGetArrayPointer(atol);
+        auto at = cvode->atol();
         at[0] = opt.cvode.atol_m;                 // w [m]
         at[1] = opt.cvode.atol_m * omega_ref;     // w' [m/s]
         at[2] = opt.cvode.atol_m * F_ref;         // D [J]
         if (nstate > 3) at[3] = opt.cvode.atol_m * F_ref;  // external work [J]
-        cv = CVodeCreate(CV_ADAMS, ctx);
-        if (!cv) throw SolverError("cvode mode: CVodeCreate failed", 0, 0.0, 0.0);
-        check(CVodeSetErrHandlerFn(cv, &Impl::error_handler, this), "CVodeSetErrHandlerFn");
-        check(CVodeInit(cv, &Impl::rhs, 0.0, y), "CVodeInit");
-        check(CVodeSVtolerances(cv, opt.cvode.rtol, atol), "CVodeSVtolerances");
-        check(CVodeSetUserData(cv, this), "CVodeSetUserData");
-        nls = SUNNonlinSol_FixedPoint(y, 0, ctx);
-        check(CVodeSetNonlinearSolver(cv, nls), "CVodeSetNonlinearSolver");
-        check(CVodeSetMaxNumSteps(cv, 100000), "CVodeSetMaxNumSteps");
-        if (opt.cvode.max_step_s > 0.0) check(CVodeSetMaxStep(cv, opt.cvode.max_step_s), "CVodeSetMaxStep");
-        check(CVodeSetStopTime(cv, t_final), "CVodeSetStopTime");
-        if (opt.cvode.root_finding && !slots.empty()) {
-            check(CVodeRootInit(cv, static_cast<int>(slots.size()), &Impl::roots), "CVodeRootInit");
-            std::vector<int> dir(slots.size(), -1);  // every witness: decreasing crossings only
-            check(CVodeSetRootDirection(cv, dir.data()), "CVodeSetRootDirection");
-            check(CVodeSetNoInactiveRootWarn(cv), "CVodeSetNoInactiveRootWarn");
-        }
-    }
-
-    void accumulate_counters() {
-        long v = 0;
-        CVodeGetNumSteps(cv, &v);
-        base_steps += v;
-        CVodeGetNumRhsEvals(cv, &v);
-        base_rhs += v;
-        if (opt.cvode.root_finding && !slots.empty()) {
-            CVodeGetNumGEvals(cv, &v);
-            base_g += v;
-        }
-    }
-
-    void update_stats() {
-        long v = 0;
-        CVodeGetNumSteps(cv, &v);
-        stats.steps = base_steps + v;
-        CVodeGetNumRhsEvals(cv, &v);
-        stats.rhs_evaluations = base_rhs + v;
-        if (opt.cvode.root_finding && !slots.empty()) {
-            CVodeGetNumGEvals(cv, &v);
-            stats.root_evaluations = base_g + v;
-        }
+        cvode->create(CV_ADAMS, &Impl::rhs, this, opt.cvode.rtol);
+        cvode->use_fixed_point();
+        cvode->set_limits(opt.cvode.max_step_s);
+        cvode->set_stop_time(t_final);
+        if (opt.cvode.root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &Impl::roots);
     }
 
     void restart(double te, double w, double wd, double D, double We) {
-        accumulate_counters();
-        double* yy = N_VGetArrayPointer(y);
+        auto yy = cvode->y();
         yy[0] = w;
         yy[1] = wd;
         yy[2] = D;
         if (nstate > 3) yy[3] = We;
-        check(CVodeReInit(cv, te, y), "CVodeReInit");
-        check(CVodeSetStopTime(cv, t_final), "CVodeSetStopTime");
+        cvode->reinit(te);
         ++stats.restarts;
     }
 
     /// State at time tau within the last step (CVODE's dense output).
     void state_at(double tau, double& w, double& wd, double& D, double& We) {
-        check(CVodeGetDky(cv, tau, 0, ydky), "CVodeGetDky");
-        const double* yy = N_VGetArrayPointer(ydky);
+        cvode->dense_output(tau);
+        const auto yy = cvode->ydky();
         w = yy[0];
         wd = yy[1];
         D = yy[2];
@@ -517,22 +444,12 @@ struct CvodeStepper::Impl {
     bool step_once() {
         if (t >= t_final) return false;
         double tret = t;
-        const int flag = CVode(cv, t_final, y, &tret, CV_ONE_STEP);
-        update_stats();
-        if (flag < 0) {
-            double h = 0.0;
-            CVodeGetLastStep(cv, &h);
-            throw SolverError("cvode mode: CVODE failed (" + detail::cvode_flag_name(flag) + ") at t = " +
-                                  format_value(tret) + " s after " + std::to_string(stats.steps) +
-                                  " steps, last step size " + format_value(h) + " s" +
-                                  (cv_error.empty() ? "" : ": " + cv_error),
-                              stats.steps, tret, 0.0);
-        }
-        if (stats.steps > opt.cvode.max_steps)
-            throw SolverError("cvode mode: more than cvode.max_steps = " + std::to_string(opt.cvode.max_steps) +
-                                  " steps at t = " + format_value(tret) + " s",
-                              stats.steps, tret, 0.0);
-        const double* yy = N_VGetArrayPointer(y);
+        const int flag = cvode->advance(t_final, CV_ONE_STEP, opt.cvode.max_steps, tret);
+        const detail::CvodeCounters& cc = cvode->counters();
+        stats.steps = cc.steps;
+        stats.rhs_evaluations = cc.rhs_evaluations;
+        stats.root_evaluations = cc.root_evaluations;
+        const auto yy = cvode->y();
         const double w = yy[0], wd = yy[1], D = yy[2], We = nstate > 3 ? yy[3] : 0.0;
 
         if (flag == CV_ROOT_RETURN) {
@@ -541,7 +458,7 @@ struct CvodeStepper::Impl {
             note_event_time(tret);
             const Eigen::VectorXd p_cur = forces(w);
             std::vector<int> found(slots.size(), 0);
-            check(CVodeGetRootInfo(cv, found.data()), "CVodeGetRootInfo");
+            cvode->root_info(found);
             decide_modes(tret, w, wd, p_cur, "root", &found);
             restart(tret, w, wd, D, We);
             return true;
@@ -578,8 +495,7 @@ struct CvodeStepper::Impl {
         }
 
         // A missed event: locate its time by bisection on the dense output of the last step.
-        double hlast = 0.0;
-        CVodeGetLastStep(cv, &hlast);
+        const double hlast = cvode->last_step();
         double lo = tret - hlast, hi = tret;
         const double tol_t = 1e-13 * std::max(1.0, std::abs(tret)) + 1e-9 * hlast;
         while (hi - lo > tol_t) {
