@@ -453,13 +453,12 @@ void parse_integrator(const Table& top, SimulationOptions& o) {
                                  " is not allowed: must be in (0, 1), a fraction of the stability bound");
     }
     if (t.has("cvode")) {
-        const Table c = t.table("cvode", {"rtol", "atol_m", "max_step_s", "root_finding", "max_steps",
+        const Table c = t.table("cvode", {"rtol", "atol_m", "max_step_s", "max_steps",
                                           "modal_cutoff_rad_per_s"});
         auto& cv = o.cvode;
         cv.rtol = c.number_or("rtol", "the relative tolerance [-], > 0", cv.rtol);
         cv.atol_m = c.number_or("atol_m", "the absolute tolerance on w [m], > 0", cv.atol_m);
         cv.max_step_s = c.number_or("max_step_s", "the largest internal step [s], >= 0 (0: no limit)", cv.max_step_s);
-        cv.root_finding = c.boolean_or("root_finding", "locate transitions by root-finding", cv.root_finding);
         cv.modal_cutoff_rad_per_s = c.number_or("modal_cutoff_rad_per_s",
                                                 "the modal cut-off of leaf inertia with friction [rad/s], >= 0 "
                                                 "(0: 10 x the stack's first frequency)",

@@ -11,6 +11,7 @@
 
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/cvode_testing.hpp"
 #include "time/cvode/event_driver.hpp"
 #include "time/step_record.hpp"
 #include "stackbeam/errors.hpp"
@@ -225,8 +226,12 @@ struct CvodeStepper::Impl final : detail::EventDriver {
 };
 
 CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options)
+    : CvodeStepper(system, options, detail::CvodeTesting{}) {}
+
+CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options, const detail::CvodeTesting& testing)
     : impl_(std::make_unique<Impl>(system, options)) {
     Impl& s = *impl_;
+    s.root_finding = testing.root_finding;
     s.opt.validate();
     require_massless_leaves(system, Mode::cvode);
     s.require_current_tau_rule();

@@ -61,7 +61,7 @@ void EventDriver::start_cvode(CVRhsFn rhs) {
     cvode->use_fixed_point();
     cvode->set_limits(opt.cvode.max_step_s);
     cvode->set_stop_time(t_final);
-    if (opt.cvode.root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
+    if (root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
 }
 
 int EventDriver::roots(sunrealtype, N_Vector y, sunrealtype* g, void* user) {

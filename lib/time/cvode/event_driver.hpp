@@ -72,6 +72,7 @@ public:
     StepRecord record;          ///< of the current output
     Vec p_out, rel_out;         ///< its forces [N] and (modal) relative positions [m]
     double e0 = 0.0;            ///< initial energy [J]
+    bool root_finding = true;   ///< CVODE's root-finding on the witnesses (off only in tests: CvodeTesting)
     long iters_since = 0, facts_since = 0;  ///< contact iterations and factorisations since the last record
     double last_check_residual = 0.0;
     std::vector<ContactEvent> events;
