@@ -43,7 +43,7 @@ struct CvodeStats {
     long linear_setups = 0;        ///< Newton matrix factorisations (leaf inertia; 0 otherwise)
     int retained_modes = 0;        ///< leaf inertia with friction: modes carrying the inertia (0 otherwise)
     double modal_cutoff_rad_per_s = 0.0; ///< leaf inertia with friction: the cut used [rad/s]
-    // Leaf inertia with friction: where the wall-clock time went [s].
+    // The event-driven steppers (massless, and leaf inertia with friction): where the wall-clock time went [s].
     double cvode_time_s = 0.0;     ///< inside CVode() (right-hand sides, root functions, steps)
     double contact_time_s = 0.0;   ///< contact iterations: per-step checks and event decisions' solves
     double event_time_s = 0.0;     ///< the rest of event handling: new modes, records of events, CVodeReInit
