@@ -56,7 +56,7 @@ const Recorded& recorded(PaperCase c) {
     Recorded r;
     r.p0 = st.contact_forces();
     for (int i = 0; i < 600; ++i) {
-        st.step();
+        st.advance();
         r.problems.push_back(st.last_problem());
     }
     return cache.emplace(c, std::move(r)).first->second;
@@ -131,7 +131,7 @@ void Scaling(benchmark::State& state) {
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = 0.0;
         for (long i = 0; i < steps; ++i) {
-            factorizations += st.step().factorizations;
+            factorizations += st.advance().factorizations;
             newton += st.last_solve().newton_iterations;
             if (i == 0) first_step = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - setup;
         }
@@ -260,7 +260,7 @@ void Transitions(benchmark::State& state) {
         tresca = continued = 0;
         for (long i = 0; i < steps; ++i) {
             const auto t1 = std::chrono::steady_clock::now();
-            factorizations += st.step().factorizations;
+            factorizations += st.advance().factorizations;
             worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
             newton += st.last_solve().newton_iterations;
             smoothing += st.last_solve().smoothing_iterations;
@@ -326,7 +326,7 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
         for (long i = 0; i < n; ++i) {
             const auto t1 = std::chrono::steady_clock::now();
             try {
-                st.step();
+                st.advance();
             } catch (const SolverError&) {
                 failed_at = i + 1;
                 break;

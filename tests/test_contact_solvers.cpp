@@ -213,7 +213,7 @@ BOOST_AUTO_TEST_CASE(solvers_agree_on_recorded_steps_of_the_paper_example) {
         int k = 0;
         for (int step = 1; step <= 180; ++step) {
             const Eigen::VectorXd p_start = st.contact_forces();
-            st.step();
+            st.advance();
             if (step != record_at[k]) continue;
             ++k;
             const ContactProblem pr = st.last_problem();

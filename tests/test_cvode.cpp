@@ -9,6 +9,7 @@
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "test_support.hpp"
+#include "time/cvode/cvode_testing.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -29,11 +30,19 @@ Run run_cvode(PaperCase c, double t_end_s, double rtol, bool root_finding = true
     o.t_end_s = t_end_s;
     o.dt_s = 1e-3;
     o.cvode.rtol = rtol;
-    o.cvode.root_finding = root_finding;
     o.solver.kind = SolverKind::accelerated;
     o.solver.tolerance_m = tol_m;
     Run r;
-    r.records = simulate(s, o, {}, &r.report);
+    if (root_finding) {
+        r.records = simulate(s, o, {}, &r.report);
+        return r;
+    }
+    detail::CvodeTesting testing;  // the per-step check alone (lib/time/cvode/cvode_testing.hpp)
+    testing.root_finding = false;
+    CvodeStepper st(s, o, testing);
+    r.records.push_back(st.current());
+    while (st.record_index() < st.num_outputs()) r.records.push_back(st.advance());
+    r.report = st.report();
     return r;
 }
 

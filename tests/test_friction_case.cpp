@@ -229,7 +229,7 @@ BOOST_AUTO_TEST_CASE(clamps_stick_for_good_and_motion_becomes_near_periodic) {
 #include "stackbeam/time/closed_form_stepper.hpp"
         while (st.current().t_s < 2.0 - 1e-9) {
 #include "stackbeam/time/closed_form_stepper.hpp"
-            st.step();
+            st.advance();
 #include "stackbeam/time/closed_form_stepper.hpp"
             const auto states = st.pair_states();
 #include "stackbeam/time/closed_form_stepper.hpp"

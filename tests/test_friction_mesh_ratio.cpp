@@ -88,7 +88,7 @@ BOOST_AUTO_TEST_CASE(failed_step_names_the_ratio) {
         ClosedFormStepper st(sys, o);
         std::string what;
         try {
-            st.step();
+            st.advance();
         } catch (const SolverError& e) {
             what = e.what();
         }

@@ -56,7 +56,7 @@ Run run(const System& sys, ContactPath path, double dt, int steps, double tol, T
     r.records.push_back(st.current());
     r.forces.push_back(st.contact_forces());
     for (int i = 0; i < steps; ++i) {
-        r.records.push_back(st.step());
+        r.records.push_back(st.advance());
         r.forces.push_back(st.contact_forces());
     }
     return r;
@@ -176,8 +176,8 @@ BOOST_AUTO_TEST_CASE(sparse_problem_is_the_dense_problem) {
     so.contact_path = ContactPath::dense;
     ClosedFormStepper de(sys, so);
     for (int i = 0; i < 5; ++i) {
-        sp.step();
-        de.step();
+        sp.advance();
+        de.advance();
     }
     const ContactProblem c = sp.last_sparse_problem().to_dense();
     const ContactProblem& ref = de.last_problem();
@@ -230,7 +230,7 @@ BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
         so.solver.tolerance_m = kTol;
         so.contact_path = ContactPath::sparse;
         ClosedFormStepper st(sys, so);
-        st.step();
+        st.advance();
         const SparseContactProblem& pr = st.last_sparse_problem();
         SparseContactSolver solver(so.solver);
         Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
@@ -282,7 +282,7 @@ BOOST_AUTO_TEST_CASE(sparse_ways_agree_on_replayed_problems) {
     ClosedFormStepper st(sys, so);
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 300; ++i) {
-        st.step();
+        st.advance();
         problems.push_back(st.last_sparse_problem());
     }
     auto replay = [&](const SparsePathTuning& tuning, int& updates, int& factorizations) {
@@ -347,7 +347,7 @@ BOOST_AUTO_TEST_CASE(low_rank_updates_agree_with_fresh_factorisations) {
     ClosedFormStepper st(sys, so);
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 400; ++i) {
-        st.step();
+        st.advance();
         problems.push_back(st.last_sparse_problem());
     }
     auto replay = [&](const SparsePathTuning& tuning, int& updates) {
@@ -413,7 +413,7 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
     ClosedFormStepper st(sys, so);
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < steps; ++i) {
-        st.step();
+        st.advance();
         problems.push_back(st.last_sparse_problem());
     }
     detail::sparse::Switches switches;
@@ -559,7 +559,7 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
     std::vector<SparseContactProblem> problems;
     std::vector<Eigen::VectorXd> reference;
     for (int i = 0; i < 25; ++i) {
-        st.step();
+        st.advance();
         problems.push_back(st.last_sparse_problem());
         reference.push_back(st.contact_forces());
     }
@@ -625,7 +625,7 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
     ClosedFormStepper st(sys, so);
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 20; ++i) {
-        st.step();
+        st.advance();
         problems.push_back(st.last_sparse_problem());
     }
     auto replay = [&](const detail::sparse::Switches& switches, int& newton) {

@@ -19,6 +19,8 @@
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/option_table.hpp"
+#include "stackbeam/time/run_report.hpp"
+#include "stackbeam/time/stepper.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/newmark_stepper.hpp"

@@ -151,13 +151,6 @@ public:
         return string(key, what, &fallback);
     }
 
-    bool boolean_or(const std::string& key, const std::string& what, bool fallback) const {
-        if (!has(key)) return fallback;
-        const auto& v = at(key);
-        if (!v.is_boolean()) wrong_type(key, v, "a boolean (true or false): " + what);
-        return v.as_boolean();
-    }
-
     /// An array of numbers; required.
     std::vector<double> numbers(const std::string& key, const std::string& what) const {
         if (!has(key)) missing(key, what);
@@ -417,7 +410,7 @@ void parse_probe(const Table& top, ModelSpec& spec) {
 void parse_integrator(const Table& top, SimulationOptions& o) {
     const std::string prefix = "integrator.";
     std::map<std::string, std::vector<std::string>> keys = {  // table path -> its allowed keys
-        {"integrator", {}}, {"integrator.solver", {}}, {"integrator.cvode", {"root_finding"}}};
+        {"integrator", {}}, {"integrator.solver", {}}, {"integrator.cvode", {}}};
     for (const OptionSpec& spec : simulation_option_table()) {
         const std::string key = spec.key;
         if (key.compare(0, prefix.size(), prefix) != 0) continue;
@@ -456,8 +449,6 @@ void parse_integrator(const Table& top, SimulationOptions& o) {
             rethrow_in_file(t.context(), e);
         }
     }
-    if (const auto c = tables.find("integrator.cvode"); c != tables.end())
-        o.cvode.root_finding = c->second.boolean_or("root_finding", "locate transitions by root-finding", o.cvode.root_finding);
 }
 
 void parse_outputs(const Table& top, ScenarioOutputs& out) {

@@ -24,6 +24,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     const double m = system_.mass_kg();
     f_ = system_.model().whole_spring_factor();
     m_whole_ = system_.model().spec().rigid_body.mass_kg;
+    report_.mode = Mode::closed_form;
     omega_ = std::sqrt(k / m);
     const double x = omega_ * options_.dt_s;
     cos_ = std::cos(x);
@@ -180,7 +181,11 @@ std::vector<PairState> ClosedFormStepper::pair_states() const {
     return s;
 }
 
-const StepRecord& ClosedFormStepper::step() {
+std::vector<PairRecord> ClosedFormStepper::pairs() const {
+    return detail::pair_records(system_, problem_, p_, rel_);
+}
+
+const StepRecord& ClosedFormStepper::advance() {
     const double k = system_.stiffness_n_per_m();
     const double dt = options_.dt_s;
     const auto& c = system_.coupling();
@@ -274,6 +279,7 @@ const StepRecord& ClosedFormStepper::step() {
         strain = 0.5 * f_ * (sparse_problem_.b[w_dof_] * zw + p_.dot(rel_) - k_r_ * zw * zw);
     }
     fill_record(solve_.iterations, solve_.factorizations, strain);
+    detail::count_step(record_, report_);
     return record_;
 }
 

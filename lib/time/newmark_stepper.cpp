@@ -24,6 +24,7 @@ NewmarkStepper::~NewmarkStepper() = default;
 NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
     : system_(system), options_(options), factor_(std::make_unique<Factor>()) {
     options_.validate();
+    report_.mode = Mode::newmark;
     detail::require_uniform_leaf_mass(system_, "newmark");
     require_initial_conditions_only(options_.loading, "mode newmark");
     path_ = choose_contact_path(system_, options_);
@@ -277,7 +278,9 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
     return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
 }
 
-const StepRecord& NewmarkStepper::step() {
+std::vector<PairRecord> NewmarkStepper::pairs() const { return detail::pair_records(system_, problem_, p_, rel_); }
+
+const StepRecord& NewmarkStepper::advance() {
     const double dt = options_.dt_s;
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     // r: the step's load with p1 = 0 (newmark_stepper.hpp). Massive leaves: the elastic force
@@ -340,6 +343,7 @@ const StepRecord& NewmarkStepper::step() {
     t_ = step_ * dt;
     detail::reanchor(problem_, p_, rel_, d_);  // paper, section 5
     fill_record(solve_.iterations, solve_.factorizations);
+    detail::count_step(record_, report_);
     return record_;
 }
 

@@ -1,17 +1,12 @@
 // Simulation options, the record columns and simulate(): the loop over the steppers.
-#include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/option_table.hpp"
 
 #include <cmath>
 #include <limits>
 
-#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
-#include "time/cvode/cvode_inertia.hpp"
-#include "stackbeam/time/newmark_stepper.hpp"
-#include "model/mesh_note.hpp"
-#include "time/step_record.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
 
@@ -140,113 +135,20 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     }
 }
 
-namespace {
-
-/// The pairs at one time from the forces p and the relative positions rel = s + d.
-std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
-                                     const Eigen::VectorXd& rel) {
-    std::vector<PairRecord> out(laws.pairs.size());
-    const Eigen::VectorXd& d0 = system.initial_offsets_m();
-    for (std::size_t k = 0; k < out.size(); ++k) {
-        const ContactPair& pr = laws.pairs[k];
-        const PairSpec& spec = system.pair_spec(static_cast<int>(k));
-        PairRecord& r = out[k];
-        r.pair = static_cast<int>(k);
-        r.interface_index = spec.interface_index;
-        r.x_m = spec.x_m;
-        r.state = pair_state(laws, static_cast<int>(k), p);
-        if (pr.row_n >= 0) {
-            r.p_n_n = p[pr.row_n];
-            r.gap_m = std::max(0.0, d0[pr.row_n] - rel[pr.row_n]);
-        }
-        if (pr.row_t >= 0) {
-            r.p_t_n = p[pr.row_t];
-            r.slip_m = rel[pr.row_t];
-        }
-    }
-    return out;
-}
-
-}  // namespace
-
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
                                  const std::function<void(const StepRecord&)>& on_step, RunReport* report,
                                  const PairObserver& on_pairs) {
     options.validate();
     const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
+    const std::unique_ptr<Stepper> stepper = make_stepper(system, options);
     std::vector<StepRecord> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
-    auto keep = [&](const StepRecord& r) {
-        out.push_back(r);
+    for (long i = 0; i <= n; ++i) {
+        out.push_back(i == 0 ? stepper->current() : stepper->advance());
         if (on_step) on_step(out.back());
-    };
-    RunReport rep;
-    rep.mode = options.mode;
-    // The event-driven cvode steppers: records, per-pair output (rel: the pairs'
-    // relative positions s + d at the output), counters and the event log.
-    ContactProblem cvode_laws;
-    cvode_laws.pairs = system.pairs();
-    cvode_laws.tau_rule = TauRule::current;
-    auto run_events = [&](auto& stepper, const auto& relative_positions) {
-        auto pairs_out = [&] {
-            if (on_pairs)
-                on_pairs(out.back().t_s, pair_records(system, cvode_laws, stepper.contact_forces(), relative_positions()));
-        };
-        keep(stepper.current());
-        pairs_out();
-        for (long i = 0; i < n; ++i) {
-            keep(stepper.advance());
-            pairs_out();
-        }
-        rep.cvode = stepper.stats();
-        rep.events = stepper.events();
-        rep.steps = rep.cvode.steps;
-        rep.contact_iterations = rep.cvode.contact_iterations;
-        rep.factorizations = rep.cvode.mode_factorizations;
-    };
-    if (options.mode == Mode::cvode && detail::has_leaf_mass(system) && detail::has_mode_changes(system)) {
-        detail::CvodeModalStepper stepper(system, options);  // docs/inertia.md
-        run_events(stepper, [&] { return stepper.relative_positions(); });
-    } else if (options.mode == Mode::cvode && detail::has_leaf_mass(system)) {
-        detail::CvodeInertiaStepper stepper(system, options);  // docs/inertia.md
-        keep(stepper.current());
-        for (long i = 0; i < n; ++i) keep(stepper.advance());
-        rep.cvode = stepper.stats();
-        rep.steps = rep.cvode.steps;
-    } else if (options.mode == Mode::cvode) {
-        CvodeStepper stepper(system, options);
-        run_events(stepper, [&] {
-            const Eigen::VectorXd& p = stepper.contact_forces();
-            return p.size() > 0 ? Eigen::VectorXd(system.compliance_held() * p + system.coupling() * out.back().w_m)
-                                : Eigen::VectorXd();
-        });
-    } else if (options.mode == Mode::newmark) {
-        NewmarkStepper stepper(system, options);
-        keep(stepper.current());
-        for (long i = 0; i < n; ++i) {
-            keep(stepper.step());
-            rep.contact_iterations += out.back().contact_iterations;
-            rep.factorizations += out.back().factorizations;
-        }
-        rep.steps = n;
-    } else {
-        ClosedFormStepper stepper(system, options);
-        auto pairs_out = [&] {
-            if (on_pairs)
-                on_pairs(out.back().t_s, pair_records(system, stepper.last_problem(), stepper.contact_forces(),
-                                                      stepper.relative_positions()));
-        };
-        keep(stepper.current());
-        pairs_out();
-        for (long i = 0; i < n; ++i) {
-            keep(stepper.step());
-            pairs_out();
-            rep.contact_iterations += out.back().contact_iterations;
-            rep.factorizations += out.back().factorizations;
-        }
-        rep.steps = n;
+        if (on_pairs) on_pairs(out.back().t_s, stepper->pairs());
     }
-    if (report) *report = std::move(rep);
+    if (report) *report = stepper->report();
     return out;
 }
 

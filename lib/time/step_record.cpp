@@ -9,6 +9,30 @@
 
 namespace stackbeam {
 
+std::vector<PairRecord> detail::pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+                                             const Eigen::VectorXd& rel) {
+    std::vector<PairRecord> out(laws.pairs.size());
+    const Eigen::VectorXd& d0 = system.initial_offsets_m();
+    for (std::size_t k = 0; k < out.size(); ++k) {
+        const ContactPair& pr = laws.pairs[k];
+        const PairSpec& spec = system.pair_spec(static_cast<int>(k));
+        PairRecord& r = out[k];
+        r.pair = static_cast<int>(k);
+        r.interface_index = spec.interface_index;
+        r.x_m = spec.x_m;
+        r.state = pair_state(laws, static_cast<int>(k), p);
+        if (pr.row_n >= 0) {
+            r.p_n_n = p[pr.row_n];
+            r.gap_m = std::max(0.0, d0[pr.row_n] - rel[pr.row_n]);
+        }
+        if (pr.row_t >= 0) {
+            r.p_t_n = p[pr.row_t];
+            r.slip_m = rel[pr.row_t];
+        }
+    }
+    return out;
+}
+
 void detail::reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel,
                       Eigen::VectorXd& d) {
     for (std::size_t j = 0; j < laws.pairs.size(); ++j) {

@@ -5,6 +5,7 @@
 // equilibrium under gravity).
 #include <Eigen/Dense>
 
+#include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/simulation.hpp"
 
 namespace stackbeam::detail {
@@ -26,6 +27,20 @@ struct LoadState {
 void fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
                 double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
                 const LoadState& load, StepRecord& r);
+
+/// The pairs at one time (Stepper::pairs()): states by `laws` (the pairs and their tau
+/// rule), forces p [N] and the relative positions rel = s + d [m], all rows; the gap of
+/// a normal row is max(0, d0 - rel) with d0 the system's initial offsets.
+std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+                                     const Eigen::VectorXd& rel);
+
+/// A fixed-step mode's counters after one more step whose record is `r`: one step, its
+/// contact iterations and factorisations added.
+inline void count_step(const StepRecord& r, RunReport& report) {
+    ++report.steps;
+    report.contact_iterations += r.contact_iterations;
+    report.factorizations += r.factorizations;
+}
 
 /// Anchors (paper, section 5): a pair that sticks keeps its d_t; every other tangential
 /// row of `laws` (not bonded) is re-anchored where it is, d_t = rel_t. `p`: the forces

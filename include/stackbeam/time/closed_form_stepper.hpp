@@ -18,6 +18,7 @@
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
 
@@ -30,15 +31,18 @@ namespace stackbeam {
 /// which is exact: eliminating z gives W = G K_aug^-1 G^T = C' + (gamma/k) c c^T and
 /// q = c w_free - d (the w row reads (k + k_R) w = (k/gamma) w_free + c^T p, and
 /// k + k_R = k/gamma). So both paths solve the same problem, to round-off.
-class ClosedFormStepper {
+class ClosedFormStepper final : public Stepper {
 public:
     ClosedFormStepper(const System& system, const SimulationOptions& options);
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
     /// contact solve fails and options.stop_on_nonconvergence.
-    const StepRecord& step();
-    const StepRecord& current() const noexcept { return record_; }
-    long step_index() const noexcept { return step_; }
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override { return record_; }
+    long record_index() const noexcept override { return step_; }
+    std::vector<PairRecord> pairs() const override;
+    /// Steps, and the contact iterations and factorisations summed over the records.
+    RunReport report() const override { return report_; }
 
     /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
     const Eigen::VectorXd& contact_forces() const noexcept { return p_; }
@@ -79,6 +83,7 @@ private:
     double e0_ = 0.0, dissipated_ = 0.0;
     long step_ = 0;
     StepRecord record_;
+    RunReport report_;
     // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
     // external work [J, whole spring], and for the rig and the sparse path R's column of
     // K (K_rw) and of G.

@@ -58,23 +58,25 @@
 
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
 #include "stackbeam/fe/system.hpp"
 
 namespace stackbeam {
 
-class NewmarkStepper {
+class NewmarkStepper final : public Stepper {
 public:
     /// Throws InputError for bad options (and on the sparse path with a solver other than exact).
     NewmarkStepper(const System& system, const SimulationOptions& options);
-    ~NewmarkStepper();
-    NewmarkStepper(const NewmarkStepper&) = delete;
-    NewmarkStepper& operator=(const NewmarkStepper&) = delete;
+    ~NewmarkStepper() override;
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
     /// contact solve fails and options.stop_on_nonconvergence.
-    const StepRecord& step();
-    const StepRecord& current() const noexcept { return record_; }
-    long step_index() const noexcept { return step_; }
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override { return record_; }
+    long record_index() const noexcept override { return step_; }
+    std::vector<PairRecord> pairs() const override;
+    /// Steps, and the contact iterations and factorisations summed over the records.
+    RunReport report() const override { return report_; }
 
     /// Reduced displacements z [m, rad] (w last), velocities [m/s, rad/s], accelerations [m/s^2, rad/s^2].
     const Eigen::VectorXd& displacements() const noexcept { return z_; }
@@ -110,6 +112,7 @@ private:
     double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
     long step_ = 0;
     StepRecord record_;
+    RunReport report_;
     void fill_record(int iterations, int factorizations);
     double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
 };

@@ -80,8 +80,6 @@ struct CvodeOptions {
     double atol_m = 1e-12;       ///< absolute tolerance on w [m]; on w_dot it is atol_m * omega, on the
                                  ///< dissipated energy atol_m * k * (amplitude scale) (see cvode_stepper.cpp)
     double max_step_s = 0.0;     ///< largest internal step [s]; 0 = no limit
-    bool root_finding = true;    ///< locate transitions by CVODE root-finding (false: only the per-step
-                                 ///< contact check finds them, by bisection; for testing that safety net)
     long max_steps = 10000000;   ///< limit on CVODE's internal steps over the whole run
     double modal_cutoff_rad_per_s = 0.0;  ///< leaf inertia with friction only: the stack's modes up to this
                                           ///< circular frequency carry the inertia, those above respond
@@ -136,7 +134,7 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading);
 /// it (leaves[i].density_kg_per_m3) instead. modal.hpp uses the density.
 void require_massless_leaves(const System& system, Mode mode);
 
-struct RunReport;  // cvode_stepper.hpp
+struct RunReport;  // run_report.hpp
 
 /// One contact pair at one time (simulate's per-pair output; meshed part, signs of
 /// conventions.hpp).

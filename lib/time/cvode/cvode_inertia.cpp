@@ -1,10 +1,6 @@
 // Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/inertia.md).
 #include "time/cvode/cvode_inertia.hpp"
 
-#include <cvode/cvode.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_band.h>
 #include <sunmatrix/sunmatrix_band.h>
 
 #include <Eigen/Eigenvalues>
@@ -15,6 +11,7 @@
 #include "stackbeam/errors.hpp"
 #include "time/step_record.hpp"
 #include "fe/tied_shape.hpp"
+#include "time/cvode/sundials.hpp"
 
 namespace stackbeam::detail {
 
@@ -50,37 +47,18 @@ struct CvodeInertiaStepper::Impl {
     Eigen::VectorXd g;         // modal load -Phi^T N^T K z_p
     Eigen::LDLT<Eigen::MatrixXd> GGt;  // G G^T, for the contact forces
     ContactProblem laws;       // the pairs (for the record's pair states)
+    Eigen::VectorXd p_out, rel_out;  // contact forces [N] and relative positions G z [m] (all rows) at the output
     double e0 = 0.0;
     long out_index = 0, num_out = 0;
     StepRecord rec;
     CvodeStats st;
 
-    SUNContext ctx = nullptr;
-    N_Vector y = nullptr, atol = nullptr;
-    SUNMatrix J = nullptr;
-    SUNLinearSolver LS = nullptr;
-    void* cv = nullptr;
-
-    ~Impl() {
-        if (cv) CVodeFree(&cv);
-        if (LS) SUNLinSolFree(LS);
-        if (J) SUNMatDestroy(J);
-        if (y) N_VDestroy(y);
-        if (atol) N_VDestroy(atol);
-        if (ctx) SUNContext_Free(&ctx);
-    }
-
-    void check(int flag, const char* what) const {
-        if (flag < 0)
-            throw SolverError(std::string("cvode mode (leaf inertia): ") + what + " failed with flag " +
-                                  std::to_string(flag),
-                              out_index, out_index * opt.dt_s, 0.0);
-    }
+    std::unique_ptr<CvodeSession> cvode;
 
     // State in energy-norm modal coordinates, interleaved: y[2i] = om_i xi_i, y[2i+1] = xi_i'
     // (1/2 sum y^2 is the energy of the motion about z_p): y[2i]' = om_i y[2i+1],
     // y[2i+1]' = -om_i y[2i] + g_i. The Jacobian is constant and block diagonal (band 1, 1).
-    static int rhs(realtype, N_Vector yv, N_Vector ydot, void* data) {
+    static int rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* data) {
         const auto* s = static_cast<const Impl*>(data);
         const double* Y = N_VGetArrayPointer(yv);
         double* D = N_VGetArrayPointer(ydot);
@@ -91,7 +69,7 @@ struct CvodeInertiaStepper::Impl {
         return 0;
     }
 
-    static int jac(realtype, N_Vector, N_Vector, SUNMatrix Jm, void* data, N_Vector, N_Vector, N_Vector) {
+    static int jac(sunrealtype, N_Vector, N_Vector, SUNMatrix Jm, void* data, N_Vector, N_Vector, N_Vector) {
         const auto* s = static_cast<const Impl*>(data);
         SUNMatZero(Jm);
         for (int i = 0; i < s->r; ++i) {
@@ -103,7 +81,7 @@ struct CvodeInertiaStepper::Impl {
 
     /// Modal coordinates xi, xi' of the state.
     void modal(Eigen::VectorXd& xi, Eigen::VectorXd& xid) const {
-        const double* Y = N_VGetArrayPointer(y);
+        const auto Y = cvode->y();
         xi.resize(r);
         xid.resize(r);
         for (int i = 0; i < r; ++i) {
@@ -123,6 +101,8 @@ struct CvodeInertiaStepper::Impl {
                                                  : Eigen::VectorXd();
         Eigen::VectorXd p = Eigen::VectorXd::Zero(sys.num_components());
         for (int k = 0; k < static_cast<int>(held.size()); ++k) p[held[k]] = pC[k];
+        p_out = p;
+        rel_out = sys.contact_rows() * z;
         // a held unilateral pair must stay compressed (p_n <= 0): a release is an event,
         // not built yet with massive leaves
         for (const auto& pr : laws.pairs)
@@ -217,15 +197,12 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
                                tied_shape(s.K, system.contact_rows(), s.held, 1.0,
                                           Eigen::VectorXd::Zero(system.num_components()));
 
-    s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create");
-    s.y = N_VNew_Serial(2 * s.r, s.ctx);
-    s.atol = N_VNew_Serial(2 * s.r, s.ctx);
-    if (!s.y || !s.atol) throw SolverError("cvode mode (leaf inertia): N_VNew_Serial failed", 0, 0.0, 0.0);
+    s.cvode = std::make_unique<CvodeSession>("cvode mode (leaf inertia)", 2 * s.r);
     {
         // xi = Phi^T Mt q (Phi^T Mt Phi = I), q = N^T (z - z_p)
         const Eigen::VectorXd xi = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * (z0 - s.zp)));
         const Eigen::VectorXd xid = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * v0));
-        double* Y = N_VGetArrayPointer(s.y);
+        auto Y = s.cvode->y();
         for (int i = 0; i < s.r; ++i) {
             Y[2 * i] = s.om[i] * xi[i];
             Y[2 * i + 1] = xid[i];
@@ -239,24 +216,14 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     const double omega = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
     s.F_ref = system.tied_stiffness_n_per_m() / system.model().whole_spring_factor() *
               std::max(std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega, 1e-6);
-    const double e_meshed = 0.5 * N_VDotProd(s.y, s.y);
-    N_VConst(std::max(std::sqrt(system.mass_kg()) * omega * s.opt.cvode.atol_m,
-                      s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed)),
-             s.atol);
+    const double e_meshed = 0.5 * N_VDotProd(s.cvode->y_vector(), s.cvode->y_vector());
+    s.cvode->atol().setConstant(std::max(std::sqrt(system.mass_kg()) * omega * s.opt.cvode.atol_m,
+                                         s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed)));
 
-    s.cv = CVodeCreate(CV_BDF, s.ctx);
-    if (!s.cv) throw SolverError("cvode mode (leaf inertia): CVodeCreate failed", 0, 0.0, 0.0);
-    s.check(CVodeInit(s.cv, &Impl::rhs, 0.0, s.y), "CVodeInit");
-    s.check(CVodeSVtolerances(s.cv, s.opt.cvode.rtol, s.atol), "CVodeSVtolerances");
-    s.check(CVodeSetUserData(s.cv, &s), "CVodeSetUserData");
-    s.check(CVodeSetMaxOrd(s.cv, 2), "CVodeSetMaxOrd");
-    s.check(CVodeSetMaxNumSteps(s.cv, 100000), "CVodeSetMaxNumSteps");
-    if (s.opt.cvode.max_step_s > 0.0) s.check(CVodeSetMaxStep(s.cv, s.opt.cvode.max_step_s), "CVodeSetMaxStep");
-    s.J = SUNBandMatrix(2 * s.r, 1, 1, s.ctx);
-    s.LS = SUNLinSol_Band(s.y, s.J, s.ctx);
-    if (!s.J || !s.LS) throw SolverError("cvode mode (leaf inertia): dense linear solver creation failed", 0, 0.0, 0.0);
-    s.check(CVodeSetLinearSolver(s.cv, s.LS, s.J), "CVodeSetLinearSolver");
-    s.check(CVodeSetJacFn(s.cv, &Impl::jac), "CVodeSetJacFn");
+    s.cvode->create(CV_BDF, &Impl::rhs, &s, s.opt.cvode.rtol);
+    s.cvode->set_max_order(2);
+    s.cvode->set_limits(s.opt.cvode.max_step_s);
+    s.cvode->use_band_newton(1, 1, &Impl::jac);  // the Jacobian is block diagonal (2 x 2 blocks)
 
     s.num_out = static_cast<long>(std::ceil(s.opt.t_end_s / s.opt.dt_s - 1e-9));
     s.fill(0.0);
@@ -268,35 +235,29 @@ const StepRecord& CvodeInertiaStepper::advance() {
     Impl& s = *impl_;
     ++s.out_index;
     const double tout = s.out_index * s.opt.dt_s;
-    realtype t = 0.0;
-    const int flag = CVode(s.cv, tout, s.y, &t, CV_NORMAL);
-    long steps = 0;
-    CVodeGetNumSteps(s.cv, &steps);
-    if (flag < 0) {
-        realtype h = 0.0;
-        CVodeGetLastStep(s.cv, &h);
-        throw SolverError("cvode mode (leaf inertia): CVode failed with flag " + std::to_string(flag) + " at t = " +
-                              format_value(t) + " s after " + std::to_string(steps) + " steps (last step " +
-                              format_value(h) + " s)",
-                          s.out_index, t, 0.0);
-    }
-    if (steps > s.opt.cvode.max_steps)
-        throw SolverError("cvode mode (leaf inertia): more than max_steps = " + std::to_string(s.opt.cvode.max_steps) +
-                              " steps by t = " + format_value(t) + " s",
-                          s.out_index, t, 0.0);
-    s.st.steps = steps;
-    long v = 0;
-    CVodeGetNumRhsEvals(s.cv, &v);
-    s.st.rhs_evaluations = v;
-    CVodeGetNumJacEvals(s.cv, &v);
-    s.st.jacobian_evaluations = v;
-    CVodeGetNumLinSolvSetups(s.cv, &v);
-    s.st.linear_setups = v;
+    double t = 0.0;
+    s.cvode->advance(tout, CV_NORMAL, s.opt.cvode.max_steps, t);
+    const CvodeCounters& cc = s.cvode->counters();
+    s.st.steps = cc.steps;
+    s.st.rhs_evaluations = cc.rhs_evaluations;
+    s.st.jacobian_evaluations = cc.jacobian_evaluations;
+    s.st.linear_setups = cc.linear_setups;
     s.fill(tout);
     return s.rec;
 }
 
 const StepRecord& CvodeInertiaStepper::current() const noexcept { return impl_->rec; }
 const CvodeStats& CvodeInertiaStepper::stats() const noexcept { return impl_->st; }
+long CvodeInertiaStepper::record_index() const noexcept { return impl_->out_index; }
+std::vector<PairRecord> CvodeInertiaStepper::pairs() const {
+    return pair_records(impl_->sys, impl_->laws, impl_->p_out, impl_->rel_out);
+}
+RunReport CvodeInertiaStepper::report() const {
+    RunReport rep;
+    rep.mode = Mode::cvode;
+    rep.cvode = impl_->st;
+    rep.steps = impl_->st.steps;
+    return rep;
+}
 
 }  // namespace stackbeam::detail

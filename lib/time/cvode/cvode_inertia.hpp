@@ -9,8 +9,10 @@
 //     (N^T M N) q'' + N^T K N q = -N^T K z_p,
 // a stiff linear ODE (leaf bending modes up to ~1e5..1e6 rad/s next to the 70 rad/s
 // body mode) integrated by CVODE's BDF at order <= 2 (higher orders are unstable on
-// the lightly damped oscillatory modes), Newton with a dense direct solver and the
-// analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N.
+// the lightly damped oscillatory modes), Newton with a direct solver and the
+// analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N; in the modal
+// coordinates of B it is block diagonal (2 x 2 blocks), so the direct solver is a band one
+// (half-bandwidths 1, 1).
 // Stacks with friction (pairs that may stick or slip) run CvodeModalStepper below;
 // called directly with one, this stepper refuses it (InputError naming `mode`).
 #include <Eigen/Dense>
@@ -19,18 +21,22 @@
 
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam::detail {
 
-class CvodeInertiaStepper {
+class CvodeInertiaStepper final : public Stepper {
 public:
     CvodeInertiaStepper(const System& system, const SimulationOptions& options);
-    ~CvodeInertiaStepper();
-    CvodeInertiaStepper(const CvodeInertiaStepper&) = delete;
-    CvodeInertiaStepper& operator=(const CvodeInertiaStepper&) = delete;
+    ~CvodeInertiaStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance();
-    const StepRecord& current() const noexcept;
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output: the held components' forces, relative positions G z.
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps and counters (no contact iterations, no events: the modes never change).
+    RunReport report() const override;
     const CvodeStats& stats() const noexcept;
 
 private:
@@ -43,15 +49,18 @@ private:
 /// carry the inertia, the modes above it respond quasi-statically (residual
 /// flexibility), so the contact points are massless and the events are those of the
 /// massless cvode mode (cvode_modal.cpp, docs/inertia.md).
-class CvodeModalStepper {
+class CvodeModalStepper final : public Stepper {
 public:
     CvodeModalStepper(const System& system, const SimulationOptions& options);
-    ~CvodeModalStepper();
-    CvodeModalStepper(const CvodeModalStepper&) = delete;
-    CvodeModalStepper& operator=(const CvodeModalStepper&) = delete;
+    ~CvodeModalStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance();
-    const StepRecord& current() const noexcept;
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output (contact_forces(), relative_positions()).
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
+    RunReport report() const override;
     const CvodeStats& stats() const noexcept;
     /// Every mode transition, in time order (cause "start", "root" or "check").
     const std::vector<ContactEvent>& events() const noexcept;

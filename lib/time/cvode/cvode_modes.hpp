@@ -5,17 +5,15 @@
 // use the witnesses of cvode_stepper.hpp with these margins, read modes from a contact
 // solution the same way, apply the transitions CVODE reports the same way and log them
 // under the same labels.
-#include <cvode/cvode.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "contact/active_set.hpp"
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/time/run_report.hpp"
 
 namespace stackbeam::detail {
 
@@ -46,12 +44,17 @@ inline SolverOptions event_solver_options(const SolverOptions& user, double tole
     return ev;
 }
 
-/// CVODE's name of a return flag (CVodeGetReturnFlagName allocates it).
-inline std::string cvode_flag_name(long flag) {
-    char* name = CVodeGetReturnFlagName(flag);
-    std::string out = name ? name : "unknown flag";
-    free(name);
-    return out;
+/// The report of an event-driven cvode stepper: CVODE's steps, the contact iterations
+/// and mode factorisations, its counters and the event log.
+inline RunReport event_report(const CvodeStats& stats, const std::vector<ContactEvent>& events) {
+    RunReport rep;
+    rep.mode = Mode::cvode;
+    rep.cvode = stats;
+    rep.events = events;
+    rep.steps = stats.steps;
+    rep.contact_iterations = stats.contact_iterations;
+    rep.factorizations = stats.mode_factorizations;
+    return rep;
 }
 
 /// Label of a pair's modes (nm, tm) for the event log.

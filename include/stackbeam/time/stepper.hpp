@@ -1,0 +1,48 @@
+#pragma once
+/// @file stepper.hpp
+/// The one interface of every mode's integrator, and the factory that picks it.
+///
+/// A Stepper starts at the initial state (record 0, t = 0) and advances one record at a
+/// time on the grid t_i = i dt_s (SimulationOptions::dt_s): a step of the fixed-step modes
+/// (closed-form, newmark), an output time of the event-driven mode cvode. simulate() is a
+/// loop over one (simulation.hpp). The modes' physics: closed_form_stepper.hpp,
+/// newmark_stepper.hpp, cvode_stepper.hpp, docs/inertia.md.
+#include <memory>
+#include <vector>
+
+#include "stackbeam/fe/system.hpp"
+#include "stackbeam/time/run_report.hpp"
+#include "stackbeam/time/simulation.hpp"
+
+namespace stackbeam {
+
+class Stepper {
+public:
+    virtual ~Stepper() = default;
+    Stepper() = default;
+    Stepper(const Stepper&) = delete;
+    Stepper& operator=(const Stepper&) = delete;
+
+    /// Advances to the next record time t = (i+1) dt_s and returns its record. Throws
+    /// SolverError (step, time, residual) when the mode's solve fails.
+    virtual const StepRecord& advance() = 0;
+    /// The record at the current record time (the initial state before the first advance()).
+    virtual const StepRecord& current() const noexcept = 0;
+    /// Index i of the current record (t = i dt_s; 0 before the first advance()).
+    virtual long record_index() const noexcept = 0;
+    /// The contact state at the current record: one PairRecord per System::pairs(), in
+    /// that order (meshed part, signs of conventions.hpp).
+    virtual std::vector<PairRecord> pairs() const = 0;
+    /// The counters so far (steps, contact iterations, factorisations; mode cvode: its
+    /// CvodeStats and event log).
+    virtual RunReport report() const = 0;
+};
+
+/// The stepper of options.mode for `system`, the choice made once: closed-form ->
+/// ClosedFormStepper; newmark -> NewmarkStepper; cvode -> CvodeStepper with massless
+/// leaves, and with leaf mass (a density > 0) the leaf-inertia variants (docs/inertia.md):
+/// held-for-good contact on bonded and frictionless stacks, modal inertia with events
+/// when a pair has friction. Throws InputError for options the mode refuses.
+std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOptions& options);
+
+}  // namespace stackbeam

@@ -1,0 +1,345 @@
+// The event driver of the event-driven cvode steppers (event_driver.hpp; the method in
+// cvode_stepper.hpp).
+#include "time/cvode/event_driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "model/mesh_note.hpp"
+#include "stackbeam/errors.hpp"
+#include "time/step_record.hpp"
+
+namespace stackbeam::detail {
+
+EventDriver::EventDriver(const System& system, const SimulationOptions& options, std::string who_)
+    : sys(system), opt(options), who(std::move(who_)) {}
+
+EventDriver::~EventDriver() = default;
+
+double EventDriver::seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void EventDriver::require_current_tau_rule() const {
+    if (opt.tau_rule != TauRule::current)
+        throw InputError("tau_rule", "mode cvode takes the friction limit from the current normal force "
+                                     "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");
+}
+
+void EventDriver::init_grid() {
+    dt = opt.dt_s;
+    n_out = static_cast<long>(std::ceil(opt.t_end_s / dt - 1e-9));
+    t_final = static_cast<double>(n_out) * dt;
+}
+
+void EventDriver::init_slots() {
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = sys.pairs()[kk];
+        if (cp.kind == PairKind::bonded) continue;
+        const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
+        if (cp.kind == PairKind::coulomb && cp.row_n >= 0) slots.push_back({kk, true});
+        if (cp.kind == PairKind::clamp && friction && cp.row_n >= 0) slots.push_back({kk, true});
+        if (friction && (cp.kind == PairKind::clamp || cp.row_n >= 0)) slots.push_back({kk, false});
+    }
+}
+
+void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance_m) {
+    chk_problem.W = W;
+    chk_problem.pairs = sys.pairs();
+    chk_problem.tau_rule = TauRule::current;
+    chk_problem.tau_previous_n = Vec::Zero(np);
+    chk_problem.q = Vec::Zero(n);  // sized: ModeSet::linearize takes n from it
+    ev_problem = chk_problem;
+    chk_solver = make_solver(opt.solver);
+    ev_tolerance = event_tolerance_m;
+    ev_solver = make_solver(event_solver_options(opt.solver, ev_tolerance));
+}
+
+void EventDriver::start_cvode(CVRhsFn rhs) {
+    cvode->create(CV_ADAMS, rhs, this, opt.cvode.rtol);
+    cvode->use_fixed_point();
+    cvode->set_limits(opt.cvode.max_step_s);
+    cvode->set_stop_time(t_final);
+    if (root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
+}
+
+int EventDriver::roots(sunrealtype, N_Vector y, sunrealtype* g, void* user) {
+    const auto* self = static_cast<const EventDriver*>(user);
+    self->witnesses(Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate), g);
+    return 0;
+}
+
+StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) {
+    StepRecord rec = make_record(tau, y, p, rel);
+    rec.t_s = tau;
+    rec.contact_iterations = static_cast<int>(iters_since);
+    rec.factorizations = static_cast<int>(facts_since);
+    rec.contact_residual_m = last_check_residual;
+    iters_since = facts_since = 0;
+    return rec;
+}
+
+void EventDriver::start_record(const Vec& y0) {
+    record = record_at(0.0, y0, p_out, rel_out);
+    e0 = record.kinetic_energy_j + record.strain_energy_j;
+    record.energy_balance_error_j = 0.0;
+}
+
+std::vector<PairRecord> EventDriver::pair_records_at(const Vec& rel) const {
+    return pair_records(sys, chk_problem, p_out, rel);
+}
+
+void EventDriver::enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm) {
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = pairs()[kk];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == STICK && tmode[kk] != STICK)
+            d[cp.row_t] = rel[cp.row_t];
+    }
+    nmode = nm;
+    tmode = tm;
+}
+
+void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
+
+void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
+                               const std::vector<int>* triggered) {
+    const auto t_start = Clock::now();
+    const double contact_before = stats.contact_time_s;
+    const Vec rel = relative_at_event(y, p_cur);  // s + d
+    // Incremental problem a look-ahead away: stuck pairs keep their anchors, every
+    // other pair is anchored where it is (paper, section 5).
+    const Vec y_la = look_ahead(te, y, p_cur);
+    Vec d_la = d;
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = pairs()[kk];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
+    }
+    ev_problem.q = motion(y_la) - d_la;
+
+    std::vector<signed char> nm, tm;
+    bool decided = false;
+    if (triggered != nullptr && n > 0) {
+        nm = nmode;
+        tm = tmode;
+        for (std::size_t i = 0; i < slots.size(); ++i) {
+            if ((*triggered)[i] == 0) continue;
+            const int kk = slots[i].pair;
+            apply_transition(pairs()[kk], slots[i].normal, pairs()[kk].row_t >= 0 ? p_cur[pairs()[kk].row_t] : 0.0,
+                             nm[kk], tm[kk]);
+        }
+        const Vec d_saved = d;
+        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+        enter(rel, nm, tm);
+        build_mode();
+        // the stop test of the contact iteration at the look-ahead, and every witness
+        const Vec pl = forces(y_la);
+        const double v = error_vector(ev_problem, pl, Vec(relative(y_la) - d_la)).norm();
+        std::vector<double> g(slots.size());
+        if (!slots.empty()) witnesses(y_la, g.data());
+        decided = v < ev_tolerance && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+        ++stats.contact_iterations;
+        ++iters_since;
+        d = d_saved;  // restored either way: the log below compares with the old modes
+        nmode = nm_saved;
+        tmode = tm_saved;
+    }
+    if (!decided) {
+        Vec p_la = p_cur;
+        const auto t_solve = Clock::now();
+        const SolveResult res = ev_solver->solve(ev_problem, p_la);
+        stats.contact_time_s += seconds_since(t_solve);
+        stats.contact_iterations += res.iterations;
+        iters_since += res.iterations;
+        if (!res.converged)
+            throw SolverError(who + ": the contact iteration deciding the modes at t = " + format_value(t) + " s (" +
+                                  cause + ") did not converge: " + res.message + mesh_note(sys.model()),
+                              stats.steps, t, res.residual_m);
+        modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
+        correct_decision(y, rel, nm, tm);
+    }
+
+    // Log the transitions, enter the new modes, refactorise (unless the candidate was).
+    double w = 0.0, wd = 0.0;
+    body_motion(y, p_cur, w, wd);
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = pairs()[kk];
+        if (cp.kind == PairKind::bonded) continue;
+        if (nm[kk] == nmode[kk] && tm[kk] == tmode[kk] && cause != "start") continue;
+        ContactEvent e;
+        e.t_s = t;
+        e.pair = kk;
+        const PairSpec& spec = sys.pair_spec(kk);
+        e.interface_index = spec.interface_index;
+        e.x_m = spec.x_m;
+        e.from = cause == "start" ? "none" : mode_label(cp, nmode[kk], tmode[kk]);
+        e.to = mode_label(cp, nm[kk], tm[kk]);
+        e.cause = cause;
+        e.w_m = w;
+        e.w_dot_m_per_s = wd;
+        events.push_back(std::move(e));
+    }
+    enter(rel, nm, tm);
+    if (!decided) build_mode();
+    after_event(cause, p_cur, forces(y));
+    reset_check_anchors(y);
+    stats.event_time_s += seconds_since(t_start) - (stats.contact_time_s - contact_before);
+}
+
+void EventDriver::reset_check_anchors(const State& y) {
+    d_chk = d;
+    if (n == 0) return;
+    const Vec rel = relative(y);
+    for (int kk = 0; kk < np; ++kk) {
+        const auto& cp = pairs()[kk];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_chk[cp.row_t] = rel[cp.row_t];
+    }
+}
+
+/// True when the modes hold at y: every witness positive and the paper's incremental
+/// problem (anchors d_chk) satisfied by the mode solution to the contact tolerance.
+/// `residual` gets ||v|| (eq. 9).
+bool EventDriver::modes_hold(const State& y, double& residual, bool* witnesses_ok) {
+    std::vector<double> g(slots.size());
+    if (!slots.empty()) witnesses(y, g.data());
+    residual = 0.0;
+    if (n > 0) {
+        const Vec p = forces(y);
+        chk_problem.q = motion(y) - d_chk;
+        // s = (s + d) - d_chk, affine in the state: no product with the compliance
+        residual = error_vector(chk_problem, p, Vec(relative(y) - d_chk)).norm();
+    }
+    const bool positive = std::all_of(g.begin(), g.end(), [](double v) { return v >= 0.0; });
+    if (witnesses_ok) *witnesses_ok = positive;
+    return positive && residual < opt.solver.tolerance_m;
+}
+
+void EventDriver::restart(double te, const Vec& y) {
+    const auto t0 = Clock::now();
+    cvode->y() = y;
+    cvode->reinit(te);
+    ++stats.restarts;
+    stats.event_time_s += seconds_since(t0);
+}
+
+/// Queues the records of the output times in (t, upto] (the current modes hold there).
+void EventDriver::emit_until(double upto) {
+    long next = out_index + static_cast<long>(pending.size()) + 1;
+    while (next <= n_out && output_time(next) <= upto) {
+        const double tau = output_time(next);
+        cvode->dense_output(tau);
+        Output o;
+        o.rec = record_at(tau, cvode->ydky(), o.p, o.rel);
+        pending.push_back(std::move(o));
+        ++next;
+    }
+}
+
+void EventDriver::note_event_time(double te) {
+    if (te == last_event_t) {
+        if (++events_at_this_time > kMaxEventsAtOneTime)
+            throw SolverError(who + ": more than " + std::to_string(kMaxEventsAtOneTime) + " events at t = " +
+                                  format_value(te) + " s: the contact modes chatter (no consistent mode set found)",
+                              stats.steps, te, 0.0);
+    } else {
+        last_event_t = te;
+        events_at_this_time = 0;
+    }
+    ++stats.events;
+}
+
+/// One CVODE step and what follows it; returns false at the end of the run.
+bool EventDriver::step_once() {
+    if (t >= t_final) return false;
+    double tret = t;
+    const auto t_cv = Clock::now();
+    const int flag = cvode->advance(t_final, CV_ONE_STEP, opt.cvode.max_steps, tret);
+    stats.cvode_time_s += seconds_since(t_cv);
+    const CvodeCounters& cc = cvode->counters();
+    stats.steps = cc.steps;
+    stats.rhs_evaluations = cc.rhs_evaluations;
+    stats.root_evaluations = cc.root_evaluations;
+    const Vec y = cvode->y();
+
+    if (flag == CV_ROOT_RETURN) {
+        emit_until(tret);  // the old modes hold up to the root
+        t = tret;
+        note_event_time(tret);
+        std::vector<int> found(slots.size(), 0);
+        cvode->root_info(found);
+        decide_modes(tret, y, forces(y), "root", &found);
+        restart(tret, y);
+        return true;
+    }
+
+    // The contact iteration at the accepted step (the configured solver; the paper's
+    // projected iteration by default) on the paper's incremental problem, warm-started
+    // at the mode solution. Its first act is its stop test, ||v|| < tolerance at the
+    // warm start (modes_hold computes exactly that v): when it passes, the iteration
+    // ends there with the mode solution as its answer. Otherwise it runs, and the
+    // modes hold only if its answer leaves every pair in the mode CVODE integrated.
+    const auto t_check = Clock::now();
+    double residual = 0.0;
+    bool witnesses_ok = false;
+    bool ok = modes_hold(y, residual, &witnesses_ok);
+    stats.max_check_residual_m = std::max(stats.max_check_residual_m, residual);
+    last_check_residual = residual;
+    if (!ok && witnesses_ok && n > 0) {
+        const Vec pm = forces(y);
+        Vec p = pm;
+        const SolveResult res = chk_solver->solve(chk_problem, p);  // q was set by modes_hold
+        stats.contact_iterations += res.iterations;
+        iters_since += res.iterations;
+        last_check_residual = res.residual_m;
+        ok = res.converged;
+        for (int kk = 0; kk < np && ok; ++kk)
+            if (pair_state(chk_problem, kk, p) != pair_state(chk_problem, kk, pm)) ok = false;
+        if (ok) stats.max_check_force_difference_n = std::max(stats.max_check_force_difference_n, (p - pm).lpNorm<Eigen::Infinity>());
+    }
+    stats.contact_time_s += seconds_since(t_check);
+    if (ok) {
+        emit_until(tret);
+        t = tret;
+        reset_check_anchors(y);
+        return tret < t_final;
+    }
+
+    // A missed event: locate its time by bisection on the dense output of the last step.
+    const double hlast = cvode->last_step();
+    double lo = tret - hlast, hi = tret;
+    const double tol_t = 1e-13 * std::max(1.0, std::abs(tret)) + 1e-9 * hlast;
+    while (hi - lo > tol_t) {
+        const double mid = 0.5 * (lo + hi);
+        cvode->dense_output(mid);
+        double res_m = 0.0;
+        if (modes_hold(cvode->ydky(), res_m)) lo = mid;
+        else hi = mid;
+    }
+    cvode->dense_output(hi);
+    const Vec ye = cvode->ydky();
+    emit_until(hi);
+    t = hi;
+    ++stats.missed_events;
+    note_event_time(hi);
+    decide_modes(hi, ye, forces(ye), "check");
+    restart(hi, ye);
+    return true;
+}
+
+const StepRecord& EventDriver::advance() {
+    if (out_index >= n_out) throw InputError("advance", "the run has reached t_end = " + format_value(t_final) + " s");
+    while (pending.empty()) {
+        if (!step_once() && pending.empty())
+            throw SolverError(who + ": reached t = " + format_value(t) + " s without the output at " +
+                                  format_value(output_time(out_index + 1)) + " s",
+                              stats.steps, t, 0.0);
+    }
+    record = std::move(pending.front().rec);
+    p_out = std::move(pending.front().p);
+    rel_out = std::move(pending.front().rel);
+    pending.pop_front();
+    ++out_index;
+    return record;
+}
+
+}  // namespace stackbeam::detail
