@@ -1,5 +1,5 @@
 // Mode "cvode" with leaf inertia on stacks with friction: modal inertia with a massless
-// contact layer (cvode_inertia.hpp, docs/inertia.md "Mode cvode with leaf inertia and
+// contact layer (cvode_inertia.hpp, docs/time-integration.md "cvode with leaf mass and
 // friction").
 //
 // The motion is split (mode-acceleration method) into the retained modes of the
