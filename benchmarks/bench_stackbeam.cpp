@@ -1,5 +1,5 @@
 // Benchmarks of stackbeam (Google Benchmark; built with -DSTACKBEAM_BUILD_BENCHMARKS=ON,
-// not run as tests). Figures and the command that made them: BENCHMARKS.md.
+// not run as tests). Figures and the command that made them: docs/performance.md.
 //
 //  - ContactSolve: per-step solve time of each contact solver, replaying the
 //    recorded problems of 0.6 s of the paper example (bonded, friction) in order,
@@ -207,7 +207,7 @@ BENCHMARK_CAPTURE(WholeRun, frictionless_0p6s, PaperCase::frictionless, 0.6)->Un
 // 1 sparse), simulated ms}. The paper example itself (20 x 3) is the reference of the
 // issue's target (10 leaves x 400 elements: at most 30x its time per simulated second).
 // Dense runs stop where they become impractical (10 x 400: W alone would be 400 MB),
-// sparse friction runs where a step takes minutes (see BENCHMARKS.md).
+// sparse friction runs where a step takes minutes (see docs/performance.md).
 BENCHMARK(Scaling)
     ->ArgNames({"el", "leaves", "friction", "sparse", "ms"})
     // reference: the paper example, 1 s simulated
@@ -221,7 +221,7 @@ BENCHMARK(Scaling)
     ->Args({20, 6, 0, 0, 200})->Args({20, 6, 0, 1, 200})->Args({20, 6, 1, 0, 50})->Args({20, 6, 1, 1, 50})
     ->Args({20, 10, 0, 0, 200})->Args({20, 10, 0, 1, 200})->Args({20, 10, 1, 0, 20})->Args({20, 10, 1, 1, 20})
     // the target size: 10 leaves x 400 elements per half leaf (sparse; bonded and frictionless;
-    // its first friction step takes over 10 minutes and fails: not run, see BENCHMARKS.md);
+    // its first friction step takes over 10 minutes and fails: not run, see docs/performance.md);
     // friction on 10 leaves x 100 elements (1,782 rows), 20 steps
     ->Args({80, 10, 0, 1, 1000})->Args({400, 10, 0, 1, 1000})->Args({400, 10, 2, 1, 1000})
     ->Args({100, 10, 1, 1, 20})

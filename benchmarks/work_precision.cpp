@@ -9,7 +9,7 @@
 ///
 ///   work_precision [repeats]      (default 5)
 ///
-/// Prints a Markdown table (BENCHMARKS.md keeps the latest).
+/// Prints a Markdown table (docs/performance.md keeps the latest).
 #include <algorithm>
 #include <chrono>
 #include <cmath>

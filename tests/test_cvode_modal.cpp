@@ -1,5 +1,5 @@
 // Mode cvode with leaf inertia on a stack with friction (lib/time/cvode/cvode_modal.cpp,
-// docs/inertia.md): the stack's modes up to a cut carry the inertia, the modes above it
+// docs/time-integration.md): the stack's modes up to a cut carry the inertia, the modes above it
 // respond quasi-statically (a massless contact layer), and the events are those of the
 // massless cvode mode. Checked against the massless mode as the density falls, against
 // mode newmark (the fully massive stack), in the cut-off, and by the energy balance.

@@ -1,5 +1,5 @@
 // Static stiffness of the paper example at the rigid body, against
-// shared/reference-example.md and beam theory.
+// docs/method.md and beam theory.
 #define BOOST_TEST_MODULE stiffness
 #include <boost/test/unit_test.hpp>
 #include <cmath>

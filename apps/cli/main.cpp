@@ -11,11 +11,11 @@
 /// E = 2e10 Pa, pinned at both ends, four clamps at x = 0.1 ... 0.4 m, a 20 kg
 /// body at midspan moving at 2 m/s, in one of three cases (bonded leaves,
 /// friction mu = 0.5 with clamp force 1000 N, frictionless). Geometry:
-/// ../shared/reference-example.md; signs and units: include/stackbeam/conventions.hpp.
+/// docs/method.md; signs and units: include/stackbeam/conventions.hpp.
 ///
 ///   stackbeam simulate --case friction --t-end 2 --out friction.csv
 ///   stackbeam simulate --case friction --mode cvode --rtol 1e-8 --events events.csv --out friction.csv
-///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: scenarios/README.md;
+///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: docs/model-and-scenarios.md;
 ///                      integrator options and --out given here override the file's)
 ///
 /// writes one CSV row per time step (closed-form) or output time (cvode, every --dt),

@@ -277,7 +277,7 @@ private:
 /// (affine while the box QP's working set stays); on fine meshes its contraction factor
 /// nears 1 (neighbouring pairs' normal forces are nearly interchangeable), and the plain
 /// update creeps or oscillates there: graduated 10 leaves x 100 elements, steps that ran all
-/// 100 passes unsettled now settle in 10-13 (BENCHMARKS.md). The mixing works on the
+/// 100 passes unsettled now settle in 10-13 (docs/decisions/007-anderson-acceleration.md). The mixing works on the
 /// limits in metres, y = mu tau W_tt (the measure `accept` uses), and is projected on tau >= 0.
 ///   Anderson, J. ACM 12 (1965); Walker & Ni, SIAM J. Numer. Anal. 49 (2011), type II.
 ///   box_solve(lower, upper, at_bound) -> bool   solves the box QP into p (the path's

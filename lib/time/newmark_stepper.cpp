@@ -1,5 +1,5 @@
 // Mode "newmark": average-acceleration Newmark on the massive leaves with the paper's
-// contact problem at every step (newmark_stepper.hpp, docs/inertia.md).
+// contact problem at every step (newmark_stepper.hpp, docs/time-integration.md).
 #include "stackbeam/time/newmark_stepper.hpp"
 
 #include <Eigen/SparseCholesky>

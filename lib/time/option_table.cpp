@@ -107,7 +107,7 @@ std::vector<OptionSpec> make_table() {
         real("cvode.modal_cutoff_rad_per_s", "integrator.cvode.modal_cutoff_rad_per_s", "--modal-cutoff", "",
              "rad/s",
              "mode cvode, massive leaves with friction: the stack's modes up to this circular frequency carry the "
-             "inertia, those above respond quasi-statically (docs/inertia.md)",
+             "inertia, those above respond quasi-statically (docs/time-integration.md)",
              0.0, false, kInf, false, "0: 10 x the stack's first frequency",
              [](const O& o) { return o.cvode.modal_cutoff_rad_per_s; },
              [](O& o, double v) { o.cvode.modal_cutoff_rad_per_s = v; }),

@@ -14,7 +14,7 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
         case Mode::newmark: return std::make_unique<NewmarkStepper>(system, options);
         case Mode::cvode:
             if (!detail::has_leaf_mass(system)) return std::make_unique<CvodeStepper>(system, options);
-            // leaf inertia (docs/inertia.md): modal with events when a pair may stick or slip
+            // leaf inertia (docs/time-integration.md): modal with events when a pair may stick or slip
             if (detail::has_mode_changes(system)) return std::make_unique<detail::CvodeModalStepper>(system, options);
             return std::make_unique<detail::CvodeInertiaStepper>(system, options);
     }

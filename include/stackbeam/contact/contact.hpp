@@ -94,7 +94,7 @@ struct SolverOptions {
                                           ///< turns to the Tresca fixed point (and again after it)
     int tresca_anderson_depth = 8;        ///< exact solver (dense and sparse path): Anderson acceleration depth of
                                           ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
-                                          ///< fixed point (BENCHMARKS.md: of 3, 5 and 8 only 8 settles the graduated
+                                          ///< fixed point (decision 007: of 3, 5 and 8 only 8 settles the graduated
                                           ///< 10 x 400 first step; 3 needs 6-23 % fewer factorisations at 10 x 100)
 };
 
@@ -189,7 +189,7 @@ struct SparseContactProblem {
 /// each transition and box-QP method alone through lib/contact/sparse/switches.hpp.)
 ///
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
-/// are the measured choices, BENCHMARKS.md; tests set them to force each way; the three
+/// are the measured choices, docs/decisions/002-sparse-contact-path.md; tests set them to force each way; the three
 /// fields are those a user may tune):
 ///  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on
 ///    a Cholesky factor of K made once per run (columns K^-1 g_i^T cached per row);

@@ -4,7 +4,7 @@
 /// integrated by the implicit average-acceleration Newmark rule (beta = 1/4, gamma = 1/2)
 /// with the paper's contact problem solved at every step: the natural extension of the
 /// paper's scheme (section 4) to massive leaves, and the fixed-step reference of the
-/// inertia mode (docs/inertia.md).
+/// inertia mode (docs/time-integration.md).
 ///
 /// On the reduced DOFs z = [z_r; w] (system.hpp: K = stiffness_reduced(), M = mass_reduced(),
 /// G = contact_rows(), s = G z - d), the equations of motion are M z'' + K z = G^T p, and

@@ -67,8 +67,8 @@ const char* to_string(ContactPath path);
 ContactPath parse_contact_path(const std::string& text, const std::string& field);
 
 /// ContactPath::automatic takes the sparse path from this many contact components
-/// (rows of the contact problem) on, with the exact solver. Measured (BENCHMARKS.md,
-/// friction case, the costliest): at 636 rows both paths take the same time per step,
+/// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
+/// 002-sparse-contact-path.md, friction case, the costliest): at 636 rows both paths take the same time per step,
 /// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
 /// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
 /// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
@@ -84,7 +84,7 @@ struct CvodeOptions {
     double modal_cutoff_rad_per_s = 0.0;  ///< leaf inertia with friction only: the stack's modes up to this
                                           ///< circular frequency carry the inertia, those above respond
                                           ///< quasi-statically [rad/s]; 0 = 10 x the stack's first
-                                          ///< frequency (docs/inertia.md)
+                                          ///< frequency (docs/time-integration.md)
 };
 
 struct SimulationOptions {
@@ -103,7 +103,7 @@ struct SimulationOptions {
     /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
     ContactPath contact_path = ContactPath::automatic;
     /// Sparse path only: how its exact solver solves the linear problems and the transitions
-    /// (contact.hpp; the defaults are the measured choices, BENCHMARKS.md).
+    /// (contact.hpp; the defaults are the measured choices, docs/decisions/).
     SparsePathTuning sparse_tuning;
     /// Throw SolverError when a step's contact solve does not converge (default);
     /// if false the step is kept and flagged by its residual.
@@ -112,7 +112,7 @@ struct SimulationOptions {
     /// impact law, 0 <= e <= 1. A normal component that closes in a step leaves it with
     /// its relative velocity reversed to -e times its approach velocity at the step's
     /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
-    /// ends with relative velocity 0. Docs: docs/inertia.md.
+    /// ends with relative velocity 0. Docs: docs/time-integration.md.
     double restitution = 0.0;
     /// Throws InputError when a value is out of range; its field() is the member's path
     /// ("dt_s", "cvode.rtol", "solver.tolerance_m": option_table.hpp gives the scenario key

@@ -6,7 +6,7 @@
 /// time on the grid t_i = i dt_s (SimulationOptions::dt_s): a step of the fixed-step modes
 /// (closed-form, newmark), an output time of the event-driven mode cvode. simulate() is a
 /// loop over one (simulation.hpp). The modes' physics: closed_form_stepper.hpp,
-/// newmark_stepper.hpp, cvode_stepper.hpp, docs/inertia.md.
+/// newmark_stepper.hpp, cvode_stepper.hpp, docs/time-integration.md.
 #include <memory>
 #include <vector>
 
@@ -40,7 +40,7 @@ public:
 
 /// The stepper of options.mode for `system`, the choice made once: closed-form ->
 /// ClosedFormStepper; newmark -> NewmarkStepper; cvode -> CvodeStepper with massless
-/// leaves, and with leaf mass (a density > 0) the leaf-inertia variants (docs/inertia.md):
+/// leaves, and with leaf mass (a density > 0) the leaf-inertia variants (docs/time-integration.md):
 /// held-for-good contact on bonded and frictionless stacks, modal inertia with events
 /// when a pair has friction. Throws InputError for options the mode refuses.
 std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOptions& options);

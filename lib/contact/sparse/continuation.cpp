@@ -53,7 +53,7 @@ bool continuation_substep(SparsePath& path, const Step& step, Eigen::VectorXd& p
 /// the semismooth Newton method from the solution at a; h doubles after a success and
 /// halves after a failure. The answer at a = 1 solves the step's own problem (the same
 /// passes confirm it), so continuation changes the way, not the result.
-/// Measured (BENCHMARKS.md): on 10 identical leaves x 100 elements it settled every
+/// Measured (docs/decisions/005-continuation-on-offsets.md): on 10 identical leaves x 100 elements it settled every
 /// transition both Newton methods gave up on (5 of 300 steps), in 2-4 sub-steps each,
 /// where the Tresca fixed point had cost up to 3,621 factorisations. It does not help where the step starts
 /// from rest with every pair at zero force and zero gap (10 identical leaves x 400): the

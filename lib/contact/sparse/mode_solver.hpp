@@ -9,7 +9,7 @@
 //     [ G_S    0                  ] [p_S] = [d_S      ]
 // (K [N/m per DOF unit] the stiffness, G [-] the contact rows, d [m] the offsets, p [N] the
 // contact forces, z the displacements). ModeSolver solves it three ways (the defaults are
-// the measured choices, BENCHMARKS.md):
+// the measured choices, docs/decisions/002-sparse-contact-path.md):
 //  - at most `schur_max_rows` held rows: the dense Schur complement of the held rows on a
 //    Cholesky factor of K made once per (K, G), the columns K^-1 g_i^T cached per row;
 //  - more: a sparse LU of the saddle-point system (Eigen::SparseLU, COLAMD);

@@ -21,7 +21,7 @@ constexpr int kTrescaIterations = 100;  // as in the dense solver
 /// small problems); if it does not settle in its 50 passes, the interior-point method
 /// (15-45 iterations on every box QP measured, however degenerate; 10 identical leaves x
 /// 100 from rest: 34 instead of 50 factorisations per step with the Tresca fixed point
-/// alone, BENCHMARKS.md); the monotone primal method (one factorisation per working-set
+/// alone, docs/decisions/006-interior-point-box-qp.md); the monotone primal method (one factorisation per working-set
 /// change, cannot cycle) if neither does. Each method starts from the QP's own start.
 bool tresca_fixed_point(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
     const SparseStiffness& st = path.stiffness();

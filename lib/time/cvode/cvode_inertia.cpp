@@ -1,4 +1,4 @@
-// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/inertia.md).
+// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/time-integration.md).
 #include "time/cvode/cvode_inertia.hpp"
 
 #include <sunmatrix/sunmatrix_band.h>

@@ -1,5 +1,5 @@
 #pragma once
-// Internal: mode "cvode" with leaves of density > 0 (docs/inertia.md), first part: a
+// Internal: mode "cvode" with leaves of density > 0 (docs/time-integration.md), first part: a
 // stack whose contact components are held for good, so the contact mode never changes:
 // every kept pair bonded (both components held) or frictionless (mu = 0: the normal
 // component held, which a unilateral pair allows while it stays compressed; a tension
@@ -48,7 +48,7 @@ private:
 /// and close): the retained modes of the stack below CvodeOptions::modal_cutoff_rad_per_s
 /// carry the inertia, the modes above it respond quasi-statically (residual
 /// flexibility), so the contact points are massless and the events are those of the
-/// massless cvode mode (cvode_modal.cpp, docs/inertia.md).
+/// massless cvode mode (cvode_modal.cpp, docs/time-integration.md).
 class CvodeModalStepper final : public Stepper {
 public:
     CvodeModalStepper(const System& system, const SimulationOptions& options);
