@@ -10,7 +10,7 @@
 ///   bonded        leaves tied together: one beam 0.015 m high (analytic sinusoid)
 ///   friction      Coulomb friction mu = 0.5: hysteresis, decaying vibration
 ///   frictionless  mu = 0: three beams side by side (analytic sinusoid)
-/// Geometry as read in docs/method.md; signs: include/stackbeam/conventions.hpp.
+/// Geometry as read in docs/method.md (section 5); signs: include/stackbeam/conventions.hpp.
 ///
 /// For each case it runs both time-stepping modes with the paper's settings
 /// (t_end 0.6 s, 2.0 s for friction):

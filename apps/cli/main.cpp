@@ -15,7 +15,7 @@
 ///
 ///   stackbeam simulate --case friction --t-end 2 --out friction.csv
 ///   stackbeam simulate --case friction --mode cvode --rtol 1e-8 --events events.csv --out friction.csv
-///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: scenarios/README.md;
+///   stackbeam simulate --scenario scenarios/paper_friction.toml   (any stack: docs/model-and-scenarios.md;
 ///                      integrator options and --out given here override the file's)
 ///
 /// writes one CSV row per time step (closed-form) or output time (cvode, every --dt),

@@ -100,7 +100,8 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
         sim.add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
     CLI::Option* scenario_opt =
         sim.add_option("--scenario", a.scenario,
-                       "a scenario file (TOML, scenarios/README.md) instead of --case; options given here override its values")
+                       "a scenario file (TOML, docs/model-and-scenarios.md) instead of --case; options given here "
+                       "override its values")
             ->type_name("FILE.toml")
             ->excludes(case_opt);
     // The integrator's options: one row of the library's table each (option_table.hpp).
@@ -185,8 +186,8 @@ RunRequest make_request(const SimulateArgs& a) {
                   " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }
     if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
-        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark (or cvode, bonded and "
-                            "frictionless stacks so far): mode closed-form treats the leaves as massless, the paper");
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "
+                            "treats the leaves as massless, the paper");
     if (r.options.mode != Mode::cvode && !r.events.empty())
         throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
                             std::string(to_string(r.options.mode)) + ")");

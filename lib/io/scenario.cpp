@@ -1,5 +1,5 @@
 // Scenario files (TOML, read with toml11): every key checked, errors name the
-// key's path in the file. Format: scenarios/README.md.
+// key's path in the file. Format: docs/model-and-scenarios.md.
 #include "stackbeam/io/scenario.hpp"
 
 #include <toml.hpp>

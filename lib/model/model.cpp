@@ -328,9 +328,9 @@ std::string friction_mesh_advice(const Model& model) {
     std::snprintf(buf, sizeof buf,
                   "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is %.3g on interface %d (pair spacing h = %.4g m): "
                   "from about 1 on, the incremental Coulomb problem of this mesh can have several solutions and the "
-                  "exact solver's fixed point on the friction limits settles slowly or not at all (docs/contact-solvers.md); "
-                  "pairs spaced more than %.4g m apart there (mesh.element_length_m) or a mu below %.4g bring it "
-                  "below 1",
+                  "exact solver's fixed point on the friction limits settles slowly or not at all "
+                  "(docs/contact-solvers.md); pairs spaced more than %.4g m apart there (mesh.element_length_m) or a "
+                  "mu below %.4g bring it below 1",
                   r.ratio, r.interface_index, r.pair_spacing_m, r.spacing_for_one_m,
                   model.spec().interfaces[r.interface_index].friction_coefficient / r.ratio);
     return buf;

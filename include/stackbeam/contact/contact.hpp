@@ -94,7 +94,7 @@ struct SolverOptions {
                                           ///< turns to the Tresca fixed point (and again after it)
     int tresca_anderson_depth = 8;        ///< exact solver (dense and sparse path): Anderson acceleration depth of
                                           ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
-                                          ///< fixed point (docs/decisions/007-anderson-acceleration.md: of 3, 5 and 8 only 8 settles the graduated
+                                          ///< fixed point (decision 007: of 3, 5 and 8 only 8 settles the graduated
                                           ///< 10 x 400 first step; 3 needs 6-23 % fewer factorisations at 10 x 100)
 };
 

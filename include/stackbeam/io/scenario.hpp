@@ -2,7 +2,7 @@
 /// @file scenario.hpp
 /// Scenario files: a whole run (the stack, the loading, the integrator and the
 /// outputs) described in a TOML file, e.g. scenarios/paper_friction.toml. The
-/// format is documented in scenarios/README.md.
+/// format is documented in docs/model-and-scenarios.md.
 ///
 /// Every key is checked: an unknown key, a wrong type, a missing required field
 /// or a value out of range throws InputError whose field() is the key's path in

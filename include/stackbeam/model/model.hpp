@@ -166,8 +166,8 @@ const char* to_string(PairKind kind);
 /// contact zone ends (a leaf tip, the edge of a closed zone) only the couple of the
 /// nearest pairs, arm h, answers it: dN ~ dT (t_i + t_i+1)/(2 h), and with dT = mu dN
 /// (a slipping pair's force follows its limit) the limits-to-normal-forces map has a
-/// gain of order kappa. Measured on graduated 10-leaf springs (docs/decisions/008-friction-mesh-ratio.md, section
-/// "Friction-mesh ratio"), the exact solvers' plain fixed point on the friction limits
+/// gain of order kappa. Measured on graduated 10-leaf springs (docs/decisions/
+/// 008-friction-mesh-ratio.md), the exact solvers' plain fixed point on the friction limits
 /// settles in at most 8-9 passes at kappa 0.25-0.5, in up to 24 or not within 100 at 1, and
 /// not at all at 2 or more; at 1 the incremental problem was seen to have two
 /// solutions (graduated 10 x 100, mu = 0.5). This is a property of the

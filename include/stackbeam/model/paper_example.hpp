@@ -1,7 +1,7 @@
 #pragma once
 /// @file paper_example.hpp
 /// The built-in example of the paper's section 5 (geometry as read in
-/// docs/method.md): three identical leaves 0.5 x 0.05 x 0.005 m,
+/// docs/method.md, section 5): three identical leaves 0.5 x 0.05 x 0.005 m,
 /// E = 2e10 Pa, pinned at both ends, four clamps at x = 0.1, 0.2, 0.3, 0.4 m,
 /// a 20 kg rigid body at midspan moving at 2 m/s, 20 elements per half leaf.
 #include <string>

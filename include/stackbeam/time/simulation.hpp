@@ -67,8 +67,8 @@ const char* to_string(ContactPath path);
 ContactPath parse_contact_path(const std::string& text, const std::string& field);
 
 /// ContactPath::automatic takes the sparse path from this many contact components
-/// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/002-sparse-contact-path.md,
-/// friction case, the costliest): at 636 rows both paths take the same time per step,
+/// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
+/// 002-sparse-contact-path.md, friction case, the costliest): at 636 rows both paths take the same time per step,
 /// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
 /// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
 /// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
@@ -103,7 +103,7 @@ struct SimulationOptions {
     /// Dense or sparse contact problem (mode closed-form); automatic by problem size.
     ContactPath contact_path = ContactPath::automatic;
     /// Sparse path only: how its exact solver solves the linear problems and the transitions
-    /// (contact.hpp; the defaults are the measured choices, docs/decisions/002-sparse-contact-path.md).
+    /// (contact.hpp; the defaults are the measured choices, docs/decisions/).
     SparsePathTuning sparse_tuning;
     /// Throw SolverError when a step's contact solve does not converge (default);
     /// if false the step is kept and flagged by its residual.

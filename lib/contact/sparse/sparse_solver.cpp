@@ -68,15 +68,15 @@
 //    searches along the step on ||F||^2 (s is affine in p: O(m) per trial). From rest it
 //    starts from the open modes (set_open_modes). Its final modes are confirmed by the
 //    passes, so its answer is the exact solver's. At 10 leaves x 100 elements it took the
-//    friction run from 50-53 to 2.4 factorisations per step (docs/decisions/003-semismooth-newton-transitions.md); at 10 x 400
-//    its first step still does not converge (docs/decisions/008-friction-mesh-ratio.md: why).
+//    friction run from 50-53 to 2.4 factorisations per step; at 10 x 400 its first step
+//    still does not converge (docs/decisions/003-semismooth-newton-transitions.md).
 //    Where the semismooth method stalls (60 iterations, or no decrease of ||F||): the
 //    smoothing Newton method (smoothing_newton) from its best iterate: the natural map
 //    with every max(0, .) replaced by (y + sqrt(y^2 + 4 e^2)) / 2, so ||F_eps||^2 is
 //    differentiable and Armijo's backtracking always finds a step, and a component at its
 //    kink enters the Jacobian half held, half free instead of flipping; e falls with the
 //    residual. One sparse LU of the Jacobian's saddle-point system per iteration (its
-//    ordering made once per run). Measured (docs/decisions/003-semismooth-newton-transitions.md): on a graduated 10-leaf
+//    ordering made once per run). Measured (docs/decisions/004-smoothing-newton.md): on a graduated 10-leaf
 //    spring at 100 elements it settles the transitions that sent the semismooth method
 //    to the Tresca fixed point (thousands of factorisations) in ~20 iterations; at 10
 //    identical leaves x 400 elements it stalls too (a near-singular Jacobian from the
@@ -202,15 +202,16 @@ struct SparseContactSolver::Impl {
             // the start: the previous step's forces extrapolated linearly from the two solves
             // before, when the warm start is the last solve's answer (measured, 10 x 100
             // friction: 14.4 -> 9.5 Newton iterations per step on the graduated spring, 14.2 ->
-            // 11.1 on identical leaves, docs/decisions/005-continuation-on-offsets.md); the passes before keep the previous
-            // modes (modes read from the extrapolation cost more: 27.7 iterations per step)
+            // 11.1 on identical leaves, docs/decisions/005-continuation-on-offsets.md); the
+            // passes before keep the previous modes (modes read from the extrapolation cost
+            // more: 27.7 iterations per step)
             const bool extrapolate = previous_p.size() == m && last_p.size() == m && p_start == last_p;
             if (confirmed(semismooth_newton, extrapolate ? Eigen::VectorXd(2.0 * last_p - previous_p) : p_start))
                 return true;
         }
         // the smoothing method from the semismooth method's best iterate (measured on the
         // graduated 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s from the
-        // start, docs/decisions/005-continuation-on-offsets.md), and if that or the passes after it fail, from the start
+        // start, docs/decisions/004-smoothing-newton.md), and if that or the passes after it fail, from the start
         if (tm == TransitionMethod::newton || tm == TransitionMethod::smoothing) {
             if (tm == TransitionMethod::newton && path.best_p.size() == m && confirmed(smoothing_newton, path.best_p))
                 return true;

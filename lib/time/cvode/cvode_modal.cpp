@@ -1,6 +1,6 @@
 // Mode "cvode" with leaf inertia on stacks with friction: modal inertia with a massless
-// contact layer (cvode_inertia.hpp, docs/time-integration.md "cvode with leaf mass and
-// friction").
+// contact layer (cvode_inertia.hpp, docs/time-integration.md "Mode cvode with leaf mass",
+// stacks with friction).
 //
 // The motion is split (mode-acceleration method) into the retained modes of the
 // unconnected stack, (K, M) phi = omega^2 phi, mass-normalised, omega <= omega_cut,
