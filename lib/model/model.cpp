@@ -34,6 +34,41 @@ const char* to_string(PairKind kind) {
     return "?";
 }
 
+const char* to_string(InterfaceContact contact) {
+    switch (contact) {
+        case InterfaceContact::rigid: return "rigid";
+        case InterfaceContact::elastic: return "elastic";
+    }
+    return "?";
+}
+
+InterfaceContact parse_interface_contact(const std::string& text, const std::string& field) {
+    if (text == "rigid") return InterfaceContact::rigid;
+    if (text == "elastic") return InterfaceContact::elastic;
+    throw InputError(field, "value '" + text + "' is not allowed: must be 'rigid' or 'elastic'");
+}
+
+InterfaceLayer interface_layer(const ModelSpec& spec, int i) {
+    const LeafSpec& a = spec.leaves[static_cast<std::size_t>(i)];
+    const LeafSpec& b = spec.leaves[static_cast<std::size_t>(i) + 1];
+    const InterfaceSpec& f = spec.interfaces[static_cast<std::size_t>(i)];
+    auto plane_strain = [](const LeafSpec& l) { return l.youngs_modulus_pa / (1.0 - l.poisson_ratio * l.poisson_ratio); };
+    auto shear = [](const LeafSpec& l) { return l.youngs_modulus_pa / (2.0 * (1.0 + l.poisson_ratio)); };
+    InterfaceLayer r;
+    r.normal_stiffness_pa_per_m = f.normal_stiffness_pa_per_m > 0.0
+                                      ? f.normal_stiffness_pa_per_m
+                                      : 1.0 / (0.5 * a.height_m / plane_strain(a) + 0.5 * b.height_m / plane_strain(b));
+    r.tangential_stiffness_pa_per_m = f.tangential_stiffness_pa_per_m > 0.0
+                                          ? f.tangential_stiffness_pa_per_m
+                                          : 1.0 / (0.5 * a.height_m / shear(a) + 0.5 * b.height_m / shear(b));
+    r.contact_width_m = std::min(a.width_m, b.width_m);
+    const double EIa = a.youngs_modulus_pa * a.width_m * a.height_m * a.height_m * a.height_m / 12.0;
+    const double EIb = b.youngs_modulus_pa * b.width_m * b.height_m * b.height_m * b.height_m / 12.0;
+    const double EIeq = EIa * EIb / (EIa + EIb);
+    r.decay_length_m = std::pow(4.0 * EIeq / (r.normal_stiffness_pa_per_m * r.contact_width_m), 0.25);
+    return r;
+}
+
 namespace {
 
 std::string idx(const char* array, std::size_t i, const char* field) {
@@ -81,6 +116,9 @@ Model Model::build(ModelSpec spec) {
         require_positive(idx("leaves", i, "width_m"), l.width_m, "[m]");
         require_positive(idx("leaves", i, "youngs_modulus_pa"), l.youngs_modulus_pa, "[Pa]");
         require_nonnegative(idx("leaves", i, "density_kg_per_m3"), l.density_kg_per_m3, "[kg/m^3]");
+        if (!std::isfinite(l.poisson_ratio) || l.poisson_ratio <= -1.0 || l.poisson_ratio >= 0.5)
+            throw InputError(idx("leaves", i, "poisson_ratio"),
+                             "value " + format_value(l.poisson_ratio) + " is not allowed: must be in (-1, 0.5) [-]");
         x_min = std::min(x_min, l.x_start_m);
         x_max = std::max(x_max, leaf_end(l));
     }
@@ -97,6 +135,14 @@ Model Model::build(ModelSpec spec) {
         const auto& f = spec.interfaces[i];
         require_nonnegative(idx("interfaces", i, "friction_coefficient"), f.friction_coefficient, "[-]");
         require_nonnegative(idx("interfaces", i, "initial_gap_m"), f.initial_gap_m, "[m]");
+        for (const auto& [key, value] : {std::pair<const char*, double>{"normal_stiffness_pa_per_m", f.normal_stiffness_pa_per_m},
+                                         {"tangential_stiffness_pa_per_m", f.tangential_stiffness_pa_per_m}}) {
+            require_nonnegative(idx("interfaces", i, key), value, "[Pa/m] (0: derived from the leaves)");
+            if (value > 0.0 && f.contact != InterfaceContact::elastic)
+                throw InputError(idx("interfaces", i, key), "value " + format_value(value) +
+                                                                " is given but interfaces[" + std::to_string(i) +
+                                                                "].contact is 'rigid': a layer stiffness needs contact = 'elastic'");
+        }
         const double lo = std::max(leaves[i].x_start_m, leaves[i + 1].x_start_m);
         const double hi = std::min(leaf_end(leaves[i]), leaf_end(leaves[i + 1]));
         if (hi - lo <= tol)
@@ -142,6 +188,7 @@ Model Model::build(ModelSpec spec) {
         const auto& cl = spec.clamps[c];
         require_finite(idx("clamps", c, "x_m"), cl.x_m);
         require_nonnegative(idx("clamps", c, "preload_n"), cl.preload_n, "[N]");
+        require_nonnegative(idx("clamps", c, "length_m"), cl.length_m, "[m] (0: a point tie)");
         bool crosses = false;
         for (std::size_t i = 0; i + 1 < leaves.size(); ++i) crosses = crosses || (present(i, cl.x_m) && present(i + 1, cl.x_m));
         if (!crosses)
@@ -178,11 +225,12 @@ Model Model::build(ModelSpec spec) {
             const auto& cl = spec.clamps[c];
             if (std::abs(cl.x_m - xr) <= tol) continue;
             const bool mirrored = std::any_of(spec.clamps.begin(), spec.clamps.end(), [&](const ClampSpec& o) {
-                return std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol && o.preload_n == cl.preload_n;
+                return std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol && o.preload_n == cl.preload_n &&
+                       o.length_m == cl.length_m;
             });
             if (!mirrored)
                 throw InputError(idx("clamps", c, "x_m"), "the half model needs each clamp mirrored about x = " +
-                                                              format_value(xr) + " m with the same preload");
+                                                              format_value(xr) + " m with the same preload and length");
         }
     }
     const double x_hi = half ? rb.x_m : x_max;
@@ -249,6 +297,8 @@ Model Model::build(ModelSpec spec) {
     for (std::size_t i = 0; i + 1 < leaves.size(); ++i) {
         const int lo = std::max(m.first_node_[i], m.first_node_[i + 1]);
         const int hi = std::min(m.last_node_[i], m.last_node_[i + 1]);
+        const bool elastic = spec.interfaces[i].contact == InterfaceContact::elastic;
+        const InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
         for (int n = lo; n <= hi; ++n) {
             PairSpec p;
             p.interface_index = static_cast<int>(i);
@@ -266,6 +316,25 @@ Model Model::build(ModelSpec spec) {
                         p.kind = PairKind::clamp;
                         p.preload_n = cl.preload_n;
                     }
+            }
+            if (elastic) {
+                // The layer over the pair's area A = b L: L the tributary length (half of each
+                // neighbouring element of the interface; lumped, node to node), or a clamp's own
+                // length (half of it on the symmetry plane of the half model). A point clamp stays rigid.
+                double L = 0.0;
+                if (p.kind == PairKind::clamp) {
+                    for (const auto& cl : spec.clamps)
+                        if (std::abs(cl.x_m - p.x_m) <= tol) L = cl.length_m;
+                    if (half && n == m.attach_node_) L *= 0.5;
+                } else {
+                    if (n < hi) L += 0.5 * (m.nodes_x_[n + 1] - m.nodes_x_[n]);
+                    if (n > lo) L += 0.5 * (m.nodes_x_[n] - m.nodes_x_[n - 1]);
+                }
+                if (L > 0.0) {
+                    const double area = layer.contact_width_m * L;
+                    p.normal_compliance_m_per_n = 1.0 / (layer.normal_stiffness_pa_per_m * area);
+                    p.tangential_compliance_m_per_n = 1.0 / (layer.tangential_stiffness_pa_per_m * area);
+                }
             }
             if (p.kind == PairKind::clamp && p.initial_gap_m > 0.0)
                 throw InputError(idx("interfaces", i, "initial_gap_m"),
@@ -315,24 +384,41 @@ FrictionMeshRatio friction_mesh_ratio(const Model& model) {
             if (x[j] - x[j - 1] > tol) h = std::min(h, x[j] - x[j - 1]);
         if (!std::isfinite(h)) continue;  // fewer than two pairs: no neighbour to trade forces with
         const double arm_m = 0.5 * (spec.leaves[i].height_m + spec.leaves[i + 1].height_m);
-        const double kappa = f.friction_coefficient * arm_m / h;
-        if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m};
+        const bool elastic = f.contact == InterfaceContact::elastic;
+        const double l = elastic ? interface_layer(spec, i).decay_length_m : 0.0;
+        const double kappa = f.friction_coefficient * arm_m / std::max(h, l);
+        if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m, l, elastic};
     }
     return best;
 }
 
 std::string friction_mesh_advice(const Model& model) {
+    const ModelSpec& spec = model.spec();
+    char buf[768];
+    // Elastic interfaces: bounded ratio on every mesh, but the worst combination of slip
+    // directions has a gain of about 1.43 mu (measured; model.hpp), 1 from mu ~ 0.7 on.
+    for (std::size_t i = 0; i < spec.interfaces.size(); ++i) {
+        const InterfaceSpec& f = spec.interfaces[i];
+        if (f.contact != InterfaceContact::elastic || f.law != InterfaceLaw::coulomb || f.friction_coefficient < 0.7)
+            continue;
+        std::snprintf(buf, sizeof buf,
+                      "interface %zu has the elastic law with mu = %.3g: from mu of about 0.7 on, the worst combination "
+                      "of slip directions (a gain of about 1.43 mu) can make the incremental Coulomb problem ill-posed "
+                      "on any mesh; a contact solve may then fail to settle (docs/contact-solvers.md)",
+                      i, f.friction_coefficient);
+        return buf;
+    }
     const FrictionMeshRatio r = friction_mesh_ratio(model);
     if (r.ratio < 1.0) return {};
-    char buf[512];
     std::snprintf(buf, sizeof buf,
                   "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is %.3g on interface %d (pair spacing h = %.4g m): "
                   "from about 1 on, the incremental Coulomb problem of this mesh can have several solutions and the "
                   "exact solver's fixed point on the friction limits settles slowly or not at all "
-                  "(docs/contact-solvers.md); pairs spaced more than %.4g m apart there (mesh.element_length_m) or a "
-                  "mu below %.4g bring it below 1",
+                  "(docs/contact-solvers.md); pairs spaced more than %.4g m apart there (mesh.element_length_m), a "
+                  "mu below %.4g, or the elastic interface law (interfaces[%d].contact = \"elastic\", which spreads "
+                  "the couple over the layer's decay length) bring it below 1",
                   r.ratio, r.interface_index, r.pair_spacing_m, r.spacing_for_one_m,
-                  model.spec().interfaces[r.interface_index].friction_coefficient / r.ratio);
+                  spec.interfaces[r.interface_index].friction_coefficient / r.ratio, r.interface_index);
     return buf;
 }
 

@@ -22,6 +22,15 @@ enum class InterfaceLaw {
     coulomb, ///< unilateral contact with incremental Coulomb friction (mu = 0: frictionless)
 };
 
+/// How the surfaces of an interface meet through the leaves' thickness.
+enum class InterfaceContact {
+    rigid,    ///< rigid surface points, node to node (the paper's model; the default)
+    elastic,  ///< an elastic layer between the surfaces: a closed pair carries p_n = -k_n A x (its approach),
+              ///< a sticking pair p_t = -k_t A x (its elastic slip), up to the friction limit (Jenkins-like);
+              ///< k_n, k_t per unit contact area [Pa/m], A the pair's tributary area [m^2]
+              ///< (docs/model-and-scenarios.md, "Elastic interfaces")
+};
+
 /// Whether the whole spring is meshed, or its left half with symmetry conditions
 /// at the rigid body's attachment (u = 0 and theta = 0 on every leaf there).
 enum class Symmetry { full, half };
@@ -34,6 +43,8 @@ struct LeafSpec {
     double width_m = 0.0;                   ///< width [m], > 0
     double youngs_modulus_pa = 0.0;         ///< Young's modulus [Pa], > 0
     double density_kg_per_m3 = 0.0;         ///< mass density [kg/m^3], >= 0 (0: massless, as in the paper)
+    double poisson_ratio = 0.3;             ///< Poisson's ratio nu [-], in (-1, 0.5): the elastic interface's
+                                            ///< derived stiffness (interface_layer); nothing else uses it
     SupportKind left_support = SupportKind::free;   ///< support at x_start_m
     SupportKind right_support = SupportKind::free;  ///< support at x_start_m + length_m
 };
@@ -43,6 +54,12 @@ struct InterfaceSpec {
     InterfaceLaw law = InterfaceLaw::coulomb;
     double friction_coefficient = 0.0;  ///< Coulomb mu [-], >= 0 (ignored when bonded)
     double initial_gap_m = 0.0;         ///< initial normal gap d_n [m], >= 0 (0: touching)
+    InterfaceContact contact = InterfaceContact::rigid;  ///< rigid (the paper's) or elastic layer
+    /// Elastic contact: normal stiffness per unit contact area k_n [Pa/m], > 0; 0 = derived from the
+    /// two leaves (interface_layer). Only with contact = elastic.
+    double normal_stiffness_pa_per_m = 0.0;
+    /// Elastic contact: tangential stiffness per unit contact area k_t [Pa/m], > 0; 0 = derived.
+    double tangential_stiffness_pa_per_m = 0.0;
 };
 
 /// A clamp (band, U-bolt, rebound clip) of negligible width. It ties every
@@ -51,6 +68,10 @@ struct InterfaceSpec {
 struct ClampSpec {
     double x_m = 0.0;        ///< position [m]
     double preload_n = 0.0;  ///< clamp force F_c [N], >= 0
+    /// Physical length of the clamp along x [m], >= 0. 0: a point tie, rigid on every interface.
+    /// > 0: on an elastic interface the clamp's pair gets the layer over width x length_m (never
+    /// over the mesh's tributary length, which would soften the clamp with every refinement).
+    double length_m = 0.0;
 };
 
 /// The rigid body R on the stack (the axle seat and the mass it carries).
@@ -107,6 +128,10 @@ struct PairSpec {
     double friction_coefficient = 0.0;  ///< mu [-]
     double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
     double initial_gap_m = 0.0;         ///< d_n [m]
+    /// Elastic interface: the layer's compliance of this pair, 1 / (k_n A) and 1 / (k_t A) [m/N],
+    /// A its tributary area [m^2]; 0 on a rigid interface and at a point clamp.
+    double normal_compliance_m_per_n = 0.0;
+    double tangential_compliance_m_per_n = 0.0;
 };
 
 /// The validated, meshed model. Immutable; build with Model::build.
@@ -153,6 +178,28 @@ private:
 
 const char* to_string(SupportKind kind);
 const char* to_string(PairKind kind);
+const char* to_string(InterfaceContact contact);
+/// Parses "rigid" | "elastic"; throws InputError naming `field`.
+InterfaceContact parse_interface_contact(const std::string& text, const std::string& field);
+
+/// The elastic layer of interface i, per unit contact area. Derived (a given value replaces it):
+/// each leaf contributes its half-thickness in plane strain, in series,
+///
+///     1 / k_n = t_A / (2 E'_A) + t_B / (2 E'_B),   E' = E / (1 - nu^2)
+///     1 / k_t = t_A / (2 G_A)  + t_B / (2 G_B),    G  = E / (2 (1 + nu))
+///
+/// (7 mm steel leaves, E = 200 GPa, nu = 0.3: k_n = 3.14e13 Pa/m, k_t = 1.10e13 Pa/m). The
+/// layer spreads a couple on the interface over the Winkler decay length of the two leaves'
+/// relative bending (Hetenyi), l = (4 E I_eq / (k_n b))^(1/4), E I_eq = (E I)_A (E I)_B /
+/// ((E I)_A + (E I)_B), b the contact width min(b_A, b_B) (l = 1 / lambda).
+struct InterfaceLayer {
+    double normal_stiffness_pa_per_m = 0.0;      ///< k_n [Pa/m]
+    double tangential_stiffness_pa_per_m = 0.0;  ///< k_t [Pa/m]
+    double contact_width_m = 0.0;                ///< b [m]
+    double decay_length_m = 0.0;                 ///< l [m]
+};
+/// The layer of interface i of a spec (whatever its contact law; validated leaves assumed).
+InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index);
 
 /// The friction-mesh ratio of a model: how strongly a change of the friction forces
 /// moves the normal forces of neighbouring contact pairs, per Coulomb interface
@@ -174,18 +221,29 @@ const char* to_string(PairKind kind);
 /// node-to-node discretisation with Coulomb's law, not of a solver: refining the mesh
 /// of a frictional stack raises kappa (paper example, 5 mm leaves, mu = 0.5: kappa =
 /// 0.2 at its 20 elements per half leaf, 1 at 100, 4 at 400).
+///
+/// On an elastic interface the couple is spread over the layer's decay length l
+/// (interface_layer) where that is longer than h, and the ratio is mu (t_i + t_i+1) /
+/// (2 max(h, l)): bounded on every mesh. Measured on a graduated 4-leaf spring, the
+/// friction-to-limit loop's gain there is about 0.6 mu with every pair slipping one way and
+/// 1.43 mu in the worst combination of slip directions, so the elastic law is well posed on any
+/// mesh up to mu of about 0.7 (friction_mesh_advice warns above).
 struct FrictionMeshRatio {
     double ratio = 0.0;           ///< the largest kappa over the Coulomb interfaces [-] (0: no friction)
     int interface_index = -1;     ///< the interface where it is largest (-1: none with friction)
     double pair_spacing_m = 0.0;  ///< h of that interface [m]
     double spacing_for_one_m = 0.0;  ///< mu (t_i + t_i+1)/2 there: the pair spacing at which kappa = 1 [m]
+    double decay_length_m = 0.0;  ///< l of that interface if elastic, else 0 [m]
+    bool elastic = false;         ///< that interface has the elastic law
 };
 
 /// kappa of every Coulomb interface with mu > 0 and two or more pairs; the largest.
 FrictionMeshRatio friction_mesh_ratio(const Model& model);
 
-/// When kappa >= 1: one sentence naming the interface, kappa, h and the spacing or mu
-/// that bring kappa below 1 (for error messages and notes); otherwise empty.
+/// One sentence for error messages and notes, or empty: on a rigid interface with kappa >= 1 it
+/// names the interface, kappa, h, and the spacing, mu or the elastic law that bring kappa below 1;
+/// on an elastic interface with mu >= 0.7 it warns that the worst combination of slip directions
+/// may reach a gain of 1 (1.43 mu).
 std::string friction_mesh_advice(const Model& model);
 
 }  // namespace stackbeam
