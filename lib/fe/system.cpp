@@ -145,7 +145,7 @@ System::System(const Model& model) : model_(model) {
     const auto& cand = model_.candidate_pairs();
     const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P_;
     Triplets gt;
-    std::vector<double> gaps;
+    std::vector<double> gaps, layer;
     int row = 0;
     for (int ci = 0; ci < static_cast<int>(cand.size()); ++ci) {
         const auto& cp = cand[ci];
@@ -184,17 +184,20 @@ System::System(const Model& model) : model_(model) {
             p.row_n = row++;
             for (const auto& [col, v] : rn) gt.emplace_back(p.row_n, col, v);
             gaps.push_back(cp.initial_gap_m);
+            layer.push_back(cp.normal_compliance_m_per_n);
         }
         if (has_t) {
             p.row_t = row++;
             for (const auto& [col, v] : rt) gt.emplace_back(p.row_t, col, v);
             gaps.push_back(0.0);
+            layer.push_back(cp.tangential_compliance_m_per_n);
         }
         if (ci == model_.probe_pair()) probe_ = static_cast<int>(pairs_.size());
         pairs_.push_back(p);
         pair_candidate_.push_back(ci);
     }
     gaps_ = Eigen::Map<Eigen::VectorXd>(gaps.data(), static_cast<Eigen::Index>(gaps.size()));
+    layer_ = Eigen::Map<Eigen::VectorXd>(layer.data(), static_cast<Eigen::Index>(layer.size()));
     Eigen::SparseMatrix<double> G(row, nm);
     G.setFromTriplets(gt.begin(), gt.end());
 
@@ -217,13 +220,21 @@ System::System(const Model& model) : model_(model) {
     if (!(k_ > 0.0))
         throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
                                                " N/m): the rigid body must be carried by supported leaves");
-    // C' = G_r K_rr^-1 G_r^T is SPD exactly when G_r has full row rank (K_rr is SPD), i.e.
-    // when G_r G_r^T is: checked by a sparse LDL^T of G_r G_r^T (the rows are local, so it is
+    // C' = G_r K_rr^-1 G_r^T + C_L is SPD when the rows without a layer (c_L = 0) of G_r have
+    // full row rank (K_rr is SPD; a layer row adds c_L > 0 to the diagonal), i.e.
+    // when their G_r G_r^T is: checked by a sparse LDL^T of it (the rows are local, so it is
     // sparse and cheap) rather than by factorising the dense C', which is built only on demand.
     // A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
     // are 1 and h/2, so an independent set of rows stays far above that).
-    if (row > 0) {
-        const Eigen::SparseMatrix<double> GGt = Gr_ * Gr_.transpose();
+    std::vector<Eigen::Triplet<double>> rigid_rows;
+    int n_rigid = 0;
+    for (int r = 0; r < row; ++r)
+        if (layer_[r] == 0.0) rigid_rows.emplace_back(n_rigid++, r, 1.0);
+    if (n_rigid > 0) {
+        Eigen::SparseMatrix<double> R(n_rigid, row);
+        R.setFromTriplets(rigid_rows.begin(), rigid_rows.end());
+        const Eigen::SparseMatrix<double> Gr_rigid = R * Gr_;
+        const Eigen::SparseMatrix<double> GGt = Gr_rigid * Gr_rigid.transpose();
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
         const double scale = GGt.diagonal().maxCoeff();
         if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
@@ -237,6 +248,7 @@ const Eigen::MatrixXd& System::compliance_held() const {
         const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
         Eigen::MatrixXd C = Gr_ * X;
         C_held_->C = 0.5 * (C + C.transpose());
+        C_held_->C.diagonal() += layer_;  // the elastic interface layer (system.hpp)
         C_held_->built = true;
     });
     return C_held_->C;

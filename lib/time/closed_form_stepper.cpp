@@ -66,6 +66,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             st.b = Eigen::VectorXd::Zero(nz);
             st.b[w_dof_] = Fs;
             st.d = d_;
+            st.layer_compliance = detail::sparse_layer(system_);
             st.pairs = problem_.pairs;
             st.tau_rule = problem_.tau_rule;
             st.tau_previous_n = problem_.tau_previous_n;
@@ -73,7 +74,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             solve_ = solver.solve(st, p_, z_);
             if (n > 0 && !solve_.converged) throw SolverError(what + ": " + solve_.message, 0, 0.0, solve_.residual_m);
             w_ = z_[w_dof_];
-            detail::reanchor(problem_, p_, Eigen::VectorXd(G * z_), d_);
+            detail::reanchor(problem_, p_, detail::relative_positions(system_, z_, p_), d_);
         }
     }
     // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
@@ -111,6 +112,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
         SparseContactProblem held;  // R held at w: the problem on z_r
         held.K = K.topLeftCorner(w_dof_, w_dof_);
         held.G = G.leftCols(w_dof_);
+        held.layer_compliance = detail::sparse_layer(system_);
         held.pairs = problem_.pairs;
         held.tau_rule = problem_.tau_rule;
         held.tau_previous_n = problem_.tau_previous_n;
@@ -135,12 +137,13 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
             sparse_problem_.K = std::move(Kaug);
             sparse_problem_.G = G;
             sparse_problem_.b = Eigen::VectorXd::Zero(nz);
+            sparse_problem_.layer_compliance = detail::sparse_layer(system_);
             sparse_problem_.pairs = problem_.pairs;
             sparse_problem_.tau_rule = problem_.tau_rule;
             sparse_problem_.tau_previous_n = problem_.tau_previous_n;
         }
         sparse_problem_.d = d_;
-        rel_ = G * z_;
+        rel_ = detail::relative_positions(system_, z_, p_);
     }
     fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
     fill_record(0, 0);
@@ -151,13 +154,13 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
 void ClosedFormStepper::fill_record(int iterations, int factorizations, double strain_j) {
     const double f = f_;
     const double k = system_.stiffness_n_per_m();
-    // U = z^T K z / 2 = (p^T C' p + k w^2) / 2 on the meshed part (see system.hpp); the
-    // sparse path has z itself and never builds C'. step() passes the sparse path's U
-    // (strain_j >= 0), which it has without a product with K.
+    // U = z^T K z / 2 + p^T C_L p / 2 = (p^T C' p + k w^2) / 2 on the meshed part, leaves and
+    // elastic layer (see system.hpp); the sparse path has z itself and never builds C'.
+    // step() passes the sparse path's U (strain_j >= 0), which it has without a product with K.
     const double strain = strain_j >= 0.0 ? strain_j
                           : path_ == ContactPath::dense
                               ? 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_)
-                              : 0.5 * f * z_.dot(system_.stiffness_reduced() * z_);
+                              : f * (0.5 * z_.dot(system_.stiffness_reduced() * z_) + detail::layer_energy_j(system_, p_));
     detail::LoadState load;
     load.external_work_j = wext_;
     load.base_displacement_m = options_.loading.base_displacement_m(t_);
@@ -270,7 +273,9 @@ const StepRecord& ClosedFormStepper::advance() {
     detail::reanchor(problem_, p_, rel_, d_);
     // Sparse path: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
     // (the solved system, K_aug = K + k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2,
-    // with G z = rel_ (made above). b_w w and k_R w^2 are each about 1/gamma times U
+    // with G z = rel_ (made above; with an elastic layer the solved system is the augmented
+    // one, sparse_solver.cpp, and p^T rel_ = p^T G z + p^T C_L p adds the layer's energy twice
+    // over, as z^T K z does for the leaves). b_w w and k_R w^2 are each about 1/gamma times U
     // (~1e2-1e3 at dt = 1 ms): the difference loses that factor of round-off, 1e-13 relative.
     // (The rig's held problem is another system: fill_record takes z^T K z there.)
     double strain = -1.0;

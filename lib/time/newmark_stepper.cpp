@@ -59,6 +59,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
             held.G = G.leftCols(w_dof);
             held.b = -Eigen::VectorXd(K_.block(0, w_dof, w_dof, 1)) * w0;
             held.d = d_ - Eigen::VectorXd(G.col(w_dof)) * w0;
+            held.layer_compliance = detail::sparse_layer(system_);
             held.pairs = problem_.pairs;
             held.tau_rule = problem_.tau_rule;
             held.tau_previous_n = problem_.tau_previous_n;
@@ -69,7 +70,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
     }
     z_ = system_.reduced_displacements(p_, w0);
-    rel_ = G * z_;
+    rel_ = detail::relative_positions(system_, z_, p_);
 
     // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.
     massless_.assign(static_cast<std::size_t>(n), 0);
@@ -152,6 +153,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         Y_ = kappa * factor_->llt.solve(Eigen::MatrixXd(G.transpose()));
         const Eigen::MatrixXd W = G * Y_;
         problem_.W = 0.5 * (W + W.transpose());
+        problem_.W.diagonal() += system_.layer_compliance_m_per_n();  // the elastic layer (system.hpp)
         problem_.q = Eigen::VectorXd::Zero(m);
     } else {
         // (K_eff / kappa) z1 = r / kappa + G^T p1
@@ -160,6 +162,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         sparse_problem_.G = G;
         sparse_problem_.b = Eigen::VectorXd::Zero(n);
         sparse_problem_.d = d_;
+        sparse_problem_.layer_compliance = detail::sparse_layer(system_);
         sparse_problem_.pairs = problem_.pairs;
         sparse_problem_.tau_rule = problem_.tau_rule;
         sparse_problem_.tau_previous_n = problem_.tau_previous_n;
@@ -175,7 +178,7 @@ void NewmarkStepper::fill_record(int iterations, int factorizations) {
     const double f = system_.model().whole_spring_factor();
     const auto& body = system_.model().spec().rigid_body;
     const int w_dof = static_cast<int>(z_.size()) - 1;
-    const double strain = 0.5 * f * z_.dot(K_ * z_);
+    const double strain = f * (0.5 * z_.dot(K_ * z_) + detail::layer_energy_j(system_, p_));  // leaves and layer
     detail::fill_state(system_, problem_, p_, z_[w_dof], v_[w_dof], strain, dissipated_, e0_, detail::LoadState{}, record_);
     const double kinetic = 0.5 * f * v_.dot(M_ * v_);
     const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
@@ -199,12 +202,16 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
     //     (G_C M^-1 G_C^T) l = G_C v,   v <- v - M^-1 G_C^T l,
     // the inelastic impact law (restitution 0); the kinetic energy it removes,
     // 1/2 (v- - v+)^T M (v- - v+) >= 0, is returned [J, whole spring].
+    // Rows with an elastic layer are not held: their force is the layer's, a function of the
+    // state, and a closure there is not an impact (system.hpp).
     std::vector<int> held;
+    const Eigen::VectorXd& layer = system_.layer_compliance_m_per_n();
     for (std::size_t j = 0; j < problem_.pairs.size(); ++j) {
         const auto& pr = problem_.pairs[j];
         const PairState st = pair_state(problem_, static_cast<int>(j), p_);
-        if (pr.row_n >= 0 && (pr.kind != PairKind::coulomb || p_[pr.row_n] < 0.0)) held.push_back(pr.row_n);
-        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || st == PairState::stick) &&
+        if (pr.row_n >= 0 && layer[pr.row_n] == 0.0 && (pr.kind != PairKind::coulomb || p_[pr.row_n] < 0.0))
+            held.push_back(pr.row_n);
+        if (pr.row_t >= 0 && layer[pr.row_t] == 0.0 && (pr.kind == PairKind::bonded || st == PairState::stick) &&
             (pr.row_n < 0 || pr.kind != PairKind::coulomb || p_[pr.row_n] < 0.0))
             held.push_back(pr.row_t);
     }
@@ -313,7 +320,7 @@ const StepRecord& NewmarkStepper::advance() {
     // The contact forces' work over the step (newmark_stepper.hpp): p1^T G (z1 - z0) with
     // massive leaves, (p0 + p1)^T G (z1 - z0) / 2 with massless ones. Friction on the
     // tangential components; the rest (normal components, bonds) is the impact loss.
-    const Eigen::VectorXd rel1 = G * z1;
+    const Eigen::VectorXd rel1 = detail::relative_positions(system_, z1, p_);
     const Eigen::VectorXd pbar = massive_leaves_ ? Eigen::VectorXd(p_) : Eigen::VectorXd(0.5 * (p0 + p_));
     double friction_work = 0.0, other_work = 0.0;
     for (const auto& pr : problem_.pairs) {

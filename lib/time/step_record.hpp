@@ -34,6 +34,26 @@ void fill_state(const System& system, const ContactProblem& laws, const Eigen::V
 std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
                                      const Eigen::VectorXd& rel);
 
+/// The layer compliance for a SparseContactProblem (SparseContactProblem::layer_compliance):
+/// the system's c_L [m/N] when it has an elastic layer, else empty (rigid contact).
+inline Eigen::VectorXd sparse_layer(const System& system) {
+    return system.has_layer() ? system.layer_compliance_m_per_n() : Eigen::VectorXd();
+}
+
+/// The relative positions rel = s + d = G z + c_L p [m] from displacements z and forces p
+/// (c_L the elastic layer's compliance, 0 on rigid interfaces: system.hpp).
+inline Eigen::VectorXd relative_positions(const System& system, const Eigen::VectorXd& z, const Eigen::VectorXd& p) {
+    Eigen::VectorXd rel = system.contact_rows() * z;
+    if (system.has_layer()) rel += system.layer_compliance_m_per_n().cwiseProduct(p);
+    return rel;
+}
+
+/// The layer's elastic energy p^T C_L p / 2 on the meshed part [J] (0 on rigid interfaces).
+inline double layer_energy_j(const System& system, const Eigen::VectorXd& p) {
+    if (!system.has_layer()) return 0.0;
+    return 0.5 * p.dot(system.layer_compliance_m_per_n().cwiseProduct(p));
+}
+
 /// A fixed-step mode's counters after one more step whose record is `r`: one step, its
 /// contact iterations and factorisations added.
 inline void count_step(const StepRecord& r, RunReport& report) {

@@ -149,6 +149,12 @@ struct SparseContactProblem {
     Eigen::SparseMatrix<double> G;     ///< contact rows [-], m x n
     Eigen::VectorXd b;                 ///< load with p = 0, n entries
     Eigen::VectorXd d;                 ///< offsets [m], m entries (normal gaps, tangential anchors)
+    /// The elastic interface layer's compliance per row, c_L [m/N] (System::layer_compliance_m_per_n()):
+    /// s = G z + c_L p - d. Empty or all zero: rigid contact. The solver takes the layer as one extra
+    /// degree of freedom per layer row, of stiffness 1/c_L, between the surface and the contact force
+    /// (K' = diag(K, 1/c_L), G' = [G  E]): G' K'^-1 G'^T = G K^-1 G^T + diag(c_L), the same problem with
+    /// a positive definite K' (docs/decisions/013-elastic-interface.md).
+    Eigen::VectorXd layer_compliance;
     std::vector<ContactPair> pairs;    ///< the pairs and their rows (rows of G)
     TauRule tau_rule = TauRule::current;
     Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (TauRule::previous_step)
@@ -156,7 +162,7 @@ struct SparseContactProblem {
     int size() const { return static_cast<int>(d.size()); }
     /// Throws InputError if the sizes, rows or laws are inconsistent.
     void validate() const;
-    /// The equivalent dense problem (W = G K^-1 G^T, q = G K^-1 b - d): m solves and
+    /// The equivalent dense problem (W = G K^-1 G^T + diag(c_L), q = G K^-1 b - d): m solves and
     /// m^2 doubles; for tests and for the sparse solver's last-resort fallback.
     ContactProblem to_dense() const;
 };
@@ -218,16 +224,16 @@ public:
     SparseContactSolver& operator=(const SparseContactSolver&) = delete;
 
     /// Solves `problem`; p is the warm start on entry and the forces [N] on exit; z the
-    /// displacements on exit. It keeps its factorisations while K and G stay the same:
+    /// displacements on exit (K's degrees of freedom; the layer's deflection is c_L p). It keeps its factorisations while K and G stay the same:
     /// it compares them with the previous call's (O(nnz)), unless the caller passes
     /// `structure_unchanged` = true, a promise that K, G and the pairs are those of the
     /// previous call on this solver (the closed-form stepper's are constant over a run;
     /// at 10 leaves x 400 elements the comparison was a quarter of a step's cost).
     SolveResult solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
                       bool structure_unchanged = false);
-    /// s = G z - d at the last solution [m].
+    /// s = G z + c_L p - d at the last solution [m].
     const Eigen::VectorXd& relative_positions() const;
-    /// Diagonal of W = G K^-1 G^T [m/N] (computed once per K, G: it scales the force
+    /// Diagonal of W = G K^-1 G^T + diag(c_L) [m/N] (computed once per K, G: it scales the force
     /// violations to metres as in the dense solver).
     const Eigen::VectorXd& compliance_diagonal() const;
 

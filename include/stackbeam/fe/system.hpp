@@ -8,7 +8,8 @@
 /// displacement (+y). With massless leaves, for contact forces p and w given,
 ///     s = C' p + c w - d                  (eq. 6 with eq. 12 eliminated: u = C'p + (A/a) w)
 ///     f = k w - c^T p                     (force of R on the stack, +y; eq. 12: w = A^T p + a f)
-/// C' = G_r K_rr^-1 G_r^T is the compliance with R held (eq. A3, SPD), k = 1/a the
+/// C' = G_r K_rr^-1 G_r^T + C_L is the compliance with R held (eq. A3, SPD), C_L = diag(c_L)
+/// the elastic interface layer's compliance per contact row (0 on rigid interfaces), k = 1/a the
 /// stiffness at R with no contact force, c = A/a the relative surface motion
 /// per unit w. All of it on the meshed part (half the spring on the half model).
 #include <Eigen/Dense>
@@ -44,13 +45,24 @@ public:
     int num_components() const noexcept { return static_cast<int>(gaps_.size()); }
     /// d_n per row for normal rows (the initial gap) and 0 for tangential rows [m].
     const Eigen::VectorXd& initial_offsets_m() const noexcept { return gaps_; }
-    /// Compliance of the contact points with R held, C' [m/N] (eq. A3). Dense,
+    /// Compliance of the contact points with R held, C' [m/N] (eq. A3), the elastic
+    /// interface layer's diagonal C_L included (layer_compliance_m_per_n()). Dense,
     /// num_components()^2 doubles: built on the first call (one sparse solve per
     /// contact row), not by the constructor, so that a large model run on the sparse
     /// contact path (simulation.hpp, ContactPath) never pays for it. Thread-safe.
     const Eigen::MatrixXd& compliance_held() const;
+    /// The elastic interface layer's compliance per contact row, c_L [m/N]: 1/(k_n A) on a
+    /// normal row, 1/(k_t A) on a tangential row of an elastic interface (PairSpec), 0 on a
+    /// rigid one. With contact forces p the relative position is s = G z + c_L p - d: the
+    /// layer deflects by c_L p (a compressed pair, p_n < 0, lets the leaves approach by
+    /// -c_L p_n), so a closed pair (s_n = 0) carries p_n = -(G z - d)_n / c_L and a sticking
+    /// one p_t = -(G z - d)_t / c_L, and the layer stores p^T C_L p / 2.
+    const Eigen::VectorXd& layer_compliance_m_per_n() const noexcept { return layer_; }
+    /// Whether any contact row has an elastic layer.
+    bool has_layer() const noexcept { return layer_.size() > 0 && layer_.maxCoeff() > 0.0; }
     /// Contact rows on the reduced DOFs, G [-] (num_components() x num_reduced_dofs(),
-    /// w last): s = G z - d for reduced displacements z (paper eq. 1 and 7).
+    /// w last): s = G z - d for reduced displacements z (paper eq. 1 and 7; plus c_L p with
+    /// an elastic layer).
     const Eigen::SparseMatrix<double>& contact_rows() const noexcept { return G_; }
     /// c = A/a: relative surface displacement per unit w with p = 0 [-].
     const Eigen::VectorXd& coupling() const noexcept { return c_; }
@@ -89,6 +101,7 @@ private:
     std::vector<ContactPair> pairs_;
     std::vector<int> pair_candidate_;
     Eigen::VectorXd gaps_;
+    Eigen::VectorXd layer_;                         // c_L per contact row [m/N]
     struct LazyCompliance;                          // C', built once on demand
     std::shared_ptr<LazyCompliance> C_held_;        // shared by copies (same model, same C')
     Eigen::SparseMatrix<double> G_;                 // contact rows x reduced DOFs (w last)

@@ -43,10 +43,10 @@ struct LeafSpec {
     double width_m = 0.0;                   ///< width [m], > 0
     double youngs_modulus_pa = 0.0;         ///< Young's modulus [Pa], > 0
     double density_kg_per_m3 = 0.0;         ///< mass density [kg/m^3], >= 0 (0: massless, as in the paper)
-    double poisson_ratio = 0.3;             ///< Poisson's ratio nu [-], in (-1, 0.5): the elastic interface's
-                                            ///< derived stiffness (interface_layer); nothing else uses it
     SupportKind left_support = SupportKind::free;   ///< support at x_start_m
     SupportKind right_support = SupportKind::free;  ///< support at x_start_m + length_m
+    double poisson_ratio = 0.3;             ///< Poisson's ratio nu [-], in (-1, 0.5): the elastic interface's
+                                            ///< derived stiffness (interface_layer); nothing else uses it
 };
 
 /// The interface between leaf i (above) and leaf i+1 (below).

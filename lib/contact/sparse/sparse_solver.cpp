@@ -115,6 +115,12 @@ void SparseContactProblem::validate() const {
     if (b.size() != n) throw InputError("problem.b", "must have one entry per row of K");
     if (!b.allFinite()) throw InputError("problem.b", "has a non-finite entry");
     if (!d.allFinite()) throw InputError("problem.d", "has a non-finite entry");
+    if (layer_compliance.size() != 0 && layer_compliance.size() != d.size())
+        throw InputError("problem.layer_compliance", "has " + std::to_string(layer_compliance.size()) +
+                                                         " entries: must be empty or one per row of G (" +
+                                                         std::to_string(d.size()) + ")");
+    if (layer_compliance.size() != 0 && !(layer_compliance.allFinite() && layer_compliance.minCoeff() >= 0.0))
+        throw InputError("problem.layer_compliance", "has a negative or non-finite entry: must be finite and >= 0 [m/N]");
     detail::validate_laws(pairs, size(), tau_rule, tau_previous_n);
 }
 
@@ -126,6 +132,7 @@ ContactProblem SparseContactProblem::to_dense() const {
     pr.W = G * X;
     pr.W = 0.5 * (pr.W + pr.W.transpose()).eval();
     pr.q = G * llt.solve(b) - d;
+    if (layer_compliance.size() == pr.W.rows()) pr.W.diagonal() += layer_compliance;
     pr.pairs = pairs;
     pr.tau_rule = tau_rule;
     pr.tau_previous_n = tau_previous_n;
@@ -176,6 +183,43 @@ struct SparseContactSolver::Impl {
         : path(options, detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows},
                detail::sparse::current_switches()),
           newton_min_rows(tuning.newton_min_rows) {}
+
+    // The elastic layer (SparseContactProblem::layer_compliance) as extra degrees of freedom:
+    // the augmented problem, rebuilt when the caller does not promise the same structure.
+    SparseContactProblem layered;
+    Eigen::VectorXd z_layered;
+
+    /// Builds `layered` from `pr`: K' = diag(K, 1/c_L) over the layer rows, G' = [G  E] with
+    /// E(r, n + j) = 1 for the j-th layer row r, b' = [b; 0]. Returns false if no row has a layer.
+    bool layer_structure(const SparseContactProblem& pr) {
+        const int n = static_cast<int>(pr.K.rows());
+        std::vector<int> rows;
+        for (int r = 0; r < pr.layer_compliance.size(); ++r)
+            if (pr.layer_compliance[r] > 0.0) rows.push_back(r);
+        if (rows.empty()) return false;
+        const int ne = static_cast<int>(rows.size());
+        std::vector<Eigen::Triplet<double>> kt, gt;
+        kt.reserve(static_cast<std::size_t>(pr.K.nonZeros()) + rows.size());
+        for (int col = 0; col < pr.K.outerSize(); ++col)
+            for (detail::sparse::SpMat::InnerIterator it(pr.K, col); it; ++it)
+                kt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+        for (int col = 0; col < pr.G.outerSize(); ++col)
+            for (detail::sparse::SpMat::InnerIterator it(pr.G, col); it; ++it)
+                gt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+        for (int j = 0; j < ne; ++j) {
+            kt.emplace_back(n + j, n + j, 1.0 / pr.layer_compliance[rows[j]]);
+            gt.emplace_back(rows[j], n + j, 1.0);
+        }
+        layered.K.resize(n + ne, n + ne);
+        layered.K.setFromTriplets(kt.begin(), kt.end());
+        layered.K.makeCompressed();
+        layered.G.resize(pr.G.rows(), n + ne);
+        layered.G.setFromTriplets(gt.begin(), gt.end());
+        layered.G.makeCompressed();
+        layered.b = Eigen::VectorXd::Zero(n + ne);
+        layered.layer_compliance.resize(0);
+        return true;
+    }
 
     void reset_structure(const SparseContactProblem& pr) {
         path.reset(pr);
@@ -268,8 +312,31 @@ const Eigen::VectorXd& SparseContactSolver::compliance_diagonal() const { return
 
 SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z,
                                        bool structure_unchanged) {
-    using namespace detail::sparse;
     Impl& im = *impl_;
+    if (problem.layer_compliance.size() > 0) {
+        // The elastic layer: the same problem on the augmented stiffness (Impl::layer_structure).
+        const int n = static_cast<int>(problem.K.rows());
+        const bool have = im.layered.K.rows() > n && im.layered.G.rows() == problem.G.rows();
+        if (!structure_unchanged || !have) {
+            problem.validate();
+            if (!im.layer_structure(problem)) {
+                SparseContactProblem rigid = problem;  // every entry 0: rigid contact
+                rigid.layer_compliance.resize(0);
+                return solve(rigid, p, z, false);
+            }
+        }
+        SparseContactProblem& lp = im.layered;
+        if (problem.b.size() != n) problem.validate();
+        lp.b.head(n) = problem.b;
+        lp.d = problem.d;
+        lp.pairs = problem.pairs;
+        lp.tau_rule = problem.tau_rule;
+        lp.tau_previous_n = problem.tau_previous_n;
+        const SolveResult r = solve(lp, p, im.z_layered, structure_unchanged && have);
+        z = im.z_layered.head(n);
+        return r;
+    }
+    using namespace detail::sparse;
     SparsePath& path = im.path;
     const SparseStiffness& st = path.stiffness();
     const int m = problem.size();

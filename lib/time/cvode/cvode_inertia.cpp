@@ -35,7 +35,13 @@ struct CvodeInertiaStepper::Impl {
     SimulationOptions opt;
     int n = 0, r = 0;
     Eigen::SparseMatrix<double> K, M;
-    std::vector<int> held;     // the held contact rows (bonded: both; mu = 0: the normal one)
+    std::vector<int> held;     // the held contact rows (bonded: both; mu = 0: the normal one), rigid ones
+    // Held rows with an elastic layer (system.hpp) are springs of stiffness 1/c_L in K instead:
+    // K = K_leaves + G_L^T D G_L, load f_L = G_L^T D d_L, their force p_L = -D (G_L z - d_L).
+    std::vector<int> springs;  // those rows
+    Eigen::SparseMatrix<double> GL;  // their rows of G
+    Eigen::VectorXd DL, dL;    // their stiffness 1/c_L [N/m] and offsets [m]
+    Eigen::VectorXd fL;        // G_L^T D d_L [N]
     Eigen::MatrixXd Gd;        // the held contact rows of G, dense [-]
     Eigen::VectorXd dC;        // their offsets [m]
     double F_ref = 1.0;        // force scale of the release check [N]
@@ -97,12 +103,14 @@ struct CvodeInertiaStepper::Impl {
         const Eigen::VectorXd v = NPhi * xid;
         const Eigen::VectorXd a = NPhi * Eigen::VectorXd(g - om.cwiseProduct(om).cwiseProduct(xi));
         // the held components' forces: G^T p = M a + K z (least squares: exact on range(G^T))
-        const Eigen::VectorXd pC = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(M * a + K * z)))
+        const Eigen::VectorXd pC = Gd.rows() > 0 ? Eigen::VectorXd(GGt.solve(Gd * Eigen::VectorXd(springs.empty() ? Eigen::VectorXd(M * a + K * z) : Eigen::VectorXd(M * a + K * z - fL))))
                                                  : Eigen::VectorXd();
         Eigen::VectorXd p = Eigen::VectorXd::Zero(sys.num_components());
         for (int k = 0; k < static_cast<int>(held.size()); ++k) p[held[k]] = pC[k];
+        const Eigen::VectorXd spring_stretch = GL * z - dL;  // G_L z - d_L [m]
+        for (int k = 0; k < static_cast<int>(springs.size()); ++k) p[springs[k]] = -DL[k] * spring_stretch[k];
         p_out = p;
-        rel_out = sys.contact_rows() * z;
+        rel_out = relative_positions(sys, z, p);
         // a held unilateral pair must stay compressed (p_n <= 0): a release is an event,
         // not built yet with massive leaves
         for (const auto& pr : laws.pairs)
@@ -112,7 +120,8 @@ struct CvodeInertiaStepper::Impl {
                                       " s: contact events between massive leaves are not built yet, use mode newmark",
                                   out_index, t, 0.0);
         const double f = sys.model().whole_spring_factor();
-        const double strain = 0.5 * f * z.dot(K * z);
+        // leaves and layer: z^T K z / 2 - f_L^T z + d_L^T D d_L / 2 = z^T K_leaves z / 2 + (G_L z - d_L)^T D (G_L z - d_L) / 2
+        const double strain = f * (0.5 * z.dot(K * z) - fL.dot(z) + 0.5 * dL.dot(DL.cwiseProduct(dL)));
         fill_state(sys, laws, p, z[n - 1], v[n - 1], strain, 0.0, e0, LoadState{}, rec);
         const double kinetic = 0.5 * f * v.dot(M * v);
         rec.leaf_kinetic_energy_j = kinetic - rec.kinetic_energy_j;
@@ -143,10 +152,32 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
                                                  "stacks only so far (pair ") + std::to_string(j) + " is " +
                                          to_string(pr.kind) + " with mu = " + format_value(pr.friction_coefficient) +
                                          ": contact events between massive leaves are not built yet): use mode newmark");
-        if (pr.row_n >= 0) s.held.push_back(pr.row_n);
-        if (pr.row_t >= 0 && pr.kind == PairKind::bonded) s.held.push_back(pr.row_t);
+        const Eigen::VectorXd& layer = system.layer_compliance_m_per_n();
+        for (int row : {pr.row_n, pr.kind == PairKind::bonded ? pr.row_t : -1}) {
+            if (row < 0) continue;
+            (layer[row] > 0.0 ? s.springs : s.held).push_back(row);
+        }
     }
     s.K = system.stiffness_reduced();
+    {
+        const int ns = static_cast<int>(s.springs.size());
+        const Eigen::SparseMatrix<double, Eigen::RowMajor> Grow = system.contact_rows();
+        std::vector<Eigen::Triplet<double>> t;
+        s.DL.resize(ns);
+        s.dL.resize(ns);
+        for (int k = 0; k < ns; ++k) {
+            const int row = s.springs[k];
+            for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Grow, row); it; ++it)
+                t.emplace_back(k, static_cast<int>(it.col()), it.value());
+            s.DL[k] = 1.0 / system.layer_compliance_m_per_n()[row];
+            s.dL[k] = system.initial_offsets_m()[row];
+        }
+        s.GL.resize(ns, s.K.cols());
+        s.GL.setFromTriplets(t.begin(), t.end());
+        const Eigen::SparseMatrix<double> GLt = s.GL.transpose();
+        if (ns > 0) s.K = (s.K + GLt * s.DL.asDiagonal() * s.GL).pruned();  // rigid stacks: K as it was
+        s.fL = GLt * s.DL.cwiseProduct(s.dL);
+    }
     s.M = system.mass_reduced();
     s.n = static_cast<int>(s.K.rows());
     const int m = static_cast<int>(s.held.size());
@@ -186,7 +217,8 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
         throw SolverError("cvode mode (leaf inertia): the modal analysis of the held stack failed", 0, 0.0, 0.0);
     s.Phi = eig.eigenvectors();
     s.om = eig.eigenvalues().cwiseSqrt();
-    s.g = -s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.K * s.zp));
+    s.g = s.springs.empty() ? Eigen::VectorXd(-s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.K * s.zp)))
+                            : Eigen::VectorXd(s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.fL - s.K * s.zp)));
     s.NPhi = s.N * s.Phi;
 
     // initial state: the tied static shape at w(0), the tied shape per unit w times w'(0)

@@ -314,6 +314,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     const Eigen::MatrixXd GPhiS = s.GPhi * s.om.cwiseInverse().asDiagonal();
     s.W = Gd * KiGt - GPhiS * GPhiS.transpose();
     s.W = 0.5 * (s.W + s.W.transpose()).eval();
+    s.W.diagonal() += system.layer_compliance_m_per_n();  // the elastic layer, massless (system.hpp)
     s.phiw = s.Phi.row(s.w_dof).transpose();
     s.rw = KiGt.row(s.w_dof).transpose() - s.GPhi * s.om.cwiseProduct(s.om).cwiseInverse().cwiseProduct(s.phiw);
 
