@@ -123,6 +123,7 @@ set(_cli_bad_cases
   "beam_density_negative|--beam-density|-7850|--beam-density: value '-7850' is not allowed: must be a finite number >= 0 [kg/m^3]"
   "beam_density_nan|--beam-density|nan|--beam-density: value 'nan' is not allowed"
   "beam_density_massless_mode|--beam-density|7850|--beam-density: value '7850' needs --mode newmark"
+  "interface_unknown|--interface|bogus|--interface: value 'bogus' is not allowed: must be 'rigid' or 'elastic'"
 )
 foreach(entry IN LISTS _cli_bad_cases)
   string(REPLACE "|" ";" fields "${entry}")
@@ -298,6 +299,29 @@ stackbeam_cli_test(NAME cli_friction_mesh_ratio_failure
                         --out ${_cli_out_dir}/cli_k2.csv
                    EXPECT_RC 3 EXPECT_TEXT "the friction-mesh ratio mu (t_i + t_i+1) / (2 h) is 2 on interface 0"
                    OUT ${_cli_out_dir}/cli_k2.csv)
+
+# The elastic interface (issue 18): --interface elastic on the paper case reports each
+# interface's layer in the JSON summary (k_n = E / (1 - nu^2) / t = 2e10 / 0.91 / 0.005 =
+# 4.3956e12 Pa/m, model.hpp interface_layer) and the ratio's decay length (l = 3.1203e-3 m,
+# tests/test_friction_mesh_ratio.cpp); over a scenario file it overrides the file's contact
+# law, and the note before the run warns of the elastic law at mu = 0.8 (>= 0.7).
+stackbeam_cli_test(NAME cli_interface_elastic_summary
+                   ARGS simulate --case friction --interface elastic --t-end 0.002 --quiet --out ${_cli_out_dir}/cli_el.csv
+                        --summary ${_cli_out_dir}/cli_el.json
+                   EXPECT_RC 0 EXPECT_TEXT "elastic: k_n 4.396e+12 Pa/m" OUT ${_cli_out_dir}/cli_el.csv
+                   JSON ${_cli_out_dir}/cli_el.json JSON_PATH "interfaces|1|normal_stiffness_pa_per_m"
+                   JSON_RANGE "4.3956e12|4.3957e12")
+stackbeam_cli_test(NAME cli_interface_elastic_decay_length
+                   ARGS simulate --case friction --interface elastic --t-end 0.002 --quiet --out ${_cli_out_dir}/cli_el2.csv
+                        --summary ${_cli_out_dir}/cli_el2.json
+                   EXPECT_RC 0 OUT ${_cli_out_dir}/cli_el2.csv
+                   JSON ${_cli_out_dir}/cli_el2.json JSON_PATH "friction_mesh_ratio|decay_length_m"
+                   JSON_RANGE "3.1202e-3|3.1203e-3")
+stackbeam_cli_test(NAME cli_interface_over_scenario_warns
+                   ARGS simulate --scenario ${CMAKE_CURRENT_LIST_DIR}/cli_elastic_high_mu.toml --interface elastic
+                        --t-end 0.002 --quiet --out ${_cli_out_dir}/cli_el3.csv
+                   EXPECT_RC 0 EXPECT_TEXT "note: interface 0 has the elastic law with mu = 0.8"
+                   OUT ${_cli_out_dir}/cli_el3.csv)
 
 # Interruption (apps/cli/run.hpp): SIGTERM / SIGINT once the first rows are on disk; exit
 # status 143 / 130, the .partial files end on whole rows (every line the header's field

@@ -98,3 +98,56 @@ BOOST_AUTO_TEST_CASE(failed_step_names_the_ratio) {
         }
     }
 }
+
+// ---- the elastic interface (issue 18): kappa = mu (t_i + t_i+1) / (2 max(h, l)) ---------------
+
+namespace {
+ModelSpec elastic_paper(int elements_per_half_leaf, double mu) {
+    ModelSpec s = paper(PaperCase::friction, elements_per_half_leaf);
+    for (auto& f : s.interfaces) {
+        f.contact = InterfaceContact::elastic;
+        f.friction_coefficient = mu;
+    }
+    return s;
+}
+// The paper's leaves (5 mm, b = 50 mm, E = 2e10 Pa, nu = 0.3) by hand:
+//   k_n = E / (1 - nu^2) / t = 2e10 / 0.91 / 0.005 = 4.3956044e12 Pa/m,
+//   EI = 2e10 * 0.05 * 0.005^3 / 12 = 10.416667 N m^2, EI_eq = EI / 2 = 5.2083333 N m^2,
+//   l = (4 EI_eq / (k_n b))^(1/4) = (20.833333 / 2.1978022e11)^(1/4) = 3.1202726e-3 m.
+constexpr double kDecayLength = 3.1202726e-3;
+constexpr double kDecayDigits = 1e-7;  // 8 digits written above
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(elastic_ratio_uses_the_longer_of_spacing_and_decay_length) {
+    // coarse: 20 elements, h = 12.5 mm > l: kappa = 0.5 * 0.005 / 0.0125 = 0.2, as rigid
+    const FrictionMeshRatio coarse = friction_mesh_ratio(Model::build(elastic_paper(20, 0.5)));
+    BOOST_TEST(coarse.elastic);
+    BOOST_TEST(coarse.ratio == 0.2, tt::tolerance(kRoundOff));
+    BOOST_TEST(coarse.decay_length_m == kDecayLength, tt::tolerance(kDecayDigits));
+    // fine: 400 elements, h = 0.625 mm < l: kappa = 0.5 * 0.005 / l = 0.80121 (rigid: 4)
+    const FrictionMeshRatio fine = friction_mesh_ratio(Model::build(elastic_paper(400, 0.5)));
+    BOOST_TEST(fine.elastic);
+    BOOST_TEST(fine.pair_spacing_m == 0.25 / 400, tt::tolerance(kRoundOff));
+    BOOST_TEST(fine.ratio == 0.5 * 0.005 / kDecayLength, tt::tolerance(kDecayDigits));
+    BOOST_TEST(fine.spacing_for_one_m == 0.5 * 0.005, tt::tolerance(kRoundOff));
+    // rigid: no decay length
+    const FrictionMeshRatio rigid = friction_mesh_ratio(Model::build(paper(PaperCase::friction, 400)));
+    BOOST_TEST(!rigid.elastic);
+    BOOST_TEST(rigid.decay_length_m == 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(advice_names_the_elastic_law_and_warns_at_high_mu) {
+    // rigid, kappa = 2: the advice offers the elastic law
+    const std::string rigid = friction_mesh_advice(Model::build(paper(PaperCase::friction, 200)));
+    BOOST_TEST(rigid.find("interfaces[0].contact = \"elastic\"") != std::string::npos);
+    // elastic, mu = 0.8 (>= 0.7): the warning, on a coarse mesh too
+    for (const int n : {20, 400}) {
+        const std::string warn = friction_mesh_advice(Model::build(elastic_paper(n, 0.8)));
+        BOOST_TEST_CONTEXT(n << " elements: " << warn) {
+            BOOST_TEST(warn.find("elastic law with mu = 0.8") != std::string::npos);
+            BOOST_TEST(warn.find("1.43 mu") != std::string::npos);
+        }
+    }
+    // elastic, mu = 0.3 on the fine mesh (kappa = 0.3 * 0.005 / l = 0.48): nothing to say
+    BOOST_TEST(friction_mesh_advice(Model::build(elastic_paper(400, 0.3))).empty());
+}

@@ -4,6 +4,7 @@
 // suite, tests/bad_input/*.toml, is in bad_input_tests.cmake.)
 #define BOOST_TEST_MODULE scenario
 #include <boost/test/unit_test.hpp>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -34,6 +35,7 @@ void check_same_spec(const ModelSpec& a, const ModelSpec& b) {
             BOOST_TEST(x.width_m == y.width_m);
             BOOST_TEST(x.youngs_modulus_pa == y.youngs_modulus_pa);
             BOOST_TEST(x.density_kg_per_m3 == y.density_kg_per_m3);
+            BOOST_TEST(x.poisson_ratio == y.poisson_ratio);
             BOOST_TEST((x.left_support == y.left_support));
             BOOST_TEST((x.right_support == y.right_support));
         }
@@ -43,11 +45,15 @@ void check_same_spec(const ModelSpec& a, const ModelSpec& b) {
         BOOST_TEST((a.interfaces[i].law == b.interfaces[i].law));
         BOOST_TEST(a.interfaces[i].friction_coefficient == b.interfaces[i].friction_coefficient);
         BOOST_TEST(a.interfaces[i].initial_gap_m == b.interfaces[i].initial_gap_m);
+        BOOST_TEST((a.interfaces[i].contact == b.interfaces[i].contact));
+        BOOST_TEST(a.interfaces[i].normal_stiffness_pa_per_m == b.interfaces[i].normal_stiffness_pa_per_m);
+        BOOST_TEST(a.interfaces[i].tangential_stiffness_pa_per_m == b.interfaces[i].tangential_stiffness_pa_per_m);
     }
     BOOST_TEST_REQUIRE(a.clamps.size() == b.clamps.size());
     for (std::size_t i = 0; i < a.clamps.size(); ++i) {
         BOOST_TEST(a.clamps[i].x_m == b.clamps[i].x_m);
         BOOST_TEST(a.clamps[i].preload_n == b.clamps[i].preload_n);
+        BOOST_TEST(a.clamps[i].length_m == b.clamps[i].length_m);
     }
     BOOST_TEST(a.rigid_body.mass_kg == b.rigid_body.mass_kg);
     BOOST_TEST(a.rigid_body.x_m == b.rigid_body.x_m);
@@ -162,6 +168,16 @@ std::string edit(const std::string& from, const std::string& to) {
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
+/// "test.toml:LINE:" of the last line of the first place where a line starts with `key`
+/// (which may span lines; 1-based line numbers).
+std::string place_of(const std::string& text, const std::string& key) {
+    const auto pos = text.find("\n" + key);
+    BOOST_TEST_REQUIRE(pos != std::string::npos);
+    const long line = 2 + std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n') +
+                      std::count(key.begin(), key.end(), '\n');
+    return "test.toml:" + std::to_string(line) + ":";
+}
+
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(paper_bonded_file_reproduces_builtin) { check_reproduces("paper_bonded.toml", PaperCase::bonded, 0.3); }
@@ -265,4 +281,71 @@ BOOST_AUTO_TEST_CASE(malformed_and_unreadable) {
     const std::string text = "description = \"" + deep + "\"  # " + deep + "\n" + "# '''\"\"\" " + deep + "\n" + kGood;
     BOOST_TEST(rejection(text).first == "accepted");
     BOOST_TEST(parse_scenario(text, "t").description == deep);
+}
+
+// Issue 18: the elastic interface's keys reach the ModelSpec; absent, the defaults hold
+// (rigid, stiffnesses derived, nu = 0.3, point clamps).
+BOOST_AUTO_TEST_CASE(elastic_interface_keys) {
+    const Scenario d = parse_scenario(kGood, "good.toml");
+    BOOST_TEST((d.model.interfaces[0].contact == InterfaceContact::rigid));
+    BOOST_TEST(d.model.interfaces[0].normal_stiffness_pa_per_m == 0.0);
+    BOOST_TEST(d.model.interfaces[0].tangential_stiffness_pa_per_m == 0.0);
+    for (const auto& l : d.model.leaves) BOOST_TEST(l.poisson_ratio == 0.3);
+    BOOST_TEST(d.model.clamps[0].length_m == 0.0);
+
+    std::string text = edit("friction_coefficient = 0.3\n",
+                            "friction_coefficient = 0.3\ncontact = \"elastic\"\nnormal_stiffness_pa_per_m = 2.5e13\n"
+                            "tangential_stiffness_pa_per_m = 1e13\n");
+    text.replace(text.find("preload_n = 500\n"), 16, "preload_n = 500\nlength_m = 0.04\n");
+    text.replace(text.find("youngs_modulus_pa = 2.1e11\n"), 27, "youngs_modulus_pa = 2.1e11\npoisson_ratio = 0.29\n");
+    const Scenario s = parse_scenario(text, "test.toml");
+    BOOST_TEST((s.model.interfaces[0].contact == InterfaceContact::elastic));
+    BOOST_TEST(s.model.interfaces[0].normal_stiffness_pa_per_m == 2.5e13);
+    BOOST_TEST(s.model.interfaces[0].tangential_stiffness_pa_per_m == 1e13);
+    BOOST_TEST(s.model.leaves[0].poisson_ratio == 0.29);
+    BOOST_TEST(s.model.leaves[1].poisson_ratio == 0.3);
+    BOOST_TEST(s.model.clamps[0].length_m == 0.04);
+    BOOST_TEST(s.key_locations.count("interfaces[0].contact") == 1u);
+
+    // elastic without stiffnesses: derived (0 in the spec)
+    const Scenario e = parse_scenario(edit("friction_coefficient = 0.3\n", "friction_coefficient = 0.3\ncontact = \"elastic\"\n"),
+                                      "test.toml");
+    BOOST_TEST((e.model.interfaces[0].contact == InterfaceContact::elastic));
+    BOOST_TEST(e.model.interfaces[0].normal_stiffness_pa_per_m == 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(elastic_interface_keys_rejected_at_their_line) {
+    struct Case {
+        std::string from, to, field, key, text;
+    };
+    const std::vector<Case> cases = {
+        {"friction_coefficient = 0.3\n", "friction_coefficient = 0.3\ncontact = \"soft\"\n", "interfaces[0].contact",
+         "contact", "value 'soft' is not allowed: must be 'rigid' or 'elastic'"},
+        {"friction_coefficient = 0.3\n", "friction_coefficient = 0.3\ncontact = 1\n", "interfaces[0].contact", "contact",
+         "wrong type, an integer: must be a string"},
+        {"friction_coefficient = 0.3\n",
+         "friction_coefficient = 0.3\ncontact = \"elastic\"\nnormal_stiffness_pa_per_m = -1e13\n",
+         "interfaces[0].normal_stiffness_pa_per_m", "normal_stiffness_pa_per_m",
+         "value -1e+13 is not allowed: must be finite and >= 0 [Pa/m]"},
+        {"friction_coefficient = 0.3\n", "friction_coefficient = 0.3\ntangential_stiffness_pa_per_m = 1e13\n",
+         "interfaces[0].tangential_stiffness_pa_per_m", "tangential_stiffness_pa_per_m",
+         "value 1e+13 is given but interfaces[0].contact is 'rigid'"},
+        {"youngs_modulus_pa = 2.1e11\n", "youngs_modulus_pa = 2.1e11\npoisson_ratio = 0.5\n", "leaves[0].poisson_ratio",
+         "poisson_ratio", "value 0.5 is not allowed: must be in (-1, 0.5)"},
+        {"preload_n = 500\n", "preload_n = 500\nlength_m = -1\n", "clamps[0].length_m", "preload_n = 500\nlength_m",
+         "value -1 is not allowed: must be finite and >= 0 [m]"},
+        {"friction_coefficient = 0.3\n", "friction_coefficient = 0.3\nnormal_stifness_pa_per_m = 1\n",
+         "interfaces[0].normal_stifness_pa_per_m", "normal_stifness", "allowed keys are law, friction_coefficient, "
+         "initial_gap_m, contact, normal_stiffness_pa_per_m, tangential_stiffness_pa_per_m"},
+    };
+    for (const auto& c : cases) {
+        const std::string text = edit(c.from, c.to);
+        const auto [field, what] = rejection(text);
+        BOOST_TEST_CONTEXT(c.field << ": " << what) {
+            BOOST_TEST(field == c.field);
+            BOOST_TEST(what.rfind(place_of(text, c.key), 0) == 0);  // "test.toml:LINE:COLUMN: field: ..."
+            BOOST_TEST(contains(what, ": " + c.field + ": "));
+            BOOST_TEST(contains(what, c.text));
+        }
+    }
 }

@@ -58,6 +58,25 @@ double parse_density(const std::string& text) {
     return value;
 }
 
+/// --interface: the contact law of every interface, "rigid" | "elastic".
+InterfaceContact parse_interface(const std::string& text) {
+    try {
+        return parse_interface_contact(text, "--interface");
+    } catch (const InputError& e) {
+        throw ArgumentError(e.what());  // "--interface: value 'x' is not allowed: must be 'rigid' or 'elastic'"
+    }
+}
+
+/// Sets every interface's contact law (--interface) over the case's or the file's. With rigid,
+/// a layer stiffness the file gives is unused and dropped (it needs contact = elastic).
+void apply_interface(const std::optional<InterfaceContact>& contact, ModelSpec& spec) {
+    if (!contact) return;
+    for (auto& f : spec.interfaces) {
+        f.contact = *contact;
+        if (*contact == InterfaceContact::rigid) f.normal_stiffness_pa_per_m = f.tangential_stiffness_pa_per_m = 0.0;
+    }
+}
+
 /// The flag of `spec` the user gave ("" if neither its name nor its alias).
 std::string given_flag(const SimulateArgs& a, const OptionSpec& spec) {
     if (a.given.count(spec.flag)) return spec.flag;
@@ -130,6 +149,11 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
                    "paper), > 0 = leaves with mass (mode newmark; mode cvode) (default: the case's or the file's, "
                    "0 in the paper cases)")
         ->type_name("KG_PER_M3");
+    sim.add_option("--interface", a.interface,
+                   "contact law of every interface: rigid (surface points node to node, the paper) | elastic (an "
+                   "elastic layer of the leaves' own through-thickness stiffness; docs/model-and-scenarios.md, "
+                   "\"Elastic interfaces\"); file key interfaces[i].contact (default: the case's or the file's, rigid)")
+        ->type_name("LAW");
     sim.add_option("--out", a.out,
                    "output CSV file (written as FILE.partial, renamed when complete); required unless the scenario names "
                    "one (file key outputs.csv_path)")
@@ -153,6 +177,8 @@ RunRequest make_request(const SimulateArgs& a) {
     r.plot = a.plot;
     r.quiet = a.quiet;
     const bool density_given = a.given.count("--beam-density") > 0;
+    std::optional<InterfaceContact> contact;  // --interface, checked before the file is read
+    if (a.given.count("--interface") > 0) contact = parse_interface(a.interface);
     if (!a.scenario.empty()) {
         // A scenario file; options given on the command line override its values.
         r.scenario = load_scenario(a.scenario);
@@ -170,6 +196,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (r.plot.empty()) r.plot = scenario.outputs.plot_prefix;
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
+        apply_interface(contact, r.spec);
         r.setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
@@ -182,6 +209,7 @@ RunRequest make_request(const SimulateArgs& a) {
         r.spec = paper_example(pcase, example);
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
+        apply_interface(contact, r.spec);
         r.setup = std::string("case ") + to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
                   " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
     }

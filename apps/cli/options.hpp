@@ -35,6 +35,7 @@ struct SimulateArgs {
     std::string elements;      ///< "" = the library's default (PaperExampleOptions)
     bool full_model = false;
     std::string beam_density;  ///< "" = the leaves' own density (the case's: 0, massless)
+    std::string interface;     ///< --interface: "" = the case's or the file's contact law (rigid | elastic)
     std::string out, events, summary, pairs, plot;
     bool quiet = false;
     std::map<std::string, std::string> table_text;  ///< flag (or alias) of the option table -> text

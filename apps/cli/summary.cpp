@@ -16,6 +16,25 @@ namespace {
 /// The initial energy: the body's, and the leaves' in mode newmark (the first record).
 double initial_energy(const RunStats& s) { return s.first.kinetic_energy_j + s.first.strain_energy_j; }
 
+/// The contact law of every interface; for an elastic one the layer used (interface_layer):
+/// k_n, k_t [Pa/m] and the decay length l [m].
+nlohmann::json interfaces_json(const Model& model) {
+    nlohmann::json list = nlohmann::json::array();
+    const ModelSpec& spec = model.spec();
+    for (std::size_t i = 0; i < spec.interfaces.size(); ++i) {
+        const InterfaceContact contact = spec.interfaces[i].contact;
+        nlohmann::json f = {{"index", i}, {"contact", to_string(contact)}};
+        if (contact == InterfaceContact::elastic) {
+            const InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
+            f["normal_stiffness_pa_per_m"] = layer.normal_stiffness_pa_per_m;
+            f["tangential_stiffness_pa_per_m"] = layer.tangential_stiffness_pa_per_m;
+            f["decay_length_m"] = layer.decay_length_m;
+        }
+        list.push_back(f);
+    }
+    return list;
+}
+
 }  // namespace
 
 LoopFigures loop_figures(const RunRequest& request, const RunResult& result) {
@@ -60,6 +79,13 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
                     to_string(choose_contact_path(system, options)), system.num_components());
         std::printf("steps                      %ld\n", steps);
     }
+    const ModelSpec& spec = system.model().spec();
+    for (std::size_t i = 0; i < spec.interfaces.size(); ++i)
+        if (spec.interfaces[i].contact == InterfaceContact::elastic) {
+            const InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
+            std::printf("interface %-2zu               elastic: k_n %.4g Pa/m, k_t %.4g Pa/m, decay length %.4g m\n", i,
+                        layer.normal_stiffness_pa_per_m, layer.tangential_stiffness_pa_per_m, layer.decay_length_m);
+        }
     std::printf("contact iterations         total %ld, max per step %d, mean per step %.2f\n", s.contact_iterations,
                 s.max_contact_iterations, steps > 0 ? static_cast<double>(s.contact_iterations) / steps : 0.0);
     std::printf("final state                t %.6g s, w %.6g m, w_dot %.6g m/s\n", last.t_s, last.w_m,
@@ -111,7 +137,10 @@ void write_json_summary(const RunRequest& request, const Model& model, const Run
     j["friction_mesh_ratio"] = {{"kappa", kappa.ratio},
                                 {"interface", kappa.interface_index},
                                 {"pair_spacing_m", kappa.pair_spacing_m},
-                                {"spacing_for_kappa_one_m", kappa.spacing_for_one_m}};
+                                {"spacing_for_kappa_one_m", kappa.spacing_for_one_m},
+                                {"decay_length_m", kappa.decay_length_m},
+                                {"elastic", kappa.elastic}};
+    j["interfaces"] = interfaces_json(model);
     j["loading"] = {{"kind", to_string(options.loading.kind)},
                     {"gravity_m_per_s2", options.loading.gravity_m_per_s2},
                     {"period_s", options.loading.period_s()}};

@@ -248,7 +248,8 @@ const std::vector<std::pair<std::string, SupportKind>> kSupports = {
 void parse_leaves(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
     const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
-                                           "youngs_modulus_pa", "density_kg_per_m3", "left_support", "right_support"};
+                                           "youngs_modulus_pa", "density_kg_per_m3", "poisson_ratio", "left_support",
+                                           "right_support"};
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("leaves", i), keys);
         LeafSpec l;
@@ -258,6 +259,7 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
         l.width_m = t.number("width_m", "the leaf width [m], > 0");
         l.youngs_modulus_pa = t.number("youngs_modulus_pa", "Young's modulus [Pa], > 0");
         l.density_kg_per_m3 = t.number_or("density_kg_per_m3", "density [kg/m^3], >= 0", 0.0);
+        l.poisson_ratio = t.number_or("poisson_ratio", "Poisson's ratio [-], in (-1, 0.5)", LeafSpec{}.poisson_ratio);
         const SupportKind free = SupportKind::free;
         l.left_support = choice(t, "left_support", kSupports, &free);
         l.right_support = choice(t, "right_support", kSupports, &free);
@@ -272,7 +274,9 @@ void parse_interfaces(const Table& top, ModelSpec& spec) {
     const std::vector<std::pair<std::string, Law>> laws = {
         {"coulomb", Law::coulomb}, {"frictionless", Law::frictionless}, {"bonded", Law::bonded}};
     for (std::size_t i = 0; i < arr->size(); ++i) {
-        Table t(top.context(), (*arr)[i], element("interfaces", i), {"law", "friction_coefficient", "initial_gap_m"});
+        Table t(top.context(), (*arr)[i], element("interfaces", i),
+                {"law", "friction_coefficient", "initial_gap_m", "contact", "normal_stiffness_pa_per_m",
+                 "tangential_stiffness_pa_per_m"});
         InterfaceSpec f;
         const Law law = choice<Law>(t, "law", laws, nullptr);
         if (law == Law::coulomb) {
@@ -287,6 +291,20 @@ void parse_interfaces(const Table& top, ModelSpec& spec) {
             f.friction_coefficient = 0.0;
         }
         f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], >= 0", 0.0);
+        if (t.has("contact")) {
+            const std::string text = t.string("contact", "one of 'rigid', 'elastic'");
+            try {
+                f.contact = parse_interface_contact(text, child(t.path(), "contact"));
+            } catch (const InputError& e) {
+                rethrow_in_file(t.context(), e);  // with the key's place in the file
+            }
+        }
+        // range and "needs contact = 'elastic'": Model::build, reported at the key's line
+        f.normal_stiffness_pa_per_m = t.number_or(
+            "normal_stiffness_pa_per_m", "the elastic layer's normal stiffness per unit area k_n [Pa/m], >= 0 (0: derived)", 0.0);
+        f.tangential_stiffness_pa_per_m =
+            t.number_or("tangential_stiffness_pa_per_m",
+                        "the elastic layer's tangential stiffness per unit area k_t [Pa/m], >= 0 (0: derived)", 0.0);
         spec.interfaces.push_back(f);
     }
 }
@@ -295,10 +313,11 @@ void parse_clamps(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("clamps", "[[clamps]] tables", false);
     if (!arr) return;
     for (std::size_t i = 0; i < arr->size(); ++i) {
-        Table t(top.context(), (*arr)[i], element("clamps", i), {"x_m", "preload_n"});
+        Table t(top.context(), (*arr)[i], element("clamps", i), {"x_m", "preload_n", "length_m"});
         ClampSpec c;
         c.x_m = t.number("x_m", "the clamp position [m]");
         c.preload_n = t.number_or("preload_n", "the clamp force [N], >= 0", 0.0);
+        c.length_m = t.number_or("length_m", "the clamp's length along x [m], >= 0 (0: a point tie)", 0.0);
         spec.clamps.push_back(c);
     }
 }
