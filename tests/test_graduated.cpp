@@ -16,8 +16,8 @@ constexpr double L = 0.5, b = 0.05, h = 0.005, E = 2e10, short_len = 0.25;
 
 ModelSpec two_leaves(InterfaceLaw law, double mu, int elements_per_half) {
     ModelSpec s;
-    s.leaves.push_back({L, 0.0, h, b, E, 0.0, 0.3, SupportKind::pinned, SupportKind::pinned});
-    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, 0.3, SupportKind::free, SupportKind::free});
+    s.leaves.push_back({L, 0.0, h, b, E, 0.0, SupportKind::pinned, SupportKind::pinned});
+    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, SupportKind::free, SupportKind::free});
     s.interfaces.push_back({law, mu, 0.0});
     s.rigid_body.mass_kg = 20.0;
     s.rigid_body.x_m = 0.5 * L;

@@ -115,8 +115,8 @@ BOOST_AUTO_TEST_CASE(unrestrained_leaf_is_rejected) {
     // A short leaf with free ends and not tied by the seat floats: the stiffness with R
     // held is singular, which must be reported, not factorised into garbage.
     ModelSpec s;
-    s.leaves.push_back({0.5, 0.0, 0.005, 0.05, 2e10, 0.0, 0.3, SupportKind::pinned, SupportKind::pinned});
-    s.leaves.push_back({0.2, 0.0, 0.005, 0.05, 2e10, 0.0, 0.3, SupportKind::free, SupportKind::free});
+    s.leaves.push_back({0.5, 0.0, 0.005, 0.05, 2e10, 0.0, SupportKind::pinned, SupportKind::pinned});
+    s.leaves.push_back({0.2, 0.0, 0.005, 0.05, 2e10, 0.0, SupportKind::free, SupportKind::free});
     s.interfaces.push_back({InterfaceLaw::coulomb, 0.3, 0.0});
     s.rigid_body = {20.0, 0.25, {}, 0.0, 1.0};
     s.mesh.element_length_m = 0.025;
@@ -133,8 +133,8 @@ constexpr double kRoundOff = 1e-12;
 /// x = 0.2 m, the body at the tip; 0.05 m elements: nodes 0, 0.05, ..., 0.4 (9 pairs).
 ModelSpec two_leaves(double clamp_length_m) {
     ModelSpec s;
-    s.leaves.push_back({0.4, 0.0, 0.007, 0.06, 200e9, 0.0, 0.3, SupportKind::fixed, SupportKind::free});
-    s.leaves.push_back({0.4, 0.0, 0.007, 0.05, 200e9, 0.0, 0.3, SupportKind::fixed, SupportKind::free});
+    s.leaves.push_back({0.4, 0.0, 0.007, 0.06, 200e9, 0.0, SupportKind::fixed, SupportKind::free});
+    s.leaves.push_back({0.4, 0.0, 0.007, 0.05, 200e9, 0.0, SupportKind::fixed, SupportKind::free});
     InterfaceSpec f;
     f.friction_coefficient = 0.3;
     f.contact = InterfaceContact::elastic;

@@ -151,8 +151,8 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_graduated_stack) {
     // contact state (R held at w(0)) is exercised on both paths.
     constexpr double L = 0.5, b = 0.05, h = 0.005, E = 2e10, short_len = 0.25;
     ModelSpec s;
-    s.leaves.push_back({L, 0.0, h, b, E, 0.0, 0.3, SupportKind::pinned, SupportKind::pinned});
-    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, 0.3, SupportKind::free, SupportKind::free});
+    s.leaves.push_back({L, 0.0, h, b, E, 0.0, SupportKind::pinned, SupportKind::pinned});
+    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, SupportKind::free, SupportKind::free});
     s.interfaces.push_back({InterfaceLaw::coulomb, 0.3, 0.0});
     s.clamps = {{0.15, 200.0}, {0.35, 200.0}};
     s.rigid_body.mass_kg = 20.0;
@@ -330,8 +330,8 @@ BOOST_AUTO_TEST_CASE(low_rank_updates_agree_with_fresh_factorisations) {
     // 150 rows; a different mode at one step gives >= 1e-6); observed: see the message.
     constexpr double L = 0.5, b = 0.05, h = 0.005, E = 2e10, short_len = 0.25;
     ModelSpec s;
-    s.leaves.push_back({L, 0.0, h, b, E, 0.0, 0.3, SupportKind::pinned, SupportKind::pinned});
-    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, 0.3, SupportKind::free, SupportKind::free});
+    s.leaves.push_back({L, 0.0, h, b, E, 0.0, SupportKind::pinned, SupportKind::pinned});
+    s.leaves.push_back({short_len, 0.5 * (L - short_len), h, b, E, 0.0, SupportKind::free, SupportKind::free});
     s.interfaces.push_back({InterfaceLaw::coulomb, 0.0, 0.0});
     s.clamps = {{0.15, 200.0}, {0.35, 200.0}};
     s.rigid_body.mass_kg = 20.0;

@@ -79,7 +79,7 @@ BOOST_AUTO_TEST_CASE(single_leaf_point_load_stiffness) {
     // One pinned-pinned leaf with the mass off centre at x = a: k = 3 E I L / (a^2 b^2)
     // (beam tables); a cantilever with the mass at its tip: k = 3 E I / L^3. Exact for
     // cubic elements: tolerance 1e-10.
-    LeafSpec leaf{0.5, 0.0, 0.005, 0.05, 2e10, 0.0, 0.3, SupportKind::pinned, SupportKind::pinned};
+    LeafSpec leaf{0.5, 0.0, 0.005, 0.05, 2e10, 0.0, SupportKind::pinned, SupportKind::pinned};
     const double I = 0.05 * std::pow(0.005, 3) / 12.0;
     ModelSpec s;
     s.leaves = {leaf};
