@@ -415,8 +415,8 @@ std::string friction_mesh_advice(const Model& model) {
                   "from about 1 on, the incremental Coulomb problem of this mesh can have several solutions and the "
                   "exact solver's fixed point on the friction limits settles slowly or not at all "
                   "(docs/contact-solvers.md); pairs spaced more than %.4g m apart there (mesh.element_length_m), a "
-                  "mu below %.4g, or the elastic interface law (interfaces[%d].contact = \"elastic\", which spreads "
-                  "the couple over the layer's decay length) bring it below 1",
+                  "mu below %.4g, or the elastic interface law (interfaces[%d].contact = \"elastic\", --interface elastic on the "
+                  "command line, which spreads the couple over the layer's decay length) bring it below 1",
                   r.ratio, r.interface_index, r.pair_spacing_m, r.spacing_for_one_m,
                   spec.interfaces[r.interface_index].friction_coefficient / r.ratio, r.interface_index);
     return buf;

@@ -24,7 +24,7 @@ struct StepRecord {
     int contact_iterations = 0;         ///< solver iterations of this step
     int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
     double kinetic_energy_j = 0.0;      ///< kinetic energy [J]: m w_dot^2 / 2, plus the leaves' v^T M v / 2 in mode newmark
-    double strain_energy_j = 0.0;       ///< elastic energy of the leaves [J]
+    double strain_energy_j = 0.0;       ///< elastic energy of the leaves and of any elastic interface layer [J]
     double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
     double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
     double contact_residual_m = 0.0;    ///< ||v||_2 (eq. 9) at the converged forces [m]
@@ -147,6 +147,7 @@ struct PairRecord {
     double p_t_n = 0.0;       ///< tangential (friction) force on the upper leaf, +x [N] (0: no tangential row)
     double gap_m = 0.0;       ///< normal gap d_n - approach [m]: > 0 open, 0 closed (0: no normal row)
     double slip_m = 0.0;      ///< tangential displacement of the upper surface relative to the lower, +x [m]
+                              ///< (elastic interface: the slider's, i.e. without the layer's elastic shear c_L p_t)
 };
 /// Receives the pairs at each record's time (t [s], one entry per System::pairs()).
 using PairObserver = std::function<void(double t_s, const std::vector<PairRecord>&)>;
