@@ -39,7 +39,9 @@ struct StepRecord {
                                         ///< E(0) + external work - (kinetic + strain + dissipated)
     double leaf_kinetic_energy_j = 0.0; ///< the leaves' share of kinetic_energy_j [J] (0 with massless leaves)
     double impact_loss_j = 0.0;         ///< cumulative energy lost at contact closures net of openings [J]
-                                        ///< (mode newmark: the normal contact work, newmark_stepper.hpp)
+                                        ///< (mode newmark: the normal contact work, newmark_stepper.hpp; with
+                                        ///< massive leaves on an elastic layer also the implicit contact
+                                        ///< impulse's loss on the layer, (p1 - p0)^T C_L (p1 - p0) / 2 per step)
 };
 
 /// Column names of StepRecord in CSV order.
