@@ -126,9 +126,12 @@ BOOST_AUTO_TEST_CASE(every_solver_gives_the_same_steps) {
 }
 
 BOOST_AUTO_TEST_CASE(friction_case_differs_from_rigid_by_at_most_the_layers_compliance) {
-    // Estimate: the layer adds compliance in series where pairs hold. In the friction case the
-    // clamp pairs carry the force (the others are open or unloaded: identical leaves bend alike),
-    // so the largest change is that of the stiffness with the clamp pairs tied,
+    // Estimate: the layer adds compliance in series where pairs hold. With every pair tied
+    // (System::tied_stiffness_n_per_m, point clamps) the layer takes the bonded stack from 107,404
+    // to 107,117 N/m (-0.267 %) and the friction case's from 107,319 to 107,053 N/m (-0.247 %); the
+    // frictionless stack keeps 12,000 N/m (its contact forces are zero). But in the friction case
+    // the clamp pairs carry the force (the others are open or unloaded: identical leaves bend
+    // alike), so the largest change is that of the stiffness with the clamp pairs tied,
     // f (k + c_S^T C'_SS^-1 c_S): with point clamps (rigid) 0; with 10 mm clamps 63,092 -> 61,983
     // N/m, -1.76 %, i.e. -0.88 % on the period and +0.88 % on the peak (sqrt). While a clamp
     // slips its force is the friction limit, which the layer hardly changes, so the measured
@@ -139,6 +142,11 @@ BOOST_AUTO_TEST_CASE(friction_case_differs_from_rigid_by_at_most_the_layers_comp
         const System sr = paper_system(PaperCase::friction, false, 0.0, len);
         const System se = paper_system(PaperCase::friction, true, 0.0, len);
         const double estimate = 0.5 * std::abs(clamp_tied_stiffness(se) / clamp_tied_stiffness(sr) - 1.0);
+        if (len == 0.0) {
+            BOOST_TEST(se.tied_stiffness_n_per_m() / sr.tied_stiffness_n_per_m() - 1.0 == -0.00247, tt::tolerance(0.01));
+            const System fr = paper_system(PaperCase::frictionless, false), fe = paper_system(PaperCase::frictionless, true);
+            BOOST_TEST(fe.tied_stiffness_n_per_m() == fr.tied_stiffness_n_per_m(), tt::tolerance(1e-9));
+        }
         const auto r = simulate(sr, options(Mode::closed_form, 0.6, 1e-3));
         const auto e = simulate(se, options(Mode::closed_form, 0.6, 1e-3));
         const double peak = peak_abs_w(e) / peak_abs_w(r) - 1.0;
@@ -217,7 +225,9 @@ BOOST_AUTO_TEST_CASE(energy_balance_closes_with_the_layer_in_every_mode) {
 // (steel leaves, 0.3 s, dt 1 ms). Measured with the layer: 2.129e-3 J with 10 mm clamps (impact
 // loss 2.12e-4 J), 4.95e-5 J with point clamps (the layer carries no force there; the error
 // grows at steps where clamp pairs change between stick and slip: 1.79e-6 J at the first step,
-// 4 slipping, 4 sticking, 30 open). Newmark on massless leaves closes (4.5e-10 J).
+// 4 slipping, 4 sticking, 30 open). Newmark on massless leaves closes (4.5e-10 J). Main's
+// f83c28d (the layer rows' impulse loss booked with the impact loss) closes it: 7.2e-10 J,
+// measured on a copy of f83c28d with this file; remove expected_failures once merged.
 BOOST_AUTO_TEST_CASE(energy_balance_closes_in_newmark_with_massive_leaves, *boost::unit_test::expected_failures(1)) {
     double e0 = 0.0;
     const auto [elastic, rigid] = balances({"newmark steel", PaperCase::friction, Mode::newmark, kSteel, ContactPath::dense}, &e0);

@@ -139,3 +139,27 @@ BOOST_AUTO_TEST_CASE(stiffness_follows_the_partial_interaction_closed_form) {
         }
     }
 }
+
+BOOST_AUTO_TEST_CASE(static_equilibrium_under_a_load_is_the_tied_stiffness) {
+    // The same figure from a run: the gravity loading starts from the static equilibrium under
+    // the body's weight F = m g, solved by the contact solver with the layer (closed-form mode,
+    // dense and sparse paths). Every pair is bonded, so w(0) = -F / k_tied to the solve's
+    // round-off (the exact solver's linear solve: 1e-9 relative). k_t = 1e9 Pa/m (alpha L = 2.8),
+    // where the layer's slip carries half of the composite action.
+    ModelSpec spec = with_elastic_interfaces(two_leaves(PaperCase::bonded, 20), kStiffNormal, 1e9);
+    spec.rigid_body.initial_velocity_m_per_s = 0.0;
+    const System sys(Model::build(spec));
+    for (ContactPath path : {ContactPath::dense, ContactPath::sparse}) {
+        SimulationOptions so;
+        so.dt_s = 1e-3;
+        so.t_end_s = 1e-3;
+        so.contact_path = path;
+        so.solver.tolerance_m = 1e-12;
+        so.loading.gravity_m_per_s2 = 9.81;
+        const auto r = simulate(sys, so);
+        const double F = spec.rigid_body.mass_kg * 9.81;
+        BOOST_TEST_CONTEXT("path " << to_string(path)) {
+            BOOST_TEST(r.front().w_m == -F / sys.tied_stiffness_n_per_m(), tt::tolerance(1e-9));
+        }
+    }
+}
