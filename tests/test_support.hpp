@@ -25,12 +25,24 @@ inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_
 }
 
 /// The paper example's case `c` with `leaves` identical leaves of `elements` per half
-/// leaf (its last leaf and interface repeated below).
+/// leaf (its last leaf and interface repeated below, or the lowest ones dropped).
 inline ModelSpec paper_stack(PaperCase c, int elements, int leaves) {
     ModelSpec spec = paper_example(c, PaperExampleOptions{elements});
     while (static_cast<int>(spec.leaves.size()) < leaves) {
         spec.leaves.push_back(spec.leaves.back());
         spec.interfaces.push_back(spec.interfaces.back());
+    }
+    spec.leaves.resize(static_cast<std::size_t>(leaves));
+    spec.interfaces.resize(static_cast<std::size_t>(leaves - 1));
+    return spec;
+}
+
+/// Every interface of `spec` with the elastic law, k_n and k_t per unit area [Pa/m] (0: derived).
+inline ModelSpec with_elastic_interfaces(ModelSpec spec, double k_n_pa_per_m = 0.0, double k_t_pa_per_m = 0.0) {
+    for (auto& f : spec.interfaces) {
+        f.contact = InterfaceContact::elastic;
+        f.normal_stiffness_pa_per_m = k_n_pa_per_m;
+        f.tangential_stiffness_pa_per_m = k_t_pa_per_m;
     }
     return spec;
 }
