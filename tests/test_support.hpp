@@ -79,14 +79,28 @@ inline double mean_period(const std::vector<StepRecord>& r) {
     return (t.back() - t.front()) / static_cast<double>(t.size() - 1);
 }
 
+/// Extreme value of the parabola through three equally spaced samples a, b, c (b the extreme one).
+inline double parabola_extremum(double a, double b, double c) {
+    const double den = a - 2 * b + c;
+    return den == 0.0 ? b : b - 0.125 * (a - c) * (a - c) / den;
+}
+
 /// Largest |w| [m], refined by a parabola through the sampled maximum and its neighbours.
 inline double peak_abs_w(const std::vector<StepRecord>& r) {
     std::size_t k = 1;
     for (std::size_t i = 1; i + 1 < r.size(); ++i)
         if (std::abs(r[i].w_m) > std::abs(r[k].w_m)) k = i;
-    const double a = std::abs(r[k - 1].w_m), b = std::abs(r[k].w_m), c = std::abs(r[k + 1].w_m);
-    const double den = a - 2 * b + c;
-    return den == 0.0 ? b : b - 0.125 * (a - c) * (a - c) / den;
+    return parabola_extremum(std::abs(r[k - 1].w_m), std::abs(r[k].w_m), std::abs(r[k + 1].w_m));
+}
+
+/// First local maximum of w [m] (the first swing's extremum: w(0) = 0, w' > 0), refined by a
+/// parabola through the sampled maximum and its neighbours, so that the dt grid does not
+/// quantise it; NaN if the records hold none.
+inline double first_max_w(const std::vector<StepRecord>& r) {
+    for (std::size_t i = 1; i + 1 < r.size(); ++i)
+        if (r[i].w_m > r[i - 1].w_m && r[i].w_m >= r[i + 1].w_m)
+            return parabola_extremum(r[i - 1].w_m, r[i].w_m, r[i + 1].w_m);
+    return std::nan("");
 }
 
 }  // namespace stackbeam::testing
