@@ -13,6 +13,9 @@
 //    components, factorisations per step, semismooth Newton iterations per step (sparse
 //    path, SolveResult::newton_iterations) and the first step's time. Each is one run (Iterations(1)): the large
 //    ones take seconds to minutes and the machine is shared.
+//  - ElasticRuns: friction runs with elastic interfaces (paper example, graduated and identical
+//    10-leaf stacks up to 400 elements per half leaf) against the paper example, and which
+//    step of the sparse path's transition chain settles each step.
 //  - Inertia: 1 s of the paper example with steel leaves (7850 kg/m^3): mode newmark
 //    (friction and bonded) and mode cvode (bonded; the friction case needs the events
 //    between massive leaves, not built yet). Counters: steps, contact iterations and
@@ -358,6 +361,75 @@ BENCHMARK(FrictionMeshRatioRuns)
     ->Args({400, 625, 0, 100, 8})->Args({400, 1000, 0, 100, 8})
     // the paper's mu = 0.5 at kappa = 0.5: 50 elements per half leaf, the default chain
     ->Args({50, 5000, 0, 300, 8})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+
+/// Elastic interfaces (issue 18's targets): closed-form runs of friction stacks with every
+/// interface rigid or elastic (layer derived from the leaves), default solver chain, dt = 1 ms.
+/// args: elements per half leaf, stack (0 the paper example, 1 graduated 10 leaves, 2 identical
+/// 10 leaves), elastic (0/1), simulated ms. Counters: time per simulated second (set-up plus
+/// stepping), factorisations and Newton iterations per step, failed steps (residual above the
+/// tolerance; the run does not stop), and which step of the sparse path's chain settled each
+/// step: the active-set passes alone, the semismooth Newton method, the smoothing Newton
+/// method, the continuation, the Tresca fixed point (its answer or the dense fallback).
+void ElasticRuns(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    const int stack = static_cast<int>(state.range(1));
+    ModelSpec spec = stack == 0   ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
+                     : stack == 1 ? graduated_stack(elements, 10)
+                                  : paper_stack(PaperCase::friction, elements, 10);
+    if (state.range(2) == 1)
+        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
+    const double t_sim = 1e-3 * static_cast<double>(state.range(3));
+    double total = 0.0, factorizations = 0.0, newton = 0.0;
+    long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_continuation = 0, by_tresca = 0;
+    int components = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const System s(Model::build(spec));
+        SimulationOptions so;
+        so.t_end_s = t_sim;
+        so.stop_on_nonconvergence = false;
+        ClosedFormStepper st(s, so);
+        steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
+        factorizations = newton = 0.0;
+        failed = by_passes = by_semismooth = by_smoothing = by_continuation = by_tresca = 0;
+        for (long i = 0; i < steps; ++i) {
+            factorizations += st.advance().factorizations;
+            const SolveResult& r = st.last_solve();
+            newton += r.newton_iterations;
+            if (!r.converged) ++failed;
+            if (r.fell_back || r.tresca_iterations > 0) ++by_tresca;
+            else if (r.continuation_steps > 0) ++by_continuation;
+            else if (r.smoothing_iterations > 0) ++by_smoothing;
+            else if (r.newton_iterations > 0) ++by_semismooth;
+            else ++by_passes;
+        }
+        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        components = s.num_components();
+    }
+    state.counters["components"] = components;
+    state.counters["s_per_sim_s"] = total / t_sim;
+    state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
+    state.counters["newton_per_step"] = newton / static_cast<double>(steps);
+    state.counters["failed_steps"] = static_cast<double>(failed);
+    state.counters["by_passes"] = static_cast<double>(by_passes);
+    state.counters["by_semismooth"] = static_cast<double>(by_semismooth);
+    state.counters["by_smoothing"] = static_cast<double>(by_smoothing);
+    state.counters["by_continuation"] = static_cast<double>(by_continuation);
+    state.counters["by_tresca"] = static_cast<double>(by_tresca);
+}
+BENCHMARK(ElasticRuns)
+    ->ArgNames({"el", "stack", "elastic", "ms"})
+    // the reference: the paper example, rigid and elastic, 1 s
+    ->Args({20, 0, 0, 1000})->Args({20, 0, 1, 1000})
+    // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf
+    ->Args({100, 1, 1, 50})->Args({200, 1, 1, 50})->Args({400, 1, 1, 50})
+    ->Args({100, 2, 1, 50})->Args({200, 2, 1, 30})->Args({400, 2, 1, 30})
+    // rigid at kappa 0.5 (50 elements per half leaf): the chain the rigid model needs
+    ->Args({50, 1, 0, 100})->Args({50, 2, 0, 100})
+    // longer runs for the chain's use (docs/decisions/014)
+    ->Args({100, 1, 1, 300})->Args({100, 2, 1, 300})->Args({50, 1, 0, 300})->Args({50, 2, 0, 300})
+    ->Args({50, 1, 1, 300})->Args({50, 2, 1, 300})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
