@@ -366,7 +366,8 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// Elastic interfaces (issue 18's targets): closed-form runs of friction stacks with every
 /// interface rigid or elastic (layer derived from the leaves), default solver chain, dt = 1 ms.
 /// args: elements per half leaf, stack (0 the paper example, 1 graduated 10 leaves, 2 identical
-/// 10 leaves), elastic (0/1), simulated ms. Counters: time per simulated second (set-up plus
+/// 10 leaves), elastic (0/1), simulated ms, contact path (0 automatic: sparse from 1000 rows;
+/// 1 sparse). Counters: time per simulated second (set-up plus
 /// stepping), factorisations and Newton iterations per step, failed steps (residual above the
 /// tolerance; the run does not stop), and which step of the sparse path's chain settled each
 /// step: the active-set passes alone, the semismooth Newton method, the smoothing Newton
@@ -389,6 +390,7 @@ void ElasticRuns(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.stop_on_nonconvergence = false;
+        if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = 0.0;
@@ -419,17 +421,16 @@ void ElasticRuns(benchmark::State& state) {
     state.counters["by_tresca"] = static_cast<double>(by_tresca);
 }
 BENCHMARK(ElasticRuns)
-    ->ArgNames({"el", "stack", "elastic", "ms"})
+    ->ArgNames({"el", "stack", "elastic", "ms", "sparse"})
     // the reference: the paper example, rigid and elastic, 1 s
-    ->Args({20, 0, 0, 1000})->Args({20, 0, 1, 1000})
+    ->Args({20, 0, 0, 1000, 0})->Args({20, 0, 1, 1000, 0})
     // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf
-    ->Args({100, 1, 1, 50})->Args({200, 1, 1, 50})->Args({400, 1, 1, 50})
-    ->Args({100, 2, 1, 50})->Args({200, 2, 1, 30})->Args({400, 2, 1, 30})
-    // rigid at kappa 0.5 (50 elements per half leaf): the chain the rigid model needs
-    ->Args({50, 1, 0, 100})->Args({50, 2, 0, 100})
-    // longer runs for the chain's use (docs/decisions/014)
-    ->Args({100, 1, 1, 300})->Args({100, 2, 1, 300})->Args({50, 1, 0, 300})->Args({50, 2, 0, 300})
-    ->Args({50, 1, 1, 300})->Args({50, 2, 1, 300})
+    ->Args({100, 1, 1, 50, 0})->Args({200, 1, 1, 50, 0})->Args({400, 1, 1, 50, 0})
+    ->Args({100, 2, 1, 50, 0})->Args({200, 2, 1, 30, 0})->Args({400, 2, 1, 30, 0})
+    // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
+    // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
+    ->Args({100, 1, 1, 300, 1})->Args({100, 2, 1, 300, 1})
+    ->Args({50, 1, 0, 300, 1})->Args({50, 2, 0, 300, 1})->Args({50, 1, 1, 300, 1})->Args({50, 2, 1, 300, 1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
