@@ -349,3 +349,32 @@ BOOST_AUTO_TEST_CASE(elastic_interface_keys_rejected_at_their_line) {
         }
     }
 }
+
+BOOST_AUTO_TEST_CASE(graduated_elastic_scenario_is_the_test_suites_graduated_spring) {
+    // scenarios/graduated_elastic.toml is graduated_stack(160, 4) (tests/test_support.hpp: the
+    // paper's leaves, main leaf pinned, three shorter free leaves, two 1000 N clamps, mu = 0.5)
+    // with every interface elastic: the same leaves to the 4 decimals the file gives (lengths
+    // 0.5 - 0.12 k m exactly), and its friction-mesh ratio is the elastic one, mu t / l = 0.8
+    // with l = 3.12 mm (test_friction_mesh_ratio), against 1.6 and more for the same mesh rigid.
+    const Scenario s = load_scenario(scenario_path("graduated_elastic.toml"));
+    BOOST_TEST_REQUIRE(s.model.leaves.size() == 4u);
+    for (std::size_t k = 0; k < 4; ++k) {
+        BOOST_TEST(s.model.leaves[k].length_m == 0.5 - 0.12 * static_cast<double>(k), boost::test_tools::tolerance(1e-12));
+        BOOST_TEST(s.model.leaves[k].x_start_m == 0.06 * static_cast<double>(k), boost::test_tools::tolerance(1e-12));
+    }
+    for (const auto& f : s.model.interfaces) {
+        BOOST_TEST((f.contact == InterfaceContact::elastic));
+        BOOST_TEST(f.friction_coefficient == 0.5);
+    }
+    const Model elastic = Model::build(s.model);
+    ModelSpec rigid_spec = s.model;
+    for (auto& f : rigid_spec.interfaces) f.contact = InterfaceContact::rigid;
+    const Model rigid = Model::build(rigid_spec);
+    BOOST_TEST(friction_mesh_ratio(elastic).ratio == 0.5 * 0.005 / friction_mesh_ratio(elastic).decay_length_m,
+               boost::test_tools::tolerance(1e-12));
+    BOOST_TEST(friction_mesh_ratio(elastic).ratio < 0.81);
+    // rigid: mu t / h with h the shortest pair spacing (1.54 mm between a leaf end and a clamp)
+    BOOST_TEST(friction_mesh_ratio(rigid).ratio == 0.5 * 0.005 / friction_mesh_ratio(rigid).pair_spacing_m,
+               boost::test_tools::tolerance(1e-12));
+    BOOST_TEST(friction_mesh_ratio(rigid).ratio > 1.6);
+}
