@@ -404,7 +404,6 @@ namespace {
 void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
                          TransitionMethod method = TransitionMethod::newton) {
     const bool smoothing = method == TransitionMethod::smoothing;
-    const bool continuation = method == TransitionMethod::continuation;
     const bool tresca = method == TransitionMethod::tresca;  // with the interior-point method on every box QP
     const System sys(Model::build(spec));
     SimulationOptions so;
@@ -430,10 +429,9 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
         const SolveResult rn = newton.solve(pr, pn, z);
         BOOST_TEST(rn.converged);
         BOOST_TEST(!rn.fell_back);  // the Newton method's answer, not the Tresca fixed point's or the dense one's
-        const int its = smoothing      ? rn.smoothing_iterations
-                        : continuation ? rn.continuation_steps
-                        : tresca       ? rn.iterations  // interior-point iterations and passes
-                                       : rn.newton_iterations;
+        const int its = smoothing ? rn.smoothing_iterations
+                        : tresca  ? rn.iterations  // interior-point iterations and passes
+                                  : rn.newton_iterations;
         newton_iterations += its;
         factorizations += rn.factorizations;
         if (its > 0) ++transitions;
@@ -446,8 +444,8 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
         worst_natural = std::max(worst_natural, natural_map(dense, pn, s).norm());
         BOOST_TEST(error_vector(dense, pn, s).norm() < kTol);  // eq. 10: v = 0 to the tolerance
     }
-    BOOST_TEST_MESSAGE((smoothing ? "smoothing Newton: " : continuation ? "continuation: " : tresca ? "interior-point Tresca: " : "semismooth Newton: ")
-                       << newton_iterations << (continuation ? " sub-steps in " : " iterations in ") << transitions
+    BOOST_TEST_MESSAGE((smoothing ? "smoothing Newton: " : tresca ? "interior-point Tresca: " : "semismooth Newton: ")
+                       << newton_iterations << " iterations in " << transitions
                                              << " solves that needed it, " << factorizations
                                              << " factorisations; max force difference to the dense exact solver "
                                              << diff / scale << " (relative), worst natural-map residual "
@@ -495,22 +493,6 @@ BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_a_finer_friction_stack) {
     PaperExampleOptions o;
     o.elements_per_half_leaf = 160;
     newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::smoothing);
-}
-
-BOOST_AUTO_TEST_CASE(continuation_equals_dense_exact_on_the_paper_friction_case) {
-    // The continuation on the offsets alone (TransitionMethod::continuation, from the warm
-    // start at every step): each sub-step ends in the passes, and the last one solves the
-    // step's own problem, so the answer is again the linear solution of the dense solver's
-    // modes: the round-off bound of the Newton methods' tests, 1e-9 relative (kRel).
-    newton_equals_dense(paper_example(PaperCase::friction), 300, kRel, TransitionMethod::continuation);
-}
-
-BOOST_AUTO_TEST_CASE(continuation_equals_dense_exact_on_a_finer_friction_stack) {
-    // 3 x 160 from rest, 20 steps (the degenerate transition), continuation alone;
-    // tolerance as for the Newton methods on this stack (cond(W) ~ 64x the example's).
-    PaperExampleOptions o;
-    o.elements_per_half_leaf = 160;
-    newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::continuation);
 }
 
 BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_the_paper_friction_case) {

@@ -115,8 +115,6 @@ struct SolveResult {
                                ///< solve of a set of modes: a factorisation, an update or a cached one)
     int smoothing_iterations = 0;  ///< sparse path: iterations of the smoothing Newton method (each one sparse LU
                                    ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
-    int continuation_steps = 0;  ///< sparse path: sub-steps of the continuation on the offsets (transitions no
-                                 ///< Newton method settles from the step's start)
     int tresca_iterations = 0;   ///< exact solver: passes of the Tresca fixed point on the friction limits (box
                                  ///< QPs solved; SolverOptions::tresca_anderson_depth), where it ran
     bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
@@ -187,9 +185,7 @@ struct SparseContactProblem {
 /// that stalls, by a smoothing Newton method (the natural map with every max(0, .)
 /// smoothed, the smoothing driven to zero with the residual; one sparse LU of its
 /// Jacobian per iteration, SolveResult::smoothing_iterations; its modes are confirmed the
-/// same way), and if that stalls too, by a continuation on the offsets d from the step's start
-/// (the start's forces solve the problem with offsets d0; d0 -> d in sub-steps, each solved
-/// from the last by the passes or the semismooth method; SolveResult::continuation_steps). If all that fails, a problem of at most 4000 rows is
+/// same way). If all that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message. (The units: lib/contact/sparse/; tests force
 /// each transition and box-QP method alone through lib/contact/sparse/switches.hpp.)

@@ -7,7 +7,8 @@
 //                      of the held rows, bordered updates)
 //   sparse_path        the shared state: modes, pair laws, active-set passes, natural map
 //   box_qp_*           the box QP of the Tresca fixed point (pivoting, interior point, primal)
-//   semismooth_newton, smoothing_newton, continuation, tresca
+//   semismooth_newton, smoothing_newton, tresca (the continuation on the offsets was removed:
+//   docs/decisions/014-transition-methods-with-elastic-interface.md)
 //                      the transition methods (transitions.hpp, one signature)
 //   switches           the test-only switches (transition and box-QP methods, newton_first)
 //
@@ -227,7 +228,7 @@ struct SparseContactSolver::Impl {
         last_p.resize(0);
     }
 
-    /// Step 2a, the Newton methods and the continuation (SparseContactSolver::solve): each
+    /// Step 2a, the Newton methods (SparseContactSolver::solve): each
     /// from its start, its answer confirmed by the active-set passes from its modes. True
     /// when one settled; otherwise p and the modes are those on entry (the passes' end).
     bool newton_transition(const detail::sparse::Step& step, const Eigen::VectorXd& p_start, Eigen::VectorXd& p,
@@ -260,12 +261,6 @@ struct SparseContactSolver::Impl {
             if (tm == TransitionMethod::newton && path.best_p.size() == m && confirmed(smoothing_newton, path.best_p))
                 return true;
             if (confirmed(smoothing_newton, p_start)) return true;
-        }
-        // then the continuation on the offsets from the step's start (2-4 sub-steps where the
-        // Newton methods stall from it, measured on 10 identical leaves x 100 elements)
-        if (tm == TransitionMethod::newton || tm == TransitionMethod::continuation) {
-            p = p_start;
-            if (continuation(path, step, p, z, r)) return true;
         }
         p = p_passes;  // the Tresca fixed point starts where the passes ended
         path.modes.nmode = nmode_passes;
@@ -369,8 +364,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         //     (one pass, normally: they re-solve its last set of modes and find no violation,
         //     so the answer is the exact solver's linear solution of those modes). If it
         //     fails, the smoothing Newton method from its best iterate (then from the step's
-        //     start), then the passes from its modes; if that fails too, the continuation on
-        //     the offsets.
+        //     start), then the passes from its modes.
         if (!r.converged && path.switches.transition != TransitionMethod::tresca &&
             (m >= im.newton_min_rows || path.switches.newton_first))
             r.converged = im.newton_transition(step, p_start, p, z, r);

@@ -8,12 +8,11 @@ namespace stackbeam::detail::sparse {
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class TransitionMethod {
     newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
-                 ///< Newton method; then the continuation on the offsets; then the Tresca fixed point (default)
+                 ///< Newton method; then the Tresca fixed point (default)
     semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
                  ///< smoothing method (kept for comparison, docs/decisions/004-smoothing-newton.md)
     smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
     tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
-    continuation,  ///< continuation on the offsets from the step's start alone, then the Tresca fixed point (tests)
 };
 
 /// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction

@@ -28,8 +28,6 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
 /// K^-1 (b + G^T p).
 bool smoothing_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r);
 
-/// Continuation on the offsets d from the step's start p (continuation.cpp).
-bool continuation(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r);
 
 /// The Tresca fixed point on the friction limits, each pass a box QP (tresca.cpp;
 /// path.switches.box_qp chooses the box-QP methods); on success its working set gives
