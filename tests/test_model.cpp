@@ -196,14 +196,16 @@ BOOST_AUTO_TEST_CASE(pair_compliance_over_the_tributary_length) {
         }
     }
     // a point clamp stays rigid; the rest of the interface keeps its layer
-    for (const PairSpec& p : Model::build(two_leaves(0.0)).candidate_pairs()) {
+    const Model point_clamp = Model::build(two_leaves(0.0));  // kept alive: the loop reads its pairs
+    for (const PairSpec& p : point_clamp.candidate_pairs()) {
         BOOST_TEST(((p.kind == PairKind::clamp) == (p.normal_compliance_m_per_n == 0.0)));
         BOOST_TEST(((p.kind == PairKind::clamp) == (p.tangential_compliance_m_per_n == 0.0)));
     }
     // a rigid interface: no compliance anywhere, even with a clamp length
     ModelSpec rigid = two_leaves(0.04);
     rigid.interfaces[0].contact = InterfaceContact::rigid;
-    for (const PairSpec& p : Model::build(rigid).candidate_pairs()) {
+    const Model rigid_model = Model::build(rigid);
+    for (const PairSpec& p : rigid_model.candidate_pairs()) {
         BOOST_TEST(p.normal_compliance_m_per_n == 0.0);
         BOOST_TEST(p.tangential_compliance_m_per_n == 0.0);
     }
