@@ -111,6 +111,12 @@ std::vector<OptionSpec> make_table() {
              0.0, false, kInf, false, "0: 10 x the stack's first frequency",
              [](const O& o) { return o.cvode.modal_cutoff_rad_per_s; },
              [](O& o, double v) { o.cvode.modal_cutoff_rad_per_s = v; }),
+        keyword("cvode.leaf_inertia", "integrator.cvode.leaf_inertia", "--leaf-inertia",
+                "mode cvode, massive leaves with friction: the whole massive stack (needs an elastic layer on every "
+                "contact row), the stack's modes below the cut with a massless contact layer, or auto (massive "
+                "where every row is elastic, else modal) (docs/time-integration.md)",
+                "auto | massive | modal", [](const O& o) { return std::string(to_string(o.cvode.leaf_inertia)); },
+                [](O& o, S t, S f) { o.cvode.leaf_inertia = parse_leaf_inertia(t, f); }),
         real("loading.gravity_m_per_s2", "loading.gravity_m_per_s2", "--gravity", "", "m/s^2",
              "gravity on R, acting in -y (static equilibrium first)", 0.0, false, kInf, false, "0: none",
              [](const O& o) { return o.loading.gravity_m_per_s2; },

@@ -58,6 +58,22 @@ Mode parse_mode(const std::string& text, const std::string& field) {
     throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
 }
 
+const char* to_string(LeafInertia kind) {
+    switch (kind) {
+        case LeafInertia::automatic: return "auto";
+        case LeafInertia::massive: return "massive";
+        case LeafInertia::modal: return "modal";
+    }
+    return "?";
+}
+
+LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field) {
+    if (text == "auto") return LeafInertia::automatic;
+    if (text == "massive") return LeafInertia::massive;
+    if (text == "modal") return LeafInertia::modal;
+    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed auto, massive, modal");
+}
+
 const char* to_string(ContactPath path) {
     switch (path) {
         case ContactPath::automatic: return "auto";

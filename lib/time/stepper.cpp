@@ -15,7 +15,12 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
         case Mode::cvode:
             if (!detail::has_leaf_mass(system)) return std::make_unique<CvodeStepper>(system, options);
             // leaf inertia (docs/time-integration.md): modal with events when a pair may stick or slip
-            if (detail::has_mode_changes(system)) return std::make_unique<detail::CvodeModalStepper>(system, options);
+            if (detail::has_mode_changes(system)) {
+                const LeafInertia li = options.cvode.leaf_inertia;
+                if (li == LeafInertia::massive || (li == LeafInertia::automatic && !detail::has_rigid_contact_row(system)))
+                    return std::make_unique<detail::CvodeMassiveStepper>(system, options);
+                return std::make_unique<detail::CvodeModalStepper>(system, options);
+            }
             return std::make_unique<detail::CvodeInertiaStepper>(system, options);
     }
     return std::make_unique<ClosedFormStepper>(system, options);

@@ -76,6 +76,17 @@ ContactPath parse_contact_path(const std::string& text, const std::string& field
 /// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
 constexpr int kSparsePathMinComponents = 1000;
 
+/// Mode cvode with leaf mass on a stack with friction: how the leaves' inertia is integrated
+/// (docs/time-integration.md, "Mode cvode with leaf mass").
+enum class LeafInertia {
+    automatic,  ///< massive where every contact row has an elastic layer, modal otherwise
+    massive,    ///< every DOF of the stack in CVODE (BDF); needs elastic contact everywhere
+    modal,      ///< the stack's modes below CvodeOptions::modal_cutoff_rad_per_s, a massless contact layer
+};
+const char* to_string(LeafInertia kind);
+/// Parses "auto" | "massive" | "modal"; throws InputError naming `field`.
+LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field);
+
 /// Options of mode "cvode" (see cvode_stepper.hpp).
 struct CvodeOptions {
     double rtol = 1e-8;          ///< CVODE relative tolerance [-]
@@ -87,6 +98,7 @@ struct CvodeOptions {
                                           ///< circular frequency carry the inertia, those above respond
                                           ///< quasi-statically [rad/s]; 0 = 10 x the stack's first
                                           ///< frequency (docs/time-integration.md)
+    LeafInertia leaf_inertia = LeafInertia::automatic;  ///< leaf mass with friction: massive or modal
 };
 
 struct SimulationOptions {

@@ -56,9 +56,14 @@ void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance
     ev_solver = make_solver(event_solver_options(opt.solver, ev_tolerance));
 }
 
-void EventDriver::start_cvode(CVRhsFn rhs) {
-    cvode->create(CV_ADAMS, rhs, this, opt.cvode.rtol);
-    cvode->use_fixed_point();
+void EventDriver::start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff) {
+    cvode->create(stiff ? CV_BDF : CV_ADAMS, rhs, this, opt.cvode.rtol);
+    if (stiff) {
+        cvode->use_preconditioned_newton(stiff->max_krylov, stiff->psetup, stiff->psolve);
+        cvode->set_max_order(stiff->max_order);
+    } else {
+        cvode->use_fixed_point();
+    }
     cvode->set_limits(opt.cvode.max_step_s);
     cvode->set_stop_time(t_final);
     if (root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
