@@ -184,8 +184,43 @@ void Inertia(benchmark::State& state) {
     state.counters["event_s"] = rep.cvode.event_time_s;
 }
 
+/// The whole massive stack under mode cvode (issue targets: docs/performance.md, "Leaf mass").
+/// args: stack (0: the paper's friction case at 20 elements, 1: the graduated 10-leaf spring at
+/// 100 elements per half leaf), simulated time [ms], beta [1e-7 s] (structural damping, 0: none).
+/// Steel leaves, elastic interfaces, 10 mm clamps, rtol 1e-6, atol 1e-12 m.
+void MassiveStack(benchmark::State& state) {
+    ModelSpec spec = state.range(0) == 0 ? paper_example(PaperCase::friction) : graduated_stack(100, 10);
+    spec = testing::with_elastic_interfaces(std::move(spec));
+    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = 7850.0;
+    for (auto& cl : spec.clamps) cl.length_m = 0.01;
+    SimulationOptions so;
+    so.mode = Mode::cvode;
+    so.t_end_s = 1e-3 * static_cast<double>(state.range(1));
+    so.cvode.rtol = 1e-6;
+    so.cvode.leaf_inertia = LeafInertia::massive;
+    so.damping.rayleigh_beta_s = 1e-7 * static_cast<double>(state.range(2));
+    RunReport rep;
+    double wall = 0.0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const System s(Model::build(spec));
+        simulate(s, so, {}, &rep);
+        wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    state.counters["s_per_sim_s"] = wall / so.t_end_s;
+    state.counters["steps"] = static_cast<double>(rep.steps);
+    state.counters["newton_mat"] = static_cast<double>(rep.cvode.linear_setups);
+    state.counters["events"] = static_cast<double>(rep.cvode.events);
+    state.counters["restarts"] = static_cast<double>(rep.cvode.restarts);
+    state.counters["mode_fact"] = static_cast<double>(rep.cvode.mode_factorizations);
+}
+
 }  // namespace
 
+BENCHMARK(MassiveStack)
+    ->ArgNames({"stack", "ms", "beta_e7"})
+    ->Args({0, 10, 0})->Args({0, 1000, 10})->Args({0, 100, 100})->Args({1, 2, 10})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(Inertia)
     ->ArgNames({"friction", "cvode", "dt_us|rtol", "cut"})
     ->Args({1, 0, 1000, 0})->Args({1, 0, 100, 0})->Args({0, 0, 1000, 0})->Args({0, 0, 100, 0})

@@ -15,7 +15,7 @@ std::vector<std::string> step_record_columns() {
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
             "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
             "spring_force", "external_force", "base_displacement", "external_work", "leaf_kinetic_energy",
-            "impact_loss"};
+            "impact_loss", "damping_energy"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -39,7 +39,8 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.base_displacement_m,
             r.external_work_j,
             r.leaf_kinetic_energy_j,
-            r.impact_loss_j};
+            r.impact_loss_j,
+            r.damping_energy_j};
 }
 
 const char* to_string(Mode m) {

@@ -140,6 +140,9 @@ protected:
     /// the stepper (default none).
     virtual void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                                   std::vector<signed char>& tm);
+    /// True when the state y alone decides every pair's modes (no instantaneous coupling but
+    /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
+    virtual bool settle_at_state() const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
