@@ -40,8 +40,8 @@
 // y = [z, v, D, D_c], J = [0 I; -M^-1 K_eff -M^-1 C], is solved exactly by block elimination,
 //     (M + gamma C + gamma^2 K_eff) x_v = M r_v - gamma K_eff r_z,   x_z = r_z + gamma x_v,
 // one sparse LU of that banded n x n matrix (Eigen::SparseLU; M^-1 K_eff is dense, so a KLU
-// or band matrix of J itself would not be sparse); it is handed to CVODE as the
-// preconditioner of GMRES, which then converges in one iteration.
+// or band matrix of J itself would not be sparse), handed to CVODE as a matrix-embedded
+// linear solver (CvodeSession::use_embedded_newton: psetup factorises, psolve solves).
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <algorithm>
@@ -459,7 +459,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
         A[2 * s.ndof] = A[2 * s.ndof + 1] = std::max(1e-300, s.opt.cvode.rtol * e_meshed);
     }
     s.start_record(Y);
-    const EventDriver::StiffIntegrator stiff{2, 5, &Impl::psetup, &Impl::psolve};
+    const EventDriver::StiffIntegrator stiff{2, &Impl::psetup, &Impl::psolve};
     s.start_cvode(&Impl::rhs, &stiff);
 }
 

@@ -59,7 +59,7 @@ void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance
 void EventDriver::start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff) {
     cvode->create(stiff ? CV_BDF : CV_ADAMS, rhs, this, opt.cvode.rtol);
     if (stiff) {
-        cvode->use_preconditioned_newton(stiff->max_krylov, stiff->psetup, stiff->psolve);
+        cvode->use_embedded_newton(stiff->psetup, stiff->psolve, this);
         cvode->set_max_order(stiff->max_order);
     } else {
         cvode->use_fixed_point();

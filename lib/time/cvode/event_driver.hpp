@@ -90,11 +90,11 @@ public:
     /// The check and event problems on the compliance W [m/N], their solvers (the event
     /// solver to `event_tolerance_m`).
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
-    /// A stiff stepper's integrator: BDF up to `max_order`, Newton with GMRES and the
-    /// stepper's preconditioner (CvodeSession::use_preconditioned_newton).
+    /// A stiff stepper's integrator: BDF up to `max_order`, Newton on the stepper's exact
+    /// factorisation (psetup) and solve (psolve) of the Newton matrix, as a matrix-embedded
+    /// linear solver (CvodeSession::use_embedded_newton).
     struct StiffIntegrator {
         int max_order = 2;
-        int max_krylov = 5;
         CVLsPrecSetupFn psetup = nullptr;
         CVLsPrecSolveFn psolve = nullptr;
     };

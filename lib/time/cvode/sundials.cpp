@@ -3,16 +3,72 @@
 
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_band.h>
-#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunmatrix/sunmatrix_band.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <utility>
 
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam::detail {
+
+/// The content of the matrix-embedded linear solver: the stepper's factorisation and solve,
+/// the gamma of the last factorisation, and the number of factorisations.
+struct CvodeSession::Embedded {
+    void* cv = nullptr;
+    CVLsPrecSetupFn setup = nullptr;
+    CVLsPrecSolveFn solve = nullptr;
+    void* user = nullptr;
+    double gamma = 0.0;
+    long setups = 0;
+
+    static Embedded* of(SUNLinearSolver S) { return static_cast<Embedded*>(S->content); }
+    static SUNLinearSolver_Type type(SUNLinearSolver) { return SUNLINEARSOLVER_MATRIX_EMBEDDED; }
+    static SUNLinearSolver_ID id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+    /// CVODE (6.x) calls no setup on a matrix-embedded solver: the solve decides. It
+    /// factorises at the current gamma when there is no factorisation of the current modes
+    /// (the stepper's solve answers > 0) or gamma moved by more than kRefactor since the last
+    /// one (CVODE's own rule for its direct solvers, dgmax = 0.3), and scales the solution by
+    /// 2 / (1 + gamma / gamma_lu) as CVODE does for a direct solver's stale gamma.
+    static constexpr double kRefactor = 0.3;
+    int factorise(sunrealtype t, N_Vector y, sunrealtype gamma_now) {
+        sunbooleantype jcur = SUNFALSE;
+        const int flag = setup(t, y, nullptr, SUNFALSE, &jcur, gamma_now, user);
+        if (flag != 0) return flag > 0 ? SUNLS_PSET_FAIL_REC : SUNLS_PSET_FAIL_UNREC;
+        gamma = gamma_now;
+        ++setups;
+        return SUNLS_SUCCESS;
+    }
+    static int do_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, sunrealtype tol) {
+        Embedded* e = of(S);
+        sunrealtype t = 0.0, gamma_now = 0.0;
+        N_Vector y = nullptr;
+        if (CVodeGetCurrentTime(e->cv, &t) < 0 || CVodeGetCurrentGamma(e->cv, &gamma_now) < 0 ||
+            CVodeGetCurrentState(e->cv, &y) < 0)
+            return SUNLS_PSOLVE_FAIL_UNREC;
+        if (!(e->gamma > 0.0) || std::abs(gamma_now / e->gamma - 1.0) > kRefactor) {
+            const int f = e->factorise(t, y, gamma_now);
+            if (f != SUNLS_SUCCESS) return f;
+        }
+        int flag = e->solve(t, y, nullptr, b, x, e->gamma, tol, 0, e->user);
+        if (flag > 0) {  // no factorisation of the current modes yet (a restart): factorise, again
+            const int f = e->factorise(t, y, gamma_now);
+            if (f != SUNLS_SUCCESS) return f;
+            flag = e->solve(t, y, nullptr, b, x, e->gamma, tol, 0, e->user);
+        }
+        if (flag != 0) return flag > 0 ? SUNLS_PSOLVE_FAIL_REC : SUNLS_PSOLVE_FAIL_UNREC;
+        if (gamma_now != e->gamma) N_VScale(2.0 / (1.0 + gamma_now / e->gamma), x, x);
+        return SUNLS_SUCCESS;
+    }
+    static int do_free(SUNLinearSolver S) {
+        if (S == nullptr) return SUNLS_SUCCESS;
+        S->content = nullptr;  // owned by the session
+        SUNLinSolFreeEmpty(S);
+        return SUNLS_SUCCESS;
+    }
+};
 
 std::string cvode_flag_name(int flag) {
     char* name = CVodeGetReturnFlagName(flag);
@@ -85,13 +141,21 @@ void CvodeSession::use_band_newton(int mu, int ml, CVLsJacFn jac) {
     linear_ = true;
 }
 
-void CvodeSession::use_preconditioned_newton(int maxl, CVLsPrecSetupFn psetup, CVLsPrecSolveFn psolve) {
-    ls_ = SUNLinSol_SPGMR(y_, SUN_PREC_LEFT, maxl, ctx_);
-    if (!ls_) throw SolverError(who_ + ": SUNLinSol_SPGMR failed", 0, 0.0, 0.0);
+void CvodeSession::use_embedded_newton(CVLsPrecSetupFn setup, CVLsPrecSolveFn solve, void* user) {
+    embedded_ = std::make_unique<Embedded>();
+    embedded_->cv = cv_;
+    embedded_->setup = setup;
+    embedded_->solve = solve;
+    embedded_->user = user;
+    ls_ = SUNLinSolNewEmpty(ctx_);
+    if (!ls_) throw SolverError(who_ + ": SUNLinSolNewEmpty failed", 0, 0.0, 0.0);
+    ls_->content = embedded_.get();
+    ls_->ops->gettype = &Embedded::type;
+    ls_->ops->getid = &Embedded::id;
+    ls_->ops->solve = &Embedded::do_solve;
+    ls_->ops->free = &Embedded::do_free;
     check(CVodeSetLinearSolver(cv_, ls_, nullptr), "CVodeSetLinearSolver");
-    check(CVodeSetPreconditioner(cv_, psetup, psolve), "CVodeSetPreconditioner");
     linear_ = true;
-    krylov_ = true;
 }
 
 void CvodeSession::set_limits(double max_step_s) {
@@ -126,17 +190,14 @@ void CvodeSession::read_counters() {
         counters_.root_evaluations = base_.root_evaluations + v;
     }
     if (linear_) {
-        if (krylov_) {  // the preconditioner's setups are its Jacobian evaluations
-            check(CVodeGetNumPrecEvals(cv_, &v), "CVodeGetNumPrecEvals");
-            counters_.jacobian_evaluations = base_.jacobian_evaluations + v;
-            check(CVodeGetNumLinIters(cv_, &v), "CVodeGetNumLinIters");
-            counters_.linear_iterations = base_.linear_iterations + v;
+        if (embedded_) {  // the stepper's factorisations are its Jacobians and Newton matrices
+            counters_.jacobian_evaluations = counters_.linear_setups = embedded_->setups;  // across reinit
         } else {
             check(CVodeGetNumJacEvals(cv_, &v), "CVodeGetNumJacEvals");
             counters_.jacobian_evaluations = base_.jacobian_evaluations + v;
+            check(CVodeGetNumLinSolvSetups(cv_, &v), "CVodeGetNumLinSolvSetups");
+            counters_.linear_setups = base_.linear_setups + v;
         }
-        check(CVodeGetNumLinSolvSetups(cv_, &v), "CVodeGetNumLinSolvSetups");
-        counters_.linear_setups = base_.linear_setups + v;
     }
 }
 
