@@ -10,6 +10,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"
+#include "stackbeam/io/scenario.hpp"
 
 using namespace stackbeam;
 namespace tt = boost::test_tools;
@@ -181,4 +182,22 @@ BOOST_AUTO_TEST_CASE(bad_ends_name_the_field) {
     s = leaf_on(SupportKind::hinged, SupportKind::hinged);
     s.symmetry = Symmetry::half;
     BOOST_TEST(field_of(s) == "leaves[0].left_support");
+}
+
+// The example scenarios/parabolic_two_leaf.toml: its liner pads close the gap that the tapers
+// leave at the second leaf's tips (straight axes, stacked at the seat: the gap is half the
+// thinning of the two leaves against the seat's 24 + 24 mm), and the gap opens between.
+BOOST_AUTO_TEST_CASE(parabolic_example_liners_close_the_taper_gap) {
+    const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/parabolic_two_leaf.toml");
+    const Model m = Model::build(sc.model);
+    int pads = 0;
+    for (const PairSpec& p : m.candidate_pairs()) {
+        const double t = leaf_thickness_m(sc.model.leaves[0], p.x_m) + leaf_thickness_m(sc.model.leaves[1], p.x_m);
+        BOOST_TEST(p.initial_gap_m == 0.5 * (0.048 - t), tt::tolerance(1e-12));
+        const bool pad = p.x_m < 0.13 + 1e-9 || p.x_m > 1.07 - 1e-9;
+        if (pad) ++pads;
+        if (pad) BOOST_TEST(std::abs(p.initial_gap_m) < 1e-12);
+        if (std::abs(p.x_m - 0.3) < 1e-9) BOOST_TEST(p.initial_gap_m > 0.004);
+    }
+    BOOST_TEST(pads == 6);  // x = 0.1, 0.115, 0.13 (the pad to the ramp's start) and their mirror images
 }
