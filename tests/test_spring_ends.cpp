@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "single_leaf.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/io/scenario.hpp"
@@ -22,19 +23,7 @@ const double kEI = kE * kB * kT * kT * kT / 12.0, kEA = kE * kB * kT;
 
 /// One prismatic leaf from x = 0 to kL, the load (the rigid body) at the centre.
 ModelSpec leaf_on(SupportKind left, SupportKind right, double seat_x = 0.5 * kL) {
-    ModelSpec s;
-    LeafSpec l;
-    l.length_m = kL;
-    l.height_m = kT;
-    l.width_m = kB;
-    l.youngs_modulus_pa = kE;
-    l.left_support = left;
-    l.right_support = right;
-    s.leaves = {l};
-    s.rigid_body.mass_kg = 1.0;
-    s.rigid_body.x_m = seat_x;
-    s.mesh.element_length_m = kL / 20;
-    return s;
+    return testing::single_leaf(kL, kT, kB, kE, left, right, seat_x, kL / 20);
 }
 
 double stiffness(const ModelSpec& s) { return System(Model::build(s)).free_stiffness_n_per_m(); }

@@ -200,7 +200,7 @@ System::System(const Model& model) : model_(model) {
         // the moment arms: half the local thickness (a profiled leaf's axis lies midway between its surfaces)
         const double ha = leaf_thickness_m(spec.leaves[a], cp.x_m), hb = leaf_thickness_m(spec.leaves[b], cp.x_m);
         // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
-        // On the reduced DOFs: each full DOF is at most one master times a coefficient (a row
+        // On the reduced DOFs: each full DOF is a few masters times coefficients (a row
         // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
         auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
             std::vector<std::pair<int, double>> out;
