@@ -216,6 +216,19 @@ BOOST_AUTO_TEST_CASE(taper_opens_the_gap_away_from_the_seat) {
     BOOST_CHECK_THROW(Model::build(s), InputError);
 }
 
+// The half model of a mirrored profile is the full one (the symmetric taper of the simply
+// supported case; to 1e-9: the same elements, the same equations); an unmirrored one is refused.
+BOOST_AUTO_TEST_CASE(half_model_of_a_mirrored_profile) {
+    const double L = 1.4;
+    ModelSpec s = one_leaf(L, SupportKind::pinned, SupportKind::pinned, 0.5 * L, L / 28);
+    s.leaves[0].profile = LeafProfile{{0.0, 0.1, 0.5 * L, L - 0.1, L}, {kT1, kT1, kT0, kT1, kT1}, {}};
+    ModelSpec half = s;
+    half.symmetry = Symmetry::half;
+    BOOST_TEST(1.0 / compliance_m_per_n(half) == 1.0 / compliance_m_per_n(s), tt::tolerance(1e-9));
+    half.leaves[0].profile.thickness_m[1] = 0.013;
+    BOOST_CHECK_THROW(Model::build(half), InputError);
+}
+
 // Bad profiles are InputErrors naming the field.
 BOOST_AUTO_TEST_CASE(bad_profiles_name_the_field) {
     auto field_of = [](ModelSpec s) {

@@ -178,6 +178,12 @@ BOOST_AUTO_TEST_CASE(bad_ends_name_the_field) {
 // thinning of the two leaves against the seat's 24 + 24 mm), and the gap opens between.
 BOOST_AUTO_TEST_CASE(parabolic_example_liners_close_the_taper_gap) {
     const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/parabolic_two_leaf.toml");
+    const LeafSpec& main_leaf = sc.model.leaves[0];  // the keys as read
+    BOOST_TEST((main_leaf.left_support == SupportKind::hinged && main_leaf.right_support == SupportKind::shackle));
+    BOOST_TEST(main_leaf.left_end.eye_offset_m == 0.0285);
+    BOOST_TEST(main_leaf.right_end.shackle_angle_rad == 0.15);
+    BOOST_TEST(main_leaf.profile.thickness_m.size() == 14u);
+    BOOST_TEST(main_leaf.height_m == 0.0);
     const Model m = Model::build(sc.model);
     int pads = 0;
     for (const PairSpec& p : m.candidate_pairs()) {

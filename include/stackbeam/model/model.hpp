@@ -22,6 +22,9 @@ enum class SupportKind {
 
 /// A leaf's thickness and width along it, piecewise linear between points (empty: constant
 /// height_m / width_m). docs/model-and-scenarios.md, "Leaf profiles, eyes and shackles".
+/// Each leaf keeps a straight axis, its thickness symmetric about it; the leaves are stacked
+/// touching at the seat (RigidBodySpec::x_m), so where they are thinner than there a pair's gap
+/// is larger by half the thinning of the two (PairSpec::initial_gap_m). Every point is a node.
 struct LeafProfile {
     std::vector<double> x_m;          ///< points from the leaf's left end [m]: 0 first, length_m last, increasing
     std::vector<double> thickness_m;  ///< thickness at each point [m], > 0 (empty: height_m, which must then be given)
@@ -32,8 +35,8 @@ struct LeafProfile {
 /// deflection: the support point at height e above the leaf's axis moves (u - e theta, v).
 struct LeafEndSpec {
     double eye_offset_m = 0.0;  ///< e: the support point (eye centre) above the leaf's axis [m], signed (+y up)
-    /// Shackle: the link's direction from the eye to its frame pin, from +y, positive leaning to +x
-    /// [rad], |angle| < pi/2; 0 is a vertical link (a roller, as pinned).
+    /// Shackle: the link's inclination from the vertical (+y) [rad], |angle| < pi/2, positive when its
+    /// upper end lies at larger x (hanging or standing alike); 0 is a vertical link (a roller, as pinned).
     double shackle_angle_rad = 0.0;
     double bushing_x_n_per_m = 0.0;               ///< bushing: axial stiffness at the support point [N/m], >= 0
     double bushing_y_n_per_m = 0.0;               ///< bushing: transverse stiffness [N/m], >= 0
@@ -157,7 +160,7 @@ struct PairSpec {
     PairKind kind = PairKind::coulomb;
     double friction_coefficient = 0.0;  ///< mu [-]
     double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
-    double initial_gap_m = 0.0;         ///< d_n [m]
+    double initial_gap_m = 0.0;         ///< d_n [m] (with a profile: plus the taper's gap, LeafProfile)
     /// Elastic interface: the layer's compliance of this pair, 1 / (k_n A) and 1 / (k_t A) [m/N],
     /// A its tributary area [m^2]; 0 on a rigid interface and at a point clamp.
     double normal_compliance_m_per_n = 0.0;
