@@ -124,7 +124,8 @@ BOOST_AUTO_TEST_CASE(width_taper_cantilever) {
 }
 
 // A profile of constant section is the constant leaf: the integration is exact, so the
-// stiffness agrees to rounding (1e-12) with height_m / width_m (whose code path is unchanged).
+// stiffness and the mass agree to rounding (1e-12) with height_m / width_m (whose code path
+// is unchanged). The profile's extra node at 0.3 m is on the constant leaf's grid too (0.05 m).
 BOOST_AUTO_TEST_CASE(constant_profile_is_the_constant_leaf) {
     ModelSpec c = one_leaf(1.0, SupportKind::pinned, SupportKind::pinned, 0.5, 0.05);
     c.leaves[0].height_m = 0.01;
@@ -134,6 +135,11 @@ BOOST_AUTO_TEST_CASE(constant_profile_is_the_constant_leaf) {
     p.leaves[0].profile = LeafProfile{{0.0, 0.3, 1.0}, {0.01, 0.01, 0.01}, {kB, kB, kB}};
     const double kc = 1.0 / compliance_m_per_n(c), kp = 1.0 / compliance_m_per_n(p);
     BOOST_TEST(std::abs(kp - kc) / kc < 1e-12);
+    // and the consistent mass (density > 0) is the constant leaf's, entry by entry
+    c.leaves[0].density_kg_per_m3 = p.leaves[0].density_kg_per_m3 = 7850.0;
+    const Eigen::SparseMatrix<double> mc = System(Model::build(c)).mass_reduced(), mp = System(Model::build(p)).mass_reduced();
+    BOOST_TEST((mc.rows() == mp.rows() && mc.cols() == mp.cols()));
+    BOOST_TEST(Eigen::MatrixXd(mp - mc).cwiseAbs().maxCoeff() < 1e-12 * Eigen::MatrixXd(mc).cwiseAbs().maxCoeff());
 }
 
 // The element matrices of leaf_sections.hpp against hand integrals over one element with t and
@@ -214,6 +220,21 @@ BOOST_AUTO_TEST_CASE(taper_opens_the_gap_away_from_the_seat) {
     // thicker away from the seat than at it: the leaves would overlap (an InputError)
     s.leaves[1].profile.thickness_m = {0.04, kT1, 0.04};  // at the ends 4 mm more than at the seat
     BOOST_CHECK_THROW(Model::build(s), InputError);
+}
+
+// The friction-mesh ratio takes the largest local arm of the interface: two tapered leaves
+// (12 -> 30 -> 12 mm), mu = 0.5, pairs 50 mm apart: kappa = mu (t + t)/(2 h) at the seat,
+// 0.5 x 0.030 / 0.05 = 0.3 (to rounding).
+BOOST_AUTO_TEST_CASE(friction_mesh_ratio_takes_the_local_thickness) {
+    const double L = 1.4;
+    ModelSpec s = one_leaf(L, SupportKind::pinned, SupportKind::pinned, 0.5 * L, 0.05);
+    s.leaves[0].profile = LeafProfile{{0.0, 0.5 * L, L}, {kT1, kT0, kT1}, {}};
+    s.leaves.push_back(s.leaves[0]);
+    s.leaves[1].left_support = s.leaves[1].right_support = SupportKind::free;
+    s.interfaces = {InterfaceSpec{}};
+    s.interfaces[0].friction_coefficient = 0.5;
+    const FrictionMeshRatio r = friction_mesh_ratio(Model::build(s));
+    BOOST_TEST(r.ratio == 0.5 * kT0 / 0.05, tt::tolerance(1e-12));
 }
 
 // The half model of a mirrored profile is the full one (the symmetric taper of the simply

@@ -525,7 +525,9 @@ FrictionMeshRatio friction_mesh_ratio(const Model& model) {
             if (x[j] - x[j - 1] > tol) h = std::min(h, x[j] - x[j - 1]);
         if (!std::isfinite(h)) continue;  // fewer than two pairs: no neighbour to trade forces with
         const bool elastic = f.contact == InterfaceContact::elastic;
-        const double l = elastic ? interface_layer(spec, i).decay_length_m : 0.0;
+        double l = elastic ? interface_layer(spec, i).decay_length_m : 0.0;
+        if (elastic && (!spec.leaves[i].profile.x_m.empty() || !spec.leaves[i + 1].profile.x_m.empty()))
+            for (double xp : x) l = std::min(l, interface_layer(spec, i, xp).decay_length_m);  // the shortest over the pairs
         const double kappa = f.friction_coefficient * arm_m / std::max(h, l);
         if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m, l, elastic};
     }

@@ -240,8 +240,9 @@ InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index, doubl
 ///
 ///     kappa_i = mu_i (t_i + t_i+1) / (2 h_i),
 ///
-/// t_i, t_i+1 the thicknesses of the leaves above and below [m], h_i the shortest
-/// spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
+/// t_i, t_i+1 the thicknesses of the leaves above and below [m] (profiles: the largest local sum
+/// over the interface's pairs, and on an elastic interface the shortest decay length l), h_i the
+/// shortest spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
 /// Why: a change dT of a pair's tangential force acts at the interface, t/2 off each
 /// leaf's axis, so it puts a moment dT (t_i + t_i+1)/2 on the two leaves. Where a
 /// contact zone ends (a leaf tip, the edge of a closed zone) only the couple of the
