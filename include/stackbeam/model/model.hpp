@@ -3,6 +3,7 @@
 /// The model description of a stacked-beam spring: what the user specifies
 /// (ModelSpec, plain data) and its validated, immutable, meshed form (Model).
 /// Sign conventions and units: conventions.hpp.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,32 @@ enum class SupportKind {
     free,    ///< no constraint
     pinned,  ///< transverse displacement v = 0; rotation and axial displacement free
     fixed,   ///< built in: u = v = theta = 0
+    hinged,  ///< a pin through the eye: the support point (LeafEndSpec::eye_offset_m) held in x and y, rotation free
+    shackle, ///< a link (small deflection: an inclined roller): the support point does not move along the link
+    bushing, ///< elastic: springs (LeafEndSpec::bushing_*) between the support point and the ground
+};
+
+/// A leaf's thickness and width along it, piecewise linear between points (empty: constant
+/// height_m / width_m). docs/model-and-scenarios.md, "Leaf profiles, eyes and shackles".
+/// Each leaf keeps a straight axis, its thickness symmetric about it; the leaves are stacked
+/// touching at the seat (RigidBodySpec::x_m), so where they are thinner than there a pair's gap
+/// is larger by half the thinning of the two (PairSpec::initial_gap_m). Every point is a node.
+struct LeafProfile {
+    std::vector<double> x_m;          ///< points from the leaf's left end [m]: 0 first, length_m last, increasing
+    std::vector<double> thickness_m;  ///< thickness at each point [m], > 0 (empty: height_m, which must then be given)
+    std::vector<double> width_m;      ///< width at each point [m], > 0 (empty: width_m, which must then be given)
+};
+
+/// The support point at a leaf end and its eye, shackle or bushings (SupportKind). Small
+/// deflection: the support point at height e above the leaf's axis moves (u - e theta, v).
+struct LeafEndSpec {
+    double eye_offset_m = 0.0;  ///< e: the support point (eye centre) above the leaf's axis [m], signed (+y up)
+    /// Shackle: the link's inclination from the vertical (+y) [rad], |angle| < pi/2, positive when its
+    /// upper end lies at larger x (hanging or standing alike); 0 is a vertical link (a roller, as pinned).
+    double shackle_angle_rad = 0.0;
+    double bushing_x_n_per_m = 0.0;               ///< bushing: axial stiffness at the support point [N/m], >= 0
+    double bushing_y_n_per_m = 0.0;               ///< bushing: transverse stiffness [N/m], >= 0
+    double bushing_rotation_n_m_per_rad = 0.0;    ///< bushing: rotational stiffness [N m/rad], >= 0
 };
 
 /// Contact law of an interface between two adjacent leaves.
@@ -39,15 +66,21 @@ enum class Symmetry { full, half };
 struct LeafSpec {
     double length_m = 0.0;                  ///< leaf length [m], > 0
     double x_start_m = 0.0;                 ///< x of its left end [m]
-    double height_m = 0.0;                  ///< thickness, normal to the stack [m], > 0
-    double width_m = 0.0;                   ///< width [m], > 0
+    double height_m = 0.0;                  ///< thickness, normal to the stack [m], > 0 (0 with profile.thickness_m)
+    double width_m = 0.0;                   ///< width [m], > 0 (0 with profile.width_m)
     double youngs_modulus_pa = 0.0;         ///< Young's modulus [Pa], > 0
     double density_kg_per_m3 = 0.0;         ///< mass density [kg/m^3], >= 0 (0: massless, as in the paper)
     SupportKind left_support = SupportKind::free;   ///< support at x_start_m
     SupportKind right_support = SupportKind::free;  ///< support at x_start_m + length_m
     double poisson_ratio = 0.3;             ///< Poisson's ratio nu [-], in (-1, 0.5): the elastic interface's
                                             ///< derived stiffness (interface_layer); nothing else uses it
+    LeafProfile profile;                    ///< thickness / width along x (empty: constant)
+    LeafEndSpec left_end, right_end;        ///< eyes, shackle, bushings at the two ends
 };
+
+/// Thickness and width of a leaf at x [m] (absolute x; the profile, or height_m / width_m).
+double leaf_thickness_m(const LeafSpec& leaf, double x_m);
+double leaf_width_m(const LeafSpec& leaf, double x_m);
 
 /// The interface between leaf i (above) and leaf i+1 (below).
 struct InterfaceSpec {
@@ -127,7 +160,7 @@ struct PairSpec {
     PairKind kind = PairKind::coulomb;
     double friction_coefficient = 0.0;  ///< mu [-]
     double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
-    double initial_gap_m = 0.0;         ///< d_n [m]
+    double initial_gap_m = 0.0;         ///< d_n [m] (with a profile: plus the taper's gap, LeafProfile)
     /// Elastic interface: the layer's compliance of this pair, 1 / (k_n A) and 1 / (k_t A) [m/N],
     /// A its tributary area [m^2]; 0 on a rigid interface and at a point clamp.
     double normal_compliance_m_per_n = 0.0;
@@ -198,16 +231,18 @@ struct InterfaceLayer {
     double contact_width_m = 0.0;                ///< b [m]
     double decay_length_m = 0.0;                 ///< l [m]
 };
-/// The layer of interface i of a spec (whatever its contact law; validated leaves assumed).
-InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index);
+/// The layer of interface i of a spec (whatever its contact law; validated leaves assumed),
+/// with the leaves' sections at x_m (NaN: at the left end of their overlap; the same for constant leaves).
+InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index, double x_m = std::nan(""));
 
 /// The friction-mesh ratio of a model: how strongly a change of the friction forces
 /// moves the normal forces of neighbouring contact pairs, per Coulomb interface
 ///
 ///     kappa_i = mu_i (t_i + t_i+1) / (2 h_i),
 ///
-/// t_i, t_i+1 the thicknesses of the leaves above and below [m], h_i the shortest
-/// spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
+/// t_i, t_i+1 the thicknesses of the leaves above and below [m] (profiles: the largest local sum
+/// over the interface's pairs, and on an elastic interface the shortest decay length l), h_i the
+/// shortest spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
 /// Why: a change dT of a pair's tangential force acts at the interface, t/2 off each
 /// leaf's axis, so it puts a moment dT (t_i + t_i+1)/2 on the two leaves. Where a
 /// contact zone ends (a leaf tip, the edge of a closed zone) only the couple of the
