@@ -1,0 +1,344 @@
+// Free camber and the assembly of the stack (model.hpp LeafSpec::free_camber_m,
+// simulation.hpp require_no_assembly): the two-leaf nip against its closed form, the
+// static rate unchanged by the preload, the friction loop grown by it, and a graduated
+// spring's rate against the leaf-end contact theory and the SAE formula.
+#define BOOST_TEST_MODULE assembly
+#include <boost/test/unit_test.hpp>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+
+namespace tt = boost::test_tools;
+using namespace stackbeam;
+
+namespace {
+
+constexpr double kE = 2e11, kWidth = 0.06;
+
+double bending_stiffness(double t_m) { return kE * kWidth * t_m * t_m * t_m / 12.0; }
+
+/// A leaf of length 2 l centred on x = l0 (the seat), thickness t, free radius R (0: flat).
+LeafSpec leaf(double l0, double l, double t, double radius_m, bool pinned) {
+    LeafSpec s;
+    s.length_m = 2.0 * l;
+    s.x_start_m = l0 - l;
+    s.height_m = t;
+    s.width_m = kWidth;
+    s.youngs_modulus_pa = kE;
+    s.free_radius_m = radius_m;
+    s.left_support = s.right_support = pinned ? SupportKind::pinned : SupportKind::free;
+    return s;
+}
+
+/// A graduated spring: n leaves of thickness t, the main leaf 2 l long pinned at its ends
+/// (eyes), leaf k shorter, 2 l (n - k)/n, centred, free; leaf k's free radius radii[k]
+/// (0: flat); every interface Coulomb with mu; the seat (R, 10 kg) at x = l.
+ModelSpec graduated(int n, double l, double t, const std::vector<double>& radii, double mu,
+                    double element_m = 0.0125) {
+    ModelSpec spec;
+    for (int k = 0; k < n; ++k) spec.leaves.push_back(leaf(l, l * (n - k) / n, t, radii[k], k == 0));
+    for (int k = 0; k + 1 < n; ++k) spec.interfaces.push_back({InterfaceLaw::coulomb, mu});
+    spec.rigid_body.mass_kg = 10.0;
+    spec.rigid_body.x_m = l;
+    spec.mesh.element_length_m = element_m;
+    return spec;
+}
+
+SimulationOptions rig(const TimeFunction& w, double dt_s, double t_end_s) {
+    SimulationOptions so;
+    so.mode = Mode::closed_form;
+    so.dt_s = dt_s;
+    so.t_end_s = t_end_s;
+    so.solver.tolerance_m = 1e-12;
+    so.loading.kind = LoadingKind::prescribed_displacement;
+    so.loading.displacement_m = w;
+    return so;
+}
+
+/// The rate [N/m] of the rig's ramp w_c -+ dw, and the fewest and most pairs closed (p_n < 0) at its two ends.
+struct Rate {
+    double k_n_per_m = 0.0;
+    int closed_min = 0, closed_max = 0;
+};
+Rate rate_at(const System& sys, double w_c, double dw) {
+    TimeFunction ramp;
+    ramp.shape = TimeFunction::Shape::table;
+    ramp.times_s = {0.0, 1.0};
+    ramp.values = {w_c - dw, w_c + dw};
+    ClosedFormStepper st(sys, rig(ramp, 1.0, 1.0));
+    auto closed = [&] {
+        int c = 0;
+        for (const PairRecord& r : st.pairs()) c += r.p_n_n < 0.0 ? 1 : 0;
+        return c;
+    };
+    const double f0 = st.current().spring_force_n;
+    const int c0 = closed();
+    const double f1 = st.advance().spring_force_n;
+    const int c1 = closed();
+    return {(f1 - f0) / (2.0 * dw), std::min(c0, c1), std::max(c0, c1)};
+}
+
+/// The leaf-end contact theory of a spring's rate [N/m]: each half is cantilevers from the seat,
+/// leaf k of length l_k (decreasing) and bending stiffness EI_k, touching only at the tips: leaf
+/// k-1 pushes leaf k down at l_k with P_k, the pin pushes the main leaf down at l_0 with Q = F/2.
+/// With g(a, b) = a^2 (3b - a)/6 (a <= b), b^2 (3a - b)/6 (a >= b), the deflection at a of a
+/// cantilever per unit load at b and per unit EI, leaf j deflects by
+/// v_j(a) = (-P_j g(a, l_j) + P_(j+1) g(a, l_(j+1))) / EI_j (P_0 = Q, P_n = 0); compatibility
+/// v_(k-1)(l_k) = v_k(l_k) at each tip gives the P_k, and the rate is 2 Q / (-v_0(l_0)).
+double leaf_end_rate(const std::vector<double>& l, const std::vector<double>& EI) {
+    const int n = static_cast<int>(l.size());
+    auto g = [](double a, double b) { return a <= b ? a * a * (3 * b - a) / 6 : b * b * (3 * a - b) / 6; };
+    const double Q = 1.0;
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n - 1, n - 1);  // unknown P_k in column k - 1
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n - 1);
+    for (int k = 1; k < n; ++k) {
+        const int r = k - 1;
+        // v_(k-1)(l_k): -P_(k-1) g(l_k, l_(k-1)) / EI_(k-1) + P_k g(l_k, l_k) / EI_(k-1)
+        if (k == 1) rhs[r] += Q * g(l[k], l[0]) / EI[0];
+        else A(r, k - 2) -= g(l[k], l[k - 1]) / EI[k - 1];
+        A(r, k - 1) += g(l[k], l[k]) / EI[k - 1];
+        // - v_k(l_k): + P_k g(l_k, l_k) / EI_k - P_(k+1) g(l_k, l_(k+1)) / EI_k
+        A(r, k - 1) += g(l[k], l[k]) / EI[k];
+        if (k + 1 < n) A(r, k) -= g(l[k], l[k + 1]) / EI[k];
+    }
+    const Eigen::VectorXd P = A.partialPivLu().solve(rhs);
+    const double delta = (Q * g(l[0], l[0]) - P[0] * g(l[0], l[1])) / EI[0];
+    return 2.0 * Q / delta;
+}
+
+/// The assembled state (t = 0) of a free run: w [m] and the pairs.
+struct Assembled {
+    double w_m = 0.0;
+    std::vector<PairRecord> pairs;
+};
+Assembled assemble(const System& sys) {
+    SimulationOptions so;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-4;
+    so.solver.tolerance_m = 1e-12;
+    ClosedFormStepper st(sys, so);
+    return {st.current().w_m, st.pairs()};
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(two_leaf_nip_tip_force_matches_the_curvature_mismatch) {
+    // The classic nip: two leaves bolted at the centre (the seat), leaf 1 (below, half length
+    // L2 = 0.3 m, t2 = 6 mm, free radius R2 = 3 m) more curved than leaf 0 (L1 = 0.5 m,
+    // t1 = 8 mm, R1 = 5 m), frictionless. Free shapes v0_i = x^2 / (2 R_i) from the seat.
+    // Derivation (each half a pair of cantilevers clamped at the seat, x from the seat): the
+    // bolt closes the tip interference (1/R2 - 1/R1) L2^2 / 2 by a tip force P, upward on
+    // leaf 0, downward on leaf 1, at x = L2. Tip deflections P L2^3 / (3 EI_i), so
+    //     P L2^3 / 3 (1/EI1 + 1/EI2) = (1/R2 - 1/R1) L2^2 / 2
+    //     P = 3 (1/R2 - 1/R1) / (2 L2 (1/EI1 + 1/EI2))                           (= 101.3 N)
+    // and the gap inside, (1/R2 - 1/R1) x^2 (L2 - x) / (4 L2) >= 0, is open: contact only at
+    // the tips. Leaf 0 beyond L2 carries nothing (its pinned ends see no reaction: R is free and
+    // the assembly puts no force on it), so its end rises by P L2^2 (3 L1 - L2) / (6 EI1) from
+    // the seat, and the seat is w = -that below the ends' pins.
+    // Tolerance: cubic beam elements are exact for point loads at nodes and the free shape
+    // enters only at the nodes (exactly), so only round-off and the solver's 1e-12 m remain:
+    // 1e-8 relative.
+    const double L1 = 0.5, L2 = 0.3, t1 = 0.008, t2 = 0.006, R1 = 5.0, R2 = 3.0;
+    ModelSpec spec;
+    spec.leaves = {leaf(L1, L1, t1, R1, true), leaf(L1, L2, t2, R2, false)};
+    spec.interfaces = {{InterfaceLaw::coulomb, 0.0}};
+    spec.rigid_body.mass_kg = 10.0;
+    spec.rigid_body.x_m = L1;
+    spec.mesh.element_length_m = 0.01;
+    const double EI1 = bending_stiffness(t1), EI2 = bending_stiffness(t2);
+    const double P = 3.0 * (1.0 / R2 - 1.0 / R1) / (2.0 * L2 * (1.0 / EI1 + 1.0 / EI2));
+    const double w = -P * L2 * L2 * (3.0 * L1 - L2) / (6.0 * EI1);
+    for (Symmetry sym : {Symmetry::full, Symmetry::half}) {
+        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model") {
+            spec.symmetry = sym;
+            const System sys(Model::build(spec));
+            const Assembled a = assemble(sys);
+            int tips = 0;
+            for (const PairRecord& r : a.pairs) {
+                const bool tip = std::abs(std::abs(r.x_m - L1) - L2) < 1e-9;
+                if (tip) {
+                    ++tips;
+                    BOOST_TEST(-r.p_n_n == P, tt::tolerance(1e-8));
+                } else {
+                    BOOST_TEST(r.p_n_n == 0.0);
+                }
+            }
+            BOOST_TEST(tips == (sym == Symmetry::full ? 2 : 1));
+            BOOST_TEST(a.w_m == w, tt::tolerance(1e-8));
+        }
+    }
+    BOOST_TEST_MESSAGE("two-leaf nip: tip force " << P << " N, seat " << w << " m");
+}
+
+BOOST_AUTO_TEST_CASE(preload_leaves_the_frictionless_rate_unchanged) {
+    // The two-leaf nip spring of the test above, flat and cambered, frictionless, on the rig:
+    // the rate at ride height (a ramp of +-2 mm about the flat spring's deflection under a ride
+    // load of 500 N; the cambered spring: the same ramp about its assembled w plus that).
+    // The stack is linear while every pair keeps its state; in both the tips are closed and
+    // nothing else (checked at both ends of the ramp), so it is the same linear system and the
+    // preload (the nip, 101 N per tip) cannot change the rate. Independent value: the leaf-end
+    // contact theory (leaf_end_rate), exact here. Tolerance 1e-8: round-off of the same solves
+    // (beam elements exact for point loads at nodes).
+    const double L1 = 0.5, L2 = 0.3, t1 = 0.008, t2 = 0.006;
+    auto spring = [&](double R1, double R2) {
+        ModelSpec spec;
+        spec.leaves = {leaf(L1, L1, t1, R1, true), leaf(L1, L2, t2, R2, false)};
+        spec.interfaces = {{InterfaceLaw::coulomb, 0.0}};
+        spec.rigid_body.mass_kg = 10.0;
+        spec.rigid_body.x_m = L1;
+        spec.mesh.element_length_m = 0.01;
+        return spec;
+    };
+    const double k_theory = leaf_end_rate({L1, L2}, {bending_stiffness(t1), bending_stiffness(t2)});
+    const System s_flat(Model::build(spring(0.0, 0.0)));
+    const System s_camb(Model::build(spring(5.0, 3.0)));
+    const double w_ride = 500.0 / k_theory, dw = 0.002;
+    const Rate flat = rate_at(s_flat, w_ride, dw);
+    const Rate camb = rate_at(s_camb, assemble(s_camb).w_m + w_ride, dw);
+    BOOST_TEST_MESSAGE("two-leaf spring: rate flat " << flat.k_n_per_m << " N/m, cambered " << camb.k_n_per_m
+                                                     << " N/m, leaf-end theory " << k_theory << " N/m");
+    BOOST_TEST(flat.closed_min == 2);
+    BOOST_TEST(flat.closed_max == 2);
+    BOOST_TEST(camb.closed_min == 2);
+    BOOST_TEST(camb.closed_max == 2);
+    BOOST_TEST(camb.k_n_per_m == flat.k_n_per_m, tt::tolerance(1e-8));
+    BOOST_TEST(flat.k_n_per_m == k_theory, tt::tolerance(1e-8));
+}
+
+BOOST_AUTO_TEST_CASE(graduated_cambered_spring_rate_against_leaf_end_theory_and_sae) {
+    // A graduated 4-leaf spring (half span l = 0.5 m, t = 8 mm, leaf k of half length
+    // l (n - k)/n), each lower leaf more curved (free radii 4, 3.2, 2.6, 2.2 m): the assembly
+    // preloads every tip. Its rate at ride height (+-2 mm about the deflection under 2 kN):
+    //
+    // (1) the leaf-end contact theory (leaf_end_rate): the leaves touch only at the tips. The
+    // preloaded stack also closes pairs within three elements (37.5 mm) of the seat and next to
+    // the tips (the nip of a multi-leaf stack spreads there), which adds constraints, so it is
+    // a little stiffer: measured 5e-6 above the flat spring's, itself 3e-7 above the theory
+    // (the flat one touches at one more node next to each tip). Tolerance 1e-4: these pairs sit
+    // where the leaves' relative motion under the load is small (next to the seat the gap varies
+    // as x^2 from it; a tip's neighbour shares its deflection to O(h/l)).
+    //
+    // (2) SAE (SAE J788 / HS-788) for a graduated multi-leaf spring: k = 8 E n b t^3 / (3 L^3),
+    // L = 2 l the span. It assumes the equal-strength plan (a triangular plate of base n b,
+    // every leaf bending with one curvature) and no friction. Our leaves are stepped: the
+    // stepped plan is wider than the triangle everywhere, so the rate lies above SAE's, and tip
+    // contact is freer than one common curvature, so below the common-curvature stepped spring's,
+    // SAE / (1 - 1/n + 2 H_n / (3 n^2)) (H_n = 1 + 1/2 + ... + 1/n; the stepped plan's deflection
+    // integral by hand): for n = 4, SAE < k < 1.195 SAE. (The leaf-end theory gives 1.106 SAE:
+    // SAE's formula underestimates a 4-leaf stepped spring by about 10 %, an O(1/n) error.)
+    const int n = 4;
+    const double l = 0.5, t = 0.008;
+    const System s_flat(Model::build(graduated(n, l, t, std::vector<double>(n, 0.0), 0.0)));
+    const System s_camb(Model::build(graduated(n, l, t, {4.0, 3.2, 2.6, 2.2}, 0.0)));
+    std::vector<double> lengths, EIs;
+    for (int k = 0; k < n; ++k) {
+        lengths.push_back(l * (n - k) / n);
+        EIs.push_back(bending_stiffness(t));
+    }
+    const double k_theory = leaf_end_rate(lengths, EIs);
+    const double k_sae = 8.0 * kE * n * kWidth * t * t * t / (3.0 * std::pow(2.0 * l, 3));
+    double harmonic = 0.0;
+    for (int i = 1; i <= n; ++i) harmonic += 1.0 / i;
+    const double k_common = k_sae / (1.0 - 1.0 / n + 2.0 * harmonic / (3.0 * n * n));
+    const double w_ride = 2000.0 / k_theory, dw = 0.002;
+    const Rate flat = rate_at(s_flat, w_ride, dw);
+    const Assembled a = assemble(s_camb);
+    const Rate camb = rate_at(s_camb, a.w_m + w_ride, dw);
+    int preloaded_tips = 0;
+    for (const PairRecord& r : a.pairs)
+        for (int k = 1; k < n; ++k)
+            if (std::abs(std::abs(r.x_m - l) - lengths[k]) < 1e-9 && r.interface_index == k - 1 && r.p_n_n < 0.0)
+                ++preloaded_tips;
+    BOOST_TEST_MESSAGE("graduated 4 x 8 mm: rate flat " << flat.k_n_per_m << " N/m, cambered " << camb.k_n_per_m
+                                                        << " N/m, leaf-end theory " << k_theory << " N/m, SAE " << k_sae
+                                                        << " N/m (theory / SAE " << k_theory / k_sae << "), common curvature "
+                                                        << k_common << " N/m; assembled w " << a.w_m << " m");
+    BOOST_TEST(preloaded_tips == 2 * (n - 1));
+    BOOST_TEST(k_theory / k_sae == 1.10599, tt::tolerance(1e-5));  // the hand figure quoted above
+    for (double k : {flat.k_n_per_m, camb.k_n_per_m}) {
+        BOOST_TEST(k == k_theory, tt::tolerance(1e-4));
+        BOOST_TEST(k > k_sae);
+        BOOST_TEST(k < k_common);
+    }
+}
+
+BOOST_AUTO_TEST_CASE(preload_grows_the_friction_loop) {
+    // The same graduated spring with mu = 0.3 on the rig, a harmonic stroke of +-2 mm about the
+    // ride deflection (flat: 2 kN / k; cambered: the same stroke about its assembled w plus that),
+    // two cycles, the last read. The frictionless loads are the same in both (same linear
+    // system, every tip closed), and the preload adds its tip forces N_0 to every tip's normal
+    // force; the loop's area is the friction work of the cycle, sum over the tips of
+    // mu |p_n| x (slip path), so the preload must enlarge it, by about mu N_0 x (slip path per
+    // cycle) per tip: the increase grows with the preload. Checked: area(cambered) > area(flat),
+    // and the increase from a preload about twice as large (twice the curvature mismatch) is
+    // more than the first increase but at most twice it (a larger normal force also lengthens
+    // the sticking spells at the reversals, which shortens the slip path: sub-linear).
+    const int n = 4;
+    const double l = 0.5, t = 0.008, mu = 0.3;
+    auto radii = [](double s) {  // curvature mismatch scaled by s on 1/4 m^-1
+        std::vector<double> r;
+        for (int k = 0; k < 4; ++k) r.push_back(1.0 / (0.25 + s * 0.05 * k));
+        return r;
+    };
+    const double k_rate = 2.2e5;  // about the rate (only to place the stroke)
+    const double w_ride = 2000.0 / k_rate, amp = 0.002;
+    double area[3] = {};
+    for (int c = 0; c < 3; ++c) {
+        const System sys(Model::build(graduated(n, l, t, radii(c), mu)));
+        const double w_a = assemble(sys).w_m;
+        TimeFunction h;
+        h.shape = TimeFunction::Shape::harmonic;
+        h.mean = w_a + w_ride;
+        h.amplitude = amp;
+        h.frequency_hz = 1.0;
+        h.phase_rad = 0.0;
+        const auto run = simulate(sys, rig(h, 1.0 / 200.0, 2.0));
+        const HysteresisMetrics m = hysteresis_metrics(run, 1.0, 2.0);
+        area[c] = m.loop_area_j;
+        BOOST_TEST_MESSAGE("mismatch x" << c << ": assembled w " << w_a << " m, loop area " << m.loop_area_j
+                                        << " J, secant " << m.secant_stiffness_n_per_m << " N/m");
+    }
+    BOOST_TEST(area[0] > 0.0);
+    BOOST_TEST(area[1] > area[0]);
+    BOOST_TEST(area[2] - area[0] > area[1] - area[0]);
+    BOOST_TEST(area[2] - area[0] <= 2.0 * (area[1] - area[0]) * (1 + 1e-6));
+}
+
+BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_named) {
+    ModelSpec spec = graduated(3, 0.5, 0.008, {4.0, 3.0, 2.5}, 0.0);
+    const System sys(Model::build(spec));
+    for (Mode mode : {Mode::newmark, Mode::cvode}) {
+        SimulationOptions so;
+        so.mode = mode;
+        so.dt_s = 1e-4;
+        so.t_end_s = 1e-3;
+        try {
+            simulate(sys, so);
+            BOOST_ERROR("no error in mode " << to_string(mode));
+        } catch (const InputError& e) {
+            BOOST_TEST(e.field() == "leaves[0].free_radius_m");
+        }
+    }
+    auto expect = [](ModelSpec s, const std::string& field) {
+        try {
+            Model::build(s);
+            BOOST_ERROR("no error for " << field);
+        } catch (const InputError& e) {
+            BOOST_TEST(e.field() == field);
+        }
+    };
+    ModelSpec bad = spec;
+    bad.leaves[1].free_camber_m = 0.2;  // more than a tenth of 0.667 m
+    bad.leaves[1].free_radius_m = 0.0;
+    expect(bad, "leaves[1].free_camber_m");
+    bad = spec;
+    bad.leaves[2].free_radius_m = 0.3;  // a tighter arc than 1.25 L = 0.42 m
+    expect(bad, "leaves[2].free_radius_m");
+    bad = spec;
+    bad.leaves[0].free_camber_m = 0.01;  // both
+    expect(bad, "leaves[0].free_radius_m");
+}

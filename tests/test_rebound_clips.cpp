@@ -1,0 +1,150 @@
+// Rebound clips (model.hpp ClipSpec): a spring pulled apart opens up to the clip's clearance
+// and then carries the load through the clip; its force against statics by hand.
+#define BOOST_TEST_MODULE rebound_clips
+#include <boost/test/unit_test.hpp>
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
+
+namespace tt = boost::test_tools;
+using namespace stackbeam;
+
+namespace {
+
+constexpr double kE = 2e11, kWidth = 0.06;
+constexpr double kL1 = 0.5, kL2 = 0.3, kT1 = 0.008, kT2 = 0.006, kA = 0.2, kClearance = 0.001, kStrap = 2e6;
+
+double bending_stiffness(double t_m) { return kE * kWidth * t_m * t_m * t_m / 12.0; }
+
+/// Two flat leaves: the main leaf 2 L1 long pinned at its ends (eyes), below it a leaf 2 L2
+/// long, centred and free, frictionless; the seat at x = L1; clips at L1 -+ a (clearance c,
+/// a soft strap of k = 2e6 N/m, so that its stretch T / k, 76 um at 151 N, is seen).
+ModelSpec clipped_spring(Symmetry sym) {
+    ModelSpec spec;
+    for (int k = 0; k < 2; ++k) {
+        LeafSpec s;
+        const double l = k == 0 ? kL1 : kL2;
+        s.length_m = 2.0 * l;
+        s.x_start_m = kL1 - l;
+        s.height_m = k == 0 ? kT1 : kT2;
+        s.width_m = kWidth;
+        s.youngs_modulus_pa = kE;
+        s.left_support = s.right_support = k == 0 ? SupportKind::pinned : SupportKind::free;
+        spec.leaves.push_back(s);
+    }
+    spec.interfaces = {{InterfaceLaw::coulomb, 0.0}};
+    spec.clips = {{kL1 - kA, 0, 1, kClearance, kStrap}, {kL1 + kA, 0, 1, kClearance, kStrap}};
+    spec.rigid_body.mass_kg = 10.0;
+    spec.rigid_body.x_m = kL1;
+    spec.mesh.element_length_m = 0.01;
+    spec.symmetry = sym;
+    return spec;
+}
+
+/// The rig pulls R down from 0 to w_end in `steps` quasi-static steps; the records and the
+/// pairs at the end.
+std::pair<std::vector<StepRecord>, std::vector<PairRecord>> pull(const System& sys, double w_end, int steps) {
+    SimulationOptions so;
+    so.mode = Mode::closed_form;
+    so.dt_s = 1.0 / steps;
+    so.t_end_s = 1.0;
+    so.solver.tolerance_m = 1e-12;
+    so.loading.kind = LoadingKind::prescribed_displacement;
+    so.loading.displacement_m.shape = TimeFunction::Shape::table;
+    so.loading.displacement_m.times_s = {0.0, 1.0};
+    so.loading.displacement_m.values = {0.0, w_end};
+    ClosedFormStepper st(sys, so);
+    std::vector<StepRecord> records{st.current()};
+    for (int i = 0; i < steps; ++i) records.push_back(st.advance());
+    return {records, st.pairs()};
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(clip_takes_the_rebound_load_beyond_its_clearance) {
+    // Rebound: the rig pulls the seat down by W (w = -W) below the eyes' pins. Each half is two
+    // cantilevers from the seat (x from it): the main leaf (L1, EI1) with its pin's force Q
+    // at L1, the lower leaf (L2, EI2) free. Pulled apart, the leaves touch nowhere but at the
+    // seat; the opening at the clip (x = a) is the main leaf's deflection there, W g(a, L1) /
+    // g(L1, L1), with g(a, b) = a^2 (3b - a)/6 (a <= b), b^2 (3a - b)/6 (a >= b) the
+    // cantilever's deflection at a per unit load at b and per unit EI. The clip engages when
+    // it reaches the clearance c: at W_c = c g(L1, L1) / g(a, L1) (4.81 mm). Beyond, the clip's
+    // tension T pulls the main leaf down and the lower leaf up at a, and the strap stretches by T/k:
+    //     (Q g(a, L1) - T g(a, a)) / EI1 - T g(a, a) / EI2 = c + T / k   (opening = c + T/k)
+    //     (Q g(L1, L1) - T g(L1, a)) / EI1 = W                          (the pin)
+    // two equations for Q, T; the rig's force is -2 Q (whole spring, R pulled down).
+    // Tolerance: beam elements are exact for point loads at nodes (the clip, the pins and the
+    // seat are nodes), so 1e-8 relative (round-off, solver 1e-12 m).
+    auto g = [](double a, double b) { return a <= b ? a * a * (3 * b - a) / 6 : b * b * (3 * a - b) / 6; };
+    const double EI1 = bending_stiffness(kT1), EI2 = bending_stiffness(kT2);
+    const double W_c = kClearance * g(kL1, kL1) / g(kA, kL1);
+    const double W = 0.015;
+    Eigen::Matrix2d M;
+    M << g(kA, kL1) / EI1, -g(kA, kA) * (1.0 / EI1 + 1.0 / EI2) - 1.0 / kStrap, g(kL1, kL1) / EI1, -g(kL1, kA) / EI1;
+    const Eigen::Vector2d QT = M.partialPivLu().solve(Eigen::Vector2d(kClearance, W));
+    const double Q = QT[0], T = QT[1];
+    BOOST_TEST_MESSAGE("rebound clip: engages at w = " << -W_c << " m; at w = " << -W << " m pin force " << Q
+                                                      << " N, clip tension " << T << " N");
+    BOOST_TEST(T > 0.0);
+    for (Symmetry sym : {Symmetry::full, Symmetry::half}) {
+        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model") {
+            const System sys(Model::build(clipped_spring(sym)));
+            const auto [records, pairs] = pull(sys, -W, 30);
+            BOOST_TEST(records.back().w_m == -W, tt::tolerance(1e-12));
+            BOOST_TEST(records.back().spring_force_n == -2.0 * Q, tt::tolerance(1e-8));
+            int clips = 0;
+            for (const PairRecord& r : pairs) {
+                if (std::abs(std::abs(r.x_m - kL1) - kA) > 1e-9 || r.p_t_n != 0.0) continue;
+                // the clip's row and the interface's pair share the node: the clip's carries the tension
+                if (r.p_n_n != 0.0) {
+                    ++clips;
+                    BOOST_TEST(-r.p_n_n == T, tt::tolerance(1e-8));
+                }
+            }
+            BOOST_TEST(clips == (sym == Symmetry::full ? 2 : 1));
+            // before the clip engages the spring is the main leaf alone: 2 * 3 EI1 / L1^3
+            for (const StepRecord& r : records)
+                if (-r.w_m < W_c * (1 - 1e-9))
+                    BOOST_TEST(r.spring_force_n == 2.0 * 3.0 * EI1 / std::pow(kL1, 3) * r.w_m, tt::tolerance(1e-8));
+        }
+    }
+}
+
+BOOST_AUTO_TEST_CASE(clip_input_is_checked) {
+    auto expect = [](ModelSpec s, const std::string& field) {
+        try {
+            Model::build(s);
+            BOOST_ERROR("no error for " << field);
+        } catch (const InputError& e) {
+            BOOST_TEST(e.field() == field);
+        }
+    };
+    ModelSpec bad = clipped_spring(Symmetry::full);
+    bad.clips[1].clearance_m = 0.0;
+    expect(bad, "clips[1].clearance_m");
+    bad = clipped_spring(Symmetry::full);
+    bad.clips[0].x_m = 0.1;  // off the lower leaf (0.2..0.8 m)
+    expect(bad, "clips[0].x_m");
+    bad = clipped_spring(Symmetry::full);
+    bad.clips[0].last_leaf = 0;
+    expect(bad, "clips[0].last_leaf");
+    bad = clipped_spring(Symmetry::full);
+    bad.clips[0].x_m = kL1;  // at the seat
+    expect(bad, "clips[0].x_m");
+    bad = clipped_spring(Symmetry::half);
+    bad.clips.pop_back();  // the half model needs the mirrored twin
+    expect(bad, "clips[0].x_m");
+    const System sys(Model::build(clipped_spring(Symmetry::full)));
+    SimulationOptions so;
+    so.mode = Mode::cvode;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-3;
+    try {
+        simulate(sys, so);
+        BOOST_ERROR("no error in mode cvode");
+    } catch (const InputError& e) {
+        BOOST_TEST(e.field() == "clips[0]");
+    }
+}
