@@ -115,8 +115,9 @@ struct Assembled {
     double w_m = 0.0;
     std::vector<PairRecord> pairs;
 };
-Assembled assemble(const System& sys) {
+Assembled assemble(const System& sys, ContactPath path = ContactPath::automatic) {
     SimulationOptions so;
+    so.contact_path = path;
     so.dt_s = 1e-4;
     so.t_end_s = 1e-4;
     so.solver.tolerance_m = 1e-12;
@@ -152,11 +153,13 @@ BOOST_AUTO_TEST_CASE(two_leaf_nip_tip_force_matches_the_curvature_mismatch) {
     const double EI1 = bending_stiffness(t1), EI2 = bending_stiffness(t2);
     const double P = 3.0 * (1.0 / R2 - 1.0 / R1) / (2.0 * L2 * (1.0 / EI1 + 1.0 / EI2));
     const double w = -P * L2 * L2 * (3.0 * L1 - L2) / (6.0 * EI1);
-    for (Symmetry sym : {Symmetry::full, Symmetry::half}) {
-        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model") {
+    for (const auto& [sym, path] : {std::pair{Symmetry::full, ContactPath::dense}, std::pair{Symmetry::half, ContactPath::dense},
+                                    std::pair{Symmetry::full, ContactPath::sparse}}) {
+        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model, "
+                                                                      << (path == ContactPath::dense ? "dense" : "sparse") << " path") {
             spec.symmetry = sym;
             const System sys(Model::build(spec));
-            const Assembled a = assemble(sys);
+            const Assembled a = assemble(sys, path);
             int tips = 0;
             for (const PairRecord& r : a.pairs) {
                 const bool tip = std::abs(std::abs(r.x_m - L1) - L2) < 1e-9;

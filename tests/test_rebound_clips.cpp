@@ -45,8 +45,10 @@ ModelSpec clipped_spring(Symmetry sym) {
 
 /// The rig pulls R down from 0 to w_end in `steps` quasi-static steps; the records and the
 /// pairs at the end.
-std::pair<std::vector<StepRecord>, std::vector<PairRecord>> pull(const System& sys, double w_end, int steps) {
+std::pair<std::vector<StepRecord>, std::vector<PairRecord>> pull(const System& sys, double w_end, int steps,
+                                                                 ContactPath path) {
     SimulationOptions so;
+    so.contact_path = path;
     so.mode = Mode::closed_form;
     so.dt_s = 1.0 / steps;
     so.t_end_s = 1.0;
@@ -88,10 +90,12 @@ BOOST_AUTO_TEST_CASE(clip_takes_the_rebound_load_beyond_its_clearance) {
     BOOST_TEST_MESSAGE("rebound clip: engages at w = " << -W_c << " m; at w = " << -W << " m pin force " << Q
                                                       << " N, clip tension " << T << " N");
     BOOST_TEST(T > 0.0);
-    for (Symmetry sym : {Symmetry::full, Symmetry::half}) {
-        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model") {
+    for (const auto& [sym, path] : {std::pair{Symmetry::full, ContactPath::dense}, std::pair{Symmetry::half, ContactPath::dense},
+                                    std::pair{Symmetry::full, ContactPath::sparse}}) {
+        BOOST_TEST_CONTEXT((sym == Symmetry::full ? "full" : "half") << " model, "
+                                                                      << (path == ContactPath::dense ? "dense" : "sparse") << " path") {
             const System sys(Model::build(clipped_spring(sym)));
-            const auto [records, pairs] = pull(sys, -W, 30);
+            const auto [records, pairs] = pull(sys, -W, 30, path);
             BOOST_TEST(records.back().w_m == -W, tt::tolerance(1e-12));
             BOOST_TEST(records.back().spring_force_n == -2.0 * Q, tt::tolerance(1e-8));
             int clips = 0;
