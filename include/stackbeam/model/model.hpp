@@ -72,7 +72,7 @@ struct InterfaceSpec {
     double tangential_stiffness_pa_per_m = 0.0;
 };
 
-/// A clamp (band, U-bolt, rebound clip) of negligible width. It ties every
+/// A clamp (band, U-bolt) of negligible width. It ties every
 /// interface it crosses in the normal direction (never opens) and squeezes it
 /// with its preload, which adds to the compressive reaction in the friction limit.
 struct ClampSpec {
@@ -88,7 +88,8 @@ struct ClampSpec {
 /// (separate in y) by at most clearance_m in total, and is free tangentially (no friction).
 /// A unilateral limit on the opening: one contact row s = (gap sum) - clearance - T/k <= 0 whose
 /// force (the strap's tension T >= 0) holds the outer leaves together once the clearance is
-/// used up; the strap's elastic stretch T/k is the row's compliance (as an elastic interface's) (docs/model-and-scenarios.md, "Free camber, assembly and rebound clips").
+/// used up; the strap's elastic stretch T/k is the row's compliance (as an elastic interface's).
+/// Mode closed-form only (docs/model-and-scenarios.md, "Free camber, assembly and rebound clips").
 struct ClipSpec {
     double x_m = 0.0;          ///< position [m]: on every strapped leaf, not at the rigid body's seat
     int first_leaf = 0;        ///< the top leaf in the strap
