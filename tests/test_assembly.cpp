@@ -163,6 +163,41 @@ BOOST_AUTO_TEST_CASE(two_leaf_nip_tip_force_matches_the_curvature_mismatch) {
     BOOST_TEST_MESSAGE("two-leaf nip: tip force " << P << " N, seat " << w << " m");
 }
 
+BOOST_AUTO_TEST_CASE(frictional_assembly_is_the_initial_sticking_state) {
+    // The two-leaf nip with mu = 0.3: the assembly's one frictional step leaves the tips with
+    // tangential forces (the leaves slid against each other as the bolt closed the nip) and
+    // re-anchored where they slid to. Left alone (no force, no velocity), the assembled stack
+    // is in equilibrium: R stays where the assembly put it and every pair keeps its forces,
+    // step after step (to round-off and the solver's 1e-12 m: 1e-9 relative to the nip force).
+    // Its tips slid while the bolt closed the nip: their friction force is at its limit,
+    // 0.3 x 101.4 N = 30.4 N.
+    ModelSpec spec = two_leaf_spring(5.0, 3.0);
+    spec.interfaces[0].friction_coefficient = 0.3;
+    const System sys(Model::build(spec));
+    SimulationOptions so;
+    so.dt_s = 1e-3;
+    so.t_end_s = 1.0;
+    so.solver.tolerance_m = 1e-12;
+    ClosedFormStepper st(sys, so);
+    const double w0 = st.current().w_m;
+    const std::vector<PairRecord> p0 = st.pairs();
+    double friction = 0.0, nip = 0.0;
+    for (const PairRecord& r : p0) {
+        friction = std::max(friction, std::abs(r.p_t_n));
+        nip = std::max(nip, -r.p_n_n);
+    }
+    BOOST_TEST_MESSAGE("frictional nip: tip force " << nip << " N, largest friction force " << friction << " N");
+    BOOST_TEST(friction == 0.3 * nip, tt::tolerance(1e-9));
+    for (int i = 0; i < 20; ++i) st.advance();
+    BOOST_TEST(std::abs(st.current().w_m - w0) <= 1e-9 * std::abs(w0));
+    const std::vector<PairRecord> p1 = st.pairs();
+    for (std::size_t k = 0; k < p0.size(); ++k) {
+        BOOST_TEST(std::abs(p1[k].p_n_n - p0[k].p_n_n) <= 1e-9 * nip);
+        BOOST_TEST(std::abs(p1[k].p_t_n - p0[k].p_t_n) <= 1e-9 * nip);
+    }
+    BOOST_CHECK_SMALL(st.current().dissipated_energy_j, 1e-12);  // [J]: nothing slips (round-off of ~0.1 J of nip energy)
+}
+
 BOOST_AUTO_TEST_CASE(preload_leaves_the_frictionless_rate_unchanged) {
     // The two-leaf nip spring of the test above, flat and cambered, frictionless, on the rig:
     // the rate at ride height (a ramp of +-2 mm about the flat spring's deflection under a ride
