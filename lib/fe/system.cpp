@@ -180,7 +180,7 @@ System::System(const Model& model) : model_(model) {
         const bool has_n = !rn.empty();
         bool has_t = !rt.empty();
         if (!has_n && cp.initial_gap_m < 0.0)
-            throw InputError("leaves[" + std::to_string(b) + "].free_camber_m",
+            throw InputError("leaves[" + std::to_string(b) + (spec.leaves[b].free_radius_m != 0.0 ? "].free_radius_m" : "].free_camber_m"),
                              "gives an interference of " + format_value(-cp.initial_gap_m) + " m with leaves[" + std::to_string(a) +
                                  "] at x = " + format_value(cp.x_m) + " m, where supports fix both leaves: the assembly cannot close it");
         // A friction pair whose normal motion a support or the seat fixes has no normal

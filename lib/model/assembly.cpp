@@ -88,10 +88,11 @@ void validate_clips(const ModelSpec& spec, double tol_m, double x_hi_m,
             bool mirrored = false;
             for (const ClipSpec& o : spec.clips)
                 mirrored = mirrored || (std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol_m && o.first_leaf == cl.first_leaf &&
-                                        o.last_leaf == cl.last_leaf && o.clearance_m == cl.clearance_m);
+                                        o.last_leaf == cl.last_leaf && o.clearance_m == cl.clearance_m &&
+                                        o.stiffness_n_per_m == cl.stiffness_n_per_m);
             if (!mirrored)
                 throw InputError(field("clips", c, "x_m"), "the half model needs each clip mirrored about x = " + format_value(xr) +
-                                                               " m with the same leaves and clearance");
+                                                               " m with the same leaves, clearance and stiffness");
         }
         for (std::size_t d = 0; d < c; ++d)
             if (std::abs(spec.clips[d].x_m - cl.x_m) <= tol_m)
