@@ -223,6 +223,26 @@ BOOST_AUTO_TEST_CASE(preload_leaves_the_frictionless_rate_unchanged) {
     BOOST_TEST(flat.k_n_per_m == k_theory, tt::tolerance(1e-8));
 }
 
+BOOST_AUTO_TEST_CASE(gravity_acts_on_the_assembled_stack) {
+    // Assembly first, then gravity's static step from the assembled state: the frictionless
+    // two-leaf nip spring with R's weight (10 kg, g = 9.81 m/s^2) settles at the assembled w
+    // less m g / k, k the leaf-end theory's rate (the weight unloads the tips by about 60 N of
+    // their 101 N nip, so they stay closed and the rate holds). Tolerance 1e-8 (exact elements).
+    const System sys(Model::build(two_leaf_spring(5.0, 3.0)));
+    const double k = leaf_end_rate({kL1, kL2}, {bending_stiffness(kT1), bending_stiffness(kT2)});
+    const double w_a = assemble(sys).w_m;
+    SimulationOptions so;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-4;
+    so.solver.tolerance_m = 1e-12;
+    so.loading.gravity_m_per_s2 = 9.81;
+    const ClosedFormStepper st(sys, so);
+    BOOST_TEST(st.current().w_m == w_a - 10.0 * 9.81 / k, tt::tolerance(1e-8));
+    int closed = 0;
+    for (const PairRecord& r : st.pairs()) closed += r.p_n_n < 0.0 ? 1 : 0;
+    BOOST_TEST(closed == 2);
+}
+
 BOOST_AUTO_TEST_CASE(graduated_cambered_spring_rate_against_leaf_end_theory_and_sae) {
     // A graduated 4-leaf spring (half span l = 0.5 m, t = 8 mm, leaf k of half length
     // l (n - k)/n), each lower leaf more curved (free radii 4, 3.2, 2.6, 2.2 m): the assembly
