@@ -52,7 +52,7 @@ double free_shape_m(const ModelSpec& spec, int leaf, double x_m) {
     return 0.5 * free_curvature_per_m(spec.leaves[static_cast<std::size_t>(leaf)]) * dx * dx;
 }
 
-void validate_clips(const ModelSpec& spec, double tol_m, double x_hi_m,
+void validate_clips(const ModelSpec& spec, double tol_m,
                     const std::function<bool(std::size_t, double)>& present) {
     const int nleaf = static_cast<int>(spec.leaves.size());
     const bool half = spec.symmetry == Symmetry::half;
@@ -83,8 +83,10 @@ void validate_clips(const ModelSpec& spec, double tol_m, double x_hi_m,
         if (std::abs(cl.x_m - xr) <= tol_m)
             throw InputError(field("clips", c, "x_m"), "value " + format_value(cl.x_m) +
                                                            " is at the rigid body's seat, which already ties the leaves: move the clip");
-        if (half && cl.x_m > x_hi_m + tol_m) continue;  // the mirrored half: checked below from its twin
-        if (half) {
+    }
+    for (std::size_t c = 0; c < spec.clips.size(); ++c) {  // across clips, once each one's own values are valid
+        const ClipSpec& cl = spec.clips[c];
+        if (half) {  // each clip needs its twin (the meshed half holds one of them)
             bool mirrored = false;
             for (const ClipSpec& o : spec.clips)
                 mirrored = mirrored || (std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol_m && o.first_leaf == cl.first_leaf &&

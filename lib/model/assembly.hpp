@@ -15,8 +15,8 @@ void validate_free_shapes(const ModelSpec& spec);
 double free_shape_m(const ModelSpec& spec, int leaf, double x_m);
 
 /// Checks the clips (InputError naming clips[c].field): `present(leaf, x)` tells whether a
-/// leaf reaches x; `x_hi_m` the end of the meshed region.
-void validate_clips(const ModelSpec& spec, double tol_m, double x_hi_m,
+/// leaf reaches x.
+void validate_clips(const ModelSpec& spec, double tol_m,
                     const std::function<bool(std::size_t, double)>& present);
 
 /// The clip rows as candidate pairs (appended after the interfaces' pairs): kind coulomb,

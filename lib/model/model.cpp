@@ -236,7 +236,7 @@ Model Model::build(ModelSpec spec) {
         }
     }
     const double x_hi = half ? rb.x_m : x_max;
-    detail::validate_clips(spec, tol, x_hi, present);
+    detail::validate_clips(spec, tol, present);
 
     // --- probe ------------------------------------------------------------
     if (spec.probe) {
