@@ -100,6 +100,38 @@ BOOST_AUTO_TEST_CASE(clip_takes_the_rebound_load_beyond_its_clearance) {
     }
 }
 
+BOOST_AUTO_TEST_CASE(clip_closes_an_initial_gap_wider_than_its_clearance) {
+    // The flat two-leaf spring with a uniform initial gap of 3 mm and clips of 2.5 mm clearance:
+    // the assembly (before t = 0, no force on R) pulls the leaves together at the clips until the
+    // opening is the clearance plus the strap's stretch. Each half: the clip's tension T acts at
+    // a on two cantilevers from the seat (the pins carry nothing: R is free and unloaded), so
+    //     T g(a, a) (1/EI1 + 1/EI2) + T / k = gap - clearance = 0.5 mm       (T = 27.7 N)
+    // and the main leaf's end falls by T g(L1, a) / EI1 below the seat: w = +that. (Leaf 1's tip,
+    // 0.1 m beyond the clip, closes 0.9 mm of its 3 mm gap: it stays open.) Tolerance 1e-8.
+    auto g = [](double a, double b) { return a <= b ? a * a * (3 * b - a) / 6 : b * b * (3 * a - b) / 6; };
+    const double EI1 = steel_leaf_bending_stiffness(kT1), EI2 = steel_leaf_bending_stiffness(kT2);
+    const double gap = 0.003, clearance = 0.0025;
+    const double T = (gap - clearance) / (g(kA, kA) * (1.0 / EI1 + 1.0 / EI2) + 1.0 / kStrap);
+    ModelSpec spec = clipped_spring(Symmetry::full);
+    spec.interfaces[0].initial_gap_m = gap;
+    for (auto& c : spec.clips) c.clearance_m = clearance;
+    const System sys(Model::build(spec));
+    SimulationOptions so;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-4;
+    so.solver.tolerance_m = 1e-12;
+    const ClosedFormStepper st(sys, so);
+    BOOST_TEST(st.current().w_m == T * g(kL1, kA) / EI1, tt::tolerance(1e-8));
+    int engaged = 0;
+    for (const PairRecord& r : st.pairs()) {
+        if (r.p_n_n == 0.0) continue;
+        ++engaged;
+        BOOST_TEST(std::abs(std::abs(r.x_m - kL1) - kA) < 1e-9);
+        BOOST_TEST(-r.p_n_n == T, tt::tolerance(1e-8));
+    }
+    BOOST_TEST(engaged == 2);
+}
+
 BOOST_AUTO_TEST_CASE(clip_input_is_checked) {
     auto expect = [](const ModelSpec& s, const std::string& field) {
         BOOST_TEST(input_error_field([&] { Model::build(s); }) == field);

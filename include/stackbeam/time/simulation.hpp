@@ -127,8 +127,9 @@ struct SimulationOptions {
 /// dense otherwise. Throws InputError for the sparse path with a solver other than exact.
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options);
 
-/// The assembly of a spring whose leaves have a free camber (LeafSpec::free_camber_m): every run
-/// of mode closed-form starts from the assembled, pre-stressed stack. The leaves start in their
+/// The assembly of a spring whose leaves have a free camber (LeafSpec::free_camber_m) or that has
+/// rebound clips (a clip closes initial gaps wider than its clearance): every run of mode
+/// closed-form starts from the assembled, pre-stressed stack. The leaves start in their
 /// free shapes, anchored there (d_t = 0), touching wherever their offsets d_n (interface gap plus
 /// the free shapes' difference, PairSpec::initial_gap_m) are <= 0; the centre bolt (the rigid
 /// body's seat) and the clamps pull them together in one quasi-static, monotonic load step with
