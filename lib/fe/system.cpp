@@ -214,10 +214,22 @@ System::System(const Model& model) : model_(model) {
             std::sort(out.begin(), out.end());
             return out;
         };
-        const auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
-        const auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
+        auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        if (cp.clip_index >= 0) {  // rebound clip: s = v_first - v_last - d (opening beyond the clearance), no tangent
+            const int last = spec.clips[cp.clip_index].last_leaf;
+            rn = reduce({{da + 1, 1.0}, {3 * node_dof(last, cp.node) + 1, -1.0}});
+            rt.clear();
+            if (rn.empty())
+                throw InputError("clips[" + std::to_string(cp.clip_index) + "].x_m",
+                                 "value " + format_value(cp.x_m) + " is where supports fix the strapped leaves' opening: the clip does nothing there");
+        }
         const bool has_n = !rn.empty();
         bool has_t = !rt.empty();
+        if (!has_n && cp.initial_gap_m < 0.0)
+            throw InputError("leaves[" + std::to_string(b) + (spec.leaves[b].free_radius_m != 0.0 ? "].free_radius_m" : "].free_camber_m"),
+                             "gives an interference of " + format_value(-cp.initial_gap_m) + " m with leaves[" + std::to_string(a) +
+                                 "] at x = " + format_value(cp.x_m) + " m, where supports fix both leaves: the assembly cannot close it");
         // A friction pair whose normal motion a support or the seat fixes has no normal
         // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
         if (!has_n && cp.kind == PairKind::coulomb) has_t = false;

@@ -271,7 +271,8 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
     const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
                                            "youngs_modulus_pa", "density_kg_per_m3", "poisson_ratio", "left_support",
-                                           "right_support", "profile", "left_end", "right_end"};
+                                           "right_support", "profile", "left_end", "right_end", "free_camber_m",
+                                           "free_radius_m"};
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("leaves", i), keys);
         LeafSpec l;
@@ -288,6 +289,8 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
         const SupportKind free = SupportKind::free;
         l.left_support = choice(t, "left_support", kSupports, &free);
         l.right_support = choice(t, "right_support", kSupports, &free);
+        l.free_camber_m = t.number_or("free_camber_m", "the free arc height [m], + ends up (0: flat)", 0.0);
+        l.free_radius_m = t.number_or("free_radius_m", "the free radius [m], + ends up (0: flat)", 0.0);
         spec.leaves.push_back(l);
     }
 }
@@ -344,6 +347,22 @@ void parse_clamps(const Table& top, ModelSpec& spec) {
         c.preload_n = t.number_or("preload_n", "the clamp force [N], >= 0", 0.0);
         c.length_m = t.number_or("length_m", "the clamp's length along x [m], >= 0 (0: a point tie)", 0.0);
         spec.clamps.push_back(c);
+    }
+}
+
+void parse_clips(const Table& top, ModelSpec& spec) {
+    const auto* arr = top.array("clips", "[[clips]] tables (rebound clips)", false);
+    if (!arr) return;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        Table t(top.context(), (*arr)[i], element("clips", i), {"x_m", "first_leaf", "last_leaf", "clearance_m", "stiffness_n_per_m"});
+        ClipSpec c;
+        c.x_m = t.number("x_m", "the clip position [m]");
+        const long long n = static_cast<long long>(spec.leaves.size());  // the range against the stack: Model::build
+        c.first_leaf = static_cast<int>(t.integer("first_leaf", "a leaf index 0.." + std::to_string(n - 2), 0, n - 2));
+        c.last_leaf = static_cast<int>(t.integer("last_leaf", "a leaf index 1.." + std::to_string(n - 1), 1, n - 1));
+        c.clearance_m = t.number("clearance_m", "the opening the clip allows [m], > 0");
+        c.stiffness_n_per_m = t.number_or("stiffness_n_per_m", "the strap's stiffness [N/m], > 0", ClipSpec{}.stiffness_n_per_m);
+        spec.clips.push_back(c);
     }
 }
 
@@ -565,11 +584,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     s.source = source_name;
     const Table top(ctx, root, "",
                     {"description", "leaves", "interfaces", "clamps", "rigid_body", "loading", "mesh", "probe",
-                     "integrator", "outputs"});
+                     "integrator", "outputs", "clips"});
     s.description = top.string_or("description", "free text", "");
     parse_leaves(top, s.model);
     parse_interfaces(top, s.model);
     parse_clamps(top, s.model);
+    parse_clips(top, s.model);
     parse_rigid_body(top, s.model);
     const Loading loading = parse_loading(top, s.model);
     parse_mesh(top, s.model);

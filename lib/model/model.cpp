@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "model/assembly.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -227,6 +228,7 @@ Model Model::build(ModelSpec spec) {
         x_min = std::min(x_min, l.x_start_m);
         x_max = std::max(x_max, leaf_end(l));
     }
+    detail::validate_free_shapes(spec);
     const double extent = x_max - x_min;
     const double tol = 1e-9 * std::max(extent, std::abs(x_max));
     m.x_tol_ = tol;
@@ -346,6 +348,7 @@ Model Model::build(ModelSpec spec) {
         }
     }
     const double x_hi = half ? rb.x_m : x_max;
+    detail::validate_clips(spec, tol, present);
 
     // --- probe ------------------------------------------------------------
     if (spec.probe) {
@@ -368,6 +371,7 @@ Model Model::build(ModelSpec spec) {
         for (double px : l.profile.x_m) breaks.push_back(l.x_start_m + px);  // a profile's breakpoints are nodes
     }
     for (const auto& cl : spec.clamps) breaks.push_back(cl.x_m);
+    for (const auto& cl : spec.clips) breaks.push_back(cl.x_m);
     breaks.push_back(rb.x_m);
     if (spec.probe) breaks.push_back(spec.probe->x_m);
     std::sort(breaks.begin(), breaks.end());
@@ -477,6 +481,8 @@ Model Model::build(ModelSpec spec) {
                 throw InputError(idx("interfaces", i, "initial_gap_m"),
                                  "value " + format_value(p.initial_gap_m) +
                                      " is not allowed where a clamp crosses the interface: a clamp closes the gap (use 0)");
+            p.initial_gap_m += detail::free_shape_m(spec, static_cast<int>(i), p.x_m) -
+                               detail::free_shape_m(spec, static_cast<int>(i) + 1, p.x_m);  // free camber
             m.pairs_.push_back(p);
         }
     }
@@ -501,6 +507,7 @@ Model Model::build(ModelSpec spec) {
         for (std::size_t k = 0; k < m.pairs_.size(); ++k)
             if (m.pairs_[k].interface_index == probe.interface_index && m.pairs_[k].node == n) m.probe_pair_ = static_cast<int>(k);
     }
+    detail::add_clip_pairs(spec, m.nodes_x_, tol, m.pairs_);  // after the probe's: never the probe pair
     m.spec_ = std::move(spec);
     return m;
 }

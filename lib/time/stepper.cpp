@@ -9,6 +9,7 @@
 namespace stackbeam {
 
 std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOptions& options) {
+    if (options.mode != Mode::closed_form) require_no_assembly(system.model().spec(), options.mode);
     switch (options.mode) {
         case Mode::closed_form: return std::make_unique<ClosedFormStepper>(system, options);
         case Mode::newmark: return std::make_unique<NewmarkStepper>(system, options);

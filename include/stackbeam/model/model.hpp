@@ -76,6 +76,16 @@ struct LeafSpec {
                                             ///< derived stiffness (interface_layer); nothing else uses it
     LeafProfile profile;                    ///< thickness / width along x (empty: constant)
     LeafEndSpec left_end, right_end;        ///< eyes, shackle, bushings at the two ends
+    /// Free (unassembled) camber: the arc height H [m] of the unstressed leaf over its length, a
+    /// circular arc of curvature 8 H / L^2 (small deflection: the free shape is
+    /// v0(x) = 4 H (x - x_R)^2 / L^2, x_R the rigid body's attachment, where v0 = v0' = 0).
+    /// H > 0: the ends above the seat (+y), the usual spring that a load on R in +y flattens;
+    /// 0: flat. |H| <= L/10. At most one of free_camber_m, free_radius_m.
+    /// docs/model-and-scenarios.md, "Free camber, assembly and rebound clips".
+    double free_camber_m = 0.0;
+    /// Free camber as the radius R [m] of the arc instead (curvature 1/R, v0 = (x - x_R)^2 / (2 R)):
+    /// R > 0 ends up, R < 0 ends down, 0: flat (no radius given). |R| >= 1.25 L (arc height <= L/10).
+    double free_radius_m = 0.0;
 };
 
 /// Thickness and width of a leaf at x [m] (absolute x; the profile, or height_m / width_m).
@@ -95,7 +105,7 @@ struct InterfaceSpec {
     double tangential_stiffness_pa_per_m = 0.0;
 };
 
-/// A clamp (band, U-bolt, rebound clip) of negligible width. It ties every
+/// A clamp (band, U-bolt) of negligible width. It ties every
 /// interface it crosses in the normal direction (never opens) and squeezes it
 /// with its preload, which adds to the compressive reaction in the friction limit.
 struct ClampSpec {
@@ -105,6 +115,22 @@ struct ClampSpec {
     /// > 0: on an elastic interface the clamp's pair gets the layer over width x length_m (never
     /// over the mesh's tributary length, which would soften the clamp with every refinement).
     double length_m = 0.0;
+};
+
+/// A rebound clip: a strap around leaves first_leaf..last_leaf at x_m that lets them open
+/// (separate in y) by at most clearance_m in total, and is free tangentially (no friction).
+/// A unilateral limit on the opening: one contact row s = (gap sum) - clearance - T/k <= 0 whose
+/// force (the strap's tension T >= 0) holds the outer leaves together once the clearance is
+/// used up; the strap's elastic stretch T/k is the row's compliance (as an elastic interface's).
+/// Mode closed-form only (docs/model-and-scenarios.md, "Free camber, assembly and rebound clips").
+struct ClipSpec {
+    double x_m = 0.0;          ///< position [m]: on every strapped leaf, not at the rigid body's seat
+    int first_leaf = 0;        ///< the top leaf in the strap
+    int last_leaf = 1;         ///< the bottom leaf in the strap, > first_leaf
+    double clearance_m = 0.0;  ///< free opening allowed [m], > 0: the sum of the strapped interfaces' gaps
+    /// The strap's stiffness in tension k [N/m], > 0: once engaged, the opening grows by T / k
+    /// with the clip's tension T (default 1e8 N/m, about a steel band of 1 cm^2 over a 0.2 m loop)
+    double stiffness_n_per_m = 1e8;
 };
 
 /// The rigid body R on the stack (the axle seat and the mass it carries).
@@ -143,6 +169,7 @@ struct ModelSpec {
     MeshSpec mesh;
     Symmetry symmetry = Symmetry::full;
     std::optional<ProbeSpec> probe;          ///< default: top interface at the leftmost clamp
+    std::vector<ClipSpec> clips;             ///< rebound clips
 };
 
 /// Kind of a contact pair.
@@ -160,11 +187,15 @@ struct PairSpec {
     PairKind kind = PairKind::coulomb;
     double friction_coefficient = 0.0;  ///< mu [-]
     double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
-    double initial_gap_m = 0.0;         ///< d_n [m] (with a profile: plus the taper's gap, LeafProfile)
+    double initial_gap_m = 0.0;         ///< d_n [m]: the interface's gap plus the taper's gap (LeafProfile) plus the
+                                        ///< free shapes' difference v0_A - v0_B (< 0: interference, resolved by the
+                                        ///< assembly); a clip row: clearance - the strapped gaps' sum
     /// Elastic interface: the layer's compliance of this pair, 1 / (k_n A) and 1 / (k_t A) [m/N],
     /// A its tributary area [m^2]; 0 on a rigid interface and at a point clamp.
     double normal_compliance_m_per_n = 0.0;
     double tangential_compliance_m_per_n = 0.0;
+    int clip_index = -1;                ///< >= 0: the row of clips[clip_index] (kind coulomb, mu 0), on
+                                        ///< v_first - v_last; interface_index is then the clip's first leaf
 };
 
 /// The validated, meshed model. Immutable; build with Model::build.
@@ -208,6 +239,11 @@ private:
     int probe_pair_ = -1;
     double x_tol_ = 0.0;
 };
+
+/// The curvature of a leaf's free shape [1/m]: 1/free_radius_m, or 8 free_camber_m / L^2 (0: flat).
+double free_curvature_per_m(const LeafSpec& leaf);
+/// Whether any leaf has a free camber (then every run starts with the assembly, simulation.hpp).
+bool has_free_camber(const ModelSpec& spec);
 
 const char* to_string(SupportKind kind);
 const char* to_string(PairKind kind);
