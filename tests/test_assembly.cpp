@@ -11,6 +11,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
+#include "stackbeam/time/cvode_stepper.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;
@@ -426,6 +427,8 @@ BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_n
         so.dt_s = 1e-4;
         so.t_end_s = 1e-3;
         BOOST_TEST(input_error_field([&] { simulate(sys, so); }) == "leaves[0].free_radius_m");
+        if (mode == Mode::cvode)  // the stepper made directly refuses too, as NewmarkStepper does
+            BOOST_TEST(input_error_field([&] { CvodeStepper st(sys, so); }) == "leaves[0].free_radius_m");
     }
     auto expect = [](const ModelSpec& s, const std::string& field) {
         BOOST_TEST(input_error_field([&] { Model::build(s); }) == field);
@@ -446,4 +449,12 @@ BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_n
     pinned.leaves[1] = steel_leaf(kL1, kL1, kT2, 3.0, true);
     const Model m = Model::build(pinned);
     BOOST_TEST(input_error_field([&] { System s(m); }) == "leaves[1].free_radius_m");
+    // hinged eyes (decision 016) fix v as the pins do, whatever the eye's offset
+    ModelSpec hinged = pinned;
+    for (LeafSpec& l : hinged.leaves) {
+        l.left_support = l.right_support = SupportKind::hinged;
+        l.left_end.eye_offset_m = l.right_end.eye_offset_m = 0.02;
+    }
+    const Model mh = Model::build(hinged);
+    BOOST_TEST(input_error_field([&] { System s(mh); }) == "leaves[1].free_radius_m");
 }

@@ -28,7 +28,7 @@ std::string flag_by_rule(const std::string& key) {
         const std::string parent = key.substr(0, key.find_last_of('.'));
         last = parent.substr(parent.find_last_of('.') + 1);
     }
-    for (const std::string suffix : {"_rad_per_s", "_m_per_s2", "_s", "_m"})
+    for (const std::string suffix : {"_rad_per_s", "_m_per_s2", "_per_s", "_s", "_m"})
         if (last.size() > suffix.size() && last.compare(last.size() - suffix.size(), suffix.size(), suffix) == 0) {
             last.erase(last.size() - suffix.size());
             break;

@@ -468,25 +468,25 @@ void parse_probe(const Table& top, ModelSpec& spec) {
     spec.probe = p;
 }
 
-/// [integrator], [integrator.solver], [integrator.cvode]: the keys of the option table
+/// [integrator], [integrator.solver], [integrator.cvode], [integrator.damping]: the keys of the option table
 /// (option_table.hpp) under "integrator.", each checked by its row as it is read.
 void parse_integrator(const Table& top, SimulationOptions& o) {
     const std::string prefix = "integrator.";
     std::map<std::string, std::vector<std::string>> keys = {  // table path -> its allowed keys
-        {"integrator", {}}, {"integrator.solver", {}}, {"integrator.cvode", {}}};
+        {"integrator", {}}, {"integrator.solver", {}}, {"integrator.cvode", {}}, {"integrator.damping", {}}};
     for (const OptionSpec& spec : simulation_option_table()) {
         const std::string key = spec.key;
         if (key.compare(0, prefix.size(), prefix) != 0) continue;
         const auto cut = key.find_last_of('.');
         keys[key.substr(0, cut)].push_back(key.substr(cut + 1));
     }
-    keys["integrator"].insert(keys["integrator"].end(), {"solver", "cvode"});
+    keys["integrator"].insert(keys["integrator"].end(), {"solver", "cvode", "damping"});
     const Table t = top.table("integrator", keys["integrator"]);
     for (const char* required : {"mode", "dt_s", "t_end_s"})
         if (!t.has(required)) t.missing(required, find_option_by_member(required)->help);
     std::map<std::string, Table> tables;
     tables.emplace("integrator", t);
-    for (const char* sub : {"solver", "cvode"})
+    for (const char* sub : {"solver", "cvode", "damping"})
         if (t.has(sub)) tables.emplace(prefix + sub, t.table(sub, keys[prefix + sub]));
     for (const OptionSpec& spec : simulation_option_table()) {
         const std::string key = spec.key;

@@ -15,7 +15,7 @@ std::vector<std::string> step_record_columns() {
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
             "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
             "spring_force", "external_force", "base_displacement", "external_work", "leaf_kinetic_energy",
-            "impact_loss"};
+            "impact_loss", "damping_energy"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -39,7 +39,8 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.base_displacement_m,
             r.external_work_j,
             r.leaf_kinetic_energy_j,
-            r.impact_loss_j};
+            r.impact_loss_j,
+            r.damping_energy_j};
 }
 
 const char* to_string(Mode m) {
@@ -56,6 +57,22 @@ Mode parse_mode(const std::string& text, const std::string& field) {
     if (text == "cvode") return Mode::cvode;
     if (text == "newmark") return Mode::newmark;
     throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
+}
+
+const char* to_string(LeafInertia kind) {
+    switch (kind) {
+        case LeafInertia::automatic: return "auto";
+        case LeafInertia::massive: return "massive";
+        case LeafInertia::modal: return "modal";
+    }
+    return "?";
+}
+
+LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field) {
+    if (text == "auto") return LeafInertia::automatic;
+    if (text == "massive") return LeafInertia::massive;
+    if (text == "modal") return LeafInertia::modal;
+    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed auto, massive, modal");
 }
 
 const char* to_string(ContactPath path) {

@@ -33,6 +33,8 @@ struct CvodeStats {
     long events = 0;               ///< event times handled (after t = 0); one may switch several pairs
     long missed_events = 0;        ///< events the per-step check found (root-finding missed them)
     long restarts = 0;             ///< CVodeReInit calls
+    long settled_transitions = 0;  ///< massive leaves: passes at an event that changed a pair whose decided
+                                   ///< modes did not hold at the event's state itself (EventDriver::settle_at_state)
     long mode_factorizations = 0;  ///< dense LU factorisations of a mode set
     long contact_iterations = 0;   ///< iterations of the contact solvers (checks and event decisions)
     double max_force_jump_n = 0.0; ///< largest change of a contact force across an event [N] (0 in exact arithmetic)

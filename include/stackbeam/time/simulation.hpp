@@ -26,7 +26,8 @@ struct StepRecord {
     double kinetic_energy_j = 0.0;      ///< kinetic energy [J]: m w_dot^2 / 2, plus the leaves' v^T M v / 2 in mode newmark
     double strain_energy_j = 0.0;       ///< elastic energy of the leaves and of any elastic interface layer [J]
     double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
-    double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated) [J]
+    double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated + impact loss
+                                        ///< + damping energy) [J]
     double contact_residual_m = 0.0;    ///< ||v||_2 (eq. 9) at the converged forces [m]
     int factorizations = 0;             ///< dense factorisations of the step (exact solver)
     // Loadings (loading.hpp); all zero under the paper's initial conditions.
@@ -42,6 +43,8 @@ struct StepRecord {
                                         ///< (mode newmark: the normal contact work, newmark_stepper.hpp; with
                                         ///< massive leaves on an elastic layer also the implicit contact
                                         ///< impulse's loss on the layer, (p1 - p0)^T C_L (p1 - p0) / 2 per step)
+    double damping_energy_j = 0.0;      ///< cumulative energy taken by structural damping, int v^T C v dt [J]
+                                        ///< (SimulationOptions::damping; 0 without); in the balance as dissipated
 };
 
 /// Column names of StepRecord in CSV order.
@@ -76,6 +79,17 @@ ContactPath parse_contact_path(const std::string& text, const std::string& field
 /// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
 constexpr int kSparsePathMinComponents = 1000;
 
+/// Mode cvode with leaf mass on a stack with friction: how the leaves' inertia is integrated
+/// (docs/time-integration.md, "Mode cvode with leaf mass").
+enum class LeafInertia {
+    automatic,  ///< massive where every contact row has an elastic layer, modal otherwise
+    massive,    ///< every DOF of the stack in CVODE (BDF); needs elastic contact everywhere
+    modal,      ///< the stack's modes below CvodeOptions::modal_cutoff_rad_per_s, a massless contact layer
+};
+const char* to_string(LeafInertia kind);
+/// Parses "auto" | "massive" | "modal"; throws InputError naming `field`.
+LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field);
+
 /// Options of mode "cvode" (see cvode_stepper.hpp).
 struct CvodeOptions {
     double rtol = 1e-8;          ///< CVODE relative tolerance [-]
@@ -87,6 +101,19 @@ struct CvodeOptions {
                                           ///< circular frequency carry the inertia, those above respond
                                           ///< quasi-statically [rad/s]; 0 = 10 x the stack's first
                                           ///< frequency (docs/time-integration.md)
+    LeafInertia leaf_inertia = LeafInertia::automatic;  ///< leaf mass with friction: massive or modal
+};
+
+/// Structural (Rayleigh) damping of the leaves, C = alpha M + beta K (M the consistent mass of
+/// the leaves and R, K the leaves' stiffness; the elastic layer is not damped): the modal damping
+/// ratio of a mode of circular frequency omega is zeta = alpha / (2 omega) + beta omega / 2.
+/// Off by default: a leaf spring's steel is lightly damped, and the friction between the leaves
+/// is the damping stackbeam computes. Taken by mode cvode with the massive stack only
+/// (docs/time-integration.md, "Structural damping").
+struct StructuralDamping {
+    double rayleigh_alpha_per_s = 0.0;  ///< alpha [1/s], >= 0
+    double rayleigh_beta_s = 0.0;       ///< beta [s], >= 0
+    bool active() const noexcept { return rayleigh_alpha_per_s > 0.0 || rayleigh_beta_s > 0.0; }
 };
 
 struct SimulationOptions {
@@ -116,6 +143,8 @@ struct SimulationOptions {
     /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
     /// ends with relative velocity 0. Docs: docs/time-integration.md.
     double restitution = 0.0;
+    /// Structural damping of the leaves (mode cvode with the massive stack only).
+    StructuralDamping damping;
     /// Throws InputError when a value is out of range; its field() is the member's path
     /// ("dt_s", "cvode.rtol", "solver.tolerance_m": option_table.hpp gives the scenario key
     /// and the command-line flag of each).

@@ -74,6 +74,36 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+/// Mode "cvode" with leaf inertia on stacks with friction and an elastic layer on every
+/// contact row: the whole massive stack in CVODE, BDF with Newton, events on every
+/// transition (cvode_massive.cpp, docs/time-integration.md). Refuses a rigid contact row
+/// (InputError naming the interface's contact or the clamp's length_m).
+class CvodeMassiveStepper final : public Stepper {
+public:
+    CvodeMassiveStepper(const System& system, const SimulationOptions& options);
+    ~CvodeMassiveStepper() override;
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps, Newton matrices (preconditioner set-ups), the events and restarts.
+    RunReport report() const override;
+    const CvodeStats& stats() const noexcept;
+    /// Every mode transition, in time order (cause "start", "root" or "check").
+    const std::vector<ContactEvent>& events() const noexcept;
+    /// Contact forces p [N] (all rows) at the last output.
+    const Eigen::VectorXd& contact_forces() const noexcept;
+    /// Relative positions s + d [m] (all rows) at the last output.
+    const Eigen::VectorXd& relative_positions() const noexcept;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// True when a contact row of `system` has no elastic layer (a rigid interface or a point clamp).
+bool has_rigid_contact_row(const System& system);
+
 /// True when a pair of `system` carries friction (it may stick or slip): mode cvode with
 /// leaf mass then runs the modal stepper; without friction the held-for-good one.
 bool has_mode_changes(const System& system);

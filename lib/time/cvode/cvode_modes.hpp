@@ -31,6 +31,8 @@ constexpr double kMotionMargin = 1e-12;
 constexpr double kLookahead = 1e-7;
 /// At most this many events at one instant before the run is declared chattering.
 constexpr int kMaxEventsAtOneTime = 200;
+/// Passes of EventDriver::decide_modes that make the decided modes hold at the event's state.
+constexpr int kSettlePasses = 4;
 
 /// The options of the event solver that decides the modes at an event: the exact solver
 /// at `tolerance_m` (each stepper's own, from its scales), with the user's active-set

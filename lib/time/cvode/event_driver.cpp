@@ -56,9 +56,14 @@ void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance
     ev_solver = make_solver(event_solver_options(opt.solver, ev_tolerance));
 }
 
-void EventDriver::start_cvode(CVRhsFn rhs) {
-    cvode->create(CV_ADAMS, rhs, this, opt.cvode.rtol);
-    cvode->use_fixed_point();
+void EventDriver::start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff) {
+    cvode->create(stiff ? CV_BDF : CV_ADAMS, rhs, this, opt.cvode.rtol);
+    if (stiff) {
+        cvode->use_preconditioned_newton(stiff->max_krylov, stiff->psetup, stiff->psolve);
+        cvode->set_max_order(stiff->max_order);
+    } else {
+        cvode->use_fixed_point();
+    }
     cvode->set_limits(opt.cvode.max_step_s);
     cvode->set_stop_time(t_final);
     if (root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
@@ -101,6 +106,8 @@ void EventDriver::enter(const Vec& rel, const std::vector<signed char>& nm, cons
 }
 
 void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
+
+bool EventDriver::settle_at_state() const { return false; }
 
 void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
                                const std::vector<int>* triggered) {
@@ -157,6 +164,40 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
                               stats.steps, t, res.residual_m);
         modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
         correct_decision(y, rel, nm, tm);
+    }
+
+    // A stepper whose state decides every pair by itself (settle_at_state: the massive stack,
+    // where only the layer is instantaneous) restarts only in modes that hold at y itself: a
+    // witness the decided modes leave negative at y (a pair the look-ahead keeps closed that is
+    // still in tension at y, its gap closing within the look-ahead) takes its transition, so
+    // that root-finding, not the per-step check, finds the next one. Each such transition makes
+    // its witness positive at y (closed in tension -> open with the gap c p; penetrating ->
+    // closed in compression; over the cone -> slipping; a reversing slip -> sticking at its force).
+    if (settle_at_state() && !slots.empty()) {
+        const Vec d_saved = d;
+        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+        std::vector<double> g(slots.size());
+        for (int pass = 0; pass < kSettlePasses; ++pass) {
+            enter(rel, nm, tm);
+            if (pass > 0 || !decided) build_mode();
+            decided = true;  // the factorisation is of (nm, tm)
+            witnesses(y, g.data());
+            const Vec py = forces(y);
+            bool changed = false;
+            for (std::size_t i = 0; i < slots.size(); ++i) {
+                if (!(g[i] < 0.0)) continue;
+                const auto& cp = pairs()[slots[i].pair];
+                apply_transition(cp, slots[i].normal, cp.row_t >= 0 ? py[cp.row_t] : 0.0, nm[slots[i].pair],
+                                 tm[slots[i].pair]);
+                changed = true;
+            }
+            d = d_saved;
+            nmode = nm_saved;
+            tmode = tm_saved;
+            if (!changed) break;
+            decided = false;  // (nm, tm) changed after the last factorisation
+            ++stats.settled_transitions;
+        }
     }
 
     // Log the transitions, enter the new modes, refactorise (unless the candidate was).

@@ -90,9 +90,18 @@ public:
     /// The check and event problems on the compliance W [m/N], their solvers (the event
     /// solver to `event_tolerance_m`).
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
-    /// CVODE on the state y() and atol() set by the stepper: Adams, fixed point, the user's
-    /// limits, stop time t_final, the witnesses as roots (if root-finding is on).
-    void start_cvode(CVRhsFn rhs);
+    /// A stiff stepper's integrator: BDF up to `max_order`, Newton with GMRES and the
+    /// stepper's preconditioner (CvodeSession::use_preconditioned_newton).
+    struct StiffIntegrator {
+        int max_order = 2;
+        int max_krylov = 5;
+        CVLsPrecSetupFn psetup = nullptr;
+        CVLsPrecSolveFn psolve = nullptr;
+    };
+    /// CVODE on the state y() and atol() set by the stepper: Adams with fixed point (or
+    /// `stiff`), the user's limits, stop time t_final, the witnesses as roots (if
+    /// root-finding is on).
+    void start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff = nullptr);
     /// The initial record: `make_record` at t = 0, its balance error 0, e0 from it.
     void start_record(const Vec& y0);
 
@@ -131,6 +140,9 @@ protected:
     /// the stepper (default none).
     virtual void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                                   std::vector<signed char>& tm);
+    /// True when the state y alone decides every pair's modes (no instantaneous coupling but
+    /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
+    virtual bool settle_at_state() const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;

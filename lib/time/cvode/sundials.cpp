@@ -3,6 +3,7 @@
 
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_band.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunmatrix/sunmatrix_band.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
@@ -84,6 +85,15 @@ void CvodeSession::use_band_newton(int mu, int ml, CVLsJacFn jac) {
     linear_ = true;
 }
 
+void CvodeSession::use_preconditioned_newton(int maxl, CVLsPrecSetupFn psetup, CVLsPrecSolveFn psolve) {
+    ls_ = SUNLinSol_SPGMR(y_, SUN_PREC_LEFT, maxl, ctx_);
+    if (!ls_) throw SolverError(who_ + ": SUNLinSol_SPGMR failed", 0, 0.0, 0.0);
+    check(CVodeSetLinearSolver(cv_, ls_, nullptr), "CVodeSetLinearSolver");
+    check(CVodeSetPreconditioner(cv_, psetup, psolve), "CVodeSetPreconditioner");
+    linear_ = true;
+    krylov_ = true;
+}
+
 void CvodeSession::set_limits(double max_step_s) {
     check(CVodeSetMaxNumSteps(cv_, kCvodeMaxStepsPerCall), "CVodeSetMaxNumSteps");
     if (max_step_s > 0.0) check(CVodeSetMaxStep(cv_, max_step_s), "CVodeSetMaxStep");
@@ -116,8 +126,15 @@ void CvodeSession::read_counters() {
         counters_.root_evaluations = base_.root_evaluations + v;
     }
     if (linear_) {
-        check(CVodeGetNumJacEvals(cv_, &v), "CVodeGetNumJacEvals");
-        counters_.jacobian_evaluations = base_.jacobian_evaluations + v;
+        if (krylov_) {  // the preconditioner's setups are its Jacobian evaluations
+            check(CVodeGetNumPrecEvals(cv_, &v), "CVodeGetNumPrecEvals");
+            counters_.jacobian_evaluations = base_.jacobian_evaluations + v;
+            check(CVodeGetNumLinIters(cv_, &v), "CVodeGetNumLinIters");
+            counters_.linear_iterations = base_.linear_iterations + v;
+        } else {
+            check(CVodeGetNumJacEvals(cv_, &v), "CVodeGetNumJacEvals");
+            counters_.jacobian_evaluations = base_.jacobian_evaluations + v;
+        }
         check(CVodeGetNumLinSolvSetups(cv_, &v), "CVodeGetNumLinSolvSetups");
         counters_.linear_setups = base_.linear_setups + v;
     }

@@ -32,6 +32,7 @@ std::string cvode_flag_name(int flag);
 /// CVODE's cumulative counters over a run (across restarts).
 struct CvodeCounters {
     long steps = 0, rhs_evaluations = 0, root_evaluations = 0, jacobian_evaluations = 0, linear_setups = 0;
+    long linear_iterations = 0;  ///< Krylov iterations (preconditioned Newton only)
 };
 
 class CvodeSession {
@@ -58,6 +59,10 @@ public:
     void use_fixed_point();
     /// Newton with a band direct solver of half-bandwidths (mu, ml) and the Jacobian jac.
     void use_band_newton(int mu, int ml, CVLsJacFn jac);
+    /// Newton with GMRES (SUNLinSol_SPGMR, left preconditioning, at most `maxl` Krylov
+    /// vectors) and the stepper's preconditioner (psetup, psolve). With an exact
+    /// preconditioner (the Newton matrix solved directly) GMRES ends in one iteration.
+    void use_preconditioned_newton(int maxl, CVLsPrecSetupFn psetup, CVLsPrecSolveFn psolve);
     /// The step limits: the per-call guard and the user's largest step [s] (0: none).
     void set_limits(double max_step_s);
     /// CVODE stops exactly at t_stop [s] (kept across reinit()).
@@ -93,7 +98,7 @@ private:
     std::string error_;           // CVODE's last error message
     double t_stop_ = 0.0;
     bool has_stop_ = false;
-    bool roots_ = false, linear_ = false;
+    bool roots_ = false, linear_ = false, krylov_ = false;
     CvodeCounters counters_, base_;  // now, and before the last CVodeReInit
     double t_ = 0.0;                 // the last time reached [s]
 

@@ -1,0 +1,487 @@
+// Mode "cvode" with leaf inertia on stacks with friction and elastic interfaces: the whole
+// massive stack in CVODE (cvode_inertia.hpp, docs/time-integration.md "Mode cvode with
+// leaf mass", docs/decisions/015-massive-stack-under-cvode.md).
+//
+// With an elastic layer on every contact row (system.hpp: s = G z + C_L p - d) each contact
+// force is a function of the displacements z once the pair's mode is known:
+//     closed normal / sticking tangential row:  p_i = (d_i - G_i z) / c_i    (s_i = 0)
+//     slipping row:  p_t = sigma mu tau(p_n)     (paper eq. 8 with the current tau)
+//     open row:      p = 0
+// so between events the stack obeys a smooth, stiff, linear ODE on the reduced DOFs,
+//     M z'' + K z = G^T p(z),   p(z) = P z + p0,   i.e.   M z'' + K_eff z = G^T p0,
+// K_eff = K - G^T P (non-symmetric where pairs slip), with M the consistent mass of the
+// leaves and R (System::mass_reduced). Nothing is massless, so no contact point can move
+// without inertia: a gap closes without an impact and every force is continuous in time
+// except where a slipping pair reverses (its force jumps from +mu tau to -mu tau; the layer
+// energy released is booked as dissipated, as in the modal stepper).
+//
+// The events are those of the other event-driven steppers (event_driver.hpp) with the
+// instantaneous compliance W = C_L (diagonal): at fixed z only the layer deflects, so the
+// contact iteration deciding the modes at an event is per pair. Witnesses (positive while the
+// modes hold, decreasing crossings): a closed pair's compression, an open pair's gap, a
+// sticking pair's margin mu tau - |p_t|, a slipping pair's slider rate against its force.
+// A pair at the slip/stick boundary: when a slipping pair's slider rate reaches 0 its stick
+// force equals its slip force and their first derivatives agree, so sticking is decided at
+// second order by the look-ahead (stick if the stick force stays inside the cone); a pair
+// that would leave the cone at once slips on, and the sign of a new slip follows the slider
+// rate (correct_decision). No sliding mode arises: a slip that stops reverses its rate.
+//
+// Structural damping (SimulationOptions::damping, off by default): C = alpha M + beta K of the
+// leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j).
+//
+// At an event the driver makes the decided modes hold at the event's state itself
+// (settle_at_state): the look-ahead may keep a pair closed that is still in tension at y (its
+// gap of c p closing within the look-ahead); that pair opens, and root-finding finds its closure.
+// Without it the per-step check found such pairs at every step after the restart (measured:
+// 10,519 of 11,562 events in the first ms of the steel friction case, steps of 3e-11 s).
+//
+// CVODE: BDF (order <= 2: higher orders are unstable on the lightly damped oscillatory
+// modes, as for the bonded stack), Newton. The Newton matrix I - gamma J of
+// y = [z, v, D, D_c], J = [0 I; -M^-1 K_eff -M^-1 C], is solved exactly by block elimination,
+//     (M + gamma C + gamma^2 K_eff) x_v = M r_v - gamma K_eff r_z,   x_z = r_z + gamma x_v,
+// one sparse LU of that banded n x n matrix (Eigen::SparseLU; M^-1 K_eff is dense, so a KLU
+// or band matrix of J itself would not be sparse); it is handed to CVODE as the
+// preconditioner of GMRES, which then converges in one iteration.
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "contact/active_set.hpp"
+#include "fe/tied_shape.hpp"
+#include "stackbeam/errors.hpp"
+#include "time/cvode/cvode_inertia.hpp"
+#include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/event_driver.hpp"
+#include "time/step_record.hpp"
+
+namespace stackbeam::detail {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+using RowSpMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// The scenario field that makes contact row `row` of pair kk rigid, for the message.
+std::string rigid_row_field(const System& system, int kk) {
+    const PairSpec& ps = system.pair_spec(kk);
+    const auto& spec = system.model().spec();
+    if (ps.kind == PairKind::clamp) {
+        for (std::size_t j = 0; j < spec.clamps.size(); ++j)
+            if (std::abs(spec.clamps[j].x_m - ps.x_m) <= system.model().x_tolerance_m())
+                return "clamps[" + std::to_string(j) + "].length_m";
+    }
+    return "interfaces[" + std::to_string(ps.interface_index) + "].contact";
+}
+
+}  // namespace
+
+bool has_rigid_contact_row(const System& system) {
+    const Eigen::VectorXd& c = system.layer_compliance_m_per_n();
+    for (const auto& cp : system.pairs()) {
+        if (cp.row_n >= 0 && !(c[cp.row_n] > 0.0)) return true;
+        if (cp.row_t >= 0 && !(c[cp.row_t] > 0.0)) return true;
+    }
+    return false;
+}
+
+struct CvodeMassiveStepper::Impl final : EventDriver {
+    Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (massive leaves)") {}
+
+    int ndof = 0, w_dof = 0;
+    SpMat K, M, Gt;
+    SpMat C;                  // structural damping alpha M + beta K [N s/m] (empty: none)
+    bool damped = false;
+    RowSpMat Grow;            // G, row-major [-]
+    Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
+    Eigen::SimplicialLDLT<SpMat> mass;  // M
+    double f = 1.0, m_body = 0.0;
+    // the current modes: p = P z + p0, s + d = Hs z + hs, M z'' = -Keff z + b0
+    RowSpMat P, Hs;
+    SpMat Keff;
+    Eigen::VectorXd p0, hs, b0;
+    std::vector<int> slip_rows;
+    // the Newton matrix M + gamma C + gamma^2 K_eff of the current modes
+    Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> nlu;
+    double gamma_lu = -1.0;
+    double jump_dissipation = 0.0;  // friction work in force jumps at events [J, whole spring]
+
+    // ---- modes ------------------------------------------------------------------
+
+    void build_mode() override {
+        ModeLinearization lin;
+        modes.linearize(chk_problem, lin);
+        std::vector<int> pos(static_cast<std::size_t>(n), -1);
+        for (std::size_t i = 0; i < lin.S.size(); ++i) pos[static_cast<std::size_t>(lin.S[i])] = static_cast<int>(i);
+        std::vector<Eigen::Triplet<double>> tp;
+        p0 = lin.e;
+        // held rows: c_i p_i + G_i z - d_i = 0 (W = C_L is diagonal: no coupling to other rows)
+        for (int row : lin.S) {
+            const double c = cL[row];
+            if (!(c > 0.0))
+                throw SolverError(who + ": contact row " + std::to_string(row) + " has no elastic layer", stats.steps, t, 0.0);
+            for (RowSpMat::InnerIterator it(Grow, row); it; ++it) tp.emplace_back(row, it.col(), -it.value() / c);
+            p0[row] = d[row] / c;
+        }
+        // slipping rows: p_t = e_t + coef p_n
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int rt = lin.coupled[a].first, rn = lin.coupled[a].second;
+            if (pos[static_cast<std::size_t>(rn)] < 0) continue;
+            const double coef = lin.coef[a], c = cL[rn];
+            for (RowSpMat::InnerIterator it(Grow, rn); it; ++it) tp.emplace_back(rt, it.col(), -coef * it.value() / c);
+            p0[rt] = lin.e[rt] + coef * p0[rn];
+        }
+        P.resize(n, ndof);
+        P.setFromTriplets(tp.begin(), tp.end());
+        const RowSpMat CP = cL.asDiagonal() * P;
+        Hs = Grow + CP;
+        hs = cL.cwiseProduct(p0);
+        Keff = K - SpMat(Gt * P);
+        Keff.makeCompressed();
+        b0 = Gt * p0;
+        slip_rows.clear();
+        for (int kk = 0; kk < np; ++kk) {
+            const int rt = pairs()[kk].row_t;
+            if (rt >= 0 && (tmode[kk] == SLIP_POS || tmode[kk] == SLIP_NEG)) slip_rows.push_back(rt);
+        }
+        // the Newton matrix's pattern (M + K_eff: the same for every gamma)
+        SpMat A = M + Keff;
+        if (damped) A += C;
+        A.makeCompressed();
+        nlu.analyzePattern(A);
+        gamma_lu = -1.0;
+        ++stats.mode_factorizations;
+        ++facts_since;
+    }
+
+    Vec forces_z(const Eigen::Ref<const Eigen::VectorXd>& z) const { return P * z + p0; }
+    Vec forces(const State& y) const override { return forces_z(y.head(ndof)); }
+    Vec relative(const State& y) const override { return Hs * y.head(ndof) + hs; }
+    Vec relative_at_event(const State& y, const Vec& p_cur) const override {
+        return Grow * y.head(ndof) + cL.cwiseProduct(p_cur);
+    }
+    Vec motion(const State& y) const override { return Grow * y.head(ndof); }
+
+    /// z'' = M^-1 (G^T p0 - K_eff z - C z') [m/s^2, rad/s^2] of the current modes.
+    Vec acceleration(const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v) const {
+        Eigen::VectorXd r = b0 - Keff * z;
+        if (damped) r -= C * v;
+        return mass.solve(r);
+    }
+
+    void witnesses(const State& y, double* g) const override {
+        const auto z = y.head(ndof);
+        const auto v = y.segment(ndof, ndof);
+        const Eigen::VectorXd p = forces_z(z);
+        for (std::size_t i = 0; i < slots.size(); ++i) {
+            const int kk = slots[i].pair;
+            const auto& cp = pairs()[kk];
+            double val = 1.0, margin = kForceMargin;
+            if (slots[i].normal) {
+                const double pn = p[cp.row_n];
+                if (cp.kind == PairKind::coulomb) {
+                    if (nmode[kk] == CLOSED) {
+                        val = -pn / F_ref;
+                    } else {
+                        val = -(Hs.row(cp.row_n).dot(z) + hs[cp.row_n] - d[cp.row_n]) / L_ref;
+                        margin = gap_margin;
+                    }
+                } else {
+                    val = tmode[kk] == FREE ? (pn - cp.preload_n) / F_ref : (cp.preload_n - pn) / F_ref;
+                }
+            } else {
+                const int rt = cp.row_t;
+                switch (tmode[kk]) {
+                    case STICK:
+                        val = (cp.friction_coefficient * friction_normal_force(chk_problem, kk, p) - std::abs(p[rt])) / F_ref;
+                        break;
+                    case SLIP_POS: val = -Hs.row(rt).dot(v) / V_ref; margin = kMotionMargin; break;
+                    case SLIP_NEG: val = Hs.row(rt).dot(v) / V_ref; margin = kMotionMargin; break;
+                    default: val = 1.0; break;
+                }
+            }
+            g[i] = val + margin;
+        }
+    }
+
+    /// The look-ahead: the contact points move by ~kLookahead L_ref and the forces by
+    /// ~kLookahead F_ref (as the modal stepper), on the second-order Taylor expansion.
+    Vec look_ahead(double, const State& y, const Vec&) const override {
+        const auto z = y.head(ndof);
+        const auto v = y.segment(ndof, ndof);
+        const Eigen::VectorXd a = acceleration(z, v);
+        const double target = kLookahead * L_ref;
+        const double vmax = (Grow * v).lpNorm<Eigen::Infinity>(), amax = (Grow * a).lpNorm<Eigen::Infinity>();
+        double delta = std::numeric_limits<double>::infinity();
+        if (vmax > 0.0) delta = std::min(delta, target / vmax);
+        if (amax > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / amax));
+        const double prate = (P * v).lpNorm<Eigen::Infinity>();
+        if (prate > 0.0) delta = std::min(delta, kLookahead * F_ref / prate);
+        if (!std::isfinite(delta)) delta = 0.0;
+        Vec yl = y;
+        yl.head(ndof) = z + delta * v + 0.5 * delta * delta * a;
+        yl.segment(ndof, ndof) = v + delta * a;
+        return yl;
+    }
+
+    void body_motion(const State& y, const Vec&, double& w, double& wd) const override {
+        w = y[w_dof];
+        wd = y[ndof + w_dof];
+    }
+
+    /// A slipping pair slips against its slider rate: where the new modes' rate contradicts
+    /// the decided sign beyond the margin, the sign follows the rate (as the modal stepper).
+    void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
+                          std::vector<signed char>& tm) override {
+        const Eigen::VectorXd d_saved = d;
+        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+        for (int pass = 0; pass < 3; ++pass) {
+            enter(rel, nm, tm);
+            build_mode();
+            const Eigen::VectorXd rate = Hs * y.segment(ndof, ndof);
+            bool changed = false;
+            for (int kk = 0; kk < np; ++kk) {
+                const int rt = pairs()[kk].row_t;
+                if (rt < 0) continue;
+                if (tm[kk] == SLIP_POS && rate[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
+                else if (tm[kk] == SLIP_NEG && rate[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
+            }
+            d = d_saved;
+            nmode = nm_saved;
+            tmode = tm_saved;
+            if (!changed) break;
+        }
+    }
+
+    /// A force jump at an event (a slip that reverses) releases the layer's energy
+    /// p^T C_L p / 2 of the jump: friction work, booked as dissipated (z and z' are continuous).
+    void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) override {
+        if (cause == "start") return;
+        const double loss = 0.5 * f * (p_cur.dot(cL.cwiseProduct(p_cur)) - p_new.dot(cL.cwiseProduct(p_new)));
+        jump_dissipation += loss;
+        stats.min_jump_dissipation_j = std::min(stats.min_jump_dissipation_j, loss);
+        stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+    }
+
+    /// At fixed z only the diagonal layer is instantaneous: the state decides every pair.
+    bool settle_at_state() const override { return true; }
+
+    // ---- CVODE ------------------------------------------------------------------
+
+    static Impl* self(void* user) { return static_cast<Impl*>(static_cast<EventDriver*>(user)); }
+
+    /// y = [z, z', D, D_c]: z' = v, v' = M^-1 (G^T p0 - K_eff z - C v), D' = friction power
+    /// -sum_slip p_t ds_t/dt >= 0, D_c' = damping power v^T C v >= 0 [W, meshed part].
+    static int rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
+        const Impl* s = self(user);
+        const int n_ = s->ndof;
+        const double* Y = N_VGetArrayPointer(yv);
+        double* D = N_VGetArrayPointer(ydot);
+        const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
+        Eigen::Map<Eigen::VectorXd>(D, n_) = v;
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(z, v);
+        double pw = 0.0;
+        for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
+        D[2 * n_] = pw;
+        D[2 * n_ + 1] = s->damped ? v.dot(s->C * v) : 0.0;
+        return 0;
+    }
+
+    /// Factorises M + gamma C + gamma^2 K_eff (the Newton matrix after block elimination).
+    static int psetup(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
+                      void* user) {
+        Impl* s = self(user);
+        *jcur = SUNTRUE;
+        if (gamma == s->gamma_lu) return 0;
+        SpMat A = s->M + (gamma * gamma) * s->Keff;
+        if (s->damped) A += gamma * s->C;
+        A.makeCompressed();
+        s->nlu.factorize(A);
+        if (s->nlu.info() != Eigen::Success) {
+            s->gamma_lu = -1.0;
+            return 1;  // recoverable: CVODE retries with a smaller step
+        }
+        s->gamma_lu = gamma;
+        return 0;
+    }
+
+    /// Solves (I - gamma J) x = r: the (z, v) block by elimination on the LU of psetup, the
+    /// friction-power row by its linearisation at y.
+    static int psolve(sunrealtype, N_Vector yv, N_Vector, N_Vector rv, N_Vector xv, sunrealtype gamma, sunrealtype,
+                      int, void* user) {
+        const Impl* s = self(user);
+        if (s->gamma_lu < 0.0) return 1;
+        const int n_ = s->ndof;
+        const double* Y = N_VGetArrayPointer(yv);
+        const double* R = N_VGetArrayPointer(rv);
+        double* X = N_VGetArrayPointer(xv);
+        const Eigen::Map<const Eigen::VectorXd> rz(R, n_), rvel(R + n_, n_);
+        const Eigen::VectorXd rhs_v = s->M * rvel - gamma * (s->Keff * rz);  // (M + g C + g^2 Keff) x_v
+        const Eigen::VectorXd xvel = s->nlu.solve(rhs_v);
+        const Eigen::VectorXd xz = rz + gamma * xvel;
+        Eigen::Map<Eigen::VectorXd>(X, n_) = xz;
+        Eigen::Map<Eigen::VectorXd>(X + n_, n_) = xvel;
+        const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
+        // d(pw) = -sum (P_t dz) (Hs_t v) + (P_t z + p0_t) (Hs_t dv)
+        double dpw = 0.0;
+        for (int rt : s->slip_rows)
+            dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
+        X[2 * n_] = R[2 * n_] + gamma * dpw;
+        X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
+        return 0;
+    }
+
+    // ---- records ----------------------------------------------------------------
+
+    /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R), strain
+    /// z^T K z / 2 + p^T C_L p / 2 (leaves and layer), whole spring.
+    StepRecord make_record(double, const State& Y, Vec& p, Vec& rel) const override {
+        const auto z = Y.head(ndof);
+        const auto v = Y.segment(ndof, ndof);
+        p = forces_z(z);
+        rel = Grow * z + cL.cwiseProduct(p);
+        const Eigen::VectorXd a = acceleration(z, v);
+        const double strain = 0.5 * f * (z.dot(K * z) + p.dot(cL.cwiseProduct(p)));
+        StepRecord rec;
+        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0,
+                   LoadState{}, rec);
+        const double kinetic = 0.5 * f * v.dot(M * v);
+        rec.leaf_kinetic_energy_j = kinetic - rec.kinetic_energy_j;
+        rec.kinetic_energy_j = kinetic;
+        rec.impact_loss_j = 0.0;
+        rec.damping_energy_j = f * Y[2 * ndof + 1];
+        rec.force_on_mass_n = m_body * a[w_dof];
+        rec.energy_balance_error_j = e0 - (kinetic + strain + rec.dissipated_energy_j + rec.damping_energy_j);
+        return rec;
+    }
+};
+
+CvodeMassiveStepper::~CvodeMassiveStepper() = default;
+
+CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
+    : impl_(std::make_unique<Impl>(system, options)) {
+    Impl& s = *impl_;
+    s.opt.validate();
+    require_uniform_leaf_mass(system, "cvode");
+    require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
+    s.require_current_tau_rule();
+    if (!has_leaf_mass(system))
+        throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
+    const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();
+    for (int kk = 0; kk < static_cast<int>(system.pairs().size()); ++kk) {
+        const auto& cp = system.pairs()[kk];
+        const bool rigid = (cp.row_n >= 0 && !(cL[cp.row_n] > 0.0)) || (cp.row_t >= 0 && !(cL[cp.row_t] > 0.0));
+        if (!rigid) continue;
+        const std::string field = rigid_row_field(system, kk);
+        const bool clamp = cp.kind == PairKind::clamp && field.rfind("clamps", 0) == 0;
+        throw InputError(field, std::string("value ") + (clamp ? "0" : "'rigid'") +
+                                    ": mode cvode integrates the whole massive stack (cvode.leaf_inertia 'massive') only "
+                                    "with an elastic layer on every contact row (a rigid contact point with mass has no "
+                                    "force law: every transition would be an impulse). Give " +
+                                    (clamp ? field + " > 0 on an elastic interface" : field + " = 'elastic'") +
+                                    ", or cvode.leaf_inertia = 'modal'");
+    }
+    s.K = system.stiffness_reduced();
+    s.M = system.mass_reduced();
+    const SpMat& G = system.contact_rows();
+    s.Grow = G;
+    s.Gt = G.transpose();
+    s.cL = cL;
+    s.ndof = static_cast<int>(s.K.rows());
+    s.w_dof = s.ndof - 1;
+    s.n = system.num_components();
+    s.np = static_cast<int>(system.pairs().size());
+    s.f = system.model().whole_spring_factor();
+    s.d = system.initial_offsets_m();
+    const auto& body = system.model().spec().rigid_body;
+    s.m_body = body.mass_kg;
+    s.damped = s.opt.damping.active();
+    if (s.damped) {
+        s.C = s.opt.damping.rayleigh_alpha_per_s * s.M + s.opt.damping.rayleigh_beta_s * s.K;
+        s.C.makeCompressed();
+    }
+    s.mass.compute(s.M);
+    if (s.mass.info() != Eigen::Success || !(s.mass.vectorD().minCoeff() > 0.0))
+        throw SolverError(s.who + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
+
+    // scales (as the modal stepper): R's amplitude on the tied stack and its frequency
+    const double omega_t = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
+    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t;
+    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
+    s.V_ref = omega_t * s.L_ref;
+    double preload = 0.0;
+    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
+    s.F_ref = std::max(preload, system.tied_stiffness_n_per_m() / s.f * s.L_ref);
+
+    // the instantaneous compliance: only the layer (z is held by the leaves' inertia)
+    const Eigen::MatrixXd W = cL.asDiagonal();
+    s.init_problems(W, 1e-9 * s.F_ref * cL.maxCoeff());
+    s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
+    s.init_slots();
+
+    // initial state (as mode newmark and the modal stepper): the leaves in the static shape of
+    // w(0), moving with R in the tied shape per unit w times w'(0)
+    std::vector<int> tied;
+    for (const auto& pr : system.pairs()) {
+        if (pr.row_n >= 0) tied.push_back(pr.row_n);
+        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0)) tied.push_back(pr.row_t);
+    }
+    const Eigen::VectorXd z0 = tied_shape(s.K, G, tied, body.initial_displacement_m, s.d);
+    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
+    s.nstate = 2 * s.ndof + 2;
+    s.init_grid();
+    s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
+    auto Y = s.cvode->y();
+    Y.head(s.ndof) = z0;
+    Y.segment(s.ndof, s.ndof) = v0;
+    Y[2 * s.ndof] = Y[2 * s.ndof + 1] = 0.0;
+
+    // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
+    Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
+    {
+        s.ev_problem.q = G * z0 - s.d;
+        const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p_init);
+        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
+    }
+    modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
+    s.build_mode();
+    s.decide_modes(0.0, Y, p_init, "start");
+
+    // tolerances: displacements and rotations to atol_m, velocities to omega_t atol_m, the
+    // dissipated energy to rtol of the initial energy
+    {
+        auto A = s.cvode->atol();
+        A.head(s.ndof).setConstant(s.opt.cvode.atol_m);
+        A.segment(s.ndof, s.ndof).setConstant(omega_t * s.opt.cvode.atol_m);
+        const double e_meshed = 0.5 * v0.dot(s.M * v0) + 0.5 * z0.dot(s.K * z0);
+        A[2 * s.ndof] = A[2 * s.ndof + 1] = std::max(1e-300, s.opt.cvode.rtol * e_meshed);
+    }
+    s.start_record(Y);
+    const EventDriver::StiffIntegrator stiff{2, 5, &Impl::psetup, &Impl::psolve};
+    s.start_cvode(&Impl::rhs, &stiff);
+}
+
+const StepRecord& CvodeMassiveStepper::advance() {
+    const StepRecord& r = impl_->advance();
+    const CvodeCounters& cc = impl_->cvode->counters();
+    impl_->stats.jacobian_evaluations = cc.jacobian_evaluations;
+    impl_->stats.linear_setups = cc.linear_setups;
+    return r;
+}
+const StepRecord& CvodeMassiveStepper::current() const noexcept { return impl_->current(); }
+const CvodeStats& CvodeMassiveStepper::stats() const noexcept { return impl_->stats; }
+const std::vector<ContactEvent>& CvodeMassiveStepper::events() const noexcept { return impl_->events; }
+const Eigen::VectorXd& CvodeMassiveStepper::contact_forces() const noexcept { return impl_->p_out; }
+const Eigen::VectorXd& CvodeMassiveStepper::relative_positions() const noexcept { return impl_->rel_out; }
+long CvodeMassiveStepper::record_index() const noexcept { return impl_->record_index(); }
+std::vector<PairRecord> CvodeMassiveStepper::pairs() const { return impl_->pair_records_at(impl_->rel_out); }
+RunReport CvodeMassiveStepper::report() const {
+    RunReport r = impl_->report();
+    r.cvode.jacobian_evaluations = impl_->cvode->counters().jacobian_evaluations;
+    r.cvode.linear_setups = impl_->cvode->counters().linear_setups;
+    return r;
+}
+
+}  // namespace stackbeam::detail
