@@ -230,6 +230,9 @@ stackbeam_cli_test(NAME cli_scenario_output_from_file
                    ARGS simulate --scenario ${_scenarios}/paper_frictionless.toml --t-end 0.01
                    EXPECT_RC 0 EXPECT_TEXT "output                     paper_frictionless.csv"
                    OUT ${_cli_out_dir}/paper_frictionless.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_scenario_parabolic_two_leaf  # profiles, eyes, a shackle (scenarios/README.md)
+                   ARGS simulate --scenario ${_scenarios}/parabolic_two_leaf.toml --quiet --out ${_cli_out_dir}/cli_parabolic.csv
+                   EXPECT_RC 0 OUT ${_cli_out_dir}/cli_parabolic.csv MIN_LINES 1001)
 stackbeam_cli_test(NAME cli_scenario_with_case
                    ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --case bonded --out ${_cli_out_dir}/cli_x.csv
                    EXPECT_RC 2 EXPECT_TEXT "--case excludes --scenario" OUT ${_cli_out_dir}/cli_x.csv)

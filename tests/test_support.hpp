@@ -3,8 +3,10 @@
 // example, the many-leaf stacks built from its leaf, and measurements on time series
 // (period from zero crossings, peaks).
 #include <cmath>
+#include <string>
 #include <vector>
 
+#include "stackbeam/errors.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -101,6 +103,50 @@ inline double first_max_w(const std::vector<StepRecord>& r) {
         if (r[i].w_m > r[i - 1].w_m && r[i].w_m >= r[i + 1].w_m)
             return parabola_extremum(r[i - 1].w_m, r[i].w_m, r[i + 1].w_m);
     return std::nan("");
+}
+
+/// Steel leaves of a vehicle spring (E = 200 GPa, 60 mm wide), for the assembly and clip tests.
+constexpr double kSteelE_pa = 2e11, kSteelLeafWidth_m = 0.06;
+inline double steel_leaf_bending_stiffness(double t_m) { return kSteelE_pa * kSteelLeafWidth_m * t_m * t_m * t_m / 12.0; }
+
+/// A steel leaf of length 2 half_length centred on x = seat_x (the seat), thickness t, free
+/// radius R (0: flat), pinned at both ends or free.
+inline LeafSpec steel_leaf(double seat_x_m, double half_length_m, double t_m, double free_radius_m, bool pinned) {
+    LeafSpec s;
+    s.length_m = 2.0 * half_length_m;
+    s.x_start_m = seat_x_m - half_length_m;
+    s.height_m = t_m;
+    s.width_m = kSteelLeafWidth_m;
+    s.youngs_modulus_pa = kSteelE_pa;
+    s.free_radius_m = free_radius_m;
+    s.left_support = s.right_support = pinned ? SupportKind::pinned : SupportKind::free;
+    return s;
+}
+
+/// A two-leaf spring: leaf 0 (half length L1 = 0.5 m, t1 = 8 mm, free radius R1) pinned at its
+/// eyes, below it leaf 1 (L2 = 0.3 m, t2 = 6 mm, R2), centred and free, frictionless; the seat
+/// (R, 10 kg) at x = L1; elements of 10 mm.
+constexpr double kTwoLeafL1_m = 0.5, kTwoLeafL2_m = 0.3, kTwoLeafT1_m = 0.008, kTwoLeafT2_m = 0.006;
+inline ModelSpec two_leaf_spring(double R1_m, double R2_m) {
+    ModelSpec spec;
+    spec.leaves = {steel_leaf(kTwoLeafL1_m, kTwoLeafL1_m, kTwoLeafT1_m, R1_m, true),
+                   steel_leaf(kTwoLeafL1_m, kTwoLeafL2_m, kTwoLeafT2_m, R2_m, false)};
+    spec.interfaces = {{InterfaceLaw::coulomb, 0.0}};
+    spec.rigid_body.mass_kg = 10.0;
+    spec.rigid_body.x_m = kTwoLeafL1_m;
+    spec.mesh.element_length_m = 0.01;
+    return spec;
+}
+
+/// The field named by the InputError that `f` throws, or "" when it throws none.
+template <class F>
+std::string input_error_field(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.field();
+    }
+    return "";
 }
 
 }  // namespace stackbeam::testing

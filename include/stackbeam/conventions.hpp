@@ -14,6 +14,9 @@
 ///  - A point at height y above a leaf's centroid moves axially by u - y*theta
 ///    (plane sections, Bernoulli-Euler); so the top surface moves u - (h/2) theta
 ///    and the bottom surface u + (h/2) theta (paper eq. 1).
+///  - A leaf end's support point (an eye's centre) lies eye_offset_m = e above the axis
+///    (+y; negative below) and moves by (u - e*theta, v). A shackle's angle is the link's
+///    inclination from +y, positive when its upper end lies at larger x.
 ///
 /// Rigid body R: its displacement w [m] is along +y (up); its initial velocity
 /// sets the direction of the motion. Output "w positive in the direction of the

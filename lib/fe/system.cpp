@@ -8,6 +8,7 @@
 #include <mutex>
 #include <string>
 
+#include "fe/leaf_sections.hpp"
 #include "fe/system_internal.hpp"
 #include "stackbeam/errors.hpp"
 
@@ -43,6 +44,12 @@ void add_element(Triplets& t, int a, int b, double EA, double EI, double L) {
             if (k[i][j] != 0.0) t.emplace_back(d[i], d[j], k[i][j]);
 }
 
+/// Whether an end support holds the stack axially through its eye (then the seat does not).
+bool holds_axially(SupportKind s, const LeafEndSpec& e) {
+    return s == SupportKind::hinged || (s == SupportKind::shackle && e.shackle_angle_rad != 0.0) ||
+           (s == SupportKind::bushing && e.bushing_x_n_per_m > 0.0);
+}
+
 }  // namespace
 
 int System::node_dof(int leaf, int node) const {
@@ -74,29 +81,58 @@ System::System(const Model& model) : model_(model) {
         const auto& leaf = spec.leaves[l];
         const double EA = leaf.youngs_modulus_pa * leaf.width_m * leaf.height_m;
         const double EI = leaf.youngs_modulus_pa * leaf.width_m * std::pow(leaf.height_m, 3) / 12.0;
-        for (int j = model_.first_node(l); j < model_.last_node(l); ++j)
-            add_element(kt, node_dof(l, j), node_dof(l, j + 1), EA, EI, xs[j + 1] - xs[j]);
+        for (int j = model_.first_node(l); j < model_.last_node(l); ++j) {
+            if (leaf.profile.x_m.empty()) add_element(kt, node_dof(l, j), node_dof(l, j + 1), EA, EI, xs[j + 1] - xs[j]);
+            else detail::add_matrix(kt, node_dof(l, j), node_dof(l, j + 1), detail::profiled_stiffness(leaf, xs[j], xs[j + 1]));
+        }
     }
-    Eigen::SparseMatrix<double> K(num_full_, num_full_);
-    K.setFromTriplets(kt.begin(), kt.end());
 
     // --- constraints: each full DOF = sum of coef * master ------------------------
-    // kind per full dof: -1 fixed, -2 seat w, -3 seat theta, -4 seat axial (-y theta_R), >=0 own master
+    // kind per full dof: -1 fixed, -2 seat w, -3 seat theta, -4 seat axial (-y theta_R), >=0 own master,
+    // -5 a combination of other full DOFs (an eye or a shackle: dependent[dof])
     const bool seat_rotates = !half;
+    // The seat locates the stack axially unless an end's eye does (a hinged eye, a shackle, a bushing):
+    // then it slides, with the axial displacement u_R of its own (docs/model-and-scenarios.md).
+    const bool seat_slides = !half && std::any_of(spec.leaves.begin(), spec.leaves.end(), [](const LeafSpec& l) {
+        return holds_axially(l.left_support, l.left_end) || holds_axially(l.right_support, l.right_end);
+    });
     std::vector<int> role(num_full_, 0);
+    std::vector<std::vector<std::pair<int, double>>> dependent(num_full_);
     for (int l = 0; l < nleaf; ++l) {
         const auto& leaf = spec.leaves[l];
         const bool is_tied = std::find(tied.begin(), tied.end(), l) != tied.end();
         for (int j = model_.first_node(l); j <= model_.last_node(l); ++j) {
             const int b = 3 * node_dof(l, j);
-            auto support = [&](SupportKind s) {
+            // The support point at height e above the axis moves (u - e theta, v) (small deflection).
+            auto support = [&](SupportKind s, const LeafEndSpec& end) {
+                const double e = end.eye_offset_m;
                 if (s == SupportKind::pinned) role[b + 1] = -1;
                 if (s == SupportKind::fixed) role[b] = role[b + 1] = role[b + 2] = -1;
+                if (s == SupportKind::hinged) {  // v = 0, u - e theta = 0
+                    role[b + 1] = -1;
+                    role[b] = e == 0.0 ? -1 : -5;
+                    dependent[b] = {{b + 2, e}};
+                }
+                if (s == SupportKind::shackle) {  // along the link (sin a, cos a): sin a (u - e theta) + cos a v = 0
+                    const double tan_a = std::tan(end.shackle_angle_rad);
+                    role[b + 1] = tan_a == 0.0 ? -1 : -5;
+                    dependent[b + 1] = {{b, -tan_a}, {b + 2, tan_a * e}};
+                }
+                if (s == SupportKind::bushing) {  // springs from the support point to the ground
+                    const double kx = end.bushing_x_n_per_m;
+                    const int d[3] = {b, b + 1, b + 2};
+                    const double ax[3] = {1.0, 0.0, -e};  // its axial displacement u - e theta
+                    for (int r = 0; r < 3; ++r)
+                        for (int c = 0; c < 3; ++c)
+                            if (ax[r] * ax[c] != 0.0 && kx > 0.0) kt.emplace_back(d[r], d[c], kx * ax[r] * ax[c]);
+                    if (end.bushing_y_n_per_m > 0.0) kt.emplace_back(b + 1, b + 1, end.bushing_y_n_per_m);
+                    if (end.bushing_rotation_n_m_per_rad > 0.0) kt.emplace_back(b + 2, b + 2, end.bushing_rotation_n_m_per_rad);
+                }
             };
             const bool left_end = std::abs(xs[j] - leaf.x_start_m) <= tol;
             const bool right_end = std::abs(xs[j] - (leaf.x_start_m + leaf.length_m)) <= tol;
-            if (left_end) support(leaf.left_support);
-            if (right_end) support(leaf.right_support);
+            if (left_end) support(leaf.left_support, leaf.left_end);
+            if (right_end) support(leaf.right_support, leaf.right_end);
             if (j == attach && is_tied) {
                 if ((left_end && leaf.left_support != SupportKind::free) ||
                     (right_end && leaf.right_support != SupportKind::free))
@@ -122,6 +158,7 @@ System::System(const Model& model) : model_(model) {
             for (int d = 0; d < 3; ++d)
                 if (role[3 * node_dof(l, j) + d] == 0) master[3 * node_dof(l, j) + d] = nm++;
         }
+    const int slide_master = seat_slides ? nm++ : -1;
     const int theta_master = seat_rotates ? nm++ : -1;
     const int w_master = nm++;
     Triplets pt;
@@ -133,10 +170,19 @@ System::System(const Model& model) : model_(model) {
                     case 0: pt.emplace_back(i, master[i], 1.0); break;
                     case -2: pt.emplace_back(i, w_master, 1.0); break;
                     case -3: pt.emplace_back(i, theta_master, 1.0); break;
-                    case -4: if (yc[l] != 0.0) pt.emplace_back(i, theta_master, -yc[l]); break;
+                    case -4:
+                        if (yc[l] != 0.0) pt.emplace_back(i, theta_master, -yc[l]);
+                        if (seat_slides) pt.emplace_back(i, slide_master, 1.0);
+                        break;
+                    case -5:
+                        for (const auto& [dof, coef] : dependent[i])
+                            if (coef != 0.0 && master[dof] >= 0) pt.emplace_back(i, master[dof], coef);
+                        break;
                     default: break;
                 }
             }
+    Eigen::SparseMatrix<double> K(num_full_, num_full_);  // the leaves and the bushings
+    K.setFromTriplets(kt.begin(), kt.end());
     P_.resize(num_full_, nm);
     P_.setFromTriplets(pt.begin(), pt.end());
     K_red_ = (P_.transpose() * K * P_).pruned();
@@ -151,9 +197,10 @@ System::System(const Model& model) : model_(model) {
         const auto& cp = cand[ci];
         const int a = cp.interface_index, b = a + 1;
         const int da = 3 * node_dof(a, cp.node), db = 3 * node_dof(b, cp.node);
-        const double ha = spec.leaves[a].height_m, hb = spec.leaves[b].height_m;
+        // the moment arms: half the local thickness (a profiled leaf's axis lies midway between its surfaces)
+        const double ha = leaf_thickness_m(spec.leaves[a], cp.x_m), hb = leaf_thickness_m(spec.leaves[b], cp.x_m);
         // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
-        // On the reduced DOFs: each full DOF is at most one master times a coefficient (a row
+        // On the reduced DOFs: each full DOF is a few masters times coefficients (a row
         // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
         auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
             std::vector<std::pair<int, double>> out;
@@ -167,10 +214,22 @@ System::System(const Model& model) : model_(model) {
             std::sort(out.begin(), out.end());
             return out;
         };
-        const auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
-        const auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
+        auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        if (cp.clip_index >= 0) {  // rebound clip: s = v_first - v_last - d (opening beyond the clearance), no tangent
+            const int last = spec.clips[cp.clip_index].last_leaf;
+            rn = reduce({{da + 1, 1.0}, {3 * node_dof(last, cp.node) + 1, -1.0}});
+            rt.clear();
+            if (rn.empty())
+                throw InputError("clips[" + std::to_string(cp.clip_index) + "].x_m",
+                                 "value " + format_value(cp.x_m) + " is where supports fix the strapped leaves' opening: the clip does nothing there");
+        }
         const bool has_n = !rn.empty();
         bool has_t = !rt.empty();
+        if (!has_n && cp.initial_gap_m < 0.0)
+            throw InputError("leaves[" + std::to_string(b) + (spec.leaves[b].free_radius_m != 0.0 ? "].free_radius_m" : "].free_camber_m"),
+                             "gives an interference of " + format_value(-cp.initial_gap_m) + " m with leaves[" + std::to_string(a) +
+                                 "] at x = " + format_value(cp.x_m) + " m, where supports fix both leaves: the assembly cannot close it");
         // A friction pair whose normal motion a support or the seat fixes has no normal
         // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
         if (!has_n && cp.kind == PairKind::coulomb) has_t = false;

@@ -1,6 +1,7 @@
 // Consistent mass matrices of the leaves and the rigid body's mass (system.hpp).
 #include <cmath>
 
+#include "fe/leaf_sections.hpp"
 #include "stackbeam/fe/system.hpp"
 
 namespace stackbeam {
@@ -37,6 +38,12 @@ Eigen::SparseMatrix<double> System::mass_reduced() const {
     Triplets mt;
     for (int l = 0; l < static_cast<int>(spec.leaves.size()); ++l) {
         const auto& leaf = spec.leaves[l];
+        if (!leaf.profile.x_m.empty()) {  // a profile: rho b(x) t(x) integrated exactly (leaf_sections.hpp)
+            if (leaf.density_kg_per_m3 == 0.0) continue;
+            for (int j = model_.first_node(l); j < model_.last_node(l); ++j)
+                detail::add_matrix(mt, node_dof(l, j), node_dof(l, j + 1), detail::profiled_mass(leaf, xs[j], xs[j + 1]));
+            continue;
+        }
         const double rho_a = leaf.density_kg_per_m3 * leaf.width_m * leaf.height_m;  // [kg/m]
         if (rho_a == 0.0) continue;
         for (int j = model_.first_node(l); j < model_.last_node(l); ++j) {

@@ -243,26 +243,54 @@ std::string file_path_of(const std::string& field) {
 
 
 const std::vector<std::pair<std::string, SupportKind>> kSupports = {
-    {"free", SupportKind::free}, {"pinned", SupportKind::pinned}, {"fixed", SupportKind::fixed}};
+    {"free", SupportKind::free}, {"pinned", SupportKind::pinned}, {"fixed", SupportKind::fixed},
+    {"hinged", SupportKind::hinged}, {"shackle", SupportKind::shackle}, {"bushing", SupportKind::bushing}};
+
+/// [leaves.profile] and [leaves.left_end] / [leaves.right_end] (ranges: Model::build).
+void parse_profile_and_ends(const Table& t, LeafSpec& l) {
+    if (t.has("profile")) {
+        const Table p = t.table("profile", {"x_m", "thickness_m", "width_m"});
+        l.profile.x_m = p.numbers("x_m", "the profile's points from the leaf's left end [m]: 0, ..., length_m");
+        if (p.has("thickness_m")) l.profile.thickness_m = p.numbers("thickness_m", "the thickness at each point [m], > 0");
+        if (p.has("width_m")) l.profile.width_m = p.numbers("width_m", "the width at each point [m], > 0");
+    }
+    for (const auto& [key, end] : {std::pair<const char*, LeafEndSpec*>{"left_end", &l.left_end}, {"right_end", &l.right_end}}) {
+        if (!t.has(key)) continue;
+        const Table e = t.table(key, {"eye_offset_m", "shackle_angle_rad", "bushing_x_n_per_m", "bushing_y_n_per_m",
+                                      "bushing_rotation_n_m_per_rad"});
+        end->eye_offset_m = e.number_or("eye_offset_m", "the eye centre above the leaf's axis [m]", 0.0);
+        end->shackle_angle_rad = e.number_or("shackle_angle_rad", "the link from the vertical [rad]", 0.0);
+        end->bushing_x_n_per_m = e.number_or("bushing_x_n_per_m", "the axial bushing stiffness [N/m], >= 0", 0.0);
+        end->bushing_y_n_per_m = e.number_or("bushing_y_n_per_m", "the transverse bushing stiffness [N/m], >= 0", 0.0);
+        end->bushing_rotation_n_m_per_rad =
+            e.number_or("bushing_rotation_n_m_per_rad", "the rotational bushing stiffness [N m/rad], >= 0", 0.0);
+    }
+}
 
 void parse_leaves(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
     const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
                                            "youngs_modulus_pa", "density_kg_per_m3", "poisson_ratio", "left_support",
-                                           "right_support"};
+                                           "right_support", "profile", "left_end", "right_end", "free_camber_m",
+                                           "free_radius_m"};
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("leaves", i), keys);
         LeafSpec l;
         l.length_m = t.number("length_m", "the leaf length [m], > 0");
         l.x_start_m = t.number_or("x_start_m", "x of the leaf's left end [m]", 0.0);
-        l.height_m = t.number("height_m", "the leaf thickness [m], > 0");
-        l.width_m = t.number("width_m", "the leaf width [m], > 0");
+        parse_profile_and_ends(t, l);  // height_m / width_m optional with a profile of them
+        l.height_m = l.profile.thickness_m.empty() ? t.number("height_m", "the leaf thickness [m], > 0")
+                                                   : t.number_or("height_m", "the leaf thickness [m], > 0", 0.0);
+        l.width_m = l.profile.width_m.empty() ? t.number("width_m", "the leaf width [m], > 0")
+                                              : t.number_or("width_m", "the leaf width [m], > 0", 0.0);
         l.youngs_modulus_pa = t.number("youngs_modulus_pa", "Young's modulus [Pa], > 0");
         l.density_kg_per_m3 = t.number_or("density_kg_per_m3", "density [kg/m^3], >= 0", 0.0);
         l.poisson_ratio = t.number_or("poisson_ratio", "Poisson's ratio [-], in (-1, 0.5)", LeafSpec{}.poisson_ratio);
         const SupportKind free = SupportKind::free;
         l.left_support = choice(t, "left_support", kSupports, &free);
         l.right_support = choice(t, "right_support", kSupports, &free);
+        l.free_camber_m = t.number_or("free_camber_m", "the free arc height [m], + ends up (0: flat)", 0.0);
+        l.free_radius_m = t.number_or("free_radius_m", "the free radius [m], + ends up (0: flat)", 0.0);
         spec.leaves.push_back(l);
     }
 }
@@ -319,6 +347,22 @@ void parse_clamps(const Table& top, ModelSpec& spec) {
         c.preload_n = t.number_or("preload_n", "the clamp force [N], >= 0", 0.0);
         c.length_m = t.number_or("length_m", "the clamp's length along x [m], >= 0 (0: a point tie)", 0.0);
         spec.clamps.push_back(c);
+    }
+}
+
+void parse_clips(const Table& top, ModelSpec& spec) {
+    const auto* arr = top.array("clips", "[[clips]] tables (rebound clips)", false);
+    if (!arr) return;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        Table t(top.context(), (*arr)[i], element("clips", i), {"x_m", "first_leaf", "last_leaf", "clearance_m", "stiffness_n_per_m"});
+        ClipSpec c;
+        c.x_m = t.number("x_m", "the clip position [m]");
+        const long long n = static_cast<long long>(spec.leaves.size());  // the range against the stack: Model::build
+        c.first_leaf = static_cast<int>(t.integer("first_leaf", "a leaf index 0.." + std::to_string(n - 2), 0, n - 2));
+        c.last_leaf = static_cast<int>(t.integer("last_leaf", "a leaf index 1.." + std::to_string(n - 1), 1, n - 1));
+        c.clearance_m = t.number("clearance_m", "the opening the clip allows [m], > 0");
+        c.stiffness_n_per_m = t.number_or("stiffness_n_per_m", "the strap's stiffness [N/m], > 0", ClipSpec{}.stiffness_n_per_m);
+        spec.clips.push_back(c);
     }
 }
 
@@ -540,11 +584,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     s.source = source_name;
     const Table top(ctx, root, "",
                     {"description", "leaves", "interfaces", "clamps", "rigid_body", "loading", "mesh", "probe",
-                     "integrator", "outputs"});
+                     "integrator", "outputs", "clips"});
     s.description = top.string_or("description", "free text", "");
     parse_leaves(top, s.model);
     parse_interfaces(top, s.model);
     parse_clamps(top, s.model);
+    parse_clips(top, s.model);
     parse_rigid_body(top, s.model);
     const Loading loading = parse_loading(top, s.model);
     parse_mesh(top, s.model);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "model/assembly.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -21,6 +22,9 @@ const char* to_string(SupportKind kind) {
         case SupportKind::free: return "free";
         case SupportKind::pinned: return "pinned";
         case SupportKind::fixed: return "fixed";
+        case SupportKind::hinged: return "hinged";
+        case SupportKind::shackle: return "shackle";
+        case SupportKind::bushing: return "bushing";
     }
     return "?";
 }
@@ -48,9 +52,33 @@ InterfaceContact parse_interface_contact(const std::string& text, const std::str
     throw InputError(field, "value '" + text + "' is not allowed: must be 'rigid' or 'elastic'");
 }
 
-InterfaceLayer interface_layer(const ModelSpec& spec, int i) {
-    const LeafSpec& a = spec.leaves[static_cast<std::size_t>(i)];
-    const LeafSpec& b = spec.leaves[static_cast<std::size_t>(i) + 1];
+namespace {
+/// The profile's value at absolute x (linear between its points, clamped to its ends), or `constant`.
+double profile_at(const LeafSpec& leaf, const std::vector<double>& values, double constant, double x) {
+    const auto& px = leaf.profile.x_m;
+    if (values.empty() || values.size() != px.size()) return constant;
+    const double s = x - leaf.x_start_m;
+    if (s <= px.front()) return values.front();
+    if (s >= px.back()) return values.back();
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(px.begin(), px.end(), s) - px.begin());
+    const double f = (s - px[k - 1]) / (px[k] - px[k - 1]);
+    return values[k - 1] + f * (values[k] - values[k - 1]);
+}
+}  // namespace
+
+double leaf_thickness_m(const LeafSpec& leaf, double x_m) { return profile_at(leaf, leaf.profile.thickness_m, leaf.height_m, x_m); }
+double leaf_width_m(const LeafSpec& leaf, double x_m) { return profile_at(leaf, leaf.profile.width_m, leaf.width_m, x_m); }
+
+InterfaceLayer interface_layer(const ModelSpec& spec, int i, double x_m) {
+    const LeafSpec& la = spec.leaves[static_cast<std::size_t>(i)];
+    const LeafSpec& lb = spec.leaves[static_cast<std::size_t>(i) + 1];
+    // the two leaves as constant sections of their thickness and width at x (a profile's local section)
+    const double x = std::isnan(x_m) ? std::max(la.x_start_m, lb.x_start_m) : x_m;
+    LeafSpec a = la, b = lb;
+    a.height_m = leaf_thickness_m(la, x);
+    a.width_m = leaf_width_m(la, x);
+    b.height_m = leaf_thickness_m(lb, x);
+    b.width_m = leaf_width_m(lb, x);
     const InterfaceSpec& f = spec.interfaces[static_cast<std::size_t>(i)];
     auto plane_strain = [](const LeafSpec& l) { return l.youngs_modulus_pa / (1.0 - l.poisson_ratio * l.poisson_ratio); };
     auto shear = [](const LeafSpec& l) { return l.youngs_modulus_pa / (2.0 * (1.0 + l.poisson_ratio)); };
@@ -94,6 +122,83 @@ void require_finite(const std::string& field, double value) {
 
 double leaf_end(const LeafSpec& leaf) { return leaf.x_start_m + leaf.length_m; }
 
+/// leaves[i]: its thickness and width, constant (height_m, width_m) or a profile.
+void validate_section(const LeafSpec& l, std::size_t i) {
+    const LeafProfile& p = l.profile;
+    const std::string pre = idx("leaves", i, "profile.");
+    struct Part {
+        const char *key, *pkey;
+        const std::vector<double>& values;
+        double constant;
+    };
+    for (const Part& part : {Part{"height_m", "thickness_m", p.thickness_m, l.height_m}, Part{"width_m", "width_m", p.width_m, l.width_m}}) {
+        const char *key = part.key, *pkey = part.pkey;
+        const std::vector<double>& values = part.values;
+        const double constant = part.constant;
+        if (values.empty()) {
+            require_positive(idx("leaves", i, key), constant, "[m]");
+            continue;
+        }
+        if (constant != 0.0)
+            throw InputError(idx("leaves", i, key), "value " + format_value(constant) + " is given with " + pre + pkey +
+                                                        ": give the leaf's " + pkey + " one way, the constant or the profile");
+        if (values.size() != p.x_m.size())
+            throw InputError(pre + pkey, "has " + std::to_string(values.size()) + " values: must have one per point of " +
+                                             pre + "x_m (" + std::to_string(p.x_m.size()) + ")");
+        for (std::size_t k = 0; k < values.size(); ++k)
+            require_positive(pre + pkey + "[" + std::to_string(k) + "]", values[k], "[m]");
+    }
+    if (p.x_m.empty()) return;
+    if (p.thickness_m.empty() && p.width_m.empty())
+        throw InputError(pre + "x_m", "is given without thickness_m or width_m: a profile needs one of them");
+    if (p.x_m.size() < 2)
+        throw InputError(pre + "x_m", "has " + std::to_string(p.x_m.size()) + " point: a profile needs at least 2 (0 and the leaf's length)");
+    const double tol = 1e-9 * l.length_m;
+    for (std::size_t k = 0; k < p.x_m.size(); ++k) {
+        const std::string f = pre + "x_m[" + std::to_string(k) + "]";
+        const double x = p.x_m[k];
+        require_finite(f, x);
+        if (k == 0 && std::abs(x) > tol)
+            throw InputError(f, "value " + format_value(x) + " is not allowed: the profile's first point must be 0 (the leaf's left end; x_m is measured from x_start_m)");
+        if (k + 1 == p.x_m.size() && std::abs(x - l.length_m) > tol)
+            throw InputError(f, "value " + format_value(x) + " is not allowed: the profile's last point must be the leaf's length " +
+                                    format_value(l.length_m) + " m");
+        if (k > 0 && !(x - p.x_m[k - 1] > tol))
+            throw InputError(f, "value " + format_value(x) + " is not allowed: the points must increase (previous " +
+                                    format_value(p.x_m[k - 1]) + " m)");
+    }
+}
+
+/// leaves[i].<side>_end against its support kind.
+void validate_end(SupportKind kind, const LeafEndSpec& e, std::size_t i, const char* side, bool half) {
+    const std::string pre = idx("leaves", i, (std::string(side) + "_end.").c_str());
+    const std::string support = idx("leaves", i, (std::string(side) + "_support").c_str());
+    require_finite(pre + "eye_offset_m", e.eye_offset_m);
+    require_finite(pre + "shackle_angle_rad", e.shackle_angle_rad);
+    if (e.shackle_angle_rad != 0.0 && kind != SupportKind::shackle)
+        throw InputError(pre + "shackle_angle_rad", "value " + format_value(e.shackle_angle_rad) + " is given but " + support +
+                                                        " is '" + to_string(kind) + "': a shackle angle needs support 'shackle'");
+    if (!(std::abs(e.shackle_angle_rad) < 2.0 * std::atan(1.0)))
+        throw InputError(pre + "shackle_angle_rad", "value " + format_value(e.shackle_angle_rad) +
+                                                        " is not allowed: must be in (-pi/2, pi/2) [rad] (from the vertical)");
+    bool any = false;
+    for (const auto& [key, k] : {std::pair<const char*, double>{"bushing_x_n_per_m", e.bushing_x_n_per_m},
+                                 {"bushing_y_n_per_m", e.bushing_y_n_per_m},
+                                 {"bushing_rotation_n_m_per_rad", e.bushing_rotation_n_m_per_rad}}) {
+        require_nonnegative(pre + key, k, "[N/m, N m/rad]");
+        if (k > 0.0 && kind != SupportKind::bushing)
+            throw InputError(pre + key, "value " + format_value(k) + " is given but " + support + " is '" + to_string(kind) +
+                                            "': a bushing stiffness needs support 'bushing'");
+        any = any || k > 0.0;
+    }
+    if (kind == SupportKind::bushing && !any)
+        throw InputError(pre + "bushing_y_n_per_m", "the support is 'bushing' but every bushing stiffness is 0: give one > 0");
+    const bool plain = kind == SupportKind::free || kind == SupportKind::pinned || kind == SupportKind::fixed;
+    if (half && (!plain || e.eye_offset_m != 0.0))
+        throw InputError(plain ? pre + "eye_offset_m" : support,
+                         "the half model takes supports 'free', 'pinned' or 'fixed' without an eye offset: use mesh.symmetry = 'full'");
+}
+
 }  // namespace
 
 bool Model::leaf_has_node(int leaf, int node) const {
@@ -112,8 +217,9 @@ Model Model::build(ModelSpec spec) {
         const auto& l = leaves[i];
         require_positive(idx("leaves", i, "length_m"), l.length_m, "[m]");
         require_finite(idx("leaves", i, "x_start_m"), l.x_start_m);
-        require_positive(idx("leaves", i, "height_m"), l.height_m, "[m]");
-        require_positive(idx("leaves", i, "width_m"), l.width_m, "[m]");
+        validate_section(l, i);
+        validate_end(l.left_support, l.left_end, i, "left", spec.symmetry == Symmetry::half);
+        validate_end(l.right_support, l.right_end, i, "right", spec.symmetry == Symmetry::half);
         require_positive(idx("leaves", i, "youngs_modulus_pa"), l.youngs_modulus_pa, "[Pa]");
         require_nonnegative(idx("leaves", i, "density_kg_per_m3"), l.density_kg_per_m3, "[kg/m^3]");
         if (!std::isfinite(l.poisson_ratio) || l.poisson_ratio <= -1.0 || l.poisson_ratio >= 0.5)
@@ -122,6 +228,7 @@ Model Model::build(ModelSpec spec) {
         x_min = std::min(x_min, l.x_start_m);
         x_max = std::max(x_max, leaf_end(l));
     }
+    detail::validate_free_shapes(spec);
     const double extent = x_max - x_min;
     const double tol = 1e-9 * std::max(extent, std::abs(x_max));
     m.x_tol_ = tol;
@@ -218,6 +325,13 @@ Model Model::build(ModelSpec spec) {
                                      " m; this leaf's centre is at " + format_value(l.x_start_m + 0.5 * l.length_m) + " m");
             if (l.left_support != l.right_support)
                 throw InputError(idx("leaves", i, "right_support"), "the half model needs equal supports at both ends");
+            for (double px : l.profile.x_m) {  // a profile mirrored about the attachment
+                const double x = l.x_start_m + px, xm = 2.0 * xr - x;
+                if (std::abs(leaf_thickness_m(l, x) - leaf_thickness_m(l, xm)) > 1e-9 * leaf_thickness_m(l, x) ||
+                    std::abs(leaf_width_m(l, x) - leaf_width_m(l, xm)) > 1e-9 * leaf_width_m(l, x))
+                    throw InputError(idx("leaves", i, "profile"), "the half model needs each profile mirrored about the attachment x = " +
+                                                                      format_value(xr) + " m; at x = " + format_value(x) + " m it is not");
+            }
         }
         if (m.tied_.size() != leaves.size())
             throw InputError("rigid_body.tied_leaves", "the half model needs the seat to tie every leaf");
@@ -234,6 +348,7 @@ Model Model::build(ModelSpec spec) {
         }
     }
     const double x_hi = half ? rb.x_m : x_max;
+    detail::validate_clips(spec, tol, present);
 
     // --- probe ------------------------------------------------------------
     if (spec.probe) {
@@ -253,8 +368,10 @@ Model Model::build(ModelSpec spec) {
     for (const auto& l : leaves) {
         breaks.push_back(l.x_start_m);
         breaks.push_back(leaf_end(l));
+        for (double px : l.profile.x_m) breaks.push_back(l.x_start_m + px);  // a profile's breakpoints are nodes
     }
     for (const auto& cl : spec.clamps) breaks.push_back(cl.x_m);
+    for (const auto& cl : spec.clips) breaks.push_back(cl.x_m);
     breaks.push_back(rb.x_m);
     if (spec.probe) breaks.push_back(spec.probe->x_m);
     std::sort(breaks.begin(), breaks.end());
@@ -282,14 +399,16 @@ Model Model::build(ModelSpec spec) {
     m.attach_node_ = node_at(rb.x_m);
 
     // --- centroid heights (y up, leaf 0 on top) ------------------------------
-    std::vector<double> yc(leaves.size());
+    // at the seat: a profiled leaf's axis lies half its local thickness from its surfaces
+    std::vector<double> yc(leaves.size()), ts(leaves.size());
     double top = 0.0;
     for (std::size_t i = 0; i < leaves.size(); ++i) {
-        yc[i] = top - 0.5 * leaves[i].height_m;
-        top -= leaves[i].height_m + (i < spec.interfaces.size() ? spec.interfaces[i].initial_gap_m : 0.0);
+        ts[i] = leaf_thickness_m(leaves[i], rb.x_m);
+        yc[i] = top - 0.5 * ts[i];
+        top -= ts[i] + (i < spec.interfaces.size() ? spec.interfaces[i].initial_gap_m : 0.0);
     }
     const int t0 = m.tied_.front(), t1 = m.tied_.back();
-    const double mid = 0.5 * ((yc[t0] + 0.5 * leaves[t0].height_m) + (yc[t1] - 0.5 * leaves[t1].height_m));
+    const double mid = 0.5 * ((yc[t0] + 0.5 * ts[t0]) + (yc[t1] - 0.5 * ts[t1]));
     for (auto& y : yc) y -= mid;
     m.y_centroid_ = yc;
 
@@ -298,14 +417,28 @@ Model Model::build(ModelSpec spec) {
         const int lo = std::max(m.first_node_[i], m.first_node_[i + 1]);
         const int hi = std::min(m.last_node_[i], m.last_node_[i + 1]);
         const bool elastic = spec.interfaces[i].contact == InterfaceContact::elastic;
-        const InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
+        const bool profiled = !leaves[i].profile.x_m.empty() || !leaves[i + 1].profile.x_m.empty();
+        InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
         for (int n = lo; n <= hi; ++n) {
+            if (elastic && profiled) layer = interface_layer(spec, static_cast<int>(i), m.nodes_x_[n]);  // the local sections
             PairSpec p;
             p.interface_index = static_cast<int>(i);
             p.node = n;
             p.x_m = m.nodes_x_[n];
             p.friction_coefficient = spec.interfaces[i].friction_coefficient;
             p.initial_gap_m = spec.interfaces[i].initial_gap_m;
+            double taper_gap = 0.0;
+            if (profiled) {  // straight axes, stacked at the seat: sections thinner than there leave a gap
+                const double here = leaf_thickness_m(leaves[i], p.x_m) + leaf_thickness_m(leaves[i + 1], p.x_m);
+                taper_gap = 0.5 * (ts[i] + ts[i + 1] - here);
+                if (p.initial_gap_m + taper_gap < -1e-9 * here)
+                    throw InputError(idx("interfaces", i, "initial_gap_m"),
+                                     "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) + "] would overlap by " +
+                                         format_value(-taper_gap - p.initial_gap_m) + " m at x = " + format_value(p.x_m) +
+                                         " m: the leaves are stacked at the seat (rigid_body.x_m) on straight axes, so their "
+                                         "profiles must not be thicker elsewhere than there, or the gap must make room");
+                p.initial_gap_m = std::max(0.0, p.initial_gap_m + taper_gap);
+            }
             p.kind = PairKind::coulomb;
             if (spec.interfaces[i].law == InterfaceLaw::bonded) {
                 p.kind = PairKind::bonded;
@@ -336,10 +469,20 @@ Model Model::build(ModelSpec spec) {
                     p.tangential_compliance_m_per_n = 1.0 / (layer.tangential_stiffness_pa_per_m * area);
                 }
             }
+            if (p.kind == PairKind::clamp && taper_gap > 1e-12) {
+                std::size_t c = 0;
+                while (std::abs(spec.clamps[c].x_m - p.x_m) > tol) ++c;
+                throw InputError(idx("clamps", c, "x_m"), "value " + format_value(p.x_m) + " crosses interfaces[" + std::to_string(i) +
+                                                              "] where the leaves' profiles leave a gap of " + format_value(taper_gap) +
+                                                              " m (they are stacked at the seat, x = " + format_value(rb.x_m) +
+                                                              " m): a clamp needs the leaves' sections there as thick as at the seat");
+            }
             if (p.kind == PairKind::clamp && p.initial_gap_m > 0.0)
                 throw InputError(idx("interfaces", i, "initial_gap_m"),
                                  "value " + format_value(p.initial_gap_m) +
                                      " is not allowed where a clamp crosses the interface: a clamp closes the gap (use 0)");
+            p.initial_gap_m += detail::free_shape_m(spec, static_cast<int>(i), p.x_m) -
+                               detail::free_shape_m(spec, static_cast<int>(i) + 1, p.x_m);  // free camber
             m.pairs_.push_back(p);
         }
     }
@@ -364,6 +507,7 @@ Model Model::build(ModelSpec spec) {
         for (std::size_t k = 0; k < m.pairs_.size(); ++k)
             if (m.pairs_[k].interface_index == probe.interface_index && m.pairs_[k].node == n) m.probe_pair_ = static_cast<int>(k);
     }
+    detail::add_clip_pairs(spec, m.nodes_x_, tol, m.pairs_);  // after the probe's: never the probe pair
     m.spec_ = std::move(spec);
     return m;
 }
@@ -376,16 +520,21 @@ FrictionMeshRatio friction_mesh_ratio(const Model& model) {
         const InterfaceSpec& f = spec.interfaces[i];
         if (f.law != InterfaceLaw::coulomb || f.friction_coefficient <= 0.0) continue;
         std::vector<double> x;
+        double arm_m = 0.0;  // the largest over the pairs (a profile's local thicknesses)
         for (const PairSpec& c : model.candidate_pairs())
-            if (c.interface_index == i) x.push_back(c.x_m);
+            if (c.interface_index == i) {
+                x.push_back(c.x_m);
+                arm_m = std::max(arm_m, 0.5 * (leaf_thickness_m(spec.leaves[i], c.x_m) + leaf_thickness_m(spec.leaves[i + 1], c.x_m)));
+            }
         std::sort(x.begin(), x.end());
         double h = std::numeric_limits<double>::infinity();
         for (std::size_t j = 1; j < x.size(); ++j)
             if (x[j] - x[j - 1] > tol) h = std::min(h, x[j] - x[j - 1]);
         if (!std::isfinite(h)) continue;  // fewer than two pairs: no neighbour to trade forces with
-        const double arm_m = 0.5 * (spec.leaves[i].height_m + spec.leaves[i + 1].height_m);
         const bool elastic = f.contact == InterfaceContact::elastic;
-        const double l = elastic ? interface_layer(spec, i).decay_length_m : 0.0;
+        double l = elastic ? interface_layer(spec, i).decay_length_m : 0.0;
+        if (elastic && (!spec.leaves[i].profile.x_m.empty() || !spec.leaves[i + 1].profile.x_m.empty()))
+            for (double xp : x) l = std::min(l, interface_layer(spec, i, xp).decay_length_m);  // the shortest over the pairs
         const double kappa = f.friction_coefficient * arm_m / std::max(h, l);
         if (kappa > best.ratio) best = {kappa, i, h, f.friction_coefficient * arm_m, l, elastic};
     }

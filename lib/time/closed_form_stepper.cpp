@@ -48,12 +48,17 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
         gw_ = Eigen::VectorXd(G.col(w_dof_));
     }
 
+    // 0. Assembly (free camber, clips): the leaves bolted from their free shapes, one quasi-static
+    //    step with no force on R (the interference of the offsets d resolved, with friction;
+    //    simulation.hpp, "assembly"), its sticking forces the initial state.
     // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
-    //    from the unloaded stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
+    //    from the unloaded (assembled) stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
     w_ = 0.0;
-    if (load.gravity_m_per_s2 > 0.0) {
-        const double Fs = -m * load.gravity_m_per_s2;  // R's weight on the meshed part [N]
-        const std::string what = "static equilibrium under gravity";
+    const bool assemble = (has_free_camber(system_.model().spec()) || !system_.model().spec().clips.empty()) && n > 0;
+    for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
+        if (stage == 0 ? !assemble : !(load.gravity_m_per_s2 > 0.0)) continue;
+        const double Fs = stage == 0 ? 0.0 : -m * load.gravity_m_per_s2;  // [N] on the meshed part
+        const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
         if (path_ == ContactPath::dense) {
             auto solver = make_solver(options_.solver);
             const detail::StaticState st = detail::static_equilibrium_dense(system_, problem_, Fs, *solver, p_, d_, what);

@@ -138,6 +138,17 @@ void require_massless_leaves(const System& system, Mode mode) {
                                  "(mode newmark integrates the leaves' inertia)");
 }
 
+void require_no_assembly(const ModelSpec& model, Mode mode) {
+    const std::string why = std::string(" is not available in mode ") + to_string(mode) +
+                            " yet: the assembly and the clips' limit are honoured in mode closed-form only (use it)";
+    for (std::size_t i = 0; i < model.leaves.size(); ++i)
+        for (const auto& [key, v] : {std::pair<const char*, double>{"free_camber_m", model.leaves[i].free_camber_m},
+                                     {"free_radius_m", model.leaves[i].free_radius_m}})
+            if (v != 0.0)
+                throw InputError("leaves[" + std::to_string(i) + "]." + key, "value " + format_value(v) + ": a free camber" + why);
+    if (!model.clips.empty()) throw InputError("clips[0]", "a rebound clip" + why);
+}
+
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     const auto& rb = model.rigid_body;
     if (loading.kind == LoadingKind::prescribed_displacement) {

@@ -26,6 +26,7 @@ void require_no_damping(const SimulationOptions& options, const std::string& ste
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOptions& options) {
+    if (options.mode != Mode::closed_form) require_no_assembly(system.model().spec(), options.mode);
     switch (options.mode) {
         case Mode::closed_form:
             require_no_damping(options, "mode closed-form");

@@ -3,6 +3,7 @@
 /// The model description of a stacked-beam spring: what the user specifies
 /// (ModelSpec, plain data) and its validated, immutable, meshed form (Model).
 /// Sign conventions and units: conventions.hpp.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,32 @@ enum class SupportKind {
     free,    ///< no constraint
     pinned,  ///< transverse displacement v = 0; rotation and axial displacement free
     fixed,   ///< built in: u = v = theta = 0
+    hinged,  ///< a pin through the eye: the support point (LeafEndSpec::eye_offset_m) held in x and y, rotation free
+    shackle, ///< a link (small deflection: an inclined roller): the support point does not move along the link
+    bushing, ///< elastic: springs (LeafEndSpec::bushing_*) between the support point and the ground
+};
+
+/// A leaf's thickness and width along it, piecewise linear between points (empty: constant
+/// height_m / width_m). docs/model-and-scenarios.md, "Leaf profiles, eyes and shackles".
+/// Each leaf keeps a straight axis, its thickness symmetric about it; the leaves are stacked
+/// touching at the seat (RigidBodySpec::x_m), so where they are thinner than there a pair's gap
+/// is larger by half the thinning of the two (PairSpec::initial_gap_m). Every point is a node.
+struct LeafProfile {
+    std::vector<double> x_m;          ///< points from the leaf's left end [m]: 0 first, length_m last, increasing
+    std::vector<double> thickness_m;  ///< thickness at each point [m], > 0 (empty: height_m, which must then be given)
+    std::vector<double> width_m;      ///< width at each point [m], > 0 (empty: width_m, which must then be given)
+};
+
+/// The support point at a leaf end and its eye, shackle or bushings (SupportKind). Small
+/// deflection: the support point at height e above the leaf's axis moves (u - e theta, v).
+struct LeafEndSpec {
+    double eye_offset_m = 0.0;  ///< e: the support point (eye centre) above the leaf's axis [m], signed (+y up)
+    /// Shackle: the link's inclination from the vertical (+y) [rad], |angle| < pi/2, positive when its
+    /// upper end lies at larger x (hanging or standing alike); 0 is a vertical link (a roller, as pinned).
+    double shackle_angle_rad = 0.0;
+    double bushing_x_n_per_m = 0.0;               ///< bushing: axial stiffness at the support point [N/m], >= 0
+    double bushing_y_n_per_m = 0.0;               ///< bushing: transverse stiffness [N/m], >= 0
+    double bushing_rotation_n_m_per_rad = 0.0;    ///< bushing: rotational stiffness [N m/rad], >= 0
 };
 
 /// Contact law of an interface between two adjacent leaves.
@@ -39,15 +66,31 @@ enum class Symmetry { full, half };
 struct LeafSpec {
     double length_m = 0.0;                  ///< leaf length [m], > 0
     double x_start_m = 0.0;                 ///< x of its left end [m]
-    double height_m = 0.0;                  ///< thickness, normal to the stack [m], > 0
-    double width_m = 0.0;                   ///< width [m], > 0
+    double height_m = 0.0;                  ///< thickness, normal to the stack [m], > 0 (0 with profile.thickness_m)
+    double width_m = 0.0;                   ///< width [m], > 0 (0 with profile.width_m)
     double youngs_modulus_pa = 0.0;         ///< Young's modulus [Pa], > 0
     double density_kg_per_m3 = 0.0;         ///< mass density [kg/m^3], >= 0 (0: massless, as in the paper)
     SupportKind left_support = SupportKind::free;   ///< support at x_start_m
     SupportKind right_support = SupportKind::free;  ///< support at x_start_m + length_m
     double poisson_ratio = 0.3;             ///< Poisson's ratio nu [-], in (-1, 0.5): the elastic interface's
                                             ///< derived stiffness (interface_layer); nothing else uses it
+    LeafProfile profile;                    ///< thickness / width along x (empty: constant)
+    LeafEndSpec left_end, right_end;        ///< eyes, shackle, bushings at the two ends
+    /// Free (unassembled) camber: the arc height H [m] of the unstressed leaf over its length, a
+    /// circular arc of curvature 8 H / L^2 (small deflection: the free shape is
+    /// v0(x) = 4 H (x - x_R)^2 / L^2, x_R the rigid body's attachment, where v0 = v0' = 0).
+    /// H > 0: the ends above the seat (+y), the usual spring that a load on R in +y flattens;
+    /// 0: flat. |H| <= L/10. At most one of free_camber_m, free_radius_m.
+    /// docs/model-and-scenarios.md, "Free camber, assembly and rebound clips".
+    double free_camber_m = 0.0;
+    /// Free camber as the radius R [m] of the arc instead (curvature 1/R, v0 = (x - x_R)^2 / (2 R)):
+    /// R > 0 ends up, R < 0 ends down, 0: flat (no radius given). |R| >= 1.25 L (arc height <= L/10).
+    double free_radius_m = 0.0;
 };
+
+/// Thickness and width of a leaf at x [m] (absolute x; the profile, or height_m / width_m).
+double leaf_thickness_m(const LeafSpec& leaf, double x_m);
+double leaf_width_m(const LeafSpec& leaf, double x_m);
 
 /// The interface between leaf i (above) and leaf i+1 (below).
 struct InterfaceSpec {
@@ -62,7 +105,7 @@ struct InterfaceSpec {
     double tangential_stiffness_pa_per_m = 0.0;
 };
 
-/// A clamp (band, U-bolt, rebound clip) of negligible width. It ties every
+/// A clamp (band, U-bolt) of negligible width. It ties every
 /// interface it crosses in the normal direction (never opens) and squeezes it
 /// with its preload, which adds to the compressive reaction in the friction limit.
 struct ClampSpec {
@@ -72,6 +115,22 @@ struct ClampSpec {
     /// > 0: on an elastic interface the clamp's pair gets the layer over width x length_m (never
     /// over the mesh's tributary length, which would soften the clamp with every refinement).
     double length_m = 0.0;
+};
+
+/// A rebound clip: a strap around leaves first_leaf..last_leaf at x_m that lets them open
+/// (separate in y) by at most clearance_m in total, and is free tangentially (no friction).
+/// A unilateral limit on the opening: one contact row s = (gap sum) - clearance - T/k <= 0 whose
+/// force (the strap's tension T >= 0) holds the outer leaves together once the clearance is
+/// used up; the strap's elastic stretch T/k is the row's compliance (as an elastic interface's).
+/// Mode closed-form only (docs/model-and-scenarios.md, "Free camber, assembly and rebound clips").
+struct ClipSpec {
+    double x_m = 0.0;          ///< position [m]: on every strapped leaf, not at the rigid body's seat
+    int first_leaf = 0;        ///< the top leaf in the strap
+    int last_leaf = 1;         ///< the bottom leaf in the strap, > first_leaf
+    double clearance_m = 0.0;  ///< free opening allowed [m], > 0: the sum of the strapped interfaces' gaps
+    /// The strap's stiffness in tension k [N/m], > 0: once engaged, the opening grows by T / k
+    /// with the clip's tension T (default 1e8 N/m, about a steel band of 1 cm^2 over a 0.2 m loop)
+    double stiffness_n_per_m = 1e8;
 };
 
 /// The rigid body R on the stack (the axle seat and the mass it carries).
@@ -110,6 +169,7 @@ struct ModelSpec {
     MeshSpec mesh;
     Symmetry symmetry = Symmetry::full;
     std::optional<ProbeSpec> probe;          ///< default: top interface at the leftmost clamp
+    std::vector<ClipSpec> clips;             ///< rebound clips
 };
 
 /// Kind of a contact pair.
@@ -127,11 +187,15 @@ struct PairSpec {
     PairKind kind = PairKind::coulomb;
     double friction_coefficient = 0.0;  ///< mu [-]
     double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
-    double initial_gap_m = 0.0;         ///< d_n [m]
+    double initial_gap_m = 0.0;         ///< d_n [m]: the interface's gap plus the taper's gap (LeafProfile) plus the
+                                        ///< free shapes' difference v0_A - v0_B (< 0: interference, resolved by the
+                                        ///< assembly); a clip row: clearance - the strapped gaps' sum
     /// Elastic interface: the layer's compliance of this pair, 1 / (k_n A) and 1 / (k_t A) [m/N],
     /// A its tributary area [m^2]; 0 on a rigid interface and at a point clamp.
     double normal_compliance_m_per_n = 0.0;
     double tangential_compliance_m_per_n = 0.0;
+    int clip_index = -1;                ///< >= 0: the row of clips[clip_index] (kind coulomb, mu 0), on
+                                        ///< v_first - v_last; interface_index is then the clip's first leaf
 };
 
 /// The validated, meshed model. Immutable; build with Model::build.
@@ -176,6 +240,11 @@ private:
     double x_tol_ = 0.0;
 };
 
+/// The curvature of a leaf's free shape [1/m]: 1/free_radius_m, or 8 free_camber_m / L^2 (0: flat).
+double free_curvature_per_m(const LeafSpec& leaf);
+/// Whether any leaf has a free camber (then every run starts with the assembly, simulation.hpp).
+bool has_free_camber(const ModelSpec& spec);
+
 const char* to_string(SupportKind kind);
 const char* to_string(PairKind kind);
 const char* to_string(InterfaceContact contact);
@@ -198,16 +267,18 @@ struct InterfaceLayer {
     double contact_width_m = 0.0;                ///< b [m]
     double decay_length_m = 0.0;                 ///< l [m]
 };
-/// The layer of interface i of a spec (whatever its contact law; validated leaves assumed).
-InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index);
+/// The layer of interface i of a spec (whatever its contact law; validated leaves assumed),
+/// with the leaves' sections at x_m (NaN: at the left end of their overlap; the same for constant leaves).
+InterfaceLayer interface_layer(const ModelSpec& spec, int interface_index, double x_m = std::nan(""));
 
 /// The friction-mesh ratio of a model: how strongly a change of the friction forces
 /// moves the normal forces of neighbouring contact pairs, per Coulomb interface
 ///
 ///     kappa_i = mu_i (t_i + t_i+1) / (2 h_i),
 ///
-/// t_i, t_i+1 the thicknesses of the leaves above and below [m], h_i the shortest
-/// spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
+/// t_i, t_i+1 the thicknesses of the leaves above and below [m] (profiles: the largest local sum
+/// over the interface's pairs, and on an elastic interface the shortest decay length l), h_i the
+/// shortest spacing of neighbouring pairs of interface i [m] (on this mesh the node spacing).
 /// Why: a change dT of a pair's tangential force acts at the interface, t/2 off each
 /// leaf's axis, so it puts a moment dT (t_i + t_i+1)/2 on the two leaves. Where a
 /// contact zone ends (a leaf tip, the edge of a closed zone) only the couple of the

@@ -156,6 +156,21 @@ struct SimulationOptions {
 /// dense otherwise. Throws InputError for the sparse path with a solver other than exact.
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options);
 
+/// The assembly of a spring whose leaves have a free camber (LeafSpec::free_camber_m) or that has
+/// rebound clips (a clip closes initial gaps wider than its clearance): every run of mode
+/// closed-form starts from the assembled, pre-stressed stack. The leaves start in their
+/// free shapes, anchored there (d_t = 0), touching wherever their offsets d_n (interface gap plus
+/// the free shapes' difference, PairSpec::initial_gap_m) are <= 0; the centre bolt (the rigid
+/// body's seat) and the clamps pull them together in one quasi-static, monotonic load step with
+/// no force on R: the contact problem of that step (the interfaces' Coulomb friction included,
+/// incremental from the free shapes) resolves the interference; pairs that stick keep their
+/// anchors and tangential forces as the initial sticking state, the others are re-anchored where
+/// they slid to. Gravity's static step then follows from the assembled state, then w(0), w'(0).
+/// Modes newmark and cvode do not assemble: require_no_assembly refuses such a model there.
+/// Throws InputError naming leaves[i].free_camber_m (or free_radius_m) or clips[0] when the
+/// model has a free camber or a rebound clip and `mode` is not closed-form.
+void require_no_assembly(const ModelSpec& model, Mode mode);
+
 /// Throws InputError when the model's initial conditions contradict the loading
 /// (a prescribed displacement fixes w(0) and w'(0) itself).
 void require_loading_fits(const ModelSpec& model, const Loading& loading);
