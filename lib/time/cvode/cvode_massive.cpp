@@ -106,7 +106,6 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     // the Newton matrix M + gamma C + gamma^2 K_eff of the current modes
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> nlu;
     double gamma_lu = -1.0;
-    double jump_dissipation = 0.0;  // friction work in force jumps at events [J, whole spring]
 
     // ---- modes ------------------------------------------------------------------
 
@@ -231,38 +230,17 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         wd = y[ndof + w_dof];
     }
 
-    /// A slipping pair slips against its slider rate: where the new modes' rate contradicts
-    /// the decided sign beyond the margin, the sign follows the rate (as the modal stepper).
+    /// A slipping pair slips against its slider rate (EventDriver::signs_follow_slip_rates).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {
-        const Eigen::VectorXd d_saved = d;
-        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
-        for (int pass = 0; pass < 3; ++pass) {
-            enter(rel, nm, tm);
-            build_mode();
-            const Eigen::VectorXd rate = Hs * y.segment(ndof, ndof);
-            bool changed = false;
-            for (int kk = 0; kk < np; ++kk) {
-                const int rt = pairs()[kk].row_t;
-                if (rt < 0) continue;
-                if (tm[kk] == SLIP_POS && rate[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
-                else if (tm[kk] == SLIP_NEG && rate[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
-            }
-            d = d_saved;
-            nmode = nm_saved;
-            tmode = tm_saved;
-            if (!changed) break;
-        }
+        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(ndof, ndof)); });
     }
 
     /// A force jump at an event (a slip that reverses) releases the layer's energy
     /// p^T C_L p / 2 of the jump: friction work, booked as dissipated (z and z' are continuous).
     void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) override {
-        if (cause == "start") return;
-        const double loss = 0.5 * f * (p_cur.dot(cL.cwiseProduct(p_cur)) - p_new.dot(cL.cwiseProduct(p_new)));
-        jump_dissipation += loss;
-        stats.min_jump_dissipation_j = std::min(stats.min_jump_dissipation_j, loss);
-        stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+        book_force_jump(cause, 0.5 * f * (p_cur.dot(cL.cwiseProduct(p_cur)) - p_new.dot(cL.cwiseProduct(p_new))), p_cur,
+                        p_new);
     }
 
     /// At fixed z only the diagonal layer is instantaneous: the state decides every pair.

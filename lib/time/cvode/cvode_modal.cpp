@@ -55,7 +55,6 @@ struct CvodeModalStepper::Impl final : EventDriver {
     Eigen::VectorXd p0, bs, a0;
     std::vector<int> slip_rows;
 
-    double jump_dissipation = 0.0;  // friction work in force jumps at events [J, whole spring]
 
     // ---- modes ------------------------------------------------------------------
 
@@ -183,29 +182,10 @@ struct CvodeModalStepper::Impl final : EventDriver {
         wd = phiw.dot(y.segment(r, r));
     }
 
-    /// A slipping pair slips against its slip rate: where the new modes' rate at (q, q')
-    /// contradicts the solver's sign beyond the margin (a rate the look-ahead's motion is
-    /// too short to resolve), the sign follows the rate.
+    /// A slipping pair slips against its slip rate at (q, q') (EventDriver::signs_follow_slip_rates).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {
-        const Eigen::VectorXd d_saved = d;
-        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
-        for (int pass = 0; pass < 3; ++pass) {
-            enter(rel, nm, tm);
-            build_mode();
-            const Eigen::VectorXd rate = Hs * y.segment(r, r);
-            bool changed = false;
-            for (int kk = 0; kk < np; ++kk) {
-                const int rt = pairs()[kk].row_t;
-                if (rt < 0) continue;
-                if (tm[kk] == SLIP_POS && rate[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
-                else if (tm[kk] == SLIP_NEG && rate[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
-            }
-            d = d_saved;
-            nmode = nm_saved;
-            tmode = tm_saved;
-            if (!changed) break;
-        }
+        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(r, r)); });
     }
 
     /// A force jump (a slip that reverses where sticking is not admissible: the friction
@@ -213,11 +193,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
     /// strain energy p^T W p / 2 drops, and that is friction work done in the jump (the
     /// kinetic energy, q', is continuous). Booked as dissipated.
     void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) override {
-        if (cause == "start") return;
-        const double loss = 0.5 * f * (p_cur.dot(W * p_cur) - p_new.dot(W * p_new));
-        jump_dissipation += loss;
-        stats.min_jump_dissipation_j = std::min(stats.min_jump_dissipation_j, loss);
-        stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+        book_force_jump(cause, 0.5 * f * (p_cur.dot(W * p_cur) - p_new.dot(W * p_new)), p_cur, p_new);
     }
 
     // ---- CVODE ------------------------------------------------------------------

@@ -109,6 +109,35 @@ void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed 
 
 bool EventDriver::settle_at_state() const { return false; }
 
+void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
+                                          const std::function<Vec()>& rate) {
+    const Vec d_saved = d;
+    const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+    for (int pass = 0; pass < 3; ++pass) {
+        enter(rel, nm, tm);
+        build_mode();
+        const Vec r = rate();
+        bool changed = false;
+        for (int kk = 0; kk < np; ++kk) {
+            const int rt = pairs()[kk].row_t;
+            if (rt < 0) continue;
+            if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
+            else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
+        }
+        d = d_saved;
+        nmode = nm_saved;
+        tmode = tm_saved;
+        if (!changed) break;
+    }
+}
+
+void EventDriver::book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new) {
+    if (cause == "start") return;
+    jump_dissipation += loss;
+    stats.min_jump_dissipation_j = std::min(stats.min_jump_dissipation_j, loss);
+    stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+}
+
 void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
                                const std::vector<int>* triggered) {
     const auto t_start = Clock::now();

@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -143,6 +144,17 @@ protected:
     /// True when the state y alone decides every pair's modes (no instantaneous coupling but
     /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
     virtual bool settle_at_state() const;
+    /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
+    /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
+    /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
+    /// rate the look-ahead's motion is too short to resolve), the sign follows the rate.
+    /// At most three passes; the current modes and anchors are left as they were.
+    void signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
+                                 const std::function<Vec()>& rate);
+    /// Books a force jump at an event (a slip that reverses where sticking is not admissible)
+    /// that released `loss` [J, whole spring] of the contact layer's energy: friction work.
+    void book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new);
+    double jump_dissipation = 0.0;  ///< friction work in force jumps at events [J, whole spring]
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
