@@ -173,36 +173,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     void witnesses(const State& y, double* g) const override {
         const auto z = y.head(ndof);
         const auto v = y.segment(ndof, ndof);
-        const Eigen::VectorXd p = forces_z(z);
-        for (std::size_t i = 0; i < slots.size(); ++i) {
-            const int kk = slots[i].pair;
-            const auto& cp = pairs()[kk];
-            double val = 1.0, margin = kForceMargin;
-            if (slots[i].normal) {
-                const double pn = p[cp.row_n];
-                if (cp.kind == PairKind::coulomb) {
-                    if (nmode[kk] == CLOSED) {
-                        val = -pn / F_ref;
-                    } else {
-                        val = -(Hs.row(cp.row_n).dot(z) + hs[cp.row_n] - d[cp.row_n]) / L_ref;
-                        margin = gap_margin;
-                    }
-                } else {
-                    val = tmode[kk] == FREE ? (pn - cp.preload_n) / F_ref : (cp.preload_n - pn) / F_ref;
-                }
-            } else {
-                const int rt = cp.row_t;
-                switch (tmode[kk]) {
-                    case STICK:
-                        val = (cp.friction_coefficient * friction_normal_force(chk_problem, kk, p) - std::abs(p[rt])) / F_ref;
-                        break;
-                    case SLIP_POS: val = -Hs.row(rt).dot(v) / V_ref; margin = kMotionMargin; break;
-                    case SLIP_NEG: val = Hs.row(rt).dot(v) / V_ref; margin = kMotionMargin; break;
-                    default: val = 1.0; break;
-                }
-            }
-            g[i] = val + margin;
-        }
+        witnesses_from(
+            forces_z(z), [&](int row) { return Hs.row(row).dot(z) + hs[row] - d[row]; },
+            [&](int row) { return Hs.row(row).dot(v); }, g);
     }
 
     /// The look-ahead: the contact points move by ~kLookahead L_ref and the forces by

@@ -122,36 +122,9 @@ struct CvodeModalStepper::Impl final : EventDriver {
 
     void witnesses(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
                    double* g) const {
-        const Eigen::VectorXd p = forces_q(q);
-        for (std::size_t i = 0; i < slots.size(); ++i) {
-            const int kk = slots[i].pair;
-            const auto& cp = pairs()[kk];
-            double v = 1.0, margin = kForceMargin;
-            if (slots[i].normal) {
-                const double pn = p[cp.row_n];
-                if (cp.kind == PairKind::coulomb) {
-                    if (nmode[kk] == CLOSED) {
-                        v = -pn / F_ref;
-                    } else {
-                        v = -(Hs.row(cp.row_n).dot(q) + bs[cp.row_n]) / L_ref;
-                        margin = gap_margin;
-                    }
-                } else {
-                    v = tmode[kk] == FREE ? (pn - cp.preload_n) / F_ref : (cp.preload_n - pn) / F_ref;
-                }
-            } else {
-                const int rt = cp.row_t;
-                switch (tmode[kk]) {
-                    case STICK:
-                        v = (cp.friction_coefficient * friction_normal_force(chk_problem, kk, p) - std::abs(p[rt])) / F_ref;
-                        break;
-                    case SLIP_POS: v = -Hs.row(rt).dot(qd) / V_ref; margin = kMotionMargin; break;
-                    case SLIP_NEG: v = Hs.row(rt).dot(qd) / V_ref; margin = kMotionMargin; break;
-                    default: v = 1.0; break;
-                }
-            }
-            g[i] = v + margin;
-        }
+        witnesses_from(
+            forces_q(q), [&](int row) { return Hs.row(row).dot(q) + bs[row]; },
+            [&](int row) { return Hs.row(row).dot(qd); }, g);
     }
 
     /// The look-ahead: the contact points move by ~kLookahead L_ref (the fastest row) and

@@ -131,6 +131,39 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
     }
 }
 
+void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>& s_of,
+                                 const std::function<double(int)>& rate_of, double* g) const {
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+        const int kk = slots[i].pair;
+        const auto& cp = pairs()[kk];
+        double val = 1.0, margin = kForceMargin;
+        if (slots[i].normal) {
+            const double pn = p[cp.row_n];
+            if (cp.kind == PairKind::coulomb) {
+                if (nmode[kk] == CLOSED) {
+                    val = -pn / F_ref;
+                } else {
+                    val = -s_of(cp.row_n) / L_ref;
+                    margin = gap_margin;
+                }
+            } else {
+                val = tmode[kk] == FREE ? (pn - cp.preload_n) / F_ref : (cp.preload_n - pn) / F_ref;
+            }
+        } else {
+            const int rt = cp.row_t;
+            switch (tmode[kk]) {
+                case STICK:
+                    val = (cp.friction_coefficient * friction_normal_force(chk_problem, kk, p) - std::abs(p[rt])) / F_ref;
+                    break;
+                case SLIP_POS: val = -rate_of(rt) / V_ref; margin = kMotionMargin; break;
+                case SLIP_NEG: val = rate_of(rt) / V_ref; margin = kMotionMargin; break;
+                default: val = 1.0; break;
+            }
+        }
+        g[i] = val + margin;
+    }
+}
+
 void EventDriver::book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new) {
     if (cause == "start") return;
     jump_dissipation += loss;

@@ -155,6 +155,13 @@ protected:
     /// that released `loss` [J, whole spring] of the contact layer's energy: friction work.
     void book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new);
     double jump_dissipation = 0.0;  ///< friction work in force jumps at events [J, whole spring]
+    /// The witnesses of the steppers whose modes give the forces `p` [N], the relative position
+    /// s [m] of a normal row (`s_of(row)`, > 0 interpenetration) and the slider rate ds/dt [m/s]
+    /// of a tangential row (`rate_of(row)`): a closed pair's compression, an open pair's gap, a
+    /// clamp's release or engagement, a sticking pair's margin to the cone, a slipping pair's
+    /// rate against its force; each positive while its modes hold, with its margin.
+    void witnesses_from(const Vec& p, const std::function<double(int)>& s_of, const std::function<double(int)>& rate_of,
+                        double* g) const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
