@@ -49,10 +49,13 @@ private:
 /// carry the inertia, the modes above it respond quasi-statically (residual
 /// flexibility), so the contact points are massless and the events are those of the
 /// massless cvode mode (cvode_modal.cpp, docs/time-integration.md).
-class CvodeModalStepper final : public Stepper {
+class EventDriver;  // event_driver.hpp
+
+/// The Stepper face of the event-driven steppers with leaf inertia (modal and massive): every
+/// call forwards to their EventDriver.
+class EventStepper : public Stepper {
 public:
-    CvodeModalStepper(const System& system, const SimulationOptions& options);
-    ~CvodeModalStepper() override;
+    ~EventStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
     const StepRecord& advance() override;
     const StepRecord& current() const noexcept override;
@@ -69,36 +72,29 @@ public:
     /// Relative positions s + d [m] (all rows) at the last output.
     const Eigen::VectorXd& relative_positions() const noexcept;
 
+protected:
+    explicit EventStepper(std::unique_ptr<EventDriver> driver);
+    std::unique_ptr<EventDriver> driver_;
+};
+
+class CvodeModalStepper final : public EventStepper {
+public:
+    CvodeModalStepper(const System& system, const SimulationOptions& options);
+
 private:
     struct Impl;
-    std::unique_ptr<Impl> impl_;
 };
 
 /// Mode "cvode" with leaf inertia on stacks with friction and an elastic layer on every
 /// contact row: the whole massive stack in CVODE, BDF with Newton, events on every
 /// transition (cvode_massive.cpp, docs/time-integration.md). Refuses a rigid contact row
 /// (InputError naming the interface's contact or the clamp's length_m).
-class CvodeMassiveStepper final : public Stepper {
+class CvodeMassiveStepper final : public EventStepper {
 public:
     CvodeMassiveStepper(const System& system, const SimulationOptions& options);
-    ~CvodeMassiveStepper() override;
-    const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    std::vector<PairRecord> pairs() const override;
-    /// CVODE's steps, Newton matrices (preconditioner set-ups), the events and restarts.
-    RunReport report() const override;
-    const CvodeStats& stats() const noexcept;
-    /// Every mode transition, in time order (cause "start", "root" or "check").
-    const std::vector<ContactEvent>& events() const noexcept;
-    /// Contact forces p [N] (all rows) at the last output.
-    const Eigen::VectorXd& contact_forces() const noexcept;
-    /// Relative positions s + d [m] (all rows) at the last output.
-    const Eigen::VectorXd& relative_positions() const noexcept;
 
 private:
     struct Impl;
-    std::unique_ptr<Impl> impl_;
 };
 
 /// True when a contact row of `system` has no elastic layer (a rigid interface or a point clamp).

@@ -309,11 +309,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
 };
 
-CvodeMassiveStepper::~CvodeMassiveStepper() = default;
-
 CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
-    : impl_(std::make_unique<Impl>(system, options)) {
-    Impl& s = *impl_;
+    : EventStepper(std::make_unique<Impl>(system, options)) {
+    Impl& s = static_cast<Impl&>(*driver_);
     s.opt.validate();
     require_uniform_leaf_mass(system, "cvode");
     require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
@@ -412,27 +410,6 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.start_record(Y);
     const EventDriver::StiffIntegrator stiff{2, &Impl::psetup, &Impl::psolve};
     s.start_cvode(&Impl::rhs, &stiff);
-}
-
-const StepRecord& CvodeMassiveStepper::advance() {
-    const StepRecord& r = impl_->advance();
-    const CvodeCounters& cc = impl_->cvode->counters();
-    impl_->stats.jacobian_evaluations = cc.jacobian_evaluations;
-    impl_->stats.linear_setups = cc.linear_setups;
-    return r;
-}
-const StepRecord& CvodeMassiveStepper::current() const noexcept { return impl_->current(); }
-const CvodeStats& CvodeMassiveStepper::stats() const noexcept { return impl_->stats; }
-const std::vector<ContactEvent>& CvodeMassiveStepper::events() const noexcept { return impl_->events; }
-const Eigen::VectorXd& CvodeMassiveStepper::contact_forces() const noexcept { return impl_->p_out; }
-const Eigen::VectorXd& CvodeMassiveStepper::relative_positions() const noexcept { return impl_->rel_out; }
-long CvodeMassiveStepper::record_index() const noexcept { return impl_->record_index(); }
-std::vector<PairRecord> CvodeMassiveStepper::pairs() const { return impl_->pair_records_at(impl_->rel_out); }
-RunReport CvodeMassiveStepper::report() const {
-    RunReport r = impl_->report();
-    r.cvode.jacobian_evaluations = impl_->cvode->counters().jacobian_evaluations;
-    r.cvode.linear_setups = impl_->cvode->counters().linear_setups;
-    return r;
 }
 
 }  // namespace stackbeam::detail

@@ -213,11 +213,9 @@ struct CvodeModalStepper::Impl final : EventDriver {
 
 };
 
-CvodeModalStepper::~CvodeModalStepper() = default;
-
 CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptions& options)
-    : impl_(std::make_unique<Impl>(system, options)) {
-    Impl& s = *impl_;
+    : EventStepper(std::make_unique<Impl>(system, options)) {
+    Impl& s = static_cast<Impl&>(*driver_);
     s.opt.validate();
     require_uniform_leaf_mass(system, "cvode");
     require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
@@ -333,14 +331,6 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.start_cvode(&Impl::rhs);
 }
 
-const StepRecord& CvodeModalStepper::advance() { return impl_->advance(); }
-const StepRecord& CvodeModalStepper::current() const noexcept { return impl_->current(); }
-const CvodeStats& CvodeModalStepper::stats() const noexcept { return impl_->stats; }
-const std::vector<ContactEvent>& CvodeModalStepper::events() const noexcept { return impl_->events; }
-const Eigen::VectorXd& CvodeModalStepper::contact_forces() const noexcept { return impl_->p_out; }
-const Eigen::VectorXd& CvodeModalStepper::relative_positions() const noexcept { return impl_->rel_out; }
-long CvodeModalStepper::record_index() const noexcept { return impl_->record_index(); }
-std::vector<PairRecord> CvodeModalStepper::pairs() const { return impl_->pair_records_at(impl_->rel_out); }
-RunReport CvodeModalStepper::report() const { return impl_->report(); }
+
 
 }  // namespace stackbeam::detail

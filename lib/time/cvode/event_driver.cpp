@@ -1,6 +1,7 @@
 // The event driver of the event-driven cvode steppers (event_driver.hpp; the method in
 // cvode_stepper.hpp).
 #include "time/cvode/event_driver.hpp"
+#include "time/cvode/cvode_inertia.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -444,5 +445,24 @@ const StepRecord& EventDriver::advance() {
     ++out_index;
     return record;
 }
+
+EventStepper::EventStepper(std::unique_ptr<EventDriver> driver) : driver_(std::move(driver)) {}
+EventStepper::~EventStepper() = default;
+
+const StepRecord& EventStepper::advance() {
+    const StepRecord& r = driver_->advance();
+    const CvodeCounters& cc = driver_->cvode->counters();  // Newton's (0 with fixed point)
+    driver_->stats.jacobian_evaluations = cc.jacobian_evaluations;
+    driver_->stats.linear_setups = cc.linear_setups;
+    return r;
+}
+const StepRecord& EventStepper::current() const noexcept { return driver_->current(); }
+long EventStepper::record_index() const noexcept { return driver_->record_index(); }
+std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records_at(driver_->rel_out); }
+RunReport EventStepper::report() const { return driver_->report(); }
+const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats; }
+const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events; }
+const Eigen::VectorXd& EventStepper::contact_forces() const noexcept { return driver_->p_out; }
+const Eigen::VectorXd& EventStepper::relative_positions() const noexcept { return driver_->rel_out; }
 
 }  // namespace stackbeam::detail
