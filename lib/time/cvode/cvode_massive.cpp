@@ -298,13 +298,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         StepRecord rec;
         fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0,
                    LoadState{}, rec);
-        const double kinetic = 0.5 * f * v.dot(M * v);
-        rec.leaf_kinetic_energy_j = kinetic - rec.kinetic_energy_j;
-        rec.kinetic_energy_j = kinetic;
-        rec.impact_loss_j = 0.0;
-        rec.damping_energy_j = f * Y[2 * ndof + 1];
-        rec.force_on_mass_n = m_body * a[w_dof];
-        rec.energy_balance_error_j = e0 - (kinetic + strain + rec.dissipated_energy_j + rec.damping_energy_j);
+        finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_body * a[w_dof], f * Y[2 * ndof + 1]);
         return rec;
     }
 };
@@ -312,10 +306,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.opt.validate();
-    require_uniform_leaf_mass(system, "cvode");
-    require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
-    s.require_current_tau_rule();
+    s.require_leaf_inertia_options();
     if (!has_leaf_mass(system))
         throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
     const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();

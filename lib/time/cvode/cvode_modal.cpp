@@ -202,12 +202,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
         const double strain = 0.5 * f * (q.dot(om.cwiseProduct(om).cwiseProduct(q)) + p.dot(W * p));
         StepRecord rec;
         fill_state(sys, chk_problem, p, w, wd, strain, f * Y[2 * r] + jump_dissipation, e0, LoadState{}, rec);
-        const double kinetic = 0.5 * f * qd.squaredNorm();
-        rec.leaf_kinetic_energy_j = kinetic - rec.kinetic_energy_j;
-        rec.kinetic_energy_j = kinetic;
-        rec.impact_loss_j = 0.0;
-        rec.force_on_mass_n = m_body * wdd;
-        rec.energy_balance_error_j = e0 - (kinetic + strain + rec.dissipated_energy_j);
+        finish_inertia_record(rec, 0.5 * f * qd.squaredNorm(), m_body * wdd);
         return rec;
     }
 
@@ -216,10 +211,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
 CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.opt.validate();
-    require_uniform_leaf_mass(system, "cvode");
-    require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
-    s.require_current_tau_rule();
+    s.require_leaf_inertia_options();
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double> M = system.mass_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();

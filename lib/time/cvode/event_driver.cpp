@@ -2,6 +2,8 @@
 // cvode_stepper.hpp).
 #include "time/cvode/event_driver.hpp"
 #include "time/cvode/cvode_inertia.hpp"
+#include "fe/tied_shape.hpp"
+#include "stackbeam/model/loading.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +28,24 @@ void EventDriver::require_current_tau_rule() const {
     if (opt.tau_rule != TauRule::current)
         throw InputError("tau_rule", "mode cvode takes the friction limit from the current normal force "
                                      "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");
+}
+
+void EventDriver::require_leaf_inertia_options() const {
+    opt.validate();
+    require_uniform_leaf_mass(sys, "cvode");
+    require_initial_conditions_only(opt.loading, "mode cvode with leaf mass");
+    require_current_tau_rule();
+}
+
+void EventDriver::finish_inertia_record(StepRecord& rec, double kinetic_j, double force_on_mass_n,
+                                        double damping_energy_j) const {
+    rec.leaf_kinetic_energy_j = kinetic_j - rec.kinetic_energy_j;
+    rec.kinetic_energy_j = kinetic_j;
+    rec.impact_loss_j = 0.0;
+    rec.damping_energy_j = damping_energy_j;
+    rec.force_on_mass_n = force_on_mass_n;
+    rec.energy_balance_error_j =
+        e0 - (kinetic_j + rec.strain_energy_j + rec.dissipated_energy_j + rec.damping_energy_j);
 }
 
 void EventDriver::init_grid() {

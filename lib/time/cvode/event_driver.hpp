@@ -83,6 +83,14 @@ public:
 
     /// Throws InputError unless the tau rule is 'current'.
     void require_current_tau_rule() const;
+    /// The checks of the steppers with leaf inertia: the options valid, uniform leaf density,
+    /// initial conditions as the only loading, the tau rule 'current'.
+    void require_leaf_inertia_options() const;
+    /// Completes a record of a stepper with leaf inertia: the kinetic energy [J] of the leaves
+    /// and R (the leaves' share apart), m w'' [N], the damping energy [J] and the balance
+    /// with the record's strain energy and dissipation.
+    void finish_inertia_record(StepRecord& rec, double kinetic_j, double force_on_mass_n,
+                               double damping_energy_j = 0.0) const;
     /// The output grid t_i = i dt_s up to t_final = n_out dt_s (as the closed-form mode).
     void init_grid();
     /// The witness slots: every non-bonded pair's normal (unilateral, or a clamp with
