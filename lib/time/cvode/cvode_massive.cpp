@@ -163,9 +163,15 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
     Vec motion(const State& y) const override { return Grow * y.head(ndof); }
 
-    /// z'' = M^-1 (G^T p0 - K_eff z - C z') [m/s^2, rad/s^2] of the current modes.
-    Vec acceleration(const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v) const {
+    /// The applied force on R's DOF at t, meshed part: F(t) / f [N] (0 under initial conditions).
+    double load_n(double t_s) const {
+        return opt.loading.kind == LoadingKind::applied_force ? opt.loading.force_n.value(t_s) / f : 0.0;
+    }
+
+    /// z'' = M^-1 (G^T p0 + e_w F(t)/f - K_eff z - C z') [m/s^2, rad/s^2] of the current modes.
+    Vec acceleration(double t_s, const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v) const {
         Eigen::VectorXd r = b0 - Keff * z;
+        r[w_dof] += load_n(t_s);
         if (damped) r -= C * v;
         return mass.solve(r);
     }
@@ -180,10 +186,10 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     /// The look-ahead: the contact points move by ~kLookahead L_ref and the forces by
     /// ~kLookahead F_ref (as the modal stepper), on the second-order Taylor expansion.
-    Vec look_ahead(double, const State& y, const Vec&) const override {
+    Vec look_ahead(double te, const State& y, const Vec&) const override {
         const auto z = y.head(ndof);
         const auto v = y.segment(ndof, ndof);
-        const Eigen::VectorXd a = acceleration(z, v);
+        const Eigen::VectorXd a = acceleration(te, z, v);
         const double target = kLookahead * L_ref;
         const double vmax = (Grow * v).lpNorm<Eigen::Infinity>(), amax = (Grow * a).lpNorm<Eigen::Infinity>();
         double delta = std::numeric_limits<double>::infinity();
@@ -223,20 +229,22 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     static Impl* self(void* user) { return static_cast<Impl*>(static_cast<EventDriver*>(user)); }
 
-    /// y = [z, z', D, D_c]: z' = v, v' = M^-1 (G^T p0 - K_eff z - C v), D' = friction power
-    /// -sum_slip p_t ds_t/dt >= 0, D_c' = damping power v^T C v >= 0 [W, meshed part].
-    static int rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
+    /// y = [z, z', D, D_c, W]: z' = v, v' = M^-1 (G^T p0 + e_w F/f - K_eff z - C v), D' =
+    /// friction power -sum_slip p_t ds_t/dt >= 0, D_c' = damping power v^T C v >= 0, W' = the
+    /// applied force's power F/f w' [W, meshed part].
+    static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {
         const Impl* s = self(user);
         const int n_ = s->ndof;
         const double* Y = N_VGetArrayPointer(yv);
         double* D = N_VGetArrayPointer(ydot);
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
-        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(z, v);
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(t, z, v);
         double pw = 0.0;
         for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
         D[2 * n_] = pw;
         D[2 * n_ + 1] = s->damped ? v.dot(s->C * v) : 0.0;
+        D[2 * n_ + 2] = s->load_n(t) * v[s->w_dof];
         return 0;
     }
 
@@ -260,7 +268,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     /// Solves (I - gamma J) x = r: the (z, v) block by elimination on the LU of psetup, the
     /// friction-power row by its linearisation at y.
-    static int psolve(sunrealtype, N_Vector yv, N_Vector, N_Vector rv, N_Vector xv, sunrealtype gamma, sunrealtype,
+    static int psolve(sunrealtype t, N_Vector yv, N_Vector, N_Vector rv, N_Vector xv, sunrealtype gamma, sunrealtype,
                       int, void* user) {
         const Impl* s = self(user);
         if (s->gamma_lu < 0.0) return 1;
@@ -281,6 +289,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
             dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
         X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->load_n(t) * xvel[s->w_dof];                  // d(F/f w')
         return 0;
     }
 
@@ -288,17 +297,21 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R), strain
     /// z^T K z / 2 + p^T C_L p / 2 (leaves and layer), whole spring.
-    StepRecord make_record(double, const State& Y, Vec& p, Vec& rel) const override {
+    StepRecord make_record(double tau, const State& Y, Vec& p, Vec& rel) const override {
         const auto z = Y.head(ndof);
         const auto v = Y.segment(ndof, ndof);
         p = forces_z(z);
         rel = Grow * z + cL.cwiseProduct(p);
-        const Eigen::VectorXd a = acceleration(z, v);
+        const Eigen::VectorXd a = acceleration(tau, z, v);
         const double strain = 0.5 * f * (z.dot(K * z) + p.dot(cL.cwiseProduct(p)));
+        LoadState load;  // the applied force, whole spring, and its work
+        load.external_force_n = f * load_n(tau);
+        load.external_work_j = f * Y[2 * ndof + 2];
         StepRecord rec;
-        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0,
-                   LoadState{}, rec);
+        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0, load,
+                   rec);
         finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_body * a[w_dof], f * Y[2 * ndof + 1]);
+        rec.spring_force_n = rec.external_force_n - rec.force_on_mass_n;  // R's balance: m w'' = F - spring force
         return rec;
     }
 };
@@ -306,7 +319,8 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options();
+    s.require_leaf_inertia_options(true);  // initial conditions, or an applied force on R
+    s.opt.loading.prepare();
     if (!has_leaf_mass(system))
         throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
     const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();
@@ -348,7 +362,15 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
 
     // scales (as the modal stepper): R's amplitude on the tied stack and its frequency
     const double omega_t = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
-    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t;
+    // the applied force's scale [N, whole spring]: its largest value
+    const TimeFunction& F = s.opt.loading.force_n;
+    double force_scale = 0.0;
+    if (s.opt.loading.kind == LoadingKind::applied_force) {
+        force_scale = std::abs(F.mean) + F.amplitude;
+        for (double v : F.values) force_scale = std::max(force_scale, std::abs(v));
+    }
+    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t +
+              force_scale / system.tied_stiffness_n_per_m();
     if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
     s.V_ref = omega_t * s.L_ref;
     double preload = 0.0;
@@ -370,13 +392,13 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     }
     const Eigen::VectorXd z0 = tied_shape(s.K, G, tied, body.initial_displacement_m, s.d);
     const Eigen::VectorXd v0 = body.initial_velocity_m_per_s * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
-    s.nstate = 2 * s.ndof + 2;
+    s.nstate = 2 * s.ndof + 3;
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
     auto Y = s.cvode->y();
     Y.head(s.ndof) = z0;
     Y.segment(s.ndof, s.ndof) = v0;
-    Y[2 * s.ndof] = Y[2 * s.ndof + 1] = 0.0;
+    Y[2 * s.ndof] = Y[2 * s.ndof + 1] = Y[2 * s.ndof + 2] = 0.0;
 
     // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
     Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
@@ -395,8 +417,9 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
         auto A = s.cvode->atol();
         A.head(s.ndof).setConstant(s.opt.cvode.atol_m);
         A.segment(s.ndof, s.ndof).setConstant(omega_t * s.opt.cvode.atol_m);
-        const double e_meshed = 0.5 * v0.dot(s.M * v0) + 0.5 * z0.dot(s.K * z0);
-        A[2 * s.ndof] = A[2 * s.ndof + 1] = std::max(1e-300, s.opt.cvode.rtol * e_meshed);
+        const double e_meshed = 0.5 * v0.dot(s.M * v0) + 0.5 * z0.dot(s.K * z0) +
+                                0.5 * system.tied_stiffness_n_per_m() / s.f * s.L_ref * s.L_ref;
+        A[2 * s.ndof] = A[2 * s.ndof + 1] = A[2 * s.ndof + 2] = std::max(1e-300, s.opt.cvode.rtol * e_meshed);
     }
     s.start_record(Y);
     const EventDriver::StiffIntegrator stiff{2, &Impl::psetup, &Impl::psolve};

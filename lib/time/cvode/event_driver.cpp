@@ -30,10 +30,12 @@ void EventDriver::require_current_tau_rule() const {
                                      "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");
 }
 
-void EventDriver::require_leaf_inertia_options() const {
+void EventDriver::require_leaf_inertia_options(bool applied_force) const {
     opt.validate();
     require_uniform_leaf_mass(sys, "cvode");
-    require_initial_conditions_only(opt.loading, "mode cvode with leaf mass");
+    Loading rest = opt.loading;  // what must be the paper's initial conditions
+    if (applied_force && rest.kind == LoadingKind::applied_force) rest.kind = LoadingKind::initial_conditions;
+    require_initial_conditions_only(rest, "mode cvode with leaf mass");
     require_current_tau_rule();
 }
 
@@ -44,8 +46,8 @@ void EventDriver::finish_inertia_record(StepRecord& rec, double kinetic_j, doubl
     rec.impact_loss_j = 0.0;
     rec.damping_energy_j = damping_energy_j;
     rec.force_on_mass_n = force_on_mass_n;
-    rec.energy_balance_error_j =
-        e0 - (kinetic_j + rec.strain_energy_j + rec.dissipated_energy_j + rec.damping_energy_j);
+    rec.energy_balance_error_j = e0 + rec.external_work_j -
+                                 (kinetic_j + rec.strain_energy_j + rec.dissipated_energy_j + rec.damping_energy_j);
 }
 
 void EventDriver::init_grid() {

@@ -84,11 +84,12 @@ public:
     /// Throws InputError unless the tau rule is 'current'.
     void require_current_tau_rule() const;
     /// The checks of the steppers with leaf inertia: the options valid, uniform leaf density,
-    /// initial conditions as the only loading, the tau rule 'current'.
-    void require_leaf_inertia_options() const;
+    /// initial conditions as the only loading (or an applied force on R too, where
+    /// `applied_force` is true), the tau rule 'current'.
+    void require_leaf_inertia_options(bool applied_force = false) const;
     /// Completes a record of a stepper with leaf inertia: the kinetic energy [J] of the leaves
     /// and R (the leaves' share apart), m w'' [N], the damping energy [J] and the balance
-    /// with the record's strain energy and dissipation.
+    /// with the record's external work, strain energy and dissipation.
     void finish_inertia_record(StepRecord& rec, double kinetic_j, double force_on_mass_n,
                                double damping_energy_j = 0.0) const;
     /// The output grid t_i = i dt_s up to t_final = n_out dt_s (as the closed-form mode).
