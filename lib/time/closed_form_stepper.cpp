@@ -14,6 +14,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     : system_(system), options_(options) {
     options_.validate();
     require_massless_leaves(system_, Mode::closed_form);
+    require_no_damping(options_, "mode closed-form");
     options_.loading.prepare();
     const Loading& load = options_.loading;
     rig_ = load.kind == LoadingKind::prescribed_displacement;

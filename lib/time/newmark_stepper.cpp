@@ -28,6 +28,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     detail::require_uniform_leaf_mass(system_, "newmark");
     require_initial_conditions_only(options_.loading, "mode newmark");
     require_no_assembly(system_.model().spec(), Mode::newmark);
+    require_no_damping(options_, "mode newmark");
     path_ = choose_contact_path(system_, options_);
     const double dt = options_.dt_s;
     const int m = system_.num_components();

@@ -149,6 +149,16 @@ void require_no_assembly(const ModelSpec& model, Mode mode) {
     if (!model.clips.empty()) throw InputError("clips[0]", "a rebound clip" + why);
 }
 
+void require_no_damping(const SimulationOptions& options, const std::string& stepper) {
+    const StructuralDamping& c = options.damping;
+    if (!c.active()) return;
+    const bool alpha = c.rayleigh_alpha_per_s > 0.0;
+    throw InputError(alpha ? "damping.rayleigh_alpha_per_s" : "damping.rayleigh_beta_s",
+                     "value " + format_value(alpha ? c.rayleigh_alpha_per_s : c.rayleigh_beta_s) +
+                         ": structural damping is taken by mode cvode with the massive stack only (leaves with "
+                         "mass, friction, an elastic layer on every contact row), not by " + stepper + " (give 0)");
+}
+
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     const auto& rb = model.rigid_body;
     if (loading.kind == LoadingKind::prescribed_displacement) {

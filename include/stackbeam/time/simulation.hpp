@@ -171,6 +171,11 @@ ContactPath choose_contact_path(const System& system, const SimulationOptions& o
 /// model has a free camber or a rebound clip and `mode` is not closed-form.
 void require_no_assembly(const ModelSpec& model, Mode mode);
 
+/// Structural damping (SimulationOptions::damping) is taken by mode cvode with the massive
+/// stack only: every other stepper calls this, which throws InputError naming
+/// damping.rayleigh_alpha_per_s (or _beta_s) when damping is set, `stepper` in the message.
+void require_no_damping(const SimulationOptions& options, const std::string& stepper);
+
 /// Throws InputError when the model's initial conditions contradict the loading
 /// (a prescribed displacement fixes w(0) and w'(0) itself).
 void require_loading_fits(const ModelSpec& model, const Loading& loading);

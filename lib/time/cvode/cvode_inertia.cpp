@@ -144,6 +144,8 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     s.opt.validate();
     require_uniform_leaf_mass(system, "cvode");
     require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
+    require_no_assembly(system.model().spec(), Mode::cvode);
+    require_no_damping(s.opt, "mode cvode with a bonded or frictionless stack");
     const auto& pairs = system.pairs();
     for (std::size_t j = 0; j < pairs.size(); ++j) {
         const auto& pr = pairs[j];

@@ -319,7 +319,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(true);  // initial conditions, or an applied force on R
+    s.require_leaf_inertia_options(true);  // initial conditions or an applied force on R; damping
     s.opt.loading.prepare();
     if (!has_leaf_mass(system))
         throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");

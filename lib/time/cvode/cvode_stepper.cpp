@@ -234,7 +234,8 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     s.root_finding = testing.root_finding;
     s.opt.validate();
     require_massless_leaves(system, Mode::cvode);
-    require_no_assembly(system.model().spec(), Mode::cvode);  // as NewmarkStepper: refused when made directly too
+    require_no_assembly(system.model().spec(), Mode::cvode);
+    require_no_damping(s.opt, "mode cvode with massless leaves");
     s.require_current_tau_rule();
     s.n = system.num_components();
     s.np = static_cast<int>(system.pairs().size());

@@ -30,12 +30,14 @@ void EventDriver::require_current_tau_rule() const {
                                      "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");
 }
 
-void EventDriver::require_leaf_inertia_options(bool applied_force) const {
+void EventDriver::require_leaf_inertia_options(bool massive_stack) const {
     opt.validate();
     require_uniform_leaf_mass(sys, "cvode");
+    require_no_assembly(sys.model().spec(), Mode::cvode);
     Loading rest = opt.loading;  // what must be the paper's initial conditions
-    if (applied_force && rest.kind == LoadingKind::applied_force) rest.kind = LoadingKind::initial_conditions;
+    if (massive_stack && rest.kind == LoadingKind::applied_force) rest.kind = LoadingKind::initial_conditions;
     require_initial_conditions_only(rest, "mode cvode with leaf mass");
+    if (!massive_stack) require_no_damping(opt, "mode cvode with modal leaf inertia");
     require_current_tau_rule();
 }
 
