@@ -19,7 +19,7 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
             // the whole massive stack where every contact row has an elastic layer, else modal
             if (detail::has_mode_changes(system)) {
                 const LeafInertia li = options.cvode.leaf_inertia;
-                if (li == LeafInertia::massive || (li == LeafInertia::automatic && !detail::has_rigid_contact_row(system)))
+                if (li == LeafInertia::massive || (li == LeafInertia::automatic && detail::first_rigid_pair(system) < 0))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
                 return std::make_unique<detail::CvodeModalStepper>(system, options);
             }

@@ -97,8 +97,9 @@ private:
     struct Impl;
 };
 
-/// True when a contact row of `system` has no elastic layer (a rigid interface or a point clamp).
-bool has_rigid_contact_row(const System& system);
+/// The first pair of `system` with a contact row that has no elastic layer (a rigid interface
+/// or a point clamp), or -1 when every row has one.
+int first_rigid_pair(const System& system);
 
 /// True when a pair of `system` carries friction (it may stick or slip): mode cvode with
 /// leaf mass then runs the modal stepper; without friction the held-for-good one.

@@ -78,13 +78,13 @@ std::string rigid_row_field(const System& system, int kk) {
 
 }  // namespace
 
-bool has_rigid_contact_row(const System& system) {
+int first_rigid_pair(const System& system) {
     const Eigen::VectorXd& c = system.layer_compliance_m_per_n();
-    for (const auto& cp : system.pairs()) {
-        if (cp.row_n >= 0 && !(c[cp.row_n] > 0.0)) return true;
-        if (cp.row_t >= 0 && !(c[cp.row_t] > 0.0)) return true;
+    for (int kk = 0; kk < static_cast<int>(system.pairs().size()); ++kk) {
+        const auto& cp = system.pairs()[kk];
+        if ((cp.row_n >= 0 && !(c[cp.row_n] > 0.0)) || (cp.row_t >= 0 && !(c[cp.row_t] > 0.0))) return kk;
     }
-    return false;
+    return -1;
 }
 
 struct CvodeMassiveStepper::Impl final : EventDriver {
@@ -93,7 +93,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     int ndof = 0, w_dof = 0;
     SpMat K, M, Gt;
     SpMat C;                  // structural damping alpha M + beta K [N s/m] (empty: none)
-    bool damped = false;
+    bool damped() const { return opt.damping.active(); }
     RowSpMat Grow;            // G, row-major [-]
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
@@ -147,7 +147,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         }
         // the Newton matrix's pattern (M + K_eff: the same for every gamma)
         SpMat A = M + Keff;
-        if (damped) A += C;
+        if (damped()) A += C;
         A.makeCompressed();
         nlu.analyzePattern(A);
         gamma_lu = -1.0;
@@ -172,7 +172,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     Vec acceleration(double t_s, const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v) const {
         Eigen::VectorXd r = b0 - Keff * z;
         r[w_dof] += load_n(t_s);
-        if (damped) r -= C * v;
+        if (damped()) r -= C * v;
         return mass.solve(r);
     }
 
@@ -243,7 +243,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         double pw = 0.0;
         for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
         D[2 * n_] = pw;
-        D[2 * n_ + 1] = s->damped ? v.dot(s->C * v) : 0.0;
+        D[2 * n_ + 1] = s->damped() ? v.dot(s->C * v) : 0.0;
         D[2 * n_ + 2] = s->load_n(t) * v[s->w_dof];
         return 0;
     }
@@ -255,7 +255,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         *jcur = SUNTRUE;
         if (gamma == s->gamma_lu) return 0;
         SpMat A = s->M + (gamma * gamma) * s->Keff;
-        if (s->damped) A += gamma * s->C;
+        if (s->damped()) A += gamma * s->C;
         A.makeCompressed();
         s->nlu.factorize(A);
         if (s->nlu.info() != Eigen::Success) {
@@ -288,7 +288,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         for (int rt : s->slip_rows)
             dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
-        X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
+        X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped() ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
         X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->load_n(t) * xvel[s->w_dof];                  // d(F/f w')
         return 0;
     }
@@ -324,10 +324,8 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     if (!has_leaf_mass(system))
         throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
     const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();
-    for (int kk = 0; kk < static_cast<int>(system.pairs().size()); ++kk) {
+    if (const int kk = first_rigid_pair(system); kk >= 0) {
         const auto& cp = system.pairs()[kk];
-        const bool rigid = (cp.row_n >= 0 && !(cL[cp.row_n] > 0.0)) || (cp.row_t >= 0 && !(cL[cp.row_t] > 0.0));
-        if (!rigid) continue;
         const std::string field = rigid_row_field(system, kk);
         const bool clamp = cp.kind == PairKind::clamp && field.rfind("clamps", 0) == 0;
         throw InputError(field, std::string("value ") + (clamp ? "0" : "'rigid'") +
@@ -351,8 +349,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.d = system.initial_offsets_m();
     const auto& body = system.model().spec().rigid_body;
     s.m_body = body.mass_kg;
-    s.damped = s.opt.damping.active();
-    if (s.damped) {
+    if (s.damped()) {
         s.C = s.opt.damping.rayleigh_alpha_per_s * s.M + s.opt.damping.rayleigh_beta_s * s.K;
         s.C.makeCompressed();
     }
