@@ -134,24 +134,44 @@ void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed 
 
 bool EventDriver::settle_at_state() const { return false; }
 
-void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
-                                          const std::function<Vec()>& rate) {
+void EventDriver::in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm,
+                                     const std::vector<signed char>& tm, bool build, const std::function<void()>& body) {
     const Vec d_saved = d;
     const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+    enter(rel, nm, tm);
+    if (build) build_mode();
+    body();
+    d = d_saved;
+    nmode = nm_saved;
+    tmode = tm_saved;
+}
+
+bool EventDriver::apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
+                                         std::vector<signed char>& nm, std::vector<signed char>& tm) const {
+    bool any = false;
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+        if (!take(i)) continue;
+        const int kk = slots[i].pair;
+        const auto& cp = pairs()[kk];
+        apply_transition(cp, slots[i].normal, cp.row_t >= 0 ? p[cp.row_t] : 0.0, nm[kk], tm[kk]);
+        any = true;
+    }
+    return any;
+}
+
+void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
+                                          const std::function<Vec()>& rate) {
     for (int pass = 0; pass < 3; ++pass) {
-        enter(rel, nm, tm);
-        build_mode();
-        const Vec r = rate();
         bool changed = false;
-        for (int kk = 0; kk < np; ++kk) {
-            const int rt = pairs()[kk].row_t;
-            if (rt < 0) continue;
-            if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
-            else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
-        }
-        d = d_saved;
-        nmode = nm_saved;
-        tmode = tm_saved;
+        in_candidate_modes(rel, nm, tm, true, [&] {
+            const Vec r = rate();
+            for (int kk = 0; kk < np; ++kk) {
+                const int rt = pairs()[kk].row_t;
+                if (rt < 0) continue;
+                if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
+                else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
+            }
+        });
         if (!changed) break;
     }
 }
@@ -216,27 +236,18 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     if (triggered != nullptr && n > 0) {
         nm = nmode;
         tm = tmode;
-        for (std::size_t i = 0; i < slots.size(); ++i) {
-            if ((*triggered)[i] == 0) continue;
-            const int kk = slots[i].pair;
-            apply_transition(pairs()[kk], slots[i].normal, pairs()[kk].row_t >= 0 ? p_cur[pairs()[kk].row_t] : 0.0,
-                             nm[kk], tm[kk]);
-        }
-        const Vec d_saved = d;
-        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
-        enter(rel, nm, tm);
-        build_mode();
-        // the stop test of the contact iteration at the look-ahead, and every witness
-        const Vec pl = forces(y_la);
-        const double v = error_vector(ev_problem, pl, Vec(relative(y_la) - d_la)).norm();
-        std::vector<double> g(slots.size());
-        if (!slots.empty()) witnesses(y_la, g.data());
-        decided = v < ev_tolerance && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+        apply_slot_transitions([&](std::size_t i) { return (*triggered)[i] != 0; }, p_cur, nm, tm);
+        // restored either way: the log below compares with the old modes
+        in_candidate_modes(rel, nm, tm, true, [&] {
+            // the stop test of the contact iteration at the look-ahead, and every witness
+            const Vec pl = forces(y_la);
+            const double v = error_vector(ev_problem, pl, Vec(relative(y_la) - d_la)).norm();
+            std::vector<double> g(slots.size());
+            if (!slots.empty()) witnesses(y_la, g.data());
+            decided = v < ev_tolerance && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+        });
         ++stats.contact_iterations;
         ++iters_since;
-        d = d_saved;  // restored either way: the log below compares with the old modes
-        nmode = nm_saved;
-        tmode = tm_saved;
     }
     if (!decided) {
         Vec p_la = p_cur;
@@ -261,26 +272,14 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     // its witness positive at y (closed in tension -> open with the gap c p; penetrating ->
     // closed in compression; over the cone -> slipping; a reversing slip -> sticking at its force).
     if (settle_at_state() && !slots.empty()) {
-        const Vec d_saved = d;
-        const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
         std::vector<double> g(slots.size());
         for (int pass = 0; pass < kSettlePasses; ++pass) {
-            enter(rel, nm, tm);
-            if (pass > 0 || !decided) build_mode();
-            decided = true;  // the factorisation is of (nm, tm)
-            witnesses(y, g.data());
-            const Vec py = forces(y);
             bool changed = false;
-            for (std::size_t i = 0; i < slots.size(); ++i) {
-                if (!(g[i] < 0.0)) continue;
-                const auto& cp = pairs()[slots[i].pair];
-                apply_transition(cp, slots[i].normal, cp.row_t >= 0 ? py[cp.row_t] : 0.0, nm[slots[i].pair],
-                                 tm[slots[i].pair]);
-                changed = true;
-            }
-            d = d_saved;
-            nmode = nm_saved;
-            tmode = tm_saved;
+            in_candidate_modes(rel, nm, tm, pass > 0 || !decided, [&] {
+                witnesses(y, g.data());
+                changed = apply_slot_transitions([&](std::size_t i) { return g[i] < 0.0; }, forces(y), nm, tm);
+            });
+            decided = true;  // the factorisation is of (nm, tm)
             if (!changed) break;
             decided = false;  // (nm, tm) changed after the last factorisation
             ++stats.settled_transitions;

@@ -154,6 +154,14 @@ protected:
     /// True when the state y alone decides every pair's modes (no instantaneous coupling but
     /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
     virtual bool settle_at_state() const;
+    /// Runs `body` in the candidate modes (nm, tm): entered (pairs that start to stick anchored
+    /// at rel), factorised if `build`, then the current modes and anchors restored.
+    void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
+                            bool build, const std::function<void()>& body);
+    /// Applies to (nm, tm) the transition of every witness slot i with take(i) (a slip's
+    /// direction from p [N]); true when there was one.
+    bool apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
+                                std::vector<signed char>& nm, std::vector<signed char>& tm) const;
     /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
     /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
     /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
