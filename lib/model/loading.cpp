@@ -61,8 +61,10 @@ void TimeFunction::validate(const std::string& field, bool smooth) const {
         require_finite(field + ".phase_rad", phase_rad, "the phase");
     }
     if (shape == Shape::triangle && smooth)
-        throw InputError(field + ".shape", "value 'triangle' is not allowed here: a base displacement needs a "
-                                           "continuous acceleration (its inertial force); use harmonic or table");
+        throw InputError(field + ".shape", "value 'triangle' is not allowed here: a base displacement, or a rig's "
+                                           "displacement with leaf mass, needs a continuous acceleration (its "
+                                           "inertial force; a triangle's velocity jumps at its turning points); use "
+                                           "harmonic or table (a table is then a C2 spline)");
     if (shape == Shape::table) {
         if (times_s.size() < 2)
             throw InputError(field + ".times_s", "has " + std::to_string(times_s.size()) +
@@ -175,7 +177,7 @@ double TimeFunction::period_s() const {
     return (shape == Shape::harmonic || shape == Shape::triangle) && frequency_hz > 0.0 ? 1.0 / frequency_hz : 0.0;
 }
 
-void Loading::validate() const {
+void Loading::validate(bool leaf_mass) const {
     if (!std::isfinite(gravity_m_per_s2) || gravity_m_per_s2 < 0.0)
         throw InputError("loading.gravity_m_per_s2", "value " + format_value(gravity_m_per_s2) +
                                                          " is not allowed: g must be finite and >= 0 [m/s^2] (it acts in -y)");
@@ -183,7 +185,7 @@ void Loading::validate() const {
         case LoadingKind::initial_conditions: break;
         case LoadingKind::applied_force: force_n.validate("loading.force_n", false); break;
         case LoadingKind::prescribed_displacement:
-            displacement_m.validate("loading.displacement_m", false);
+            displacement_m.validate("loading.displacement_m", leaf_mass);
             if (gravity_m_per_s2 != 0.0)
                 throw InputError("loading.gravity_m_per_s2",
                                  "value " + format_value(gravity_m_per_s2) +
@@ -194,10 +196,11 @@ void Loading::validate() const {
     }
 }
 
-void Loading::prepare() {
-    validate();
+void Loading::prepare(bool leaf_mass) {
+    validate(leaf_mass);
     force_n.prepare(false);
-    displacement_m.prepare(kind == LoadingKind::base_excitation);
+    displacement_m.prepare(kind == LoadingKind::base_excitation ||
+                           (leaf_mass && kind == LoadingKind::prescribed_displacement));
 }
 
 double Loading::external_force_n(double t, double mass_kg) const {

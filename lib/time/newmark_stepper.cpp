@@ -26,9 +26,25 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     options_.validate();
     report_.mode = Mode::newmark;
     detail::require_uniform_leaf_mass(system_, "newmark");
-    require_initial_conditions_only(options_.loading, "mode newmark");
     require_no_assembly(system_.model().spec(), Mode::newmark);
     require_no_damping(options_, "mode newmark");
+    const auto& leaves = system_.model().spec().leaves;
+    massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
+    options_.loading.prepare(massive_leaves_);
+    require_loading_fits(system_.model().spec(), options_.loading);
+    const Loading& L = options_.loading;
+    rig_ = L.kind == LoadingKind::prescribed_displacement;
+    if (rig_ && !massive_leaves_)
+        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode newmark with "
+                                         "massless leaves (the leaves have no inertia to integrate): use mode "
+                                         "closed-form, or give the leaves a density > 0");
+    if (rig_ && detail::first_rigid_pair(system_) >= 0) {
+                throw InputError("loading.kind", "value 'prescribed-displacement' with massive leaves and rigid contact "
+                                                 "is not available in mode newmark (the impact law would move the rig's "
+                                                 "seat): give the interfaces an elastic layer (interfaces[i].contact = "
+                                                 "'elastic')");
+    }
+    load_ = std::make_unique<detail::ReducedLoad>(system_, L);
     path_ = choose_contact_path(system_, options_);
     const double dt = options_.dt_s;
     const int m = system_.num_components();
@@ -44,12 +60,25 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
     d_ = system_.initial_offsets_m();
     p_ = Eigen::VectorXd::Zero(m);
-    const double w0 = body.initial_displacement_m;
-    const double wd0 = body.initial_velocity_m_per_s;
+    // Gravity: the static equilibrium of the whole stack under its weight (the leaves' and R's,
+    // loading.hpp) first, from the unloaded stack; then R held at w(0) plus that sag (the rig:
+    // w_p(0)) with the weight on. Base excitation: the velocity relative to the supports.
+    const Eigen::VectorXd weight = -L.gravity_m_per_s2 * load_->inertia_kg();
+    double w_static = 0.0;
+    if (L.gravity_m_per_s2 > 0.0) {
+        z_ = detail::static_state(system_, problem_, weight, std::nan(""), options_, p_, d_,
+                                  "static equilibrium under gravity (the leaves' weight and R's)", &solve_);
+        w_static = z_[w_dof];
+    }
+    const double w0 = rig_ ? L.displacement_m.value(0.0) : w_static + body.initial_displacement_m;
+    const double wd0 = rig_ ? L.displacement_m.derivative(0.0) : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
 
     // Initial contact state with R held at w(0), as in the closed-form mode; the leaves
     // start at that static shape.
-    if (w0 != 0.0 && m > 0) {
+    if (L.gravity_m_per_s2 > 0.0) {
+        if (w0 != w_static)
+            z_ = detail::static_state(system_, problem_, weight, w0, options_, p_, d_, "initial contact state", &solve_);
+    } else if (w0 != 0.0 && m > 0) {
         if (path_ == ContactPath::dense) {
             ContactProblem held = problem_;
             held.W = system_.compliance_held();
@@ -71,7 +100,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         }
         if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
     }
-    z_ = system_.reduced_displacements(p_, w0);
+    if (!(L.gravity_m_per_s2 > 0.0)) z_ = system_.reduced_displacements(p_, w0);
     rel_ = detail::relative_positions(system_, z_, p_);
 
     // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.
@@ -84,8 +113,6 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
 
     // Leaves all massive (contact between massive points: impacts, velocity projection) or
     // all massless (the paper's statically condensed contact): a mix was refused above.
-    const auto& leaves = system_.model().spec().leaves;
-    massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
     if (!massive_leaves_ && options_.restitution > 0.0)
         throw InputError("restitution", "value " + format_value(options_.restitution) +
                                             " is not used with massless leaves (no impacts: the contact points are "
@@ -110,10 +137,18 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         v_ = wd0 * detail::tied_shape(K_, G, tied, 1.0, Eigen::VectorXd::Zero(m));
     }
     // Initial acceleration from the equations of motion on the massive DOFs:
-    // M_SS a_S = (G^T p0 - K z0)_S (the massless rows of the residual are zero: static shape).
+    // M_SS a_S = (G^T p0 - K z0 + q(0))_S (the massless rows of the residual are zero: static
+    // shape); the rig's reaction keeps w'' = w_p''(0) (accelerations_with_rig).
     a_ = Eigen::VectorXd::Zero(n);
-    {
-        const Eigen::VectorXd r = Eigen::VectorXd(G.transpose() * p_) - K_ * z_;
+    if (massive_leaves_) {
+        factor_->mass.compute(M_);
+        if (factor_->mass.info() != Eigen::Success)
+            throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
+    }
+    if (rig_) {
+        a_ = accelerations_with_rig(0.0, Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0), &rig_force_);
+    } else {
+        const Eigen::VectorXd r = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0);
         const int ns = static_cast<int>(massive.size());
         Eigen::SparseMatrix<double> S(ns, n);
         std::vector<Eigen::Triplet<double>> st;
@@ -131,9 +166,6 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
     // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
     if (massive_leaves_) {
-        factor_->mass.compute(M_);
-        if (factor_->mass.info() != Eigen::Success)
-            throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
         if (m > 0 && path_ == ContactPath::dense) {
             Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
             const Eigen::MatrixXd A = G * Z_;
@@ -144,25 +176,33 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // K_eff = K + 4 M / dt^2, factorised once. The contact force enters the step as
     // kappa G^T p1: kappa = 1 (massless leaves: the trapezoidal rule) or 2 (massive leaves:
     // the contact impulse over the step is dt p1, newmark_stepper.hpp).
+    // The rig: w1 = w_p(t1) is given, so the step solves the rows of z_r only (the "free" DOFs F:
+    // K_eff,rr z_r1 = r_r - K_eff,rw w1 + kappa G_r^T p1, s = G_r z_r1 + G_w w1 + c_L p1 - d).
     const double kappa = massive_leaves_ ? 2.0 : 1.0;
     Eigen::SparseMatrix<double> Keff = K_ + (4.0 / (dt * dt)) * M_;
     Keff.makeCompressed();
-    factor_->llt.compute(Keff);
+    const int nf = rig_ ? w_dof : n;
+    Eigen::SparseMatrix<double> KeffF = Keff.topLeftCorner(nf, nf), GF = G.leftCols(nf);
+    if (rig_) {
+        keff_w_ = Eigen::VectorXd(Keff.block(0, w_dof, w_dof, 1));
+        g_w_ = Eigen::VectorXd(G.col(w_dof));
+    }
+    factor_->llt.compute(KeffF);
     if (factor_->llt.info() != Eigen::Success)
         throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
     if (path_ == ContactPath::dense) {
         solver_ = make_solver(options_.solver);
-        Y_ = kappa * factor_->llt.solve(Eigen::MatrixXd(G.transpose()));
-        const Eigen::MatrixXd W = G * Y_;
+        Y_ = kappa * factor_->llt.solve(Eigen::MatrixXd(GF.transpose()));
+        const Eigen::MatrixXd W = GF * Y_;
         problem_.W = 0.5 * (W + W.transpose());
         problem_.W.diagonal() += system_.layer_compliance_m_per_n();  // the elastic layer (system.hpp)
         problem_.q = Eigen::VectorXd::Zero(m);
     } else {
         // (K_eff / kappa) z1 = r / kappa + G^T p1
         sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
-        sparse_problem_.K = (1.0 / kappa) * Keff;
-        sparse_problem_.G = G;
-        sparse_problem_.b = Eigen::VectorXd::Zero(n);
+        sparse_problem_.K = (1.0 / kappa) * KeffF;
+        sparse_problem_.G = GF;
+        sparse_problem_.b = Eigen::VectorXd::Zero(nf);
         sparse_problem_.d = d_;
         sparse_problem_.layer_compliance = detail::sparse_layer(system_);
         sparse_problem_.pairs = problem_.pairs;
@@ -176,21 +216,44 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     record_.energy_balance_error_j = 0.0;
 }
 
+Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {
+    // M a = r + lambda e_w with a_w = w_p''(t): lambda = (w_p'' - (M^-1 r)_w) / (M^-1)_ww
+    const int w_dof = static_cast<int>(r.size()) - 1;
+    Eigen::VectorXd ew = Eigen::VectorXd::Zero(r.size());
+    ew[w_dof] = 1.0;
+    const Eigen::VectorXd u = factor_->mass.solve(ew);
+    Eigen::VectorXd a = factor_->mass.solve(r);
+    const double lambda = (options_.loading.displacement_m.second_derivative(t_s) - a[w_dof]) / u[w_dof];
+    a += lambda * u;
+    if (lambda_n) *lambda_n = lambda;
+    return a;
+}
+
 void NewmarkStepper::fill_record(int iterations, int factorizations) {
     const double f = system_.model().whole_spring_factor();
     const auto& body = system_.model().spec().rigid_body;
     const int w_dof = static_cast<int>(z_.size()) - 1;
     const double strain = f * (0.5 * z_.dot(K_ * z_) + detail::layer_energy_j(system_, p_));  // leaves and layer
-    detail::fill_state(system_, problem_, p_, z_[w_dof], v_[w_dof], strain, dissipated_, e0_, detail::LoadState{}, record_);
+    const Loading& L = options_.loading;
+    detail::LoadState ls;  // the loading's force on R (the rig: the load cell's), whole spring, and its work
+    ls.external_force_n = rig_ ? f * rig_force_ - body.mass_kg * a_[w_dof] : L.external_force_n(t_, body.mass_kg);
+    ls.external_work_j = f * external_work_;
+    ls.base_displacement_m = L.base_displacement_m(t_);
+    detail::fill_state(system_, problem_, p_, z_[w_dof], v_[w_dof], strain, dissipated_, e0_, ls, record_);
     const double kinetic = 0.5 * f * v_.dot(M_ * v_);
     const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
     record_.kinetic_energy_j = kinetic;
     record_.leaf_kinetic_energy_j = kinetic - body_kinetic;
     record_.impact_loss_j = impact_loss_;
-    // R is attached to the w DOF: the force on it is m w''.
+    // R is attached to the w DOF: the force on it is m w''. With massive leaves the force of R on
+    // the stack follows from R's balance (m w'' = F - spring force); the rig's load cell reads
+    // the force on the spring (the leaves' inertia included).
     record_.force_on_mass_n = body.mass_kg * a_[w_dof];
-    record_.energy_balance_error_j =
-        e0_ - (record_.kinetic_energy_j + record_.strain_energy_j + record_.dissipated_energy_j + impact_loss_);
+    if (massive_leaves_)
+        record_.spring_force_n = rig_ ? record_.external_force_n : record_.external_force_n - record_.force_on_mass_n;
+    record_.energy_balance_error_j = e0_ + record_.external_work_j -
+                                     (record_.kinetic_energy_j + record_.strain_energy_j + record_.dissipated_energy_j +
+                                      impact_loss_);
     record_.t_s = t_;
     record_.contact_iterations = iterations;
     record_.factorizations = factorizations;
@@ -295,23 +358,41 @@ const StepRecord& NewmarkStepper::advance() {
     // r: the step's load with p1 = 0 (newmark_stepper.hpp). Massive leaves: the elastic force
     // by the trapezoidal rule, the contact impulse implicit; massless: Newmark as printed.
     const double kappa = massive_leaves_ ? 2.0 : 1.0;
-    const Eigen::VectorXd r = massive_leaves_
-                                  ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
-                                  : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
+    // The loading q(t) (detail::ReducedLoad) by the trapezoidal rule with massive leaves (r gets
+    // q0 + q1 = 2 qbar), at t1 with massless ones (Newmark as printed).
+    const double t1 = (step_ + 1) * dt;
+    const int w_dof = static_cast<int>(z_.size()) - 1;
+    const bool loaded = !load_->none();
+    const Eigen::VectorXd q0 = loaded ? load_->at(t_) : Eigen::VectorXd();
+    const Eigen::VectorXd q1 = loaded ? load_->at(t1) : Eigen::VectorXd();
+    Eigen::VectorXd r = massive_leaves_
+                            ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
+                            : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
+    if (loaded) r += massive_leaves_ ? Eigen::VectorXd(q0 + q1) : q1;
+    // The rig: the step's problem on z_r with w1 given (constructor)
+    const double w1 = rig_ ? options_.loading.displacement_m.value(t1) : 0.0;
+    const Eigen::VectorXd rF = rig_ ? Eigen::VectorXd(r.head(w_dof) - keff_w_ * w1) : r;
+    const Eigen::VectorXd dF = rig_ ? Eigen::VectorXd(d_ - g_w_ * w1) : d_;
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     const Eigen::VectorXd gv0 = massive_leaves_ && options_.restitution > 0.0 ? Eigen::VectorXd(G * v_) : Eigen::VectorXd();
-    Eigen::VectorXd z1;
+    Eigen::VectorXd zF;
     if (path_ == ContactPath::dense) {
-        const Eigen::VectorXd u = factor_->llt.solve(r);
-        problem_.q = G * u - d_;
+        const Eigen::VectorXd u = factor_->llt.solve(rF);
+        problem_.q = (rig_ ? Eigen::SparseMatrix<double>(G.leftCols(w_dof)) : G) * u - dF;
         solve_ = solver_->solve(problem_, p_);
-        z1 = u + Y_ * p_;
+        zF = u + Y_ * p_;
     } else {
-        sparse_problem_.b = r / kappa;
-        sparse_problem_.d = d_;
+        sparse_problem_.b = rF / kappa;
+        sparse_problem_.d = dF;
         sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-        solve_ = sparse_solver_->solve(sparse_problem_, p_, z1);
+        solve_ = sparse_solver_->solve(sparse_problem_, p_, zF);
+    }
+    Eigen::VectorXd z1 = zF;
+    if (rig_) {
+        z1.resize(w_dof + 1);
+        z1.head(w_dof) = zF;
+        z1[w_dof] = w1;
     }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
@@ -346,10 +427,24 @@ const StepRecord& NewmarkStepper::advance() {
         const Eigen::VectorXd dp = p_ - p0;
         impact_loss_ += f * 0.5 * dp.dot(system_.layer_compliance_m_per_n().cwiseProduct(dp));
     }
+    // The loading's work over the step, qbar^T (z1 - z0) (trapezoidal, as the step takes it).
+    if (loaded) external_work_ += 0.5 * (q0 + q1).dot(z1 - z_);
     // Newmark's update of v and a (beta = 1/4, gamma = 1/2): v1 = 2 (z1 - z0)/dt - v0.
     if (massive_leaves_) {
-        v_ = (2.0 / dt) * (z1 - z_) - v_;
-        a_ = factor_->mass.solve(Eigen::VectorXd(G.transpose() * p_ - K_ * z1));  // M a1 = G^T p1 - K z1
+        const Eigen::VectorXd v1 = (2.0 / dt) * (z1 - z_) - v_;
+        if (rig_) {
+            // The rig's mean force over the step from R's row of the step's momentum balance,
+            // M (v1 - v0) = dt [-K (z0 + z1)/2 + G^T p1 + qbar + lambda_bar e_w], and its work
+            // lambda_bar (w1 - w0): the balance closes as for the other forces.
+            Eigen::VectorXd res = M_ * Eigen::VectorXd((v1 - v_) / dt) + 0.5 * (K_ * Eigen::VectorXd(z_ + z1)) -
+                                  G.transpose() * p_;
+            if (loaded) res -= 0.5 * (q0 + q1);
+            external_work_ += res[w_dof] * (z1[w_dof] - z_[w_dof]);
+        }
+        v_ = v1;
+        Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 + q1 (+ the rig's lambda1 e_w)
+        if (loaded) r1 += q1;
+        a_ = rig_ ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_->mass.solve(r1));
     } else {
         const Eigen::VectorXd a1 = (4.0 / (dt * dt)) * (z1 - z_ - dt * v_) - a_;
         v_ += 0.5 * dt * (a_ + a1);
@@ -360,7 +455,7 @@ const StepRecord& NewmarkStepper::advance() {
         if (massless_[i]) v_[i] = a_[i] = 0.0;
     rel_ = rel1;
     if (massive_leaves_) impact_loss_ += project_velocities(p0, gv0);
-    t_ = step_ * dt;
+    t_ = t1;
     detail::reanchor(problem_, p_, rel_, d_);  // paper, section 5
     fill_record(solve_.iterations, solve_.factorizations);
     detail::count_step(record_, report_);

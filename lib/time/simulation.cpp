@@ -113,10 +113,6 @@ void SimulationOptions::validate() const {
         throw InputError("dt_s", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end_s = " + format_value(t_end_s) + " s");
     make_solver(solver);  // validates the solver options
     loading.validate();
-    if (mode == Mode::cvode && loading.kind == LoadingKind::prescribed_displacement)
-        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode: with w(t) "
-                                         "imposed there is no equation of motion to integrate, each step is "
-                                         "quasi-static (use mode closed-form, whose step is then exact)");
     if (restitution > 0.0 && mode != Mode::newmark)
         throw InputError("restitution", "value " + format_value(restitution) + " is not used by mode " + to_string(mode) +
                                             ": only mode newmark with massive leaves has impacts (give 0)");

@@ -67,6 +67,53 @@ inline void count_step(const StepRecord& r, RunReport& report) {
 /// that give the states, `rel`: the relative positions s + d [m].
 void reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel, Eigen::VectorXd& d);
 
+/// The first pair of `system` with a contact row that has no elastic layer (a rigid interface
+/// or a point clamp), or -1 when every row has one.
+int first_rigid_pair(const System& system);
+
+/// A loading on the reduced DOFs of a stack whose leaves may have mass (loading.hpp, with the
+/// leaves' own inertia): q(t) = e_w F(t)/f - (g + y_b''(t)) l [N, meshed part], with
+/// l = System::vertical_inertia_kg() (the leaves' weight and R's; massless leaves: l = m e_w,
+/// and e_w^T q = Loading::external_force_n / f). A prescribed displacement adds nothing (the
+/// rig's force is a reaction).
+class ReducedLoad {
+public:
+    ReducedLoad(const System& system, const Loading& prepared)
+        : load_(prepared), l_(system.vertical_inertia_kg()), f_(system.model().whole_spring_factor()) {}
+    /// q(t) [N, N m per reduced DOF].
+    Eigen::VectorXd at(double t_s) const {
+        Eigen::VectorXd q = -(load_.gravity_m_per_s2 + base_acceleration(t_s)) * l_;
+        if (load_.kind == LoadingKind::applied_force) q[q.size() - 1] += load_.force_n.value(t_s) / f_;
+        return q;
+    }
+    /// y_b''(t) [m/s^2] (base excitation), 0 otherwise.
+    double base_acceleration(double t_s) const {
+        return load_.kind == LoadingKind::base_excitation ? load_.displacement_m.second_derivative(t_s) : 0.0;
+    }
+    /// Whether q is zero at every t.
+    bool none() const {
+        return load_.gravity_m_per_s2 == 0.0 &&
+               (load_.kind == LoadingKind::initial_conditions || load_.kind == LoadingKind::prescribed_displacement);
+    }
+    const Eigen::VectorXd& inertia_kg() const { return l_; }
+
+private:
+    Loading load_;
+    Eigen::VectorXd l_;
+    double f_;
+};
+
+/// The quasi-static state of the stack under a load b on the reduced DOFs [N, N m per DOF]
+/// (w last), one load step with friction from the warm start p with `laws`' pairs and tau rule
+/// and the offsets d: with R free (w_held_m NaN) K z = G^T p + b on every DOF; with R held at
+/// w_held_m [m] the rows of z_r only (z_w = w_held_m). Sparse path with the exact solver and
+/// options' tuning, whatever the model's size (a one-off solve). On exit p holds the forces [N]
+/// and d is re-anchored (reanchor). Returns z [m, rad]; throws SolverError naming `what` if the
+/// solve fails; `result` (optional) receives the solve.
+Eigen::VectorXd static_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b, double w_held_m,
+                             const SimulationOptions& options, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                             const std::string& what, SolveResult* result = nullptr);
+
 /// TauRule::previous_step: sets problem.tau_previous_n [N] per pair from the forces p of
 /// the step before (|p_n| for a unilateral pair, max(0, F_c - p_n) at a clamp).
 void set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p);

@@ -15,15 +15,20 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
         case Mode::newmark: return std::make_unique<NewmarkStepper>(system, options);
         case Mode::cvode:
             if (!detail::has_leaf_mass(system)) return std::make_unique<CvodeStepper>(system, options);
-            // leaf inertia (docs/time-integration.md): with events when a pair may stick or slip,
-            // the whole massive stack where every contact row has an elastic layer, else modal
-            if (detail::has_mode_changes(system)) {
+            // leaf inertia (docs/time-integration.md): the whole massive stack where every contact
+            // row has an elastic layer (or when asked for); else, when a pair may stick or slip, the
+            // modal stepper, and the held-for-good one for bonded and frictionless stacks under the
+            // paper's initial conditions (it takes no other loading)
+            {
                 const LeafInertia li = options.cvode.leaf_inertia;
-                if (li == LeafInertia::massive || (li == LeafInertia::automatic && detail::first_rigid_pair(system) < 0))
+                const bool elastic = detail::first_rigid_pair(system) < 0;
+                const bool changes = detail::has_mode_changes(system);
+                if (li == LeafInertia::massive ||
+                    (li == LeafInertia::automatic && elastic && (changes || !options.loading.is_free())))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
-                return std::make_unique<detail::CvodeModalStepper>(system, options);
+                if (changes) return std::make_unique<detail::CvodeModalStepper>(system, options);
+                return std::make_unique<detail::CvodeInertiaStepper>(system, options);
             }
-            return std::make_unique<detail::CvodeInertiaStepper>(system, options);
     }
     return std::make_unique<ClosedFormStepper>(system, options);
 }

@@ -86,6 +86,13 @@ public:
     /// mass matrices (density from the model; 0 = massless, the paper) plus the rigid
     /// body's mass on w (the meshed part's share: half on the half model).
     Eigen::SparseMatrix<double> mass_reduced() const;
+    /// The inertia of everything per unit acceleration in +y, on the reduced DOFs [kg] (w last):
+    /// l = P^T M_full e_y + m e_w, the leaves' consistent mass times a unit translation of every
+    /// node in y (their weight's consistent nodal loads per unit g) plus the rigid body's mass
+    /// on w (meshed part's share). Gravity g loads the stack with -g l; a base acceleration
+    /// y_b'' of the supports loads it, in the frame of the supports, with -y_b'' l (loading.hpp).
+    /// Massless leaves: l = m e_w.
+    Eigen::VectorXd vertical_inertia_kg() const;
     /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
     /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
     Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;

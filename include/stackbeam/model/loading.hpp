@@ -89,9 +89,11 @@ struct Loading {
                                   ///< 0: none. Not with prescribed_displacement (the rig holds R)
 
     /// Throws InputError naming the field ("loading.force_n.amplitude", ...) when out of range.
-    void validate() const;
-    /// validate() and the derived data (splines). Steppers call it on their copy.
-    void prepare();
+    /// `leaf_mass`: the leaves have mass, so a rig's displacement must be smooth too (a
+    /// triangle is refused, a table is splined): its acceleration loads the leaves.
+    void validate(bool leaf_mass = false) const;
+    /// validate(leaf_mass) and the derived data (splines). Steppers call it on their copy.
+    void prepare(bool leaf_mass = false);
     /// True when nothing but initial conditions act (the paper).
     bool is_free() const noexcept { return kind == LoadingKind::initial_conditions && gravity_m_per_s2 == 0.0; }
 

@@ -62,6 +62,9 @@
 #include "stackbeam/fe/system.hpp"
 
 namespace stackbeam {
+namespace detail {
+class ReducedLoad;
+}
 
 class NewmarkStepper final : public Stepper {
 public:
@@ -113,7 +116,14 @@ private:
     long step_ = 0;
     StepRecord record_;
     RunReport report_;
+    std::unique_ptr<detail::ReducedLoad> load_;  // the loading's q(t) on the reduced DOFs
+    bool rig_ = false;                         // w prescribed (the rig)
+    Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
+    double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
+    double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
     void fill_record(int iterations, int factorizations);
+    /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
+    Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;
     double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
 };
 

@@ -21,6 +21,7 @@
 
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "time/step_record.hpp"
 #include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam::detail {
@@ -96,10 +97,6 @@ public:
 private:
     struct Impl;
 };
-
-/// The first pair of `system` with a contact row that has no elastic layer (a rigid interface
-/// or a point clamp), or -1 when every row has one.
-int first_rigid_pair(const System& system);
 
 /// True when a pair of `system` carries friction (it may stick or slip): mode cvode with
 /// leaf mass then runs the modal stepper; without friction the held-for-good one.

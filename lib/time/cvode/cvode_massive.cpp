@@ -29,6 +29,15 @@
 // Structural damping (SimulationOptions::damping, off by default): C = alpha M + beta K of the
 // leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j).
 //
+// Loadings (loading.hpp) with the leaves' own inertia: q(t) = e_w F(t)/f - (g + y_b''(t)) l on the
+// right-hand side (ReducedLoad; l = System::vertical_inertia_kg(): the leaves' weight and R's, and
+// in the frame of the supports the inertial force of a base acceleration on every mass); gravity
+// starts from the static equilibrium of the whole stack under its own weight and R's. The rig
+// (prescribed displacement) imposes w(t) on R's DOF by a reaction lambda e_w chosen so that
+// w'' = w_p''(t): z'' = M^-1 (r + lambda e_w), lambda = (w_p'' - (M^-1 r)_w) / (M^-1)_ww, the rig's
+// force on the meshed part including R's inertia and the leaves' (the load cell between R and the
+// spring reads lambda - m w_p''). The external work W' = q^T v (rig: lambda w') is a state.
+//
 // At an event the driver makes the decided modes hold at the event's state itself
 // (settle_at_state): the look-ahead may keep a pair closed that is still in tension at y (its
 // gap of c p closing within the look-ahead); that pair opens, and root-finding finds its closure.
@@ -78,15 +87,6 @@ std::string rigid_row_field(const System& system, int kk) {
 
 }  // namespace
 
-int first_rigid_pair(const System& system) {
-    const Eigen::VectorXd& c = system.layer_compliance_m_per_n();
-    for (int kk = 0; kk < static_cast<int>(system.pairs().size()); ++kk) {
-        const auto& cp = system.pairs()[kk];
-        if ((cp.row_n >= 0 && !(c[cp.row_n] > 0.0)) || (cp.row_t >= 0 && !(c[cp.row_t] > 0.0))) return kk;
-    }
-    return -1;
-}
-
 struct CvodeMassiveStepper::Impl final : EventDriver {
     Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (massive leaves)") {}
 
@@ -98,6 +98,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
     double f = 1.0, m_body = 0.0;
+    std::unique_ptr<ReducedLoad> load;  // q(t) of the loading (none for initial conditions and the rig)
+    bool rig = false;                   // w prescribed (LoadingKind::prescribed_displacement)
+    Eigen::VectorXd u_w;                // M^-1 e_w [1/kg] (the rig's reaction per unit force)
     // the current modes: p = P z + p0, s + d = Hs z + hs, M z'' = -Keff z + b0
     RowSpMat P, Hs;
     SpMat Keff;
@@ -148,11 +151,22 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         // the Newton matrix's pattern (M + K_eff: the same for every gamma)
         SpMat A = M + Keff;
         if (damped()) A += C;
-        A.makeCompressed();
+        prescribe_w_row(A);
         nlu.analyzePattern(A);
         gamma_lu = -1.0;
         ++stats.mode_factorizations;
         ++facts_since;
+    }
+
+    /// The rig: R's row of the Newton matrix becomes e_w^T (x_vw = r_vw: w'' does not depend on
+    /// the state). Compresses A.
+    void prescribe_w_row(SpMat& A) const {
+        if (rig) {
+            const int w = w_dof;
+            A.prune([w](const Eigen::Index& row, const Eigen::Index&, const double&) { return row != w; });
+            A.coeffRef(w, w) = 1.0;
+        }
+        A.makeCompressed();
     }
 
     Vec forces_z(const Eigen::Ref<const Eigen::VectorXd>& z) const { return P * z + p0; }
@@ -163,17 +177,28 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
     Vec motion(const State& y) const override { return Grow * y.head(ndof); }
 
-    /// The applied force on R's DOF at t, meshed part: F(t) / f [N] (0 under initial conditions).
-    double load_n(double t_s) const {
-        return opt.loading.kind == LoadingKind::applied_force ? opt.loading.force_n.value(t_s) / f : 0.0;
+    /// z'' = M^-1 (G^T p0 + q(t) - K_eff z - C z' + lambda e_w) [m/s^2, rad/s^2] of the current
+    /// modes; lambda [N, meshed part] the rig's reaction (0 without a rig), returned in `rig_n`.
+    Vec acceleration(double t_s, const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v,
+                     double* rig_n = nullptr) const {
+        Eigen::VectorXd r = b0 - Keff * z;
+        if (!load->none()) r += load->at(t_s);
+        if (damped()) r -= C * v;
+        Eigen::VectorXd a = mass.solve(r);
+        if (rig) {
+            const double lambda = (opt.loading.displacement_m.second_derivative(t_s) - a[w_dof]) / u_w[w_dof];
+            a += lambda * u_w;
+            if (rig_n) *rig_n = lambda;
+        } else if (rig_n) {
+            *rig_n = 0.0;
+        }
+        return a;
     }
 
-    /// z'' = M^-1 (G^T p0 + e_w F(t)/f - K_eff z - C z') [m/s^2, rad/s^2] of the current modes.
-    Vec acceleration(double t_s, const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v) const {
-        Eigen::VectorXd r = b0 - Keff * z;
-        r[w_dof] += load_n(t_s);
-        if (damped()) r -= C * v;
-        return mass.solve(r);
+    /// The external power [W, meshed part] at (t, v) with acceleration-side rig force lambda.
+    double external_power(double t_s, const Eigen::Ref<const Eigen::VectorXd>& v, double lambda) const {
+        if (rig) return lambda * v[w_dof];
+        return load->none() ? 0.0 : load->at(t_s).dot(v);
     }
 
     void witnesses(const State& y, double* g) const override {
@@ -229,9 +254,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     static Impl* self(void* user) { return static_cast<Impl*>(static_cast<EventDriver*>(user)); }
 
-    /// y = [z, z', D, D_c, W]: z' = v, v' = M^-1 (G^T p0 + e_w F/f - K_eff z - C v), D' =
+    /// y = [z, z', D, D_c, W]: z' = v, v' = M^-1 (G^T p0 + q(t) - K_eff z - C v + lambda e_w), D' =
     /// friction power -sum_slip p_t ds_t/dt >= 0, D_c' = damping power v^T C v >= 0, W' = the
-    /// applied force's power F/f w' [W, meshed part].
+    /// loading's power q^T v (rig: lambda w') [W, meshed part].
     static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {
         const Impl* s = self(user);
         const int n_ = s->ndof;
@@ -239,12 +264,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         double* D = N_VGetArrayPointer(ydot);
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
-        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(t, z, v);
+        double lambda = 0.0;
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(t, z, v, &lambda);
         double pw = 0.0;
         for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
         D[2 * n_] = pw;
         D[2 * n_ + 1] = s->damped() ? v.dot(s->C * v) : 0.0;
-        D[2 * n_ + 2] = s->load_n(t) * v[s->w_dof];
+        D[2 * n_ + 2] = s->external_power(t, v, lambda);
         return 0;
     }
 
@@ -256,7 +282,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         if (gamma == s->gamma_lu) return 0;
         SpMat A = s->M + (gamma * gamma) * s->Keff;
         if (s->damped()) A += gamma * s->C;
-        A.makeCompressed();
+        s->prescribe_w_row(A);
         s->nlu.factorize(A);
         if (s->nlu.info() != Eigen::Success) {
             s->gamma_lu = -1.0;
@@ -277,7 +303,8 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         const double* R = N_VGetArrayPointer(rv);
         double* X = N_VGetArrayPointer(xv);
         const Eigen::Map<const Eigen::VectorXd> rz(R, n_), rvel(R + n_, n_);
-        const Eigen::VectorXd rhs_v = s->M * rvel - gamma * (s->Keff * rz);  // (M + g C + g^2 Keff) x_v
+        Eigen::VectorXd rhs_v = s->M * rvel - gamma * (s->Keff * rz);  // (M + g C + g^2 Keff) x_v
+        if (s->rig) rhs_v[s->w_dof] = rvel[s->w_dof];                    // w'' prescribed: x_vw = r_vw
         const Eigen::VectorXd xvel = s->nlu.solve(rhs_v);
         const Eigen::VectorXd xz = rz + gamma * xvel;
         Eigen::Map<Eigen::VectorXd>(X, n_) = xz;
@@ -289,7 +316,11 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
             dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
         X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped() ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
-        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->load_n(t) * xvel[s->w_dof];                  // d(F/f w')
+        // d(q^T v) = q^T dv (the rig's lambda w': lambda dw', lambda's own change left out of this
+        // row of the Newton matrix, which nothing else depends on)
+        double lambda = 0.0;
+        if (s->rig) s->acceleration(t, z, v, &lambda);
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->external_power(t, xvel, lambda);
         return 0;
     }
 
@@ -302,16 +333,21 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         const auto v = Y.segment(ndof, ndof);
         p = forces_z(z);
         rel = Grow * z + cL.cwiseProduct(p);
-        const Eigen::VectorXd a = acceleration(tau, z, v);
+        double lambda = 0.0;
+        const Eigen::VectorXd a = acceleration(tau, z, v, &lambda);
         const double strain = 0.5 * f * (z.dot(K * z) + p.dot(cL.cwiseProduct(p)));
-        LoadState load;  // the applied force, whole spring, and its work
-        load.external_force_n = f * load_n(tau);
-        load.external_work_j = f * Y[2 * ndof + 2];
+        LoadState ls;  // the loading's force on R, whole spring, and the external work
+        const Loading& L = opt.loading;
+        ls.external_force_n = rig ? f * lambda - m_body * a[w_dof] : L.external_force_n(tau, m_body);
+        ls.external_work_j = f * Y[2 * ndof + 2];
+        ls.base_displacement_m = L.base_displacement_m(tau);
         StepRecord rec;
-        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0, load,
+        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0, ls,
                    rec);
         finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_body * a[w_dof], f * Y[2 * ndof + 1]);
-        rec.spring_force_n = rec.external_force_n - rec.force_on_mass_n;  // R's balance: m w'' = F - spring force
+        // R's balance m w'' = F - spring force; the rig: the load cell between R and the spring reads
+        // the force on the spring, lambda - m w'' (the leaves' inertia included)
+        rec.spring_force_n = rig ? rec.external_force_n : rec.external_force_n - rec.force_on_mass_n;
         return rec;
     }
 };
@@ -319,8 +355,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(true);  // initial conditions or an applied force on R; damping
-    s.opt.loading.prepare();
+    s.require_leaf_inertia_options(true);  // every loading; damping
+    s.opt.loading.prepare(true);
+    require_loading_fits(system.model().spec(), s.opt.loading);
     if (!has_leaf_mass(system))
         throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
     const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();
@@ -356,18 +393,30 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.mass.compute(s.M);
     if (s.mass.info() != Eigen::Success || !(s.mass.vectorD().minCoeff() > 0.0))
         throw SolverError(s.who + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
+    const Loading& L = s.opt.loading;
+    s.load = std::make_unique<ReducedLoad>(system, L);
+    s.rig = L.kind == LoadingKind::prescribed_displacement;
+    if (s.rig) {
+        Eigen::VectorXd ew = Eigen::VectorXd::Zero(s.ndof);
+        ew[s.w_dof] = 1.0;
+        s.u_w = s.mass.solve(ew);
+    }
 
     // scales (as the modal stepper): R's amplitude on the tied stack and its frequency
     const double omega_t = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
-    // the applied force's scale [N, whole spring]: its largest value
-    const TimeFunction& F = s.opt.loading.force_n;
-    double force_scale = 0.0;
-    if (s.opt.loading.kind == LoadingKind::applied_force) {
-        force_scale = std::abs(F.mean) + F.amplitude;
-        for (double v : F.values) force_scale = std::max(force_scale, std::abs(v));
-    }
+    // the loading's scales: the applied force's largest value [N, whole spring], the weight of
+    // everything [N, whole spring], the base's or the rig's largest displacement [m]
+    auto largest = [](const TimeFunction& F) {
+        double v = std::abs(F.mean) + F.amplitude;
+        for (double x : F.values) v = std::max(v, std::abs(x));
+        return v;
+    };
+    const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
+                               s.f * L.gravity_m_per_s2 * s.load->inertia_kg().sum();
+    const double motion_scale =
+        L.kind == LoadingKind::base_excitation || s.rig ? largest(L.displacement_m) : 0.0;
     s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t +
-              force_scale / system.tied_stiffness_n_per_m();
+              force_scale / system.tied_stiffness_n_per_m() + motion_scale;
     if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
     s.V_ref = omega_t * s.L_ref;
     double preload = 0.0;
@@ -380,15 +429,27 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
     s.init_slots();
 
-    // initial state (as mode newmark and the modal stepper): the leaves in the static shape of
-    // w(0), moving with R in the tied shape per unit w times w'(0)
+    // initial state (as mode newmark): under gravity the static equilibrium of the whole stack
+    // under its weight and R's first (loading.hpp); then the leaves in the static shape with R
+    // held at w(0) (the rig: w_p(0)) and the leaves' weight on, moving with R in the tied shape
+    // per unit w times w'(0) (base excitation: relative to the supports; the rig: w_p'(0))
+    Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
+    const Eigen::VectorXd weight = -L.gravity_m_per_s2 * s.load->inertia_kg();
+    Eigen::VectorXd z0 = Eigen::VectorXd::Zero(s.ndof);
+    if (L.gravity_m_per_s2 > 0.0)
+        z0 = static_state(system, s.chk_problem, weight, std::nan(""), s.opt, p_init, s.d,
+                          "static equilibrium under gravity (the leaves' weight and R's)");
+    const double w_start = s.rig ? L.displacement_m.value(0.0) : z0[s.w_dof] + body.initial_displacement_m;
+    const double wd_start = s.rig ? L.displacement_m.derivative(0.0)
+                                  : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
+    if (w_start != z0[s.w_dof])
+        z0 = static_state(system, s.chk_problem, weight, w_start, s.opt, p_init, s.d, "initial contact state");
     std::vector<int> tied;
     for (const auto& pr : system.pairs()) {
         if (pr.row_n >= 0) tied.push_back(pr.row_n);
         if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0)) tied.push_back(pr.row_t);
     }
-    const Eigen::VectorXd z0 = tied_shape(s.K, G, tied, body.initial_displacement_m, s.d);
-    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
+    const Eigen::VectorXd v0 = wd_start * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
     s.nstate = 2 * s.ndof + 3;
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
@@ -398,7 +459,6 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     Y[2 * s.ndof] = Y[2 * s.ndof + 1] = Y[2 * s.ndof + 2] = 0.0;
 
     // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
-    Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
     {
         s.ev_problem.q = G * z0 - s.d;
         const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p_init);

@@ -236,6 +236,10 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     require_massless_leaves(system, Mode::cvode);
     require_no_assembly(system.model().spec(), Mode::cvode);
     require_no_damping(s.opt, "mode cvode with massless leaves");
+    if (s.opt.loading.kind == LoadingKind::prescribed_displacement)
+        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode with massless "
+                                         "leaves: with w(t) imposed there is no equation of motion to integrate, each "
+                                         "step is quasi-static (use mode closed-form, whose step is then exact)");
     s.require_current_tau_rule();
     s.n = system.num_components();
     s.np = static_cast<int>(system.pairs().size());

@@ -34,10 +34,10 @@ void EventDriver::require_leaf_inertia_options(bool massive_stack) const {
     opt.validate();
     require_uniform_leaf_mass(sys, "cvode");
     require_no_assembly(sys.model().spec(), Mode::cvode);
-    Loading rest = opt.loading;  // what must be the paper's initial conditions
-    if (massive_stack && rest.kind == LoadingKind::applied_force) rest.kind = LoadingKind::initial_conditions;
-    require_initial_conditions_only(rest, "mode cvode with leaf mass");
-    if (!massive_stack) require_no_damping(opt, "mode cvode with modal leaf inertia");
+    if (!massive_stack) {  // the massive stack takes every loading and structural damping
+        require_initial_conditions_only(opt.loading, "mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal')");
+        require_no_damping(opt, "mode cvode with modal leaf inertia");
+    }
     require_current_tau_rule();
 }
 
