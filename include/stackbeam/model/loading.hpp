@@ -29,6 +29,15 @@
 ///    contact problem is quasi-static at each step (s = C'p + c w(t) - d), the rig
 ///    force is the spring force k w - c^T p (a load cell between rig and spring: R's
 ///    own inertia is not part of the loop) and the rig's work is the external work.
+/// With leaf mass (modes newmark and cvode with density > 0) the loading acts on every
+/// reduced DOF z = [z_r; w]:
+///     M z'' + K z = G^T p + q(t),   q(t) = e_w F(t)/f - (g + y_b''(t)) l,
+/// l = System::vertical_inertia_kg() (the leaves' consistent mass times a unit translation
+/// in y, plus R's mass on w): gravity is the leaves' weight and R's, the static equilibrium
+/// of the whole stack first; a base acceleration loads every mass in the supports' frame.
+/// The rig imposes w(t) through a reaction lambda on w chosen so that w'' = w_p''(t); the load
+/// cell between R and the spring reads lambda - m w_p'' (the leaves' inertia included), and
+/// w(t) must then be smooth (validate(true): a triangle is refused, a table splined).
 /// Energy balance of every loading: E(0) + W_ext(t) = kinetic + strain + dissipated.
 #include <string>
 #include <vector>

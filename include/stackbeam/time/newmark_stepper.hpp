@@ -46,6 +46,14 @@
 ///     E0 = kinetic + strain + dissipated + impact_loss
 /// closes to round-off whatever the contact solver returns.
 ///
+/// Loadings (loading.hpp): q(t) on the right-hand side, by the trapezoidal rule with massive
+/// leaves (r gains q0 + q1, the step's work is (q0 + q1)^T (z1 - z0) / 2, exact in the balance)
+/// and at t1 with massless ones. Gravity starts from the static equilibrium of the whole stack
+/// under its weight (detail::static_state). The rig (massive leaves, elastic interfaces): the
+/// step solves z_r with w1 = w_p(t1) given; its mean force over the step follows from R's row of
+/// the step's momentum balance (its work closes the balance), its force at t1 from
+/// M a1 = G^T p1 - K z1 + q1 + lambda1 e_w with a1_w = w_p''(t1).
+///
 /// Initial state: w(0), w'(0) from the rigid body; the leaves at the static shape for w(0)
 /// (contact state with R held at w(0), as in the closed-form mode), their velocity w'(0)
 /// times the static shape per unit w with the closed contact components tied (every
