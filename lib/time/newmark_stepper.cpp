@@ -27,9 +27,9 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     report_.mode = Mode::newmark;
     detail::require_uniform_leaf_mass(system_, "newmark");
     require_no_assembly(system_.model().spec(), Mode::newmark);
-    require_no_damping(options_, "mode newmark");
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
+    if (!massive_leaves_) require_no_damping(options_, "mode newmark with massless leaves");
     options_.loading.prepare(massive_leaves_);
     require_loading_fits(system_.model().spec(), options_.loading);
     const Loading& L = options_.loading;
@@ -50,6 +50,10 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     const int m = system_.num_components();
     K_ = system_.stiffness_reduced();
     M_ = system_.mass_reduced();
+    if (options_.damping.active()) {  // structural damping C = alpha M + beta K (massive leaves)
+        C_ = options_.damping.rayleigh_alpha_per_s * M_ + options_.damping.rayleigh_beta_s * K_;
+        C_.makeCompressed();
+    }
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     const int n = static_cast<int>(K_.rows());
     const int w_dof = n - 1;
@@ -140,15 +144,17 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // M_SS a_S = (G^T p0 - K z0 + q(0))_S (the massless rows of the residual are zero: static
     // shape); the rig's reaction keeps w'' = w_p''(0) (accelerations_with_rig).
     a_ = Eigen::VectorXd::Zero(n);
+    const Eigen::VectorXd r0 = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0) -
+                               (C_.nonZeros() > 0 ? Eigen::VectorXd(C_ * v_) : Eigen::VectorXd::Zero(n));
     if (massive_leaves_) {
         factor_->mass.compute(M_);
         if (factor_->mass.info() != Eigen::Success)
             throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
     }
     if (rig_) {
-        a_ = accelerations_with_rig(0.0, Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0), &rig_force_);
+        a_ = accelerations_with_rig(0.0, r0, &rig_force_);
     } else {
-        const Eigen::VectorXd r = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0);
+        const Eigen::VectorXd& r = r0;
         const int ns = static_cast<int>(massive.size());
         Eigen::SparseMatrix<double> S(ns, n);
         std::vector<Eigen::Triplet<double>> st;
@@ -180,6 +186,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // K_eff,rr z_r1 = r_r - K_eff,rw w1 + kappa G_r^T p1, s = G_r z_r1 + G_w w1 + c_L p1 - d).
     const double kappa = massive_leaves_ ? 2.0 : 1.0;
     Eigen::SparseMatrix<double> Keff = K_ + (4.0 / (dt * dt)) * M_;
+    if (C_.nonZeros() > 0) Keff += (2.0 / dt) * C_;  // the trapezoidal damping force -C (z1 - z0) / dt
     Keff.makeCompressed();
     const int nf = rig_ ? w_dof : n;
     Eigen::SparseMatrix<double> KeffF = Keff.topLeftCorner(nf, nf), GF = G.leftCols(nf);
@@ -251,9 +258,10 @@ void NewmarkStepper::fill_record(int iterations, int factorizations) {
     record_.force_on_mass_n = body.mass_kg * a_[w_dof];
     if (massive_leaves_)
         record_.spring_force_n = rig_ ? record_.external_force_n : record_.external_force_n - record_.force_on_mass_n;
+    record_.damping_energy_j = f * damping_energy_;
     record_.energy_balance_error_j = e0_ + record_.external_work_j -
                                      (record_.kinetic_energy_j + record_.strain_energy_j + record_.dissipated_energy_j +
-                                      impact_loss_);
+                                      impact_loss_ + record_.damping_energy_j);
     record_.t_s = t_;
     record_.contact_iterations = iterations;
     record_.factorizations = factorizations;
@@ -369,6 +377,8 @@ const StepRecord& NewmarkStepper::advance() {
                             ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
                             : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
     if (loaded) r += massive_leaves_ ? Eigen::VectorXd(q0 + q1) : q1;
+    const bool damped = C_.nonZeros() > 0;
+    if (damped) r += (2.0 / dt) * (C_ * z_);  // K_eff holds (2/dt) C: the step's damping force is -C (z1 - z0)/dt
     // The rig: the step's problem on z_r with w1 given (constructor)
     const double w1 = rig_ ? options_.loading.displacement_m.value(t1) : 0.0;
     const Eigen::VectorXd rF = rig_ ? Eigen::VectorXd(r.head(w_dof) - keff_w_ * w1) : r;
@@ -439,11 +449,15 @@ const StepRecord& NewmarkStepper::advance() {
             Eigen::VectorXd res = M_ * Eigen::VectorXd((v1 - v_) / dt) + 0.5 * (K_ * Eigen::VectorXd(z_ + z1)) -
                                   G.transpose() * p_;
             if (loaded) res -= 0.5 * (q0 + q1);
+            if (damped) res += C_ * Eigen::VectorXd((z1 - z_) / dt);
             external_work_ += res[w_dof] * (z1[w_dof] - z_[w_dof]);
         }
+        // the damping force's work over the step, (z1 - z0)^T C (z1 - z0) / dt >= 0
+        if (damped) damping_energy_ += (z1 - z_).dot(C_ * (z1 - z_)) / dt;
         v_ = v1;
-        Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 + q1 (+ the rig's lambda1 e_w)
+        Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 - C v1 + q1 (+ the rig's lambda1 e_w)
         if (loaded) r1 += q1;
+        if (damped) r1 -= C_ * v_;
         a_ = rig_ ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_->mass.solve(r1));
     } else {
         const Eigen::VectorXd a1 = (4.0 / (dt * dt)) * (z1 - z_ - dt * v_) - a_;

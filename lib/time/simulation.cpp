@@ -151,8 +151,9 @@ void require_no_damping(const SimulationOptions& options, const std::string& ste
     const bool alpha = c.rayleigh_alpha_per_s > 0.0;
     throw InputError(alpha ? "damping.rayleigh_alpha_per_s" : "damping.rayleigh_beta_s",
                      "value " + format_value(alpha ? c.rayleigh_alpha_per_s : c.rayleigh_beta_s) +
-                         ": structural damping is taken by mode cvode with the massive stack only (leaves with "
-                         "mass, friction, an elastic layer on every contact row), not by " + stepper + " (give 0)");
+                         ": structural damping is taken by the leaf-mass integrators only (mode newmark with "
+                         "massive leaves; mode cvode with the whole massive stack: leaves with mass and an elastic "
+                         "layer on every contact row), not by " + stepper + " (give 0)");
 }
 
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {

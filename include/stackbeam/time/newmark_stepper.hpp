@@ -54,6 +54,10 @@
 /// the step's momentum balance (its work closes the balance), its force at t1 from
 /// M a1 = G^T p1 - K z1 + q1 + lambda1 e_w with a1_w = w_p''(t1).
 ///
+/// Structural damping (SimulationOptions::damping, massive leaves): the damping force by the
+/// same rule, -C (v0 + v1)/2 = -C (z1 - z0)/dt, so K_eff gains (2/dt) C and the step loses
+/// (z1 - z0)^T C (z1 - z0)/dt (StepRecord::damping_energy_j), exactly in the balance.
+///
 /// Initial state: w(0), w'(0) from the rigid body; the leaves at the static shape for w(0)
 /// (contact state with R held at w(0), as in the closed-form mode), their velocity w'(0)
 /// times the static shape per unit w with the closed contact components tied (every
@@ -129,6 +133,8 @@ private:
     Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
     double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
     double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
+    Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)
+    double damping_energy_ = 0.0;              // its work [J, meshed part]
     void fill_record(int iterations, int factorizations);
     /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
     Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;

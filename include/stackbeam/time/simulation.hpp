@@ -108,7 +108,7 @@ struct CvodeOptions {
 /// the leaves and R, K the leaves' stiffness; the elastic layer is not damped): the modal damping
 /// ratio of a mode of circular frequency omega is zeta = alpha / (2 omega) + beta omega / 2.
 /// Off by default: a leaf spring's steel is lightly damped, and the friction between the leaves
-/// is the damping stackbeam computes. Taken by mode cvode with the massive stack only
+/// is the damping stackbeam computes. Taken by mode newmark with massive leaves and mode cvode with the massive stack only
 /// (docs/time-integration.md, "Structural damping").
 struct StructuralDamping {
     double rayleigh_alpha_per_s = 0.0;  ///< alpha [1/s], >= 0
@@ -143,7 +143,7 @@ struct SimulationOptions {
     /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
     /// ends with relative velocity 0. Docs: docs/time-integration.md.
     double restitution = 0.0;
-    /// Structural damping of the leaves (mode cvode with the massive stack only).
+    /// Structural damping of the leaves (mode newmark with massive leaves, mode cvode with the massive stack).
     StructuralDamping damping;
     /// Throws InputError when a value is out of range; its field() is the member's path
     /// ("dt_s", "cvode.rtol", "solver.tolerance_m": option_table.hpp gives the scenario key
