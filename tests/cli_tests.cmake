@@ -118,7 +118,7 @@ set(_cli_bad_cases
   "tolerance_zero|--tolerance|0|--tolerance: value '0' is not allowed: must be a finite number > 0 [m]"
   "max_iterations_fraction|--max-iterations|2.5|--max-iterations: value '2.5' is not an integer"
   "tau_rule_unknown|--tau-rule|later|--tau-rule: value 'later' is not a tau rule"
-  "events_without_cvode|--events|ev.csv|--events: the event log exists in mode cvode only"
+  "events_without_cvode|--events|ev.csv|the event log exists in mode cvode only"
   "contact_path_unknown|--contact-path|banded|--contact-path: value 'banded' is not a contact path: allowed auto, dense, sparse"
   "beam_density_negative|--beam-density|-7850|--beam-density: value '-7850' is not allowed: must be a finite number >= 0 [kg/m^3]"
   "beam_density_nan|--beam-density|nan|--beam-density: value 'nan' is not allowed"
@@ -198,6 +198,21 @@ stackbeam_cli_test(NAME cli_ok_newmark_scenario
                    ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/paper_friction.toml --mode newmark
                         --beam-density 7850 --t-end 0.01 --out ${_cli_out_dir}/cli_newmark_scenario.csv
                    EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${_cli_out_dir}/cli_newmark_scenario.csv MIN_LINES 12)
+# Loadings with leaf mass (docs/model-and-scenarios.md "Loadings"): gravity (the leaves' weight
+# too) in mode newmark from a massless example scenario, and the steel base-excitation example.
+stackbeam_cli_test(NAME cli_ok_newmark_gravity
+                   ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/gravity_friction.toml --mode newmark
+                        --beam-density 7850 --dt 1e-4 --t-end 0.01 --out ${_cli_out_dir}/cli_newmark_gravity.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${_cli_out_dir}/cli_newmark_gravity.csv MIN_LINES 12)
+stackbeam_cli_test(NAME cli_ok_newmark_base_excitation
+                   ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/base_steel_elastic.toml --t-end 0.01
+                        --out ${_cli_out_dir}/cli_newmark_base.csv
+                   EXPECT_RC 0 EXPECT_TEXT "mode newmark" OUT ${_cli_out_dir}/cli_newmark_base.csv MIN_LINES 12)
+# A file's event log with the mode changed on the command line: the file's key is named.
+stackbeam_cli_test(NAME cli_bad_events_from_file_in_newmark
+                   ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/base_friction.toml --mode newmark
+                        --beam-density 7850 --t-end 0.01 --out ${_cli_out_dir}/cli_newmark_base_bad.csv
+                   EXPECT_RC 2 EXPECT_TEXT "outputs.events_path" OUT ${_cli_out_dir}/cli_newmark_base_bad.csv)
 stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
                    ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv

@@ -217,8 +217,9 @@ RunRequest make_request(const SimulateArgs& a) {
         throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "
                             "treats the leaves as massless, the paper");
     if (r.options.mode != Mode::cvode && !r.events.empty())
-        throw ArgumentError("--events: the event log exists in mode cvode only (mode " +
-                            std::string(to_string(r.options.mode)) + ")");
+        throw ArgumentError((a.events.empty() ? "outputs.events_path (file " + a.scenario + ")" : std::string("--events")) +
+                            ": value '" + r.events + "': the event log exists in mode cvode only (mode " +
+                            std::string(to_string(r.options.mode)) + "): remove it, or use mode cvode");
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }
