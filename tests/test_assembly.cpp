@@ -421,7 +421,7 @@ BOOST_AUTO_TEST_CASE(preload_grows_the_friction_loop) {
 BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_named) {
     ModelSpec spec = graduated(3, 0.5, 0.008, {4.0, 3.0, 2.5}, 0.0);
     const System sys(Model::build(spec));
-    for (Mode mode : {Mode::newmark, Mode::cvode}) {
+    for (Mode mode : {Mode::cvode}) {  // massless leaves: mode cvode refuses (newmark and the massive stack take it)
         SimulationOptions so;
         so.mode = mode;
         so.dt_s = 1e-4;

@@ -411,3 +411,51 @@ BOOST_AUTO_TEST_CASE(rig_force_includes_the_leaves_inertia) {
     check_case("rig", s, load, 0.0, 0.05, [](const StepRecord& r) { return r.spring_force_n; }, force_ref,
                0.5 * F * 2.0 * A, 1e-3, 5e-3, 1.5);
 }
+
+BOOST_AUTO_TEST_CASE(the_assembled_stack_starts_at_the_nip_and_stays_there) {
+    // The leaf-mass integrators start from the assembled stack too (free camber, clips: the
+    // static assembly step with friction before t = 0, detail::static_stages). The classic nip
+    // (test_assembly): two steel leaves bolted at the seat, the lower one (half length L2 = 0.3 m,
+    // 6 mm, free radius 3 m) more curved than the upper (L1 = 0.5 m, 8 mm, 5 m), frictionless;
+    // each half a pair of cantilevers from the seat touching only at the lower leaf's tip, where
+    // the bolt closes the interference delta = (1/R2 - 1/R1) L2^2 / 2 by a force
+    //     P = delta / (L2^3 / 3 (1/EI1 + 1/EI2) + c_tip),
+    // c_tip the tip pair's layer compliance (0 on a rigid interface: P = 101.3 N), and the seat
+    // sits P L2^2 (3 L1 - L2) / (6 EI1) below the upper leaf's pins. Mode newmark on the rigid
+    // interface and both integrators on the elastic one: the initial tip force and w to 1e-8
+    // (cubic elements are exact for tip loads; the solver's tolerance is 1e-12 m), and with no
+    // loading the stack stays there (it starts in equilibrium): w within 1e-9 of it for 2 ms.
+    const double L1 = kTwoLeafL1_m, L2 = kTwoLeafL2_m, R1 = 5.0, R2 = 3.0;
+    const double EI1 = steel_leaf_bending_stiffness(kTwoLeafT1_m), EI2 = steel_leaf_bending_stiffness(kTwoLeafT2_m);
+    const double delta = (1.0 / R2 - 1.0 / R1) * L2 * L2 / 2.0;
+    for (const bool elastic : {false, true}) {
+        ModelSpec spec = two_leaf_spring(R1, R2);
+        for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = kSteel;
+        if (elastic) spec = with_elastic_interfaces(spec);
+        const System sys(Model::build(spec));
+        double c_tip = 0.0;
+        int tip = -1;
+        for (int k = 0; k < static_cast<int>(sys.pairs().size()); ++k)
+            if (std::abs(std::abs(sys.pair_spec(k).x_m - L1) - L2) < 1e-9) {
+                tip = k;
+                c_tip = sys.layer_compliance_m_per_n().size() ? sys.layer_compliance_m_per_n()[sys.pairs()[k].row_n] : 0.0;
+            }
+        BOOST_REQUIRE(tip >= 0);
+        const double P = delta / (L2 * L2 * L2 / 3.0 * (1.0 / EI1 + 1.0 / EI2) + c_tip);
+        const double w = -P * L2 * L2 * (3.0 * L1 - L2) / (6.0 * EI1);
+        for (Mode mode : {Mode::newmark, Mode::cvode}) {
+            if (mode == Mode::cvode && !elastic) continue;  // the massive stack needs the elastic layer
+            SimulationOptions so = options(mode, 2e-3, mode == Mode::cvode ? 1e-4 : 1e-5);
+            const auto st = make_stepper(sys, so);
+            const double p_tip = -st->pairs()[static_cast<std::size_t>(tip)].p_n_n;
+            const double w0 = st->current().w_m;
+            BOOST_TEST_MESSAGE((elastic ? "elastic, " : "rigid, ") << to_string(mode) << ": tip force " << p_tip
+                                                                  << " N (closed form " << P << "), w(0) " << w0 << " m (" << w << ")");
+            BOOST_TEST(p_tip == P, tt::tolerance(1e-8));
+            BOOST_TEST(w0 == w, tt::tolerance(1e-8));
+            double drift = 0.0;
+            while (st->current().t_s < so.t_end_s - 1e-12) drift = std::max(drift, std::abs(st->advance().w_m - w0));
+            BOOST_TEST(drift < 1e-9 * std::abs(w));
+        }
+    }
+}

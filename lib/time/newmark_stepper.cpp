@@ -26,7 +26,6 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     options_.validate();
     report_.mode = Mode::newmark;
     detail::require_uniform_leaf_mass(system_, "newmark");
-    require_no_assembly(system_.model().spec(), Mode::newmark);
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
     if (!massive_leaves_) require_no_damping(options_, "mode newmark with massless leaves");
@@ -67,19 +66,16 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // Gravity: the static equilibrium of the whole stack under its weight (the leaves' and R's,
     // loading.hpp) first, from the unloaded stack; then R held at w(0) plus that sag (the rig:
     // w_p(0)) with the weight on. Base excitation: the velocity relative to the supports.
+    // The assembly (free camber, clips: detail::static_stages) comes before gravity.
     const Eigen::VectorXd weight = -L.gravity_m_per_s2 * load_->inertia_kg();
-    double w_static = 0.0;
-    if (L.gravity_m_per_s2 > 0.0) {
-        z_ = detail::static_state(system_, problem_, weight, std::nan(""), options_, p_, d_,
-                                  "static equilibrium under gravity (the leaves' weight and R's)", &solve_);
-        w_static = z_[w_dof];
-    }
+    const bool pre_stressed = detail::static_stages(system_, problem_, weight, options_, z_, p_, d_, &solve_);
+    const double w_static = pre_stressed ? z_[w_dof] : 0.0;
     const double w0 = rig_ ? L.displacement_m.value(0.0) : w_static + body.initial_displacement_m;
     const double wd0 = rig_ ? L.displacement_m.derivative(0.0) : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
 
     // Initial contact state with R held at w(0), as in the closed-form mode; the leaves
     // start at that static shape.
-    if (L.gravity_m_per_s2 > 0.0) {
+    if (pre_stressed) {
         if (w0 != w_static)
             z_ = detail::static_state(system_, problem_, weight, w0, options_, p_, d_, "initial contact state", &solve_);
     } else if (w0 != 0.0 && m > 0) {
@@ -104,7 +100,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         }
         if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
     }
-    if (!(L.gravity_m_per_s2 > 0.0)) z_ = system_.reduced_displacements(p_, w0);
+    if (!pre_stressed) z_ = system_.reduced_displacements(p_, w0);
     rel_ = detail::relative_positions(system_, z_, p_);
 
     // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.

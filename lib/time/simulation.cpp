@@ -136,7 +136,8 @@ void require_massless_leaves(const System& system, Mode mode) {
 
 void require_no_assembly(const ModelSpec& model, Mode mode) {
     const std::string why = std::string(" is not available in mode ") + to_string(mode) +
-                            " yet: the assembly and the clips' limit are honoured in mode closed-form only (use it)";
+                            " yet: the assembly and the clips' limit are honoured in mode closed-form, in mode newmark and, "
+                            "with leaf mass on elastic interfaces, in mode cvode's massive stack (use one of them)";
     for (std::size_t i = 0; i < model.leaves.size(); ++i)
         for (const auto& [key, v] : {std::pair<const char*, double>{"free_camber_m", model.leaves[i].free_camber_m},
                                      {"free_radius_m", model.leaves[i].free_radius_m}})

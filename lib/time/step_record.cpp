@@ -129,6 +129,24 @@ Eigen::VectorXd detail::static_state(const System& system, const ContactProblem&
     return z;
 }
 
+bool detail::static_stages(const System& system, const ContactProblem& laws, const Eigen::VectorXd& weight,
+                           const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                           SolveResult* result) {
+    const ModelSpec& spec = system.model().spec();
+    bool ran = false;
+    if ((has_free_camber(spec) || !spec.clips.empty()) && system.num_components() > 0) {
+        z = static_state(system, laws, Eigen::VectorXd::Zero(system.num_reduced_dofs()), std::nan(""), options, p, d,
+                         "assembly of the cambered leaves", result);
+        ran = true;
+    }
+    if (weight.size() > 0 && weight.lpNorm<Eigen::Infinity>() > 0.0) {
+        z = static_state(system, laws, weight, std::nan(""), options, p, d,
+                         "static equilibrium under gravity (the leaves' weight and R's)", result);
+        ran = true;
+    }
+    return ran;
+}
+
 void detail::fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
                         double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
                         const LoadState& load, StepRecord& r) {

@@ -114,6 +114,16 @@ Eigen::VectorXd static_state(const System& system, const ContactProblem& laws, c
                              const SimulationOptions& options, Eigen::VectorXd& p, Eigen::VectorXd& d,
                              const std::string& what, SolveResult* result = nullptr);
 
+/// The stack before t = 0 in the steppers with leaf mass (mode newmark, the massive cvode
+/// stack), each stage a static_state with R free: the assembly of free camber and clips
+/// (no load: the interference of the offsets d resolved with friction; simulation.hpp
+/// "assembly"), then the static equilibrium under `weight` [N per reduced DOF] when it is not
+/// zero (gravity: -g l). Returns whether a stage ran; z [m, rad], p [N] and d (re-anchored)
+/// hold the state, `result` the last solve.
+bool static_stages(const System& system, const ContactProblem& laws, const Eigen::VectorXd& weight,
+                   const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                   SolveResult* result = nullptr);
+
 /// TauRule::previous_step: sets problem.tau_previous_n [N] per pair from the forces p of
 /// the step before (|p_n| for a unilateral pair, max(0, F_c - p_n) at a clamp).
 void set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p);

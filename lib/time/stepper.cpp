@@ -16,15 +16,18 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
         case Mode::cvode:
             if (!detail::has_leaf_mass(system)) return std::make_unique<CvodeStepper>(system, options);
             // leaf inertia (docs/time-integration.md): the whole massive stack where every contact
-            // row has an elastic layer (or when asked for); else, when a pair may stick or slip, the
-            // modal stepper, and the held-for-good one for bonded and frictionless stacks under the
-            // paper's initial conditions (it takes no other loading)
+            // row has an elastic layer and the stack has friction, an assembly or a loading (or when
+            // asked for); else, when a pair may stick or slip, the modal stepper, and the
+            // held-for-good one for bonded and frictionless stacks under the paper's initial
+            // conditions (it takes no assembly and no other loading)
             {
                 const LeafInertia li = options.cvode.leaf_inertia;
                 const bool elastic = detail::first_rigid_pair(system) < 0;
                 const bool changes = detail::has_mode_changes(system);
+                const ModelSpec& spec = system.model().spec();
+                const bool assembled = has_free_camber(spec) || !spec.clips.empty();
                 if (li == LeafInertia::massive ||
-                    (li == LeafInertia::automatic && elastic && (changes || !options.loading.is_free())))
+                    (li == LeafInertia::automatic && elastic && (changes || assembled || !options.loading.is_free())))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
                 if (changes) return std::make_unique<detail::CvodeModalStepper>(system, options);
                 return std::make_unique<detail::CvodeInertiaStepper>(system, options);

@@ -122,7 +122,8 @@ struct ClampSpec {
 /// A unilateral limit on the opening: one contact row s = (gap sum) - clearance - T/k <= 0 whose
 /// force (the strap's tension T >= 0) holds the outer leaves together once the clearance is
 /// used up; the strap's elastic stretch T/k is the row's compliance (as an elastic interface's).
-/// Mode closed-form only (docs/model-and-scenarios.md, "Free camber, assembly and rebound clips").
+/// Modes closed-form, newmark and cvode's massive stack (docs/model-and-scenarios.md, "Free camber,
+/// assembly and rebound clips").
 struct ClipSpec {
     double x_m = 0.0;          ///< position [m]: on every strapped leaf, not at the rigid body's seat
     int first_leaf = 0;        ///< the top leaf in the strap

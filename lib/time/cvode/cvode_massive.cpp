@@ -436,9 +436,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
     const Eigen::VectorXd weight = -L.gravity_m_per_s2 * s.load->inertia_kg();
     Eigen::VectorXd z0 = Eigen::VectorXd::Zero(s.ndof);
-    if (L.gravity_m_per_s2 > 0.0)
-        z0 = static_state(system, s.chk_problem, weight, std::nan(""), s.opt, p_init, s.d,
-                          "static equilibrium under gravity (the leaves' weight and R's)");
+    static_stages(system, s.chk_problem, weight, s.opt, z0, p_init, s.d);  // the assembly, then gravity
     const double w_start = s.rig ? L.displacement_m.value(0.0) : z0[s.w_dof] + body.initial_displacement_m;
     const double wd_start = s.rig ? L.displacement_m.derivative(0.0)
                                   : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);

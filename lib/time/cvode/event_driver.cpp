@@ -33,8 +33,8 @@ void EventDriver::require_current_tau_rule() const {
 void EventDriver::require_leaf_inertia_options(bool massive_stack) const {
     opt.validate();
     require_uniform_leaf_mass(sys, "cvode");
-    require_no_assembly(sys.model().spec(), Mode::cvode);
-    if (!massive_stack) {  // the massive stack takes every loading and structural damping
+    if (!massive_stack) {  // the massive stack takes the assembly, every loading and structural damping
+        require_no_assembly(sys.model().spec(), Mode::cvode);
         require_initial_conditions_only(opt.loading, "mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal')");
         require_no_damping(opt, "mode cvode with modal leaf inertia");
     }
