@@ -244,30 +244,22 @@ Eigen::VectorXd held_shape(const Linear& L, double w0) {
 BOOST_AUTO_TEST_CASE(free_response_follows_the_eigen_solve) {
     // R released from w0 = 1 mm with the leaves in the static shape held there (no velocity).
     // Bonded stack, 20 ms (about 1.4 periods of R's mode; the leaves' own modes at 1570 rad/s
-    // and up are in the response too).
-    const System s = stack(PaperCase::bonded);
-    const Linear L = linear(s);
-    const double w0 = 1e-3;
-    const Modal ref(L.M, L.K, held_shape(L, w0), Eigen::VectorXd::Zero(L.w + 1), Forcing{});
-    BOOST_TEST_MESSAGE("lowest frequencies " << ref.omega.head(3).transpose() << " rad/s");
-    check_case("free response", s, Loading{}, w0, 0.02, w_of, w_reference(ref, L.w),
-               0.5 * s.tied_stiffness_n_per_m() * w0 * w0);
-}
-
-BOOST_AUTO_TEST_CASE(damped_free_response_follows_the_modal_damping) {
-    // Rayleigh damping C = alpha M + beta K is diagonal in the modes: mode i decays with
-    // zeta_i = alpha / (2 omega_i) + beta omega_i / 2 (R's mode: 0.07; the layer's modes above
-    // 1e6 rad/s overdamped). The same free response as above with it, in both modes; the
+    // and up are in the response too). Undamped, then with Rayleigh damping C = alpha M + beta K,
+    // which is diagonal in the modes: mode i decays with zeta_i = alpha / (2 omega_i) +
+    // beta omega_i / 2 (R's mode: 0.07; the layer's modes above 1e6 rad/s overdamped), and the
     // damping energy is in the balance.
     const System s = stack(PaperCase::bonded);
     const Linear L = linear(s);
     const double w0 = 1e-3;
-    StructuralDamping c;
-    c.rayleigh_alpha_per_s = 10.0;
-    c.rayleigh_beta_s = 2e-6;
-    const Modal ref(L.M, L.K, held_shape(L, w0), Eigen::VectorXd::Zero(L.w + 1), Forcing{}, c);
-    check_case("damped free response", s, Loading{}, w0, 0.02, w_of, w_reference(ref, L.w),
-               0.5 * s.tied_stiffness_n_per_m() * w0 * w0, 1e-3, 1e-4, 1.8, c);
+    StructuralDamping damped;
+    damped.rayleigh_alpha_per_s = 10.0;
+    damped.rayleigh_beta_s = 2e-6;
+    for (const StructuralDamping& c : {StructuralDamping{}, damped}) {
+        const Modal ref(L.M, L.K, held_shape(L, w0), Eigen::VectorXd::Zero(L.w + 1), Forcing{}, c);
+        BOOST_TEST_MESSAGE("lowest frequencies " << ref.omega.head(3).transpose() << " rad/s");
+        check_case(c.active() ? "damped free response" : "free response", s, Loading{}, w0, 0.02, w_of,
+                   w_reference(ref, L.w), 0.5 * s.tied_stiffness_n_per_m() * w0 * w0, 1e-3, 1e-4, 1.8, c);
+    }
 }
 
 BOOST_AUTO_TEST_CASE(free_response_of_the_frictionless_stack_follows_the_eigen_solve) {
