@@ -117,6 +117,15 @@ Assembled assemble(const System& sys, ContactPath path = ContactPath::automatic)
     return {st.current().w_m, st.pairs()};
 }
 
+/// A run of 1 ms in mode `mode` (the modes that do not assemble refuse it before stepping).
+SimulationOptions short_run(Mode mode) {
+    SimulationOptions so;
+    so.mode = mode;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-3;
+    return so;
+}
+
 /// The nip's assembled state (the two-leaf spring, tips at x_R +- L2): the tip pairs carry P, the
 /// others nothing, and the seat is at w, each to the relative tolerance tol.
 void check_nip(ModelSpec spec, Symmetry sym, ContactPath path, double P, double w, double tol) {
@@ -461,13 +470,8 @@ BOOST_AUTO_TEST_CASE(an_explicit_interference_is_closed_by_the_assembly) {
     BOOST_TEST(as.w_m == w, tt::tolerance(1e-8));
     BOOST_TEST_MESSAGE("explicit interference of " << delta << " m: contact force " << F << " N, seat " << w << " m");
     // modes newmark and cvode do not assemble: the gap is named there
-    for (Mode mode : {Mode::newmark, Mode::cvode}) {
-        SimulationOptions so;
-        so.mode = mode;
-        so.dt_s = 1e-4;
-        so.t_end_s = 1e-3;
-        BOOST_TEST(input_error_field([&] { simulate(sys, so); }) == "interfaces[0].initial_gap_m");
-    }
+    for (Mode mode : {Mode::newmark, Mode::cvode})
+        BOOST_TEST(input_error_field([&] { simulate(sys, short_run(mode)); }) == "interfaces[0].initial_gap_m");
     // the same overlap on an interface that the seat ties (the two-leaf spring): refused at the seat
     ModelSpec tied = two_leaf_spring(0.0, 0.0);
     tied.interfaces[0].initial_gap_m = -delta;
@@ -479,10 +483,7 @@ BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_n
     ModelSpec spec = graduated(3, 0.5, 0.008, {4.0, 3.0, 2.5}, 0.0);
     const System sys(Model::build(spec));
     for (Mode mode : {Mode::newmark, Mode::cvode}) {
-        SimulationOptions so;
-        so.mode = mode;
-        so.dt_s = 1e-4;
-        so.t_end_s = 1e-3;
+        const SimulationOptions so = short_run(mode);
         BOOST_TEST(input_error_field([&] { simulate(sys, so); }) == "leaves[0].free_radius_m");
         if (mode == Mode::cvode)  // the stepper made directly refuses too, as NewmarkStepper does
             BOOST_TEST(input_error_field([&] { CvodeStepper st(sys, so); }) == "leaves[0].free_radius_m");
