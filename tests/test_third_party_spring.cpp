@@ -57,7 +57,7 @@ BOOST_AUTO_TEST_CASE(six_leaf_rate_against_calculix_solid_model) {
     BOOST_TEST(ratio >= 0.99);
     BOOST_TEST(ratio <= 1.04 / (1.0 - nu * nu));
 
-    // The re-runs (2026-11-24; docs/decisions/018-third-party-six-leaf-spring.md): their pre.fbd
+    // The re-runs (2026-11-24; docs/decisions/019-third-party-six-leaf-spring.md): their pre.fbd
     // and solve.inp with CalculiX from Debian (cgx 2.17, ccx 2.20), the bricks' size S = 20 (theirs),
     // 10, 5 and 2.5 mm ("div ... auto S"), the centre raised 0.2903785 mm, nu = 0.3 and nu = 0;
     // whole-spring rates [N/m] (4 x the quarter's reaction / 0.2903785 mm).
