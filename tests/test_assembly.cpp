@@ -12,6 +12,7 @@
 #include "stackbeam/post/hysteresis.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/time/stepper.hpp"
 #include "test_support.hpp"
 
 namespace tt = boost::test_tools;
@@ -115,6 +116,15 @@ Assembled assemble(const System& sys, ContactPath path = ContactPath::automatic)
     so.solver.tolerance_m = 1e-12;
     ClosedFormStepper st(sys, so);
     return {st.current().w_m, st.pairs()};
+}
+
+/// A run of 1 ms in mode `mode` (the modes that do not assemble refuse it before stepping).
+SimulationOptions short_run(Mode mode) {
+    SimulationOptions so;
+    so.mode = mode;
+    so.dt_s = 1e-4;
+    so.t_end_s = 1e-3;
+    return so;
 }
 
 /// The nip's assembled state (the two-leaf spring, tips at x_R +- L2): the tip pairs carry P, the
@@ -418,14 +428,67 @@ BOOST_AUTO_TEST_CASE(preload_grows_the_friction_loop) {
     BOOST_TEST(area[2] - area[0] <= 2.0 * (area[1] - area[0]) * (1 + 1e-6));
 }
 
+BOOST_AUTO_TEST_CASE(an_explicit_interference_is_closed_by_the_assembly) {
+    // A negative initial_gap_m (interference, needs_assembly): leaf 0 (8 mm, span S = 1 m) pinned
+    // at its eyes x = 0 and S, the seat (R) at S/2 tying leaf 0 only; below it leaf 1 (6 mm) from
+    // a = 0.2 m to S - a, built in at x = a and pinned at S - a (its own supports, not the seat),
+    // frictionless, the free leaves overlapping by delta = 1 mm along the whole interface.
+    // Derivation: leaf 1's supports are where it meets leaf 0's ends of contact, so the assembly
+    // can close the interference by pushing leaf 0 up by delta at x = a and S - a with two forces
+    // F, which leaf 1 carries straight into its own supports (it does not bend). Leaf 0 is then a
+    // simply supported beam under two symmetric point loads: under them
+    //     v(a) = F a^2 (3 S - 4 a) / (6 EI0) = delta   =>   F = 6 EI0 delta / (a^2 (3 S - 4 a))   (= 34.9 N)
+    // and between them it rises further (to F a (3 S^2 - 4 a^2) / (24 EI0) at the seat, which is w:
+    // the assembly puts no force on R), so every inner pair opens: contact at the two ends only.
+    // Leaf 1's stiffness does not enter. Why not two cantilevers from the seat (F = delta /
+    // (L^3/(3 EI0) + L^3/(3 EI1))): an interface that the seat ties has its pair at the seat without
+    // a normal row, where an overlap cannot be pressed out (refused below), and an overlap that
+    // starts next to the seat is closed over one element's length: a force that grows as h^-3.
+    // Tolerance: cubic beam elements are exact for point loads at nodes and the gap enters at the
+    // nodes exactly, so only round-off and the solver's 1e-12 m (against delta = 1e-3 m) remain: 1e-8.
+    const double S = 1.0, a = 0.2, delta = 1e-3;
+    ModelSpec spec = two_leaf_spring(0.0, 0.0);
+    spec.leaves[1] = steel_leaf(0.5 * S, 0.5 * S - a, kT2, 0.0, false);
+    spec.leaves[1].left_support = SupportKind::fixed;
+    spec.leaves[1].right_support = SupportKind::pinned;
+    spec.interfaces[0].initial_gap_m = -delta;
+    spec.rigid_body.tied_leaves = {0};
+    const System sys(Model::build(spec));
+    const double EI0 = bending_stiffness(kT1);
+    const double F = 6.0 * EI0 * delta / (a * a * (3.0 * S - 4.0 * a));
+    const double w = F * a * (3.0 * S * S - 4.0 * a * a) / (24.0 * EI0);
+    const Assembled as = assemble(sys);
+    int loaded = 0;
+    for (const PairRecord& r : as.pairs) {
+        if (std::abs(r.x_m - a) < 1e-9 || std::abs(r.x_m - (S - a)) < 1e-9) {
+            ++loaded;
+            BOOST_TEST(-r.p_n_n == F, tt::tolerance(1e-8));
+        } else {
+            BOOST_TEST(r.p_n_n == 0.0);
+        }
+    }
+    BOOST_TEST(loaded == 2);
+    BOOST_TEST(as.w_m == w, tt::tolerance(1e-8));
+    BOOST_TEST_MESSAGE("explicit interference of " << delta << " m: contact force " << F << " N, seat " << w << " m");
+    // mode cvode with massless leaves does not assemble: the gap is named there; mode newmark
+    // assembles as closed-form does (its initial state: the same forces)
+    BOOST_TEST(input_error_field([&] { simulate(sys, short_run(Mode::cvode)); }) == "interfaces[0].initial_gap_m");
+    const auto nm = make_stepper(sys, short_run(Mode::newmark));
+    for (const PairRecord& r : nm->pairs())
+        if (std::abs(r.x_m - a) < 1e-9 || std::abs(r.x_m - (S - a)) < 1e-9) BOOST_TEST(-r.p_n_n == F, tt::tolerance(1e-8));
+    BOOST_TEST(nm->current().w_m == w, tt::tolerance(1e-8));
+    // the same overlap on an interface that the seat ties (the two-leaf spring): refused at the seat
+    ModelSpec tied = two_leaf_spring(0.0, 0.0);
+    tied.interfaces[0].initial_gap_m = -delta;
+    const Model mt = Model::build(tied);
+    BOOST_TEST(input_error_field([&] { System s(mt); }) == "interfaces[0].initial_gap_m");
+}
+
 BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_named) {
     ModelSpec spec = graduated(3, 0.5, 0.008, {4.0, 3.0, 2.5}, 0.0);
     const System sys(Model::build(spec));
     for (Mode mode : {Mode::cvode}) {  // massless leaves: mode cvode refuses (newmark and the massive stack take it)
-        SimulationOptions so;
-        so.mode = mode;
-        so.dt_s = 1e-4;
-        so.t_end_s = 1e-3;
+        const SimulationOptions so = short_run(mode);
         BOOST_TEST(input_error_field([&] { simulate(sys, so); }) == "leaves[0].free_radius_m");
         if (mode == Mode::cvode)  // the stepper made directly refuses too, as NewmarkStepper does
             BOOST_TEST(input_error_field([&] { CvodeStepper st(sys, so); }) == "leaves[0].free_radius_m");
@@ -457,4 +520,19 @@ BOOST_AUTO_TEST_CASE(assembly_is_refused_outside_closed_form_and_bad_camber_is_n
     }
     const Model mh = Model::build(hinged);
     BOOST_TEST(input_error_field([&] { System s(mh); }) == "leaves[1].free_radius_m");
+    // the message names the field that makes the interference: here the upper leaf, its ends
+    // down (R = -5 m) over a flat lower leaf
+    ModelSpec upper = pinned;
+    upper.leaves[0].free_radius_m = -5.0;
+    upper.leaves[1].free_radius_m = 0.0;
+    const Model mu = Model::build(upper);
+    BOOST_TEST(input_error_field([&] { System s(mu); }) == "leaves[0].free_radius_m");
+    // both leaves make it (upper ends down, lower ends up): the larger part, the upper's 1/3 > 1/5
+    upper.leaves[0].free_radius_m = -3.0;
+    upper.leaves[1].free_camber_m = 0.02;  // 8 H / (2 L1)^2 = 0.16 1/m: R = 6.25 m
+    const Model mb = Model::build(upper);
+    BOOST_TEST(input_error_field([&] { System s(mb); }) == "leaves[0].free_radius_m");
+    upper.leaves[0].free_radius_m = -8.0;  // now the lower leaf's 0.16 1/m > 0.125 1/m
+    const Model ml = Model::build(upper);
+    BOOST_TEST(input_error_field([&] { System s(ml); }) == "leaves[1].free_camber_m");
 }

@@ -10,6 +10,7 @@
 
 #include "fe/leaf_sections.hpp"
 #include "fe/system_internal.hpp"
+#include "model/assembly.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -226,10 +227,14 @@ System::System(const Model& model) : model_(model) {
         }
         const bool has_n = !rn.empty();
         bool has_t = !rt.empty();
-        if (!has_n && cp.initial_gap_m < 0.0)
-            throw InputError("leaves[" + std::to_string(b) + (spec.leaves[b].free_radius_m != 0.0 ? "].free_radius_m" : "].free_camber_m"),
-                             "gives an interference of " + format_value(-cp.initial_gap_m) + " m with leaves[" + std::to_string(a) +
-                                 "] at x = " + format_value(cp.x_m) + " m, where supports fix both leaves: the assembly cannot close it");
+        if (!has_n && cp.initial_gap_m < 0.0) {  // named by the part that makes it: a gap or either leaf's camber
+            const detail::Interference why = detail::interference_source(spec, a, cp.x_m);
+            throw InputError(why.field, "value " + format_value(why.value) + " gives an interference of " + format_value(-cp.initial_gap_m) +
+                                            " m between leaves[" + std::to_string(a) + "] and leaves[" + std::to_string(b) +
+                                            "] at x = " + format_value(cp.x_m) +
+                                            " m, where the seat or supports fix both leaves' normal motion: the assembly "
+                                            "cannot close it, so the offset must be >= 0 there (a free camber is 0 at the seat)");
+        }
         // A friction pair whose normal motion a support or the seat fixes has no normal
         // force of its own, so no friction limit: it carries nothing (a clamp keeps its preload).
         if (!has_n && cp.kind == PairKind::coulomb) has_t = false;

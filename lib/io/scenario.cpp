@@ -318,7 +318,7 @@ void parse_interfaces(const Table& top, ModelSpec& spec) {
             f.law = law == Law::bonded ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
             f.friction_coefficient = 0.0;
         }
-        f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], >= 0", 0.0);
+        f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], finite; < 0 an interference, closed by the assembly", 0.0);
         if (t.has("contact")) {
             const std::string text = t.string("contact", "one of 'rigid', 'elastic'");
             try {

@@ -20,6 +20,12 @@ bool has_free_camber(const ModelSpec& spec) {
     return false;
 }
 
+bool needs_assembly(const ModelSpec& spec) {
+    bool interference = false;
+    for (const auto& f : spec.interfaces) interference = interference || f.initial_gap_m < 0.0;
+    return interference || has_free_camber(spec) || !spec.clips.empty();
+}
+
 namespace detail {
 
 namespace {
@@ -51,6 +57,28 @@ void validate_free_shapes(const ModelSpec& spec) {
 double free_shape_m(const ModelSpec& spec, int leaf, double x_m) {
     const double dx = x_m - spec.rigid_body.x_m;
     return 0.5 * free_curvature_per_m(spec.leaves[static_cast<std::size_t>(leaf)]) * dx * dx;
+}
+
+Interference interference_source(const ModelSpec& spec, int interface_index, double x_m) {
+    // The offset's parts that can be negative (the taper's cannot: Model::build refuses an
+    // overlap of the profiles that a positive gap does not cover): the interface's gap, the
+    // upper leaf's free shape (ends down: < 0) and the lower leaf's, negated (ends up: < 0).
+    const int a = interface_index, b = a + 1;
+    const auto camber = [&](int leaf) {
+        const LeafSpec& l = spec.leaves[static_cast<std::size_t>(leaf)];
+        return field("leaves", static_cast<std::size_t>(leaf), l.free_radius_m != 0.0 ? "free_radius_m" : "free_camber_m");
+    };
+    const auto value = [&](int leaf) {
+        const LeafSpec& l = spec.leaves[static_cast<std::size_t>(leaf)];
+        return l.free_radius_m != 0.0 ? l.free_radius_m : l.free_camber_m;
+    };
+    const double gap = spec.interfaces[static_cast<std::size_t>(a)].initial_gap_m;
+    Interference worst{field("interfaces", static_cast<std::size_t>(a), "initial_gap_m"), gap, gap};
+    const Interference upper{camber(a), value(a), free_shape_m(spec, a, x_m)};
+    const Interference lower{camber(b), value(b), -free_shape_m(spec, b, x_m)};
+    for (const Interference& part : {upper, lower})
+        if (part.part_m < worst.part_m) worst = part;
+    return worst;
 }
 
 void validate_clips(const ModelSpec& spec, double tol_m,

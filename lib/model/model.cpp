@@ -241,7 +241,7 @@ Model Model::build(ModelSpec spec) {
     for (std::size_t i = 0; i < spec.interfaces.size(); ++i) {
         const auto& f = spec.interfaces[i];
         require_nonnegative(idx("interfaces", i, "friction_coefficient"), f.friction_coefficient, "[-]");
-        require_nonnegative(idx("interfaces", i, "initial_gap_m"), f.initial_gap_m, "[m]");
+        require_finite(idx("interfaces", i, "initial_gap_m"), f.initial_gap_m);  // < 0: an interference (assembly)
         for (const auto& [key, value] : {std::pair<const char*, double>{"normal_stiffness_pa_per_m", f.normal_stiffness_pa_per_m},
                                          {"tangential_stiffness_pa_per_m", f.tangential_stiffness_pa_per_m}}) {
             require_nonnegative(idx("interfaces", i, key), value, "[Pa/m] (0: derived from the leaves)");
@@ -431,13 +431,17 @@ Model Model::build(ModelSpec spec) {
             if (profiled) {  // straight axes, stacked at the seat: sections thinner than there leave a gap
                 const double here = leaf_thickness_m(leaves[i], p.x_m) + leaf_thickness_m(leaves[i + 1], p.x_m);
                 taper_gap = 0.5 * (ts[i] + ts[i + 1] - here);
-                if (p.initial_gap_m + taper_gap < -1e-9 * here)
+                // the profiles may not overlap unless a positive gap makes room (an explicit
+                // interference, a negative gap, is the gap's own and adds to the taper's gap)
+                const double room = std::max(0.0, p.initial_gap_m);
+                if (room + taper_gap < -1e-9 * here)
                     throw InputError(idx("interfaces", i, "initial_gap_m"),
                                      "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) + "] would overlap by " +
-                                         format_value(-taper_gap - p.initial_gap_m) + " m at x = " + format_value(p.x_m) +
+                                         format_value(-taper_gap - room) + " m at x = " + format_value(p.x_m) +
                                          " m: the leaves are stacked at the seat (rigid_body.x_m) on straight axes, so their "
                                          "profiles must not be thicker elsewhere than there, or the gap must make room");
-                p.initial_gap_m = std::max(0.0, p.initial_gap_m + taper_gap);
+                p.initial_gap_m = p.initial_gap_m >= 0.0 ? std::max(0.0, p.initial_gap_m + taper_gap)
+                                                         : p.initial_gap_m + std::max(0.0, taper_gap);
             }
             p.kind = PairKind::coulomb;
             if (spec.interfaces[i].law == InterfaceLaw::bonded) {

@@ -55,7 +55,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
     //    from the unloaded (assembled) stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
     w_ = 0.0;
-    const bool assemble = (has_free_camber(system_.model().spec()) || !system_.model().spec().clips.empty()) && n > 0;
+    const bool assemble = needs_assembly(system_.model().spec()) && n > 0;
     for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
         if (stage == 0 ? !assemble : !(load.gravity_m_per_s2 > 0.0)) continue;
         const double Fs = stage == 0 ? 0.0 : -m * load.gravity_m_per_s2;  // [N] on the meshed part

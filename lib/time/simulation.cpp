@@ -135,15 +135,21 @@ void require_massless_leaves(const System& system, Mode mode) {
 }
 
 void require_no_assembly(const ModelSpec& model, Mode mode) {
-    const std::string why = std::string(" is not available in mode ") + to_string(mode) +
-                            " yet: the assembly and the clips' limit are honoured in mode closed-form, in mode newmark and, "
-                            "with leaf mass on elastic interfaces, in mode cvode's massive stack (use one of them)";
+    const std::string only = std::string(" is not available in mode ") + to_string(mode) +
+                             " yet: the assembly and the clips' limit are honoured in mode closed-form, in mode newmark "
+                             "and, with leaf mass on elastic interfaces, in mode cvode's massive stack";
+    const std::string why = only + " (use one of them)";
     for (std::size_t i = 0; i < model.leaves.size(); ++i)
         for (const auto& [key, v] : {std::pair<const char*, double>{"free_camber_m", model.leaves[i].free_camber_m},
                                      {"free_radius_m", model.leaves[i].free_radius_m}})
             if (v != 0.0)
                 throw InputError("leaves[" + std::to_string(i) + "]." + key, "value " + format_value(v) + ": a free camber" + why);
     if (!model.clips.empty()) throw InputError("clips[0]", "a rebound clip" + why);
+    for (std::size_t i = 0; i < model.interfaces.size(); ++i)
+        if (model.interfaces[i].initial_gap_m < 0.0)
+            throw InputError("interfaces[" + std::to_string(i) + "].initial_gap_m",
+                             "value " + format_value(model.interfaces[i].initial_gap_m) + ": an interference (a gap < 0)" + only +
+                                 " (use one of them, or a gap >= 0)");
 }
 
 void require_no_damping(const SimulationOptions& options, const std::string& stepper) {

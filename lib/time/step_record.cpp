@@ -134,7 +134,7 @@ bool detail::static_stages(const System& system, const ContactProblem& laws, con
                            SolveResult* result) {
     const ModelSpec& spec = system.model().spec();
     bool ran = false;
-    if ((has_free_camber(spec) || !spec.clips.empty()) && system.num_components() > 0) {
+    if (needs_assembly(spec) && system.num_components() > 0) {
         z = static_state(system, laws, Eigen::VectorXd::Zero(system.num_reduced_dofs()), std::nan(""), options, p, d,
                          "assembly of the cambered leaves", result);
         ran = true;

@@ -115,8 +115,8 @@ Eigen::VectorXd static_state(const System& system, const ContactProblem& laws, c
                              const std::string& what, SolveResult* result = nullptr);
 
 /// The stack before t = 0 in the steppers with leaf mass (mode newmark, the massive cvode
-/// stack), each stage a static_state with R free: the assembly of free camber and clips
-/// (no load: the interference of the offsets d resolved with friction; simulation.hpp
+/// stack), each stage a static_state with R free: the assembly of free camber, clips and
+/// interference (needs_assembly; no load: the interference of the offsets d resolved with friction; simulation.hpp
 /// "assembly"), then the static equilibrium under `weight` [N per reduced DOF] when it is not
 /// zero (gravity: -g l). Returns whether a stage ran; z [m, rad], p [N] and d (re-anchored)
 /// hold the state, `result` the last solve.

@@ -25,7 +25,7 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
                 const bool elastic = detail::first_rigid_pair(system) < 0;
                 const bool changes = detail::has_mode_changes(system);
                 const ModelSpec& spec = system.model().spec();
-                const bool assembled = has_free_camber(spec) || !spec.clips.empty();
+                const bool assembled = needs_assembly(spec);
                 if (li == LeafInertia::massive ||
                     (li == LeafInertia::automatic && elastic && (changes || assembled || !options.loading.is_free())))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);

@@ -96,7 +96,11 @@ double leaf_width_m(const LeafSpec& leaf, double x_m);
 struct InterfaceSpec {
     InterfaceLaw law = InterfaceLaw::coulomb;
     double friction_coefficient = 0.0;  ///< Coulomb mu [-], >= 0 (ignored when bonded)
-    double initial_gap_m = 0.0;         ///< initial normal gap d_n [m], >= 0 (0: touching)
+    /// Initial normal gap d_n [m], finite (0: touching). < 0 is an interference: the free leaves
+    /// overlap by -initial_gap_m along the interface, and the assembly (mode closed-form) closes it
+    /// where a contact row can (needs_assembly); where the seat or supports fix both leaves' normal
+    /// motion (the seat's own node, common pins) an interference is refused (System).
+    double initial_gap_m = 0.0;
     InterfaceContact contact = InterfaceContact::rigid;  ///< rigid (the paper's) or elastic layer
     /// Elastic contact: normal stiffness per unit contact area k_n [Pa/m], > 0; 0 = derived from the
     /// two leaves (interface_layer). Only with contact = elastic.
@@ -243,8 +247,11 @@ private:
 
 /// The curvature of a leaf's free shape [1/m]: 1/free_radius_m, or 8 free_camber_m / L^2 (0: flat).
 double free_curvature_per_m(const LeafSpec& leaf);
-/// Whether any leaf has a free camber (then every run starts with the assembly, simulation.hpp).
+/// Whether any leaf has a free camber.
 bool has_free_camber(const ModelSpec& spec);
+/// Whether a run of the model starts with the assembly (simulation.hpp, require_no_assembly): a
+/// free camber, a rebound clip or an interference (an interface's initial_gap_m < 0).
+bool needs_assembly(const ModelSpec& spec);
 
 const char* to_string(SupportKind kind);
 const char* to_string(PairKind kind);
