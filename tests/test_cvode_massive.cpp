@@ -176,6 +176,47 @@ BOOST_AUTO_TEST_CASE(newmark_converges_to_the_massive_cvode_run) {
     BOOST_TEST(prev < 4e-9);
 }
 
+BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation) {
+    // The friction case on supports moving 5 mm at 8 Hz (every mass feels its inertial force in
+    // their frame, loading.hpp), on top of R's initial velocity: mode newmark against the massive
+    // cvode run at rtol 1e-10, as in the case above. Measured max |w - w_cvode| at dt = 25, 12.5,
+    // 6.25 us: 1.05e-8, 3.5e-9, 2.1e-9 m (ratios 3.0, 1.7: the stick-slip event times move with
+    // dt, as above). Asked: each halving at least 1.5x closer, the finest within 4e-9 m (1e-6 of
+    // the 4 mm R moves), both balances closed.
+    // (With gravity added the two integrators start from the same static state, w(0) equal to
+    // 1e-9, and both balances close, but their runs differ by 7.5e-7 m after 2 ms at every dt:
+    // an open question, docs/time-integration.md "Loadings with leaf mass".)
+    auto loaded = [](SimulationOptions so) {
+        so.loading.kind = LoadingKind::base_excitation;
+        so.loading.displacement_m.shape = TimeFunction::Shape::harmonic;
+        so.loading.displacement_m.amplitude = 0.005;
+        so.loading.displacement_m.frequency_hz = 8.0;
+        return so;
+    };
+    const auto ref = simulate(friction_stack(kSteel), loaded(cvode_options(2e-3, 1e-10)));
+    const double scale = ref.front().kinetic_energy_j + ref.front().strain_energy_j + std::abs(ref.back().external_work_j);
+    BOOST_TEST(max_balance_error(ref) < 1e3 * 1e-10 * scale);
+    double prev = 0.0;
+    for (double dt : {2.5e-5, 1.25e-5, 6.25e-6}) {
+        SimulationOptions so;
+        so.mode = Mode::newmark;
+        so.dt_s = dt;
+        so.t_end_s = 2e-3;
+        so.solver.tolerance_m = 1e-12;
+        const auto r = simulate(friction_stack(kSteel), loaded(so));
+        const auto stride = static_cast<std::size_t>(std::llround(1e-4 / dt));
+        double dev = 0.0;
+        for (std::size_t i = 0; i < ref.size() && i * stride < r.size(); ++i)
+            dev = std::max(dev, std::abs(r[i * stride].w_m - ref[i].w_m));
+        BOOST_TEST_MESSAGE("base excitation, newmark dt " << dt << " s: max |w - w_cvode| " << dev << " m, balance "
+                                                          << max_balance_error(r) << " J");
+        BOOST_TEST(max_balance_error(r) < 1e-9 * scale);
+        if (prev > 0.0) BOOST_TEST(prev / dev > 1.5);
+        prev = dev;
+    }
+    BOOST_TEST(prev < 4e-9);
+}
+
 BOOST_AUTO_TEST_CASE(applied_force_on_the_massive_stack) {
     // A step force of 2 kN on R (whole spring) with the initial conditions, 5 ms. As the leaves'
     // density falls the run tends to the massless cvode run under the same force (measured 7.4x

@@ -122,20 +122,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     // components tied (bilateral ones always; unilateral ones whose gap is closed; their
     // tangential component too when it carries friction or is bonded).
     v_ = Eigen::VectorXd::Zero(n);
-    if (wd0 != 0.0) {
-        std::vector<int> tied;
-        for (const auto& pr : problem_.pairs) {
-            bool closed = true;
-            if (pr.row_n >= 0) {
-                const bool bilateral = pr.kind != PairKind::coulomb;
-                closed = bilateral || rel_[pr.row_n] - d_[pr.row_n] > -1e-12;
-                if (closed) tied.push_back(pr.row_n);
-            }
-            if (closed && pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0))
-                tied.push_back(pr.row_t);
-        }
-        v_ = wd0 * detail::tied_shape(K_, G, tied, 1.0, Eigen::VectorXd::Zero(m));
-    }
+    if (wd0 != 0.0) v_ = wd0 * detail::tied_shape(K_, G, detail::closed_rows(problem_.pairs, rel_, d_), 1.0, Eigen::VectorXd::Zero(m));
     // Initial acceleration from the equations of motion on the massive DOFs:
     // M_SS a_S = (G^T p0 - K z0 + q(0))_S (the massless rows of the residual are zero: static
     // shape); the rig's reaction keeps w'' = w_p''(0) (accelerations_with_rig).

@@ -129,6 +129,22 @@ Eigen::VectorXd detail::static_state(const System& system, const ContactProblem&
     return z;
 }
 
+std::vector<int> detail::closed_rows(const std::vector<ContactPair>& pairs, const Eigen::VectorXd& rel,
+                                     const Eigen::VectorXd& d) {
+    std::vector<int> tied;
+    for (const auto& pr : pairs) {
+        bool closed = true;
+        if (pr.row_n >= 0) {
+            const bool bilateral = pr.kind != PairKind::coulomb;
+            closed = bilateral || rel[pr.row_n] - d[pr.row_n] > -1e-12;
+            if (closed) tied.push_back(pr.row_n);
+        }
+        if (closed && pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0))
+            tied.push_back(pr.row_t);
+    }
+    return tied;
+}
+
 bool detail::static_stages(const System& system, const ContactProblem& laws, const Eigen::VectorXd& weight,
                            const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
                            SolveResult* result) {

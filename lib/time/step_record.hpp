@@ -124,6 +124,12 @@ bool static_stages(const System& system, const ContactProblem& laws, const Eigen
                    const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
                    SolveResult* result = nullptr);
 
+/// The contact rows tied in the initial velocity shape of the steppers with leaf mass (the stack
+/// moving with R, nothing impacting at t = 0): every bilateral normal row, a unilateral one whose
+/// gap is closed (rel - d > -1e-12 m; rel = s + d the relative positions [m]), and the tangential
+/// row of a closed pair that is bonded or carries friction.
+std::vector<int> closed_rows(const std::vector<ContactPair>& pairs, const Eigen::VectorXd& rel, const Eigen::VectorXd& d);
+
 /// TauRule::previous_step: sets problem.tau_previous_n [N] per pair from the forces p of
 /// the step before (|p_n| for a unilateral pair, max(0, F_c - p_n) at a clamp).
 void set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p);

@@ -442,11 +442,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
                                   : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
     if (w_start != z0[s.w_dof])
         z0 = static_state(system, s.chk_problem, weight, w_start, s.opt, p_init, s.d, "initial contact state");
-    std::vector<int> tied;
-    for (const auto& pr : system.pairs()) {
-        if (pr.row_n >= 0) tied.push_back(pr.row_n);
-        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0)) tied.push_back(pr.row_t);
-    }
+    const std::vector<int> tied = closed_rows(system.pairs(), detail::relative_positions(system, z0, p_init), s.d);
     const Eigen::VectorXd v0 = wd_start * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
     s.nstate = 2 * s.ndof + 3;
     s.init_grid();
