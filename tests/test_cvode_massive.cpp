@@ -183,9 +183,10 @@ BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation) {
     // 6.25 us: 1.05e-8, 3.5e-9, 2.1e-9 m (ratios 3.0, 1.7: the stick-slip event times move with
     // dt, as above). Asked: each halving at least 1.5x closer, the finest within 4e-9 m (1e-6 of
     // the 4 mm R moves), both balances closed.
-    // (With gravity added the two integrators start from the same static state, w(0) equal to
-    // 1e-9, and both balances close, but their runs differ by 7.5e-7 m after 2 ms at every dt:
-    // an open question, docs/time-integration.md "Loadings with leaf mass".)
+    // With gravity added (the friction case from its static equilibrium under the weight of the
+    // leaves and R) the two start from the same state and both balances close, but their runs
+    // differ by ~2e-8 m after 2 ms, newmark approaching only slowly as dt falls (an open question,
+    // docs/time-integration.md): guarded here at 4e-8 m (1e-5 of R's motion) at dt = 6.25 us.
     auto loaded = [](SimulationOptions so) {
         so.loading.kind = LoadingKind::base_excitation;
         so.loading.displacement_m.shape = TimeFunction::Shape::harmonic;
@@ -215,6 +216,22 @@ BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation) {
         prev = dev;
     }
     BOOST_TEST(prev < 4e-9);
+
+    SimulationOptions g = cvode_options(2e-3, 1e-10);
+    g.loading.gravity_m_per_s2 = 9.81;
+    const auto gref = simulate(friction_stack(kSteel), g);
+    SimulationOptions gn;
+    gn.mode = Mode::newmark;
+    gn.dt_s = 6.25e-6;
+    gn.t_end_s = 2e-3;
+    gn.solver.tolerance_m = 1e-12;
+    gn.loading.gravity_m_per_s2 = 9.81;
+    const auto rn = simulate(friction_stack(kSteel), gn);
+    BOOST_TEST(rn.front().w_m == gref.front().w_m, tt::tolerance(1e-9));  // the same static start
+    double gdev = 0.0;
+    for (std::size_t i = 0; i < gref.size() && 16 * i < rn.size(); ++i) gdev = std::max(gdev, std::abs(rn[16 * i].w_m - gref[i].w_m));
+    BOOST_TEST_MESSAGE("gravity, newmark dt 6.25e-6 s: max |w - w_cvode| " << gdev << " m");
+    BOOST_TEST(gdev < 4e-8);
 }
 
 BOOST_AUTO_TEST_CASE(applied_force_on_the_massive_stack) {

@@ -223,9 +223,25 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         const double prate = (P * v).lpNorm<Eigen::Infinity>();
         if (prate > 0.0) delta = std::min(delta, kLookahead * F_ref / prate);
         if (!std::isfinite(delta)) delta = 0.0;
+        // The third-order term: z^(3) = M^-1 (q'(t) - K_eff z' - C z'') of the current modes (the
+        // rig's w^(3) taken as 0). It decides where the lower orders vanish at the contact points: a
+        // start from static equilibrium (z'' = 0) with the leaves moving in the tied shape (no slider
+        // rate), where a pair left at the friction cone's edge by the static solve would otherwise be
+        // decided by round-off.
+        Eigen::VectorXd r3 = -(Keff * v);
+        if (damped()) r3 -= C * a;
+        if (!load->none()) {
+            const double h = 1e-7;  // [s] q'(t) by central differences (smooth loadings)
+            r3 += (load->at(te + h) - load->at(te - h)) / (2.0 * h);
+        }
+        Eigen::VectorXd jerk = mass.solve(r3);
+        if (rig) jerk -= (jerk[w_dof] / u_w[w_dof]) * u_w;
+        const double jmax = (Grow * jerk).lpNorm<Eigen::Infinity>();
+        if (jmax > 0.0)
+            delta = std::min(delta > 0.0 ? delta : std::numeric_limits<double>::infinity(), std::cbrt(6.0 * target / jmax));
         Vec yl = y;
-        yl.head(ndof) = z + delta * v + 0.5 * delta * delta * a;
-        yl.segment(ndof, ndof) = v + delta * a;
+        yl.head(ndof) = z + delta * v + 0.5 * delta * delta * a + delta * delta * delta / 6.0 * jerk;
+        yl.segment(ndof, ndof) = v + delta * a + 0.5 * delta * delta * jerk;
         return yl;
     }
 
