@@ -12,7 +12,7 @@ install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" gnuplot-nox  # gnuplot: the CL
 build
 # --timeout: a test that hangs (a sanitizer's abort_on_error was seen to hang a binary for
 # over 16 min instead of failing) fails after 15 min instead of stalling the run; the
-# slowest test takes under 2 min under the sanitizers.
+# slowest test (test_cvode_massive) takes about 3.3 min under the sanitizers.
 ctest --test-dir build --output-on-failure --timeout 900
 
 if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
