@@ -90,14 +90,12 @@ std::string rigid_row_field(const System& system, int kk) {
 struct CvodeMassiveStepper::Impl final : EventDriver {
     Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (massive leaves)") {}
 
-    int ndof = 0, w_dof = 0;
     SpMat K, M, Gt;
     SpMat C;                  // structural damping alpha M + beta K [N s/m] (empty: none)
     bool damped() const { return opt.damping.active(); }
     RowSpMat Grow;            // G, row-major [-]
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
-    double f = 1.0, m_body = 0.0;
     std::unique_ptr<ReducedLoad> load;  // q(t) of the loading (none for initial conditions and the rig)
     bool rig = false;                   // w prescribed (LoadingKind::prescribed_displacement)
     Eigen::VectorXd u_w;                // M^-1 e_w [1/kg] (the rig's reaction per unit force)
@@ -394,14 +392,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.Grow = G;
     s.Gt = G.transpose();
     s.cL = cL;
-    s.ndof = static_cast<int>(s.K.rows());
-    s.w_dof = s.ndof - 1;
-    s.n = system.num_components();
-    s.np = static_cast<int>(system.pairs().size());
-    s.f = system.model().whole_spring_factor();
-    s.d = system.initial_offsets_m();
     const auto& body = system.model().spec().rigid_body;
-    s.m_body = body.mass_kg;
     if (s.damped()) {
         s.C = s.opt.damping.rayleigh_alpha_per_s * s.M + s.opt.damping.rayleigh_beta_s * s.K;
         s.C.makeCompressed();

@@ -42,14 +42,13 @@ namespace stackbeam::detail {
 struct CvodeModalStepper::Impl final : EventDriver {
     Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (leaf inertia)") {}
 
-    int ndof = 0, r = 0, w_dof = 0;  // reduced DOFs, retained modes, R's DOF
+    int r = 0;                // retained modes
     Eigen::MatrixXd Phi;      // retained modes, n x r (mass-normalised)
     Eigen::VectorXd om;       // their circular frequencies [rad/s]
     Eigen::MatrixXd GPhi;     // G Phi, n x r
     Eigen::MatrixXd W;        // residual compliance G R G^T, n x n [m/N]
     Eigen::VectorXd rw;       // row w of R G^T, n: w = Phi_w q + rw . p
     Eigen::VectorXd phiw;     // row w of Phi
-    double f = 1.0, m_body = 0.0;
     // the current modes: p = P q + p0, s = Hs q + bs, q'' = A1 q + a0
     Eigen::MatrixXd P, Hs, A1;
     Eigen::VectorXd p0, bs, a0;
@@ -215,14 +214,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double> M = system.mass_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();
-    s.ndof = static_cast<int>(K.rows());
-    s.w_dof = s.ndof - 1;
-    s.n = system.num_components();
-    s.np = static_cast<int>(system.pairs().size());
-    s.f = system.model().whole_spring_factor();
-    s.d = system.initial_offsets_m();
     const auto& body = system.model().spec().rigid_body;
-    s.m_body = body.mass_kg;
 
     // modes of the unconnected stack (K, M), dense: n is a few hundred on the example
     const Eigen::MatrixXd Kd(K), Md(M);

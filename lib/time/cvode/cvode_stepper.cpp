@@ -39,7 +39,7 @@ bool ContactEvent::is_stick_slip() const {
 struct CvodeStepper::Impl final : detail::EventDriver {
     const Eigen::MatrixXd& C;  // C' [m/N]
     Eigen::VectorXd c;         // coupling [-]
-    double k = 0, m = 0, f = 1;
+    double k = 0, m = 0;
     Loading load;              // the loading (loading.hpp), prepared
     double m_whole = 0;        // R's whole mass [kg]
     /// External force on R of the meshed part at t [N] (loading.hpp: F/f - m g - m y_b'').
@@ -241,13 +241,9 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
                                          "leaves: with w(t) imposed there is no equation of motion to integrate, each "
                                          "step is quasi-static (use mode closed-form, whose step is then exact)");
     s.require_current_tau_rule();
-    s.n = system.num_components();
-    s.np = static_cast<int>(system.pairs().size());
     s.c = system.coupling();
-    s.d = system.initial_offsets_m();
     s.k = system.stiffness_n_per_m();
     s.m = system.mass_kg();
-    s.f = system.model().whole_spring_factor();
     s.load = s.opt.loading;
     s.load.prepare();
     require_loading_fits(system.model().spec(), s.load);

@@ -16,7 +16,16 @@
 namespace stackbeam::detail {
 
 EventDriver::EventDriver(const System& system, const SimulationOptions& options, std::string who_)
-    : sys(system), opt(options), who(std::move(who_)) {}
+    : sys(system),
+      opt(options),
+      who(std::move(who_)),
+      n(system.num_components()),
+      np(static_cast<int>(system.pairs().size())),
+      ndof(system.num_reduced_dofs()),
+      w_dof(system.num_reduced_dofs() - 1),
+      f(system.model().whole_spring_factor()),
+      m_body(system.model().spec().rigid_body.mass_kg),
+      d(system.initial_offsets_m()) {}
 
 EventDriver::~EventDriver() = default;
 

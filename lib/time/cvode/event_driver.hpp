@@ -51,15 +51,19 @@ public:
     const System& sys;
     SimulationOptions opt;
     std::string who;
+    // from the system (constructor)
     int n = 0;                  ///< contact rows
     int np = 0;                 ///< pairs
+    int ndof = 0, w_dof = 0;    ///< reduced DOFs (System::num_reduced_dofs), R's DOF (the last)
+    double f = 1.0;             ///< whole-spring factor (System's model)
+    double m_body = 0.0;        ///< R's mass, whole spring [kg]
     int nstate = 0;             ///< CVODE's state size
     double F_ref = 1.0, L_ref = 1.0, V_ref = 1.0;  ///< force [N], length [m], velocity [m/s] scales
     double gap_margin = kMotionMargin;             ///< margin of the gap witnesses (relative to L_ref)
     ModeSet modes;                                 ///< the current modes
     std::vector<signed char>& nmode = modes.nmode;  ///< per pair: CLOSED, OPEN (NONE: no normal row)
     std::vector<signed char>& tmode = modes.tmode;  ///< per pair: STICK, SLIP_POS, SLIP_NEG, FREE (NONE)
-    Vec d;                      ///< gaps (normal rows) and anchors (tangential rows) [m]
+    Vec d;                      ///< gaps (normal rows) and anchors (tangential rows) [m]; the system's offsets at first
     Vec d_chk;                  ///< anchors of the per-step check
     struct Slot { int pair; bool normal; };
     std::vector<Slot> slots;    ///< one witness per possible transition
