@@ -55,33 +55,23 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
     //    from the unloaded (assembled) stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
     w_ = 0.0;
-    const bool assemble = needs_assembly(system_.model().spec()) && n > 0;
-    for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
-        if (stage == 0 ? !assemble : !(load.gravity_m_per_s2 > 0.0)) continue;
-        const double Fs = stage == 0 ? 0.0 : -m * load.gravity_m_per_s2;  // [N] on the meshed part
-        const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
-        if (path_ == ContactPath::dense) {
+    if (path_ == ContactPath::dense) {
+        const bool assemble = needs_assembly(system_.model().spec()) && n > 0;
+        for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
+            if (stage == 0 ? !assemble : !(load.gravity_m_per_s2 > 0.0)) continue;
+            const double Fs = stage == 0 ? 0.0 : -m * load.gravity_m_per_s2;  // [N] on the meshed part
+            const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
             auto solver = make_solver(options_.solver);
             const detail::StaticState st = detail::static_equilibrium_dense(system_, problem_, Fs, *solver, p_, d_, what);
             w_ = st.w_m;
             solve_ = st.solve;
-        } else {
-            SparseContactProblem st;
-            st.K = K;
-            st.G = G;
-            st.b = Eigen::VectorXd::Zero(nz);
-            st.b[w_dof_] = Fs;
-            st.d = d_;
-            st.layer_compliance = detail::sparse_layer(system_);
-            st.pairs = problem_.pairs;
-            st.tau_rule = problem_.tau_rule;
-            st.tau_previous_n = problem_.tau_previous_n;
-            SparseContactSolver solver(options_.solver, options_.sparse_tuning);
-            solve_ = solver.solve(st, p_, z_);
-            if (n > 0 && !solve_.converged) throw SolverError(what + ": " + solve_.message, 0, 0.0, solve_.residual_m);
-            w_ = z_[w_dof_];
-            detail::reanchor(problem_, p_, detail::relative_positions(system_, z_, p_), d_);
         }
+    } else {
+        // the same stages on the whole sparse system, as the leaf-mass steppers take them (massless
+        // leaves: the weight is R's, -m g on w)
+        Eigen::VectorXd weight = Eigen::VectorXd::Zero(nz);
+        weight[w_dof_] = -m * load.gravity_m_per_s2;
+        if (detail::static_stages(system_, problem_, weight, options_, z_, p_, d_, &solve_)) w_ = z_[w_dof_];
     }
     // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
     //    relative to the supports, whose velocity the initial absolute velocity excludes).

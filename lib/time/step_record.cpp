@@ -157,7 +157,7 @@ bool detail::static_stages(const System& system, const ContactProblem& laws, con
     }
     if (weight.size() > 0 && weight.lpNorm<Eigen::Infinity>() > 0.0) {
         z = static_state(system, laws, weight, std::nan(""), options, p, d,
-                         "static equilibrium under gravity (the leaves' weight and R's)", result);
+                         "static equilibrium under gravity", result);
         ran = true;
     }
     return ran;
