@@ -37,12 +37,10 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode newmark with "
                                          "massless leaves (the leaves have no inertia to integrate): use mode "
                                          "closed-form, or give the leaves a density > 0");
-    if (rig_ && detail::first_rigid_pair(system_) >= 0) {
-                throw InputError("loading.kind", "value 'prescribed-displacement' with massive leaves and rigid contact "
-                                                 "is not available in mode newmark (the impact law would move the rig's "
-                                                 "seat): give the interfaces an elastic layer (interfaces[i].contact = "
-                                                 "'elastic')");
-    }
+    if (rig_ && detail::first_rigid_pair(system_) >= 0)
+        throw InputError("loading.kind", "value 'prescribed-displacement' with massive leaves and rigid contact is not "
+                                         "available in mode newmark (the impact law would move the rig's seat): give the "
+                                         "interfaces an elastic layer (interfaces[i].contact = 'elastic')");
     load_ = std::make_unique<detail::ReducedLoad>(system_, L);
     path_ = choose_contact_path(system_, options_);
     const double dt = options_.dt_s;
@@ -134,10 +132,12 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         if (factor_->mass.info() != Eigen::Success)
             throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
     }
-    if (rig_) {
+    if (rig_) {  // M^-1 e_w, once: the rig's reaction per unit force
+        Eigen::VectorXd ew = Eigen::VectorXd::Zero(n);
+        ew[w_dof] = 1.0;
+        u_w_ = factor_->mass.solve(ew);
         a_ = accelerations_with_rig(0.0, r0, &rig_force_);
     } else {
-        const Eigen::VectorXd& r = r0;
         const int ns = static_cast<int>(massive.size());
         Eigen::SparseMatrix<double> S(ns, n);
         std::vector<Eigen::Triplet<double>> st;
@@ -147,7 +147,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mf(Mss);
         if (mf.info() != Eigen::Success)
             throw SolverError("newmark: the mass matrix of the massive DOFs is singular", 0, 0.0, 0.0);
-        a_ = S.transpose() * Eigen::VectorXd(mf.solve(S * r));
+        a_ = S.transpose() * Eigen::VectorXd(mf.solve(S * r0));
     }
     for (int i = 0; i < n; ++i)
         if (massless_[i]) v_[i] = a_[i] = 0.0;
@@ -207,14 +207,9 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
 }
 
 Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {
-    // M a = r + lambda e_w with a_w = w_p''(t): lambda = (w_p'' - (M^-1 r)_w) / (M^-1)_ww
-    const int w_dof = static_cast<int>(r.size()) - 1;
-    Eigen::VectorXd ew = Eigen::VectorXd::Zero(r.size());
-    ew[w_dof] = 1.0;
-    const Eigen::VectorXd u = factor_->mass.solve(ew);
+    // M a = r + lambda e_w with a_w = w_p''(t)
     Eigen::VectorXd a = factor_->mass.solve(r);
-    const double lambda = (options_.loading.displacement_m.second_derivative(t_s) - a[w_dof]) / u[w_dof];
-    a += lambda * u;
+    const double lambda = detail::prescribe_w_acceleration(a, u_w_, options_.loading.displacement_m.second_derivative(t_s));
     if (lambda_n) *lambda_n = lambda;
     return a;
 }

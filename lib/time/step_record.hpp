@@ -124,6 +124,15 @@ bool static_stages(const System& system, const ContactProblem& laws, const Eigen
                    const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
                    SolveResult* result = nullptr);
 
+/// The rig's reaction on R's DOF (w last): adds lambda u_w to the accelerations a = M^-1 r so that
+/// a_w = w_dd [m/s^2], u_w = M^-1 e_w [1/kg]; returns lambda = (w_dd - a_w) / (u_w)_w [N].
+inline double prescribe_w_acceleration(Eigen::VectorXd& a, const Eigen::VectorXd& u_w, double w_dd) {
+    const Eigen::Index w = a.size() - 1;
+    const double lambda = (w_dd - a[w]) / u_w[w];
+    a += lambda * u_w;
+    return lambda;
+}
+
 /// The contact rows tied in the initial velocity shape of the steppers with leaf mass (the stack
 /// moving with R, nothing impacting at t = 0): every bilateral normal row, a unilateral one whose
 /// gap is closed (rel - d > -1e-12 m; rel = s + d the relative positions [m]), and the tangential

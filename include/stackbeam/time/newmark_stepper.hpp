@@ -131,6 +131,7 @@ private:
     std::unique_ptr<detail::ReducedLoad> load_;  // the loading's q(t) on the reduced DOFs
     bool rig_ = false;                         // w prescribed (the rig)
     Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
+    Eigen::VectorXd u_w_;                      // the rig: M^-1 e_w [1/kg]
     double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
     double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
     Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)

@@ -184,8 +184,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         if (damped()) r -= C * v;
         Eigen::VectorXd a = mass.solve(r);
         if (rig) {
-            const double lambda = (opt.loading.displacement_m.second_derivative(t_s) - a[w_dof]) / u_w[w_dof];
-            a += lambda * u_w;
+            const double lambda = prescribe_w_acceleration(a, u_w, opt.loading.displacement_m.second_derivative(t_s));
             if (rig_n) *rig_n = lambda;
         } else if (rig_n) {
             *rig_n = 0.0;
@@ -233,7 +232,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
             r3 += (load->at(te + h) - load->at(te - h)) / (2.0 * h);
         }
         Eigen::VectorXd jerk = mass.solve(r3);
-        if (rig) jerk -= (jerk[w_dof] / u_w[w_dof]) * u_w;
+        if (rig) prescribe_w_acceleration(jerk, u_w, 0.0);
         const double jmax = (Grow * jerk).lpNorm<Eigen::Infinity>();
         if (jmax > 0.0)
             delta = std::min(delta > 0.0 ? delta : std::numeric_limits<double>::infinity(), std::cbrt(6.0 * target / jmax));
