@@ -423,12 +423,13 @@ const StepRecord& NewmarkStepper::advance() {
         if (rig_) {
             // The rig's mean force over the step from R's row of the step's momentum balance,
             // M (v1 - v0) = dt [-K (z0 + z1)/2 + G^T p1 + qbar + lambda_bar e_w], and its work
-            // lambda_bar (w1 - w0): the balance closes as for the other forces.
-            Eigen::VectorXd res = M_ * Eigen::VectorXd((v1 - v_) / dt) + 0.5 * (K_ * Eigen::VectorXd(z_ + z1)) -
-                                  G.transpose() * p_;
-            if (loaded) res -= 0.5 * (q0 + q1);
-            if (damped) res += C_ * Eigen::VectorXd((z1 - z_) / dt);
-            external_work_ += res[w_dof] * (z1[w_dof] - z_[w_dof]);
+            // lambda_bar (w1 - w0): the balance closes as for the other forces. Only R's row is
+            // needed: M, K and C are symmetric, so row w is column w.
+            double lambda_bar = M_.col(w_dof).dot(Eigen::VectorXd((v1 - v_) / dt)) +
+                                0.5 * K_.col(w_dof).dot(Eigen::VectorXd(z_ + z1)) - G.col(w_dof).dot(p_);
+            if (loaded) lambda_bar -= 0.5 * (q0[w_dof] + q1[w_dof]);
+            if (damped) lambda_bar += C_.col(w_dof).dot(Eigen::VectorXd((z1 - z_) / dt));
+            external_work_ += lambda_bar * (z1[w_dof] - z_[w_dof]);
         }
         // the damping force's work over the step, (z1 - z0)^T C (z1 - z0) / dt >= 0
         if (damped) damping_energy_ += (z1 - z_).dot(C_ * (z1 - z_)) / dt;
