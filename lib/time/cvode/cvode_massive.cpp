@@ -99,6 +99,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     std::unique_ptr<ReducedLoad> load;  // q(t) of the loading (none for initial conditions and the rig)
     bool rig = false;                   // w prescribed (LoadingKind::prescribed_displacement)
     Eigen::VectorXd u_w;                // M^-1 e_w [1/kg] (the rig's reaction per unit force)
+    mutable double rig_lambda_rhs = 0.0;  // the rig's lambda [N] at the last right-hand side (its Newton row)
     // the current modes: p = P z + p0, s + d = Hs z + hs, M z'' = -Keff z + b0
     RowSpMat P, Hs;
     SpMat Keff;
@@ -279,6 +280,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
         double lambda = 0.0;
         Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(t, z, v, &lambda);
+        s->rig_lambda_rhs = lambda;
         double pw = 0.0;
         for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
         D[2 * n_] = pw;
@@ -329,11 +331,10 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
             dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
         X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped() ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
-        // d(q^T v) = q^T dv (the rig's lambda w': lambda dw', lambda's own change left out of this
-        // row of the Newton matrix, which nothing else depends on)
-        double lambda = 0.0;
-        if (s->rig) s->acceleration(t, z, v, &lambda);
-        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->external_power(t, xvel, lambda);
+        // d(q^T v) = q^T dv (the rig's lambda w': lambda dw' with the lambda of the last right-hand
+        // side, lambda's own change left out of this row of the Newton matrix, which nothing else
+        // depends on)
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->external_power(t, xvel, s->rig_lambda_rhs);
         return 0;
     }
 
