@@ -3,6 +3,9 @@
 
 # The packages every build needs (pkgconf: the test of the installed stackbeam.pc).
 STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+# OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
+# the tests then skip the MPI comparison).
+STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.
@@ -49,4 +52,14 @@ build_sanitized() {
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
     -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   cmake --build build-asan -j"$(nproc)"
+}
+
+# build_tsan: a third, small build in build-tsan/ under ThreadSanitizer: the library and
+# the one test that runs its points on threads (tests/test_sweep.cpp, `stackbeam sweep
+# --jobs N`'s scheduler), not the whole project (a few minutes on 2 cores). Proves the
+# library keeps no mutable state shared between runs: a data race fails the test.
+build_tsan() {
+  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
+    -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DSTACKBEAM_BUILD_DEMOS=OFF
+  cmake --build build-tsan -j"$(nproc)" --target test_sweep
 }

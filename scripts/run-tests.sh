@@ -2,13 +2,15 @@
 # The tests: installs what is missing (Debian), builds, and runs every test with CTest,
 # twice: the Release build in build/, then a second build in build-asan/ under
 # AddressSanitizer and UndefinedBehaviorSanitizer (any report fails the test that
-# made it). STACKBEAM_SANITIZERS=0 skips the second (for a quick local run; CI runs both).
+# made it); then a third, small one in build-tsan/: the sweep's threads under
+# ThreadSanitizer (the library and test_sweep only). STACKBEAM_SANITIZERS=0 skips the
+# second and third (for a quick local run; CI runs all three).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
 source scripts/common.sh
 
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" gnuplot-nox  # gnuplot: the CLI test of --plot
+install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" gnuplot-nox  # gnuplot: the CLI test of --plot; MPI: the sweep's
 build
 # --timeout: a test that hangs (a sanitizer's abort_on_error was seen to hang a binary for
 # over 16 min instead of failing) fails after 15 min instead of stalling the run; the
@@ -22,4 +24,8 @@ if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure --timeout 900
   echo "sanitizer build and tests: $(( $(date +%s) - start )) s"
+  start=$(date +%s)
+  build_tsan
+  TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir build-tsan --output-on-failure --timeout 900 -R '^test_sweep$'
+  echo "thread sanitizer build and test: $(( $(date +%s) - start )) s"
 fi

@@ -30,6 +30,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <sstream>
 #include <string>
 
 #include "options.hpp"
@@ -38,6 +39,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/model.hpp"
 #include "summary.hpp"
+#include "sweep.hpp"
 
 namespace {
 
@@ -80,9 +82,27 @@ int run_simulate(const SimulateArgs& args) {
     }
 }
 
+int run_main(int argc, char** argv, const MpiWorld& world);
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    // under mpirun (sweep): MPI first, it may take its own arguments; a plain command never starts MPI
+    MpiWorld world;
+    try {
+        world = mpi_start(argc, argv);
+    } catch (const std::exception& e) {
+        std::cerr << "stackbeam: error: " << e.what() << "\n";
+        return exit_other;
+    }
+    const int status = run_main(argc, argv, world);
+    mpi_finish(world);
+    return status;
+}
+
+namespace {
+
+int run_main(int argc, char** argv, const MpiWorld& world) {
     CLI::App app{"stackbeam: vibration of a stacked-beam leaf spring with Coulomb friction between the leaves\n"
                  "(Lee & Lim 1992, section 5 example: three leaves, four clamps, 20 kg body at 2 m/s)",
                  "stackbeam"};
@@ -100,6 +120,14 @@ int main(int argc, char** argv) {
                 "Errors name the flag as given, or the file's key with file:line:column.");
     add_simulate_options(*sim, args);
 
+    SweepArgs sweep_args;
+    CLI::App* sweep = app.add_subcommand("sweep", "Run a base scenario at many points (axes over any scenario key) on threads or "
+                                                  "MPI ranks: a table of loop figures, resumable (docs/sweep.md)");
+    sweep->footer("Exit status: 0 every point ok, 2 bad spec (nothing run), 3 some points failed (their rows say why),\n"
+                  "130 / 143 stopped by SIGINT / SIGTERM (run the same command again to resume), 1 other errors.\n"
+                  "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
+    add_sweep_options(*sweep, sweep_args);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -113,21 +141,28 @@ int main(int argc, char** argv) {
     for (const CLI::Option* option : sim->get_options())
         if (option->count() > 0) args.given.insert(option->get_name());
 
+    // an error: printed by rank 0 alone under mpirun, where it also stops the other ranks
+    auto fail = [&](int status, const std::string& message) {
+        if (world.rank == 0) std::cerr << "stackbeam: error: " << message << "\n";
+        if (world.active && world.size > 1) mpi_abort(world, status);
+        return status;
+    };
     try {
         if (sim->parsed()) return run_simulate(args);
+        if (sweep->parsed()) return run_sweep_command(sweep_args, world);
         return exit_other;
     } catch (const ArgumentError& e) {
-        std::cerr << "stackbeam: error: " << e.what() << "\n";
-        return exit_input;
+        return fail(exit_input, e.what());
     } catch (const stackbeam::InputError& e) {
-        std::cerr << "stackbeam: error: " << e.what() << "\n";
-        return exit_input;
+        return fail(exit_input, e.what());
     } catch (const stackbeam::SolverError& e) {
-        std::cerr << "stackbeam: error: solver failure at step " << e.step() << " (t = " << e.time_s()
-                  << " s, residual " << e.residual() << "): " << e.what() << "\n";
-        return exit_solver;
+        std::ostringstream message;  // the numbers as a stream prints them (6 digits)
+        message << "solver failure at step " << e.step() << " (t = " << e.time_s() << " s, residual " << e.residual()
+                << "): " << e.what();
+        return fail(exit_solver, message.str());
     } catch (const std::exception& e) {
-        std::cerr << "stackbeam: error: " << e.what() << "\n";
-        return exit_other;
+        return fail(exit_other, e.what());
     }
 }
+
+}  // namespace

@@ -9,6 +9,7 @@
 ///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
 ///   io/       scenario files (TOML) and CSV output
 ///   post/     hysteresis-loop figures of a run
+///   study/    sweeps: a base scenario at many points, on threads; the results directory
 #include "stackbeam/conventions.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/model.hpp"
@@ -27,3 +28,5 @@
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/study/sweep.hpp"
+#include "stackbeam/study/sweep_output.hpp"

@@ -1,0 +1,186 @@
+// The figures of a sweep (sweep_plot.hpp): gnuplot scripts and PNGs in DIR/figures/.
+#include "sweep_plot.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <tuple>
+
+#include "gnuplot.hpp"
+#include "stackbeam/study/sweep_output.hpp"
+
+namespace stackbeam::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The point of a product sweep at one index per axis (the last axis varies fastest).
+int product_index(const SweepSpec& spec, const std::vector<std::size_t>& at) {
+    int index = 0;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        index = index * static_cast<int>(spec.axes[a].values.size()) + static_cast<int>(at[a]);
+    return index;
+}
+
+bool numeric(const SweepAxis& axis) {
+    for (const AxisValue& v : axis.values)
+        if (!std::holds_alternative<double>(v) && !std::holds_alternative<long long>(v)) return false;
+    return true;
+}
+
+double as_number(const AxisValue& v) {
+    if (const auto* d = std::get_if<double>(&v)) return *d;
+    return static_cast<double>(std::get<long long>(v));
+}
+
+/// A file name part from a key: letters, digits and '_' kept, the rest '_'.
+std::string file_part(const std::string& key) {
+    std::string s;
+    for (char c : key) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    return s;
+}
+
+/// Log scale for an axis whose values are positive and span a factor above 20.
+bool log_scale(const SweepAxis& axis) {
+    double lo = INFINITY, hi = 0.0;
+    for (const AxisValue& v : axis.values) {
+        const double x = as_number(v);
+        if (!(x > 0.0)) return false;
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+    }
+    return hi > 20.0 * lo;
+}
+
+}  // namespace
+
+std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpec& spec,
+                                    const std::vector<SweepPoint>& points, const std::vector<PointResult>& results,
+                                    std::string& note) {
+    using namespace stackbeam::demo;
+    if (!gnuplot_on_path()) {
+        note = "gnuplot is not on PATH (install gnuplot-nox)";
+        return {};
+    }
+    const auto terminal = png_terminal();
+    if (!terminal) {
+        note = "gnuplot has neither the pngcairo nor the png terminal";
+        return {};
+    }
+    const fs::path dir = fs::path(directory) / "figures";
+    fs::create_directories(dir);
+    const std::string script_path = (dir / "figures.gp").string();
+    std::ofstream g(script_path);
+    if (!g) throw std::runtime_error("cannot write '" + script_path + "'");
+    g << "set datafile separator ','\nset terminal " << *terminal << " size 1000,680\nset grid\nset key outside right\n";
+    std::vector<std::string> files;
+    auto has_loop = [&](int i) { return fs::exists(point_file(directory, "loops", i, "csv")); };
+    auto loop_curve = [&](int i, const std::string& title) {
+        return "'" + point_file(directory, "loops", i, "csv") + "' using (1000*$2):3 skip 1 with lines lw 1.5 title '" +
+               title + "'";
+    };
+    const std::size_t n_axes = spec.axes.size();
+    // 1. loop families
+    if (spec.combine == Combine::product) {
+        std::vector<std::size_t> middle(n_axes);
+        for (std::size_t a = 0; a < n_axes; ++a) middle[a] = spec.axes[a].values.size() / 2;
+        for (std::size_t a = 0; a < n_axes; ++a) {
+            if (spec.axes[a].values.size() < 2) continue;
+            std::string curves, fixed;
+            for (std::size_t b = 0; b < n_axes; ++b)
+                if (b != a) fixed += (fixed.empty() ? "" : ", ") + spec.axes[b].key + " = " + to_string(spec.axes[b].values[middle[b]]);
+            for (std::size_t k = 0; k < spec.axes[a].values.size(); ++k) {
+                auto at = middle;
+                at[a] = k;
+                const int i = product_index(spec, at);
+                if (!has_loop(i)) continue;
+                curves += (curves.empty() ? "" : ", ") + loop_curve(i, spec.axes[a].key + " = " + to_string(spec.axes[a].values[k]));
+            }
+            if (curves.empty()) continue;
+            files.push_back((dir / ("loops_along_" + file_part(spec.axes[a].key) + ".png")).string());
+            g << "set output '" << files.back() << "'\nset title \"loops along " << spec.axes[a].key
+              << (fixed.empty() ? "" : "\\n(" + fixed + ")") << "\" noenhanced\nset xlabel 'w [mm]'\nset ylabel 'spring force [N]'\nplot "
+              << curves << "\n";
+        }
+    } else {
+        std::string curves;
+        for (const SweepPoint& p : points) {
+            if (!has_loop(p.index)) continue;
+            std::string title;
+            for (std::size_t a = 0; a < n_axes; ++a) title += (a ? ", " : "") + to_string(p.values[a]);
+            curves += (curves.empty() ? "" : ", ") + loop_curve(p.index, title);
+        }
+        if (!curves.empty()) {
+            files.push_back((dir / "loops.png").string());
+            g << "set output '" << files.back() << "'\nset title 'loops' noenhanced\nset xlabel 'w [mm]'\n"
+              << "set ylabel 'spring force [N]'\nplot " << curves << "\n";
+        }
+    }
+    // 2. maps over the first two numeric axes with two or more values (the others at their middle value)
+    std::vector<std::size_t> map_axes;
+    for (std::size_t a = 0; a < n_axes && map_axes.size() < 2; ++a)
+        if (spec.axes[a].values.size() >= 2 && numeric(spec.axes[a])) map_axes.push_back(a);
+    if (spec.combine == Combine::product && map_axes.size() == 2) {
+        const std::size_t ax = map_axes[0], ay = map_axes[1];
+        std::vector<std::size_t> at(n_axes);
+        for (std::size_t a = 0; a < n_axes; ++a) at[a] = spec.axes[a].values.size() / 2;
+        const std::string data = (dir / "map.csv").string();
+        std::ofstream d(data);
+        d << "# " << spec.axes[ax].key << "," << spec.axes[ay].key << ",loss_factor,dynamic_rate_n_per_m\n";
+        const auto& columns = point_figure_columns();
+        std::size_t c_eta = 0, c_rate = 0;
+        for (std::size_t c = 0; c < columns.size(); ++c) {
+            if (columns[c] == "loss_factor") c_eta = c;
+            if (columns[c] == "dynamic_rate_n_per_m") c_rate = c;
+        }
+        bool any = false;
+        for (std::size_t i = 0; i < spec.axes[ax].values.size(); ++i) {
+            for (std::size_t j = 0; j < spec.axes[ay].values.size(); ++j) {
+                at[ax] = i;
+                at[ay] = j;
+                const PointResult& r = results.at(static_cast<std::size_t>(product_index(spec, at)));
+                const double eta = r.figures.size() > c_eta ? r.figures[c_eta] : NAN;
+                const double rate = r.figures.size() > c_rate ? r.figures[c_rate] : NAN;
+                any = any || std::isfinite(eta);
+                char line[160];
+                std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g\n", as_number(spec.axes[ax].values[i]),
+                              as_number(spec.axes[ay].values[j]), eta, rate);
+                d << line;
+            }
+            d << "\n";
+        }
+        d.close();
+        if (any) {
+            std::string fixed;
+            for (std::size_t b = 0; b < n_axes; ++b)
+                if (b != ax && b != ay)
+                    fixed += (fixed.empty() ? "" : ", ") + spec.axes[b].key + " = " + to_string(spec.axes[b].values[at[b]]);
+            g << "set view map\nset pm3d at b corners2color c1\nunset key\nset xlabel '" << spec.axes[ax].key
+              << "' noenhanced\nset ylabel '" << spec.axes[ay].key << "' noenhanced\n"
+              << (log_scale(spec.axes[ax]) ? "set logscale x\n" : "") << (log_scale(spec.axes[ay]) ? "set logscale y\n" : "");
+            for (const auto& [name, col, label] : {std::tuple<std::string, int, std::string>{"loss_factor", 3, "loss factor [-]"},
+                                                   {"dynamic_rate", 4, "dynamic rate [N/m]"}}) {
+                files.push_back((dir / ("map_" + name + ".png")).string());
+                g << "set output '" << files.back() << "'\nset title \"" << label << (fixed.empty() ? "" : "\\n(" + fixed + ")")
+                  << "\" noenhanced\nsplot '" << data << "' using 1:2:" << col << " with pm3d\n";
+            }
+        }
+    }
+    g.close();
+    if (files.empty()) {
+        note = "no point has a loop (no periodic loading?)";
+        return {};
+    }
+    if (std::system(("gnuplot " + shell_quote(script_path) + " 2>/dev/null").c_str()) != 0) {
+        note = "gnuplot failed on " + script_path;
+        return {};
+    }
+    return files;
+}
+
+}  // namespace stackbeam::cli

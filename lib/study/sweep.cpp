@@ -1,0 +1,579 @@
+// Sweeps: the spec file, the points (the base scenario's TOML document edited at the
+// axes' key paths, then read by parse_scenario), one point's run, the thread scheduler.
+#include "stackbeam/study/sweep.hpp"
+
+#include <toml.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "stackbeam/fe/system.hpp"
+#include "stackbeam/model/model.hpp"
+#include "stackbeam/post/hysteresis.hpp"
+
+namespace stackbeam {
+
+namespace {
+
+using Document = toml::basic_value<toml::discard_comments, std::map, std::vector>;
+
+std::string line_of(const std::string& source, const toml::value& v) {
+    return source + ":" + std::to_string(v.location().line());
+}
+
+/// One part of a key path: a table key, optionally followed by [i] or [*].
+struct PathPart {
+    std::string name;
+    enum class Index { none, one, all } index = Index::none;
+    std::size_t element = 0;
+};
+
+/// Splits "a.b[2].c" / "interfaces[*].mu" into parts; throws naming the spec line on bad syntax.
+std::vector<PathPart> split_key(const std::string& key, const std::string& location, const std::string& field) {
+    auto bad = [&](const std::string& why) {
+        throw InputError(field, "value '" + key + "' is not a key path: " + why +
+                                    " (table keys joined by '.', an array element as [i] or every element as [*], "
+                                    "e.g. interfaces[*].friction_coefficient)",
+                         location);
+    };
+    if (key.empty()) bad("it is empty");
+    std::vector<PathPart> parts;
+    std::size_t i = 0;
+    while (i <= key.size()) {
+        PathPart p;
+        while (i < key.size() && key[i] != '.' && key[i] != '[') {
+            const char c = key[i];
+            if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) bad(std::string("character '") + c + "'");
+            p.name += c;
+            ++i;
+        }
+        if (p.name.empty()) bad("an empty key part");
+        if (i < key.size() && key[i] == '[') {
+            const std::size_t close = key.find(']', i);
+            if (close == std::string::npos) bad("'[' without ']'");
+            const std::string inside = key.substr(i + 1, close - i - 1);
+            if (inside == "*") {
+                p.index = PathPart::Index::all;
+            } else {
+                if (inside.empty() || inside.find_first_not_of("0123456789") != std::string::npos)
+                    bad("index '[" + inside + "]' is neither a number nor *");
+                p.index = PathPart::Index::one;
+                p.element = static_cast<std::size_t>(std::stoul(inside));
+            }
+            i = close + 1;
+        }
+        parts.push_back(p);
+        if (i == key.size()) break;
+        if (key[i] != '.') bad("expected '.' after ']'");
+        ++i;
+    }
+    return parts;
+}
+
+Document to_document(const AxisValue& v) {
+    if (const auto* d = std::get_if<double>(&v)) return Document(*d);
+    if (const auto* n = std::get_if<long long>(&v)) return Document(static_cast<toml::integer>(*n));
+    if (const auto* b = std::get_if<bool>(&v)) return Document(*b);
+    return Document(std::get<std::string>(v));
+}
+
+/// Sets `value` at `parts[k...]` under `node` (a table); creates missing tables and keys
+/// (an unknown key is then refused by the scenario reader, naming it). Throws
+/// std::invalid_argument with the reason when the path does not fit the document.
+void set_at(Document& node, const std::vector<PathPart>& parts, std::size_t k, const Document& value,
+            const std::string& done) {
+    if (!node.is_table())
+        throw std::invalid_argument("'" + done + "' is not a table in the base scenario");
+    const PathPart& p = parts[k];
+    const std::string here = done.empty() ? p.name : done + "." + p.name;
+    auto& table = node.as_table();
+    const bool last = k + 1 == parts.size();
+    if (p.index == PathPart::Index::none) {
+        if (last) {
+            table[p.name] = value;
+        } else {
+            if (table.count(p.name) == 0) table[p.name] = Document(typename Document::table_type{});
+            set_at(table[p.name], parts, k + 1, value, here);
+        }
+        return;
+    }
+    if (table.count(p.name) == 0 || !table[p.name].is_array())
+        throw std::invalid_argument("'" + here + "' is not an array in the base scenario");
+    auto& array = table[p.name].as_array();
+    auto apply = [&](std::size_t i) {
+        if (last) array[i] = value;
+        else set_at(array[i], parts, k + 1, value, here + "[" + std::to_string(i) + "]");
+    };
+    if (p.index == PathPart::Index::all) {
+        for (std::size_t i = 0; i < array.size(); ++i) apply(i);
+    } else {
+        if (p.element >= array.size())
+            throw std::invalid_argument("'" + here + "' has " + std::to_string(array.size()) + " element(s) in the base "
+                                        "scenario: index " + std::to_string(p.element) + " is out of range");
+        apply(p.element);
+    }
+}
+
+/// Does the scenario key path `field` (concrete indices) lie at or under `key` ([*] matches any index)?
+bool key_covers(const std::string& key, const std::string& field) {
+    std::size_t i = 0, j = 0;
+    while (i < key.size()) {
+        if (key.compare(i, 3, "[*]") == 0) {
+            if (j >= field.size() || field[j] != '[') return false;
+            const std::size_t close = field.find(']', j);
+            if (close == std::string::npos) return false;
+            i += 3;
+            j = close + 1;
+            continue;
+        }
+        if (j >= field.size() || key[i] != field[j]) return false;
+        ++i;
+        ++j;
+    }
+    return j == field.size() || field[j] == '.' || field[j] == '[';
+}
+
+std::string read_file(const std::string& path, const std::string& field, const std::string& location,
+                      const std::string& what) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(field, "cannot read " + what + " '" + path + "'", location);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string directory_of(const std::string& path) {
+    const auto cut = path.find_last_of('/');
+    return cut == std::string::npos ? std::string() : path.substr(0, cut + 1);
+}
+
+/// Reads one scalar of an axis' values array.
+AxisValue axis_value(const toml::value& v, const std::string& field, const std::string& where) {
+    switch (v.type()) {
+        case toml::value_t::floating: return v.as_floating();
+        case toml::value_t::integer: return static_cast<long long>(v.as_integer());
+        case toml::value_t::boolean: return v.as_boolean();
+        case toml::value_t::string: return v.as_string().str;
+        default:
+            throw InputError(field, "is not a number, boolean or string: each value of an axis is one scenario value",
+                             where);
+    }
+}
+
+double number_of(const toml::value& v, const std::string& field, const std::string& where) {
+    if (v.is_floating()) return v.as_floating();
+    if (v.is_integer()) return static_cast<double>(v.as_integer());
+    throw InputError(field, "is not a number", where);
+}
+
+std::string point_values_text(const SweepSpec& spec, const std::vector<AxisValue>& values) {
+    std::string out;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        out += (a ? ", " : "") + spec.axes[a].key + " = " + to_string(values[a]);
+    return out;
+}
+
+/// The message of `e` without its location prefix.
+std::string bare_message(const InputError& e) {
+    std::string m = e.what();
+    if (!e.location().empty() && m.rfind(e.location() + ": ", 0) == 0) m.erase(0, e.location().size() + 2);
+    if (m.rfind(e.field() + ": ", 0) == 0) m.erase(0, e.field().size() + 2);
+    return m;
+}
+
+}  // namespace
+
+std::string to_string(const AxisValue& value) {
+    if (const auto* d = std::get_if<double>(&value)) {
+        char buffer[40];
+        std::snprintf(buffer, sizeof buffer, "%.17g", *d);
+        return buffer;
+    }
+    if (const auto* n = std::get_if<long long>(&value)) return std::to_string(*n);
+    if (const auto* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+    return std::get<std::string>(value);
+}
+
+const char* to_string(Combine combine) { return combine == Combine::zip ? "zip" : "product"; }
+
+const char* to_string(PointStatus status) {
+    switch (status) {
+        case PointStatus::ok: return "ok";
+        case PointStatus::failed: return "failed";
+        case PointStatus::input_error: return "input-error";
+    }
+    return "?";
+}
+
+SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
+    SweepSpec spec;
+    spec.source = source_name;
+    toml::value root;
+    try {
+        std::istringstream in(text);
+        root = toml::parse(in, source_name);
+    } catch (const std::exception& e) {
+        throw InputError("spec", std::string("is not a valid TOML file: ") + e.what(), source_name);
+    }
+    const auto& top = root.as_table();
+    for (const auto& kv : top)
+        if (kv.first != "scenario" && kv.first != "description" && kv.first != "combine" && kv.first != "axes" &&
+            kv.first != "outputs")
+            throw InputError(kv.first, "unknown key: a sweep spec has scenario, description, combine, [[axes]], [outputs]",
+                             line_of(source_name, kv.second));
+    if (top.count("description")) {
+        const auto& d = top.at("description");
+        if (!d.is_string()) throw InputError("description", "must be a string", line_of(source_name, d));
+        spec.description = d.as_string().str;
+    }
+    if (!top.count("scenario"))
+        throw InputError("scenario", "is required: the base scenario file (relative to the spec file)", source_name);
+    const auto& sc = top.at("scenario");
+    spec.scenario_location = line_of(source_name, sc);
+    if (!sc.is_string() || sc.as_string().str.empty())
+        throw InputError("scenario", "must be a file name (a string): the base scenario, relative to the spec file",
+                         spec.scenario_location);
+    const std::string& name = sc.as_string().str;
+    spec.scenario_path = name[0] == '/' ? name : directory_of(source_name) + name;
+    spec.scenario_text = read_file(spec.scenario_path, "scenario", spec.scenario_location, "the base scenario file");
+    if (top.count("combine")) {
+        const auto& c = top.at("combine");
+        const std::string word = c.is_string() ? c.as_string().str : "";
+        if (word == "product") spec.combine = Combine::product;
+        else if (word == "zip") spec.combine = Combine::zip;
+        else
+            throw InputError("combine", "value '" + (c.is_string() ? word : toml::format(c)) +
+                                            "' is not allowed: must be 'product' (every combination) or 'zip' (the "
+                                            "i-th values together)",
+                             line_of(source_name, c));
+    }
+    if (top.count("outputs")) {
+        const auto& o = top.at("outputs");
+        if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
+        for (const auto& kv : o.as_table()) {
+            if (kv.first != "directory")
+                throw InputError("outputs." + kv.first, "unknown key: [outputs] has directory",
+                                 line_of(source_name, kv.second));
+            if (!kv.second.is_string() || kv.second.as_string().str.empty())
+                throw InputError("outputs.directory", "must be a directory name (a string)", line_of(source_name, kv.second));
+            spec.output_directory = kv.second.as_string().str;
+        }
+    }
+    if (!top.count("axes") || !top.at("axes").is_array() || top.at("axes").as_array().empty())
+        throw InputError("axes", "at least one [[axes]] table is required (key and values)",
+                         top.count("axes") ? line_of(source_name, top.at("axes")) : source_name);
+    const auto& axes = top.at("axes").as_array();
+    for (std::size_t a = 0; a < axes.size(); ++a) {
+        const std::string base = "axes[" + std::to_string(a) + "]";
+        const auto& t = axes[a];
+        const std::string where = line_of(source_name, t);
+        if (!t.is_table()) throw InputError(base, "must be a table ([[axes]])", where);
+        SweepAxis axis;
+        const auto& tab = t.as_table();
+        for (const auto& kv : tab)
+            if (kv.first != "key" && kv.first != "values" && kv.first != "from" && kv.first != "to" &&
+                kv.first != "count" && kv.first != "spacing")
+                throw InputError(base + "." + kv.first, "unknown key: an axis has key, and values or from, to, count, spacing",
+                                 line_of(source_name, kv.second));
+        if (!tab.count("key") || !tab.at("key").is_string())
+            throw InputError(base + ".key", "is required: the scenario key path (a string)", where);
+        axis.key = tab.at("key").as_string().str;
+        axis.location = line_of(source_name, tab.at("key"));
+        split_key(axis.key, axis.location, base + ".key");
+        if (axis.key.rfind("outputs", 0) == 0 && (axis.key.size() == 7 || axis.key[7] == '.'))
+            throw InputError(base + ".key", "value '" + axis.key + "': [outputs] cannot be an axis (the sweep writes its own)",
+                             axis.location);
+        for (const auto& other : spec.axes)
+            if (other.key == axis.key)
+                throw InputError(base + ".key", "value '" + axis.key + "' is an axis already (" + other.location + ")",
+                                 axis.location);
+        const bool listed = tab.count("values") > 0;
+        const bool ranged = tab.count("from") || tab.count("to") || tab.count("count") || tab.count("spacing");
+        if (listed == ranged)
+            throw InputError(base, "give either values = [...] or from, to and count (and spacing), not " +
+                                       std::string(listed ? "both" : "neither"),
+                             where);
+        if (listed) {
+            const auto& v = tab.at("values");
+            const std::string vw = line_of(source_name, v);
+            if (!v.is_array()) throw InputError(base + ".values", "must be an array of values", vw);
+            const auto& arr = v.as_array();
+            if (arr.empty())
+                throw InputError(base + ".values", "is empty: an axis needs at least one value (axis " + axis.key + ")", vw);
+            for (std::size_t i = 0; i < arr.size(); ++i)
+                axis.values.push_back(axis_value(arr[i], base + ".values[" + std::to_string(i) + "]", vw));
+        } else {
+            for (const char* k : {"from", "to", "count"})
+                if (!tab.count(k))
+                    throw InputError(base + "." + k, "is required with from/to/count (axis " + axis.key + ")", where);
+            const double from = number_of(tab.at("from"), base + ".from", line_of(source_name, tab.at("from")));
+            const double to = number_of(tab.at("to"), base + ".to", line_of(source_name, tab.at("to")));
+            const auto& c = tab.at("count");
+            const std::string cw = line_of(source_name, c);
+            if (!c.is_integer() || c.as_integer() < 1 || c.as_integer() > 1000000)
+                throw InputError(base + ".count",
+                                 "value " + toml::format(c) + " is not allowed: must be an integer from 1 to 1000000 "
+                                 "(axis " + axis.key + ")",
+                                 cw);
+            const int count = static_cast<int>(c.as_integer());
+            bool log = false;
+            if (tab.count("spacing")) {
+                const auto& s = tab.at("spacing");
+                const std::string word = s.is_string() ? s.as_string().str : toml::format(s);
+                if (word == "log") log = true;
+                else if (word != "linear")
+                    throw InputError(base + ".spacing", "value '" + word + "' is not allowed: must be 'linear' or 'log'",
+                                     line_of(source_name, s));
+            }
+            if (!std::isfinite(from) || !std::isfinite(to))
+                throw InputError(base + ".from", "from and to must be finite (axis " + axis.key + ")", where);
+            if (log && !(from > 0.0 && to > 0.0))
+                throw InputError(base + ".from", "spacing 'log' needs from > 0 and to > 0 (axis " + axis.key + ")", where);
+            if (count == 1 && from != to)
+                throw InputError(base + ".count", "value 1 needs from = to (one value)", cw);
+            const bool integers = !log && tab.at("from").is_integer() && tab.at("to").is_integer() && count > 1 &&
+                                  (static_cast<long long>(to - from)) % (count - 1) == 0;
+            for (int i = 0; i < count; ++i) {
+                const double f = count == 1 ? 0.0 : static_cast<double>(i) / (count - 1);
+                double x = log ? std::exp(std::log(from) + f * (std::log(to) - std::log(from))) : from + f * (to - from);
+                if (i == 0) x = from;
+                if (i == count - 1) x = to;  // the ends exactly as written
+                if (integers) axis.values.push_back(static_cast<long long>(std::llround(x)));
+                else axis.values.push_back(x);
+            }
+        }
+        spec.axes.push_back(std::move(axis));
+    }
+    point_count(spec);  // empty axis, unequal zip
+    return spec;
+}
+
+SweepSpec load_sweep_spec(const std::string& path) {
+    return parse_sweep_spec(read_file(path, "spec", path, "the sweep spec file"), path);
+}
+
+int point_count(const SweepSpec& spec) {
+    if (spec.axes.empty()) throw InputError("axes", "at least one axis is required", spec.source);
+    long long n = spec.combine == Combine::zip ? -1 : 1;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+        const SweepAxis& axis = spec.axes[a];
+        const std::string field = "axes[" + std::to_string(a) + "]";
+        const std::string where = axis.location.empty() ? spec.source : axis.location;
+        if (axis.values.empty())
+            throw InputError(field + ".values", "is empty: an axis needs at least one value (axis " + axis.key + ")", where);
+        const long long len = static_cast<long long>(axis.values.size());
+        if (spec.combine == Combine::zip) {
+            if (n >= 0 && len != n)
+                throw InputError(field + ".values",
+                                 "has " + std::to_string(len) + " values, axes[0] (" + spec.axes[0].key + ") has " +
+                                     std::to_string(n) + ": combine = 'zip' needs axes of equal length",
+                                 where);
+            n = len;
+        } else {
+            n *= len;
+            if (n > 10000000) throw InputError("axes", "more than 10 million points", spec.source);
+        }
+    }
+    return static_cast<int>(n);
+}
+
+std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
+    const int n = point_count(spec);
+    Document base;
+    try {
+        std::istringstream in(spec.scenario_text);
+        base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
+    } catch (const std::exception& e) {
+        throw InputError("scenario", "the base scenario '" + spec.scenario_path + "' is not a valid TOML file: " + e.what(),
+                         spec.scenario_location.empty() ? spec.source : spec.scenario_location);
+    }
+    if (base.is_table()) base.as_table().erase("outputs");  // the sweep writes its own
+    std::vector<std::vector<PathPart>> paths;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        paths.push_back(split_key(spec.axes[a].key, spec.axes[a].location, "axes[" + std::to_string(a) + "].key"));
+
+    std::vector<SweepPoint> points;
+    points.reserve(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        SweepPoint point;
+        point.index = i;
+        // product: the last axis varies fastest
+        int rest = i;
+        point.values.resize(spec.axes.size());
+        for (std::size_t a = spec.axes.size(); a-- > 0;) {
+            const auto& vals = spec.axes[a].values;
+            const int len = static_cast<int>(vals.size());
+            point.values[a] = spec.combine == Combine::zip ? vals[static_cast<std::size_t>(i)] : vals[static_cast<std::size_t>(rest % len)];
+            if (spec.combine == Combine::product) rest /= len;
+        }
+        const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
+        Document doc = base;
+        for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+            try {
+                set_at(doc, paths[a], 0, to_document(point.values[a]), "");
+            } catch (const std::invalid_argument& e) {
+                throw InputError(spec.axes[a].key, at_point + ": " + e.what() + " (axis " + std::to_string(a) + ")",
+                                 spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+            }
+        }
+        point.scenario_text = toml::format(doc, 0, std::numeric_limits<double>::max_digits10);
+        const std::string name = spec.scenario_path + " at point " + std::to_string(i);
+        try {
+            point.scenario = parse_scenario(point.scenario_text, name);
+        } catch (const InputError& e) {
+            for (std::size_t a = 0; a < spec.axes.size(); ++a)
+                if (key_covers(spec.axes[a].key, e.field()))
+                    throw InputError(e.field(), at_point + ": " + bare_message(e) + " (axis " + spec.axes[a].key + ")",
+                                     spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+            throw InputError(e.field(), at_point + ": " + bare_message(e) + " (a key of the base scenario " +
+                                            spec.scenario_path + ", with the point's values)",
+                             spec.scenario_location.empty() ? spec.source : spec.scenario_location);
+        }
+        points.push_back(std::move(point));
+    }
+    return points;
+}
+
+const std::vector<std::string>& point_figure_columns() {
+    static const std::vector<std::string> columns = {
+        "loop_area_j",   "friction_work_j", "secant_stiffness_n_per_m", "dynamic_rate_n_per_m",
+        "loss_factor",   "equivalent_damping_ratio", "force_min_n",     "force_max_n",
+        "w_min_m",       "w_max_m",         "energy_balance_error_j",
+    };
+    return columns;
+}
+
+std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
+                                  std::string& note) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> f(point_figure_columns().size(), nan);
+    note.clear();
+    const double period = options.loading.period_s();
+    if (period > 0.0) {
+        try {
+            const auto cycle = last_cycle(records, period);
+            const HysteresisMetrics m = hysteresis_metrics(records, cycle.first, cycle.second);
+            f[0] = m.loop_area_j;
+            f[1] = m.dissipated_j;
+            f[2] = m.secant_stiffness_n_per_m;
+            f[3] = m.dynamic_rate_n_per_m;
+            f[4] = m.loss_factor;
+            f[5] = m.equivalent_damping_ratio;
+            f[6] = m.force_min_n;
+            f[7] = m.force_max_n;
+            f[8] = m.w_min_m;
+            f[9] = m.w_max_m;
+        } catch (const InputError& e) {
+            note = e.what();
+        }
+    } else {
+        note = "no periodic loading: no steady cycle";
+    }
+    // the largest |energy balance error| over the run, as simulate's summary (balance_error_max_abs)
+    double balance = 0.0;
+    for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
+    f[10] = records.empty() ? nan : balance;
+    return f;
+}
+
+PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
+                      const std::function<void(const PointResult&)>& with_records) {
+    const auto t0 = std::chrono::steady_clock::now();
+    PointResult result;
+    result.index = point.index;
+    result.figures.assign(point_figure_columns().size(), std::numeric_limits<double>::quiet_NaN());
+    std::vector<StepRecord> records;
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    try {
+        // as `stackbeam simulate --scenario` (apps/cli/main.cpp): build, system, contact path, simulate
+        const Model model = Model::build(point.scenario.model);
+        const System system(model);
+        choose_contact_path(system, point.scenario.simulation);
+        auto on_step = [&](const StepRecord&) {
+            if (stop && stop->load(std::memory_order_relaxed)) throw SweepStopped();
+        };
+        records = simulate(system, point.scenario.simulation, on_step);
+        result.figures = point_figures(records, point.scenario.simulation, result.message);
+    } catch (const SolverError& e) {
+        result.status = PointStatus::failed;
+        result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +
+                         " s, residual " + format_value(e.residual()) + "): " + e.what();
+    } catch (const InputError& e) {
+        result.status = PointStatus::input_error;
+        result.message = e.what();
+    }
+    result.wall_s = elapsed();
+    if (with_records) {
+        result.records = &records;
+        with_records(result);
+        result.records = nullptr;
+    }
+    return result;
+}
+
+int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+    int jobs = opts.jobs > 0 ? opts.jobs : static_cast<int>(std::thread::hardware_concurrency());
+    if (jobs < 1) jobs = 1;
+    std::mutex hand_out, report;
+    std::size_t next = 0;
+    int run = 0;
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    auto stopped = [&] { return failed || (opts.stop && opts.stop->load()); };
+    auto take = [&]() -> int {
+        std::lock_guard<std::mutex> lock(hand_out);
+        if (stopped()) return -1;
+        if (opts.next_point) return opts.next_point();
+        while (next < points.size() && next < opts.skip.size() && opts.skip[next]) ++next;
+        return next < points.size() ? static_cast<int>(next++) : -1;
+    };
+    std::atomic<bool> abort{false};  // opts.stop, or a callback's exception
+    auto worker = [&] {
+        for (int i; (i = take()) >= 0;) {
+            try {
+                run_point(points.at(static_cast<std::size_t>(i)), &abort, [&](const PointResult& r) {
+                    std::lock_guard<std::mutex> lock(report);
+                    if (failed) return;
+                    try {
+                        on_point_done(r);
+                        ++run;
+                    } catch (...) {
+                        failed = true;
+                        error = std::current_exception();
+                        abort = true;
+                    }
+                });
+            } catch (const SweepStopped&) {
+                return;
+            }
+        }
+    };
+    // a watcher turns the caller's stop flag into `abort`, which the runs poll
+    std::atomic<bool> done{false};
+    std::thread watcher([&] {
+        while (!done.load()) {
+            if (opts.stop && opts.stop->load()) abort = true;
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    });
+    std::vector<std::thread> threads;
+    for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
+    worker();
+    for (auto& t : threads) t.join();
+    done = true;
+    watcher.join();
+    if (error) std::rethrow_exception(error);
+    return run;
+}
+
+}  // namespace stackbeam
