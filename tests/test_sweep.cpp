@@ -67,12 +67,12 @@ BOOST_AUTO_TEST_CASE(ranges_and_points) {
 
 BOOST_AUTO_TEST_CASE(zip_and_errors) {
     const SweepSpec zip = parse_sweep_spec("scenario = \"rig_small.toml\"\ncombine = \"zip\"\n"
-                                           "[[axes]]\nkey = \"clamps[0].preload_n\"\nvalues = [500.0, 800, 1000.0]\n"
+                                           "[[axes]]\nkey = \"clamps[*].preload_n\"\nvalues = [500.0, 800, 1000.0]\n"
                                            "[[axes]]\nkey = \"interfaces[1].friction_coefficient\"\nvalues = [0.1, 0.2, 0.3]\n",
                                            kSource);
     const auto zp = expand_points(zip);
     BOOST_REQUIRE_EQUAL(zp.size(), 3u);
-    BOOST_TEST(zp[1].scenario.model.clamps[0].preload_n == 800.0);  // an integer value where a float is wanted
+    BOOST_TEST(zp[1].scenario.model.clamps[3].preload_n == 800.0);  // an integer value where a float is wanted
     BOOST_TEST(zp[2].scenario.model.interfaces[1].friction_coefficient == 0.3);
     BOOST_TEST(zp[2].scenario.model.interfaces[0].friction_coefficient == 0.5);  // the base's
     // an error names the spec's line, the key and the point

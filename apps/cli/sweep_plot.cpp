@@ -38,10 +38,15 @@ double as_number(const AxisValue& v) {
     return static_cast<double>(std::get<long long>(v));
 }
 
-/// A file name part from a key: letters, digits and '_' kept, the rest '_'.
+/// A file name part from a key: letters and digits kept, every other run of characters one '_'.
 std::string file_part(const std::string& key) {
     std::string s;
-    for (char c : key) s += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    for (char c : key) {
+        const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0;
+        if (keep) s += c;
+        else if (!s.empty() && s.back() != '_') s += '_';
+    }
+    while (!s.empty() && s.back() == '_') s.pop_back();
     return s;
 }
 
@@ -77,7 +82,7 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
     const std::string script_path = (dir / "figures.gp").string();
     std::ofstream g(script_path);
     if (!g) throw std::runtime_error("cannot write '" + script_path + "'");
-    g << "set datafile separator ','\nset terminal " << *terminal << " size 1000,680\nset grid\nset key outside right\n";
+    g << "set datafile separator ','\nset terminal " << *terminal << " size 1000,760 noenhanced\nset grid\nset key below\n";
     std::vector<std::string> files;
     auto has_loop = [&](int i) { return fs::exists(point_file(directory, "loops", i, "csv")); };
     auto loop_curve = [&](int i, const std::string& title) {
@@ -104,7 +109,7 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
             if (curves.empty()) continue;
             files.push_back((dir / ("loops_along_" + file_part(spec.axes[a].key) + ".png")).string());
             g << "set output '" << files.back() << "'\nset title \"loops along " << spec.axes[a].key
-              << (fixed.empty() ? "" : "\\n(" + fixed + ")") << "\" noenhanced\nset xlabel 'w [mm]'\nset ylabel 'spring force [N]'\nplot "
+              << (fixed.empty() ? "" : "\\n(" + fixed + ")") << "\"\nset xlabel 'w [mm]'\nset ylabel 'spring force [N]'\nplot "
               << curves << "\n";
         }
     } else {
@@ -117,7 +122,7 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
         }
         if (!curves.empty()) {
             files.push_back((dir / "loops.png").string());
-            g << "set output '" << files.back() << "'\nset title 'loops' noenhanced\nset xlabel 'w [mm]'\n"
+            g << "set output '" << files.back() << "'\nset title 'loops'\nset xlabel 'w [mm]'\n"
               << "set ylabel 'spring force [N]'\nplot " << curves << "\n";
         }
     }
@@ -160,14 +165,18 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
             for (std::size_t b = 0; b < n_axes; ++b)
                 if (b != ax && b != ay)
                     fixed += (fixed.empty() ? "" : ", ") + spec.axes[b].key + " = " + to_string(spec.axes[b].values[at[b]]);
-            g << "set view map\nset pm3d at b corners2color c1\nunset key\nset xlabel '" << spec.axes[ax].key
-              << "' noenhanced\nset ylabel '" << spec.axes[ay].key << "' noenhanced\n"
+            // a square per point coloured by its value, the value written above it (no interpolation
+            // between points: a map of a few points shows what was computed)
+            g << "set datafile missing 'nan'\nunset key\nset offsets graph 0.08, graph 0.08, graph 0.1, graph 0.08\n"
+              << "set palette rgb 33,13,10\nset xlabel '" << spec.axes[ax].key
+              << "'\nset ylabel '" << spec.axes[ay].key << "'\n"
               << (log_scale(spec.axes[ax]) ? "set logscale x\n" : "") << (log_scale(spec.axes[ay]) ? "set logscale y\n" : "");
             for (const auto& [name, col, label] : {std::tuple<std::string, int, std::string>{"loss_factor", 3, "loss factor [-]"},
                                                    {"dynamic_rate", 4, "dynamic rate [N/m]"}}) {
                 files.push_back((dir / ("map_" + name + ".png")).string());
                 g << "set output '" << files.back() << "'\nset title \"" << label << (fixed.empty() ? "" : "\\n(" + fixed + ")")
-                  << "\" noenhanced\nsplot '" << data << "' using 1:2:" << col << " with pm3d\n";
+                  << "\"\nplot '" << data << "' using 1:2:" << col << " with points pt 5 ps 5 lc palette, '' using 1:2:(sprintf('%.4g', $"
+                  << col << ")) with labels offset 0,1.8\n";
             }
         }
     }

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <limits>
@@ -193,12 +194,17 @@ std::string bare_message(const InputError& e) {
 
 }  // namespace
 
-std::string to_string(const AxisValue& value) {
-    if (const auto* d = std::get_if<double>(&value)) {
-        char buffer[40];
-        std::snprintf(buffer, sizeof buffer, "%.17g", *d);
-        return buffer;
+std::string round_trip_text(double x) {
+    char buffer[40];
+    for (int digits = 15; digits <= 17; ++digits) {  // the shortest of %.15g, %.16g, %.17g that reads back as x
+        std::snprintf(buffer, sizeof buffer, "%.*g", digits, x);
+        if (std::strtod(buffer, nullptr) == x) break;
     }
+    return buffer;
+}
+
+std::string to_string(const AxisValue& value) {
+    if (const auto* d = std::get_if<double>(&value)) return round_trip_text(*d);
     if (const auto* n = std::get_if<long long>(&value)) return std::to_string(*n);
     if (const auto* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
     return std::get<std::string>(value);
@@ -511,6 +517,11 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     } catch (const InputError& e) {
         result.status = PointStatus::input_error;
         result.message = e.what();
+    } catch (const SweepStopped&) {
+        throw;
+    } catch (const std::exception& e) {  // any other failure of this run (e.g. out of memory)
+        result.status = PointStatus::failed;
+        result.message = e.what();
     }
     result.wall_s = elapsed();
     if (with_records) {
@@ -554,6 +565,12 @@ int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts
                     }
                 });
             } catch (const SweepStopped&) {
+                return;
+            } catch (...) {  // not a point's failure (run_point returns those): stop the sweep
+                std::lock_guard<std::mutex> lock(report);
+                if (!failed) error = std::current_exception();
+                failed = true;
+                abort = true;
                 return;
             }
         }

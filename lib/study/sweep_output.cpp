@@ -32,9 +32,7 @@ namespace {
 
 std::string number_cell(double x) {
     if (std::isnan(x)) return "";
-    char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.17g", x);
-    return buffer;
+    return round_trip_text(x);
 }
 
 /// A CSV cell: quoted when it holds a comma, a quote or a line break (quotes doubled,

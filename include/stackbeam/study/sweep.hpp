@@ -34,9 +34,13 @@ namespace stackbeam {
 /// One value of an axis as the spec gives it: a TOML number, integer, boolean or string.
 using AxisValue = std::variant<double, long long, bool, std::string>;
 
-/// The value as a table cell: a float with round-trip precision (%.17g), an integer,
-/// true/false, or the string as is.
+/// The value as a table cell: a float as round_trip_text, an integer, true/false, or the
+/// string as is.
 std::string to_string(const AxisValue& value);
+
+/// `x` in the fewest significant digits (15, 16 or 17, %g) that read back as the same
+/// double: 0.1 is "0.1", and equal text is an equal double (tables compare figure for figure).
+std::string round_trip_text(double x);
 
 /// One axis: a scenario key and the values it takes.
 struct SweepAxis {

@@ -27,7 +27,7 @@ namespace stackbeam {
 /// figures (point_figure_columns), wall_time_s.
 std::string point_table_header(const SweepSpec& spec);
 
-/// One row of points.csv (no newline): floats printed %.17g (round trip), NaN as an
+/// One row of points.csv (no newline): floats as round_trip_text, NaN as an
 /// empty cell; the message quoted as CSV wants.
 std::string format_point_row(const SweepPoint& point, const PointResult& result);
 
