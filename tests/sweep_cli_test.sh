@@ -5,6 +5,7 @@
 #                                                        single `simulate` run of its scenario
 #   sweep_cli_test.sh <stackbeam> <work dir> parallel [mpirun]  --jobs 1, --jobs 2 (and mpirun -n 2)
 #                                                        give the same table
+#   sweep_cli_test.sh <stackbeam> <work dir> failed     a failed point: its row, the others run, exit 3
 #   sweep_cli_test.sh <stackbeam> <work dir> resume     stopped after 3 points (--stop-after, as
 #                                                        SIGINT), resumed: the full table, no point
 #                                                        twice; SIGINT stops cleanly; another spec's
@@ -65,6 +66,9 @@ parallel)
     diff <(table "$dir/jobs1") <(table "$dir/jobs2") || fail "--jobs 1 and --jobs 2 tables differ"
     if [ -n "$mpirun" ]; then
         rm -rf "$dir/mpi"
+        # (as root OpenMPI wants the two ALLOW variables; LSAN_OPTIONS: OpenMPI's own allocations
+        # in the sanitizer build; vader's single copy needs ptrace rights containers often lack)
+        LSAN_OPTIONS="${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=$src/sweep/lsan_mpi.supp:print_suppressions=0" \
         OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
             "$mpirun" -n 2 --oversubscribe "$cli" sweep "$spec" --out-dir "$dir/mpi" --no-plot || fail "mpirun: exit status $?"
         grep -q '"processes": 2' "$dir/mpi/sweep.json" || fail "sweep.json does not say 2 processes"
@@ -129,6 +133,19 @@ resume)
         echo "SIGINT after $done of 40 points; resumed to the full table"
     fi
     echo "resume: the full table, no point twice"
+    ;;
+failed)
+    # a failed point does not stop the sweep: its row says failed with the message, exit status 3
+    out=$dir/failed
+    rm -rf "$out"
+    "$cli" sweep "$src/sweep/some_fail.toml" --out-dir "$out" --jobs 2 --no-plot 2>"$dir/failed.err"
+    rc=$?
+    [ $rc = 3 ] || fail "a failed point: exit status $rc, expected 3"
+    grep -q "1 of 2 points failed" "$dir/failed.err" || fail "stderr does not say 1 of 2 points failed"
+    grep -q '^0,paper,failed,"solver failure at step 1 ' "$out/points.csv" || fail "point 0's row does not say failed"
+    grep -q '^1,exact,ok,' "$out/points.csv" || fail "point 1 did not run to the end"
+    grep -q '"failed": 1' "$out/sweep.json" || fail "sweep.json does not count 1 failed"
+    echo "one point failed, the other ran"
     ;;
 *) fail "unknown test '$what'" ;;
 esac

@@ -26,17 +26,21 @@ int column_of(const std::string& name) {
 /// written, or a note why none were.
 }  // namespace
 
-std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note) {
+std::optional<std::string> plot_terminal(std::string& note) {
     using namespace stackbeam::demo;
     if (!gnuplot_on_path()) {
         note = "gnuplot is not on PATH: no figures (install gnuplot-nox)";
-        return {};
+        return std::nullopt;
     }
-    const auto terminal = png_terminal();
-    if (!terminal) {
-        note = "gnuplot has neither the pngcairo nor the png terminal: no figures";
-        return {};
-    }
+    auto terminal = png_terminal();
+    if (!terminal) note = "gnuplot has neither the pngcairo nor the png terminal: no figures";
+    return terminal;
+}
+
+std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note) {
+    using namespace stackbeam::demo;
+    const auto terminal = plot_terminal(note);
+    if (!terminal) return {};
     const std::string script_path = prefix + "_figures.gp";
     std::ofstream g(script_path);
     if (!g) throw ArgumentError("--plot: cannot write '" + script_path + "'");

@@ -1,10 +1,15 @@
 #pragma once
 /// @file plot.hpp
 /// --plot: PNG figures of a run with gnuplot from its CSV.
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace stackbeam::cli {
+
+/// gnuplot's PNG terminal ("pngcairo" or "png"), or none and why in `note` (no gnuplot on
+/// PATH, no PNG terminal).
+std::optional<std::string> plot_terminal(std::string& note);
 
 /// Displacement, forces, friction force at the probe and the loop (spring force against
 /// w) as PREFIX_*.png. Returns the files written, or none and a note why in `note`.

@@ -105,9 +105,11 @@ void RunStats::add(const StepRecord& r) {
     force_max_n = std::max(force_max_n, r.spring_force_n);
 }
 
-void install_interrupt_handlers() {
+void install_interrupt_handlers() { install_stop_handlers(on_stop_signal); }
+
+void install_stop_handlers(void (*handler)(int)) {
     struct sigaction action {};
-    action.sa_handler = on_stop_signal;
+    action.sa_handler = handler;
     sigemptyset(&action.sa_mask);
     action.sa_flags = 0;
     sigaction(SIGINT, &action, nullptr);

@@ -46,6 +46,9 @@ struct RunResult {
 /// Installs the SIGINT / SIGTERM handlers that ask the run to stop.
 void install_interrupt_handlers();
 
+/// Installs `handler` for SIGINT and SIGTERM (it must be async-signal-safe: set a flag).
+void install_stop_handlers(void (*handler)(int));
+
 /// Runs `request` on `system`, writing the CSV, --pairs and --events files.
 RunResult run(const RunRequest& request, const System& system);
 

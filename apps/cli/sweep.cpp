@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "options.hpp"
+#include "run.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
@@ -29,15 +30,7 @@ extern "C" void on_sweep_signal(int signal) {
     g_stop.store(true);  // lock-free (checked below): async-signal-safe
 }
 
-void install_sweep_signal_handlers() {
-    static_assert(std::atomic<bool>::is_always_lock_free, "the stop flag is set from a signal handler");
-    struct sigaction action {};
-    action.sa_handler = on_sweep_signal;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = 0;
-    sigaction(SIGINT, &action, nullptr);
-    sigaction(SIGTERM, &action, nullptr);
-}
+static_assert(std::atomic<bool>::is_always_lock_free, "the stop flag is set from a signal handler");
 
 std::string clock_text(double s) {
     const long t = static_cast<long>(s + 0.5);
@@ -114,7 +107,7 @@ int run_sweep_command(const SweepArgs& a, MpiWorld world) {
     const int jobs = world.active && world.size > 1 ? 1
                      : a.jobs > 0                   ? a.jobs
                                                     : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    install_sweep_signal_handlers();
+    install_stop_handlers(on_sweep_signal);
     if (world.rank != 0) {
 #ifdef STACKBEAM_WITH_MPI
         mpi_work(world, points, directory, a.keep_series, g_stop);

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "gnuplot.hpp"
+#include "plot.hpp"
 #include "stackbeam/study/sweep_output.hpp"
 
 namespace stackbeam::cli {
@@ -68,15 +69,8 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
                                     const std::vector<SweepPoint>& points, const std::vector<PointResult>& results,
                                     std::string& note) {
     using namespace stackbeam::demo;
-    if (!gnuplot_on_path()) {
-        note = "gnuplot is not on PATH (install gnuplot-nox)";
-        return {};
-    }
-    const auto terminal = png_terminal();
-    if (!terminal) {
-        note = "gnuplot has neither the pngcairo nor the png terminal";
-        return {};
-    }
+    const auto terminal = plot_terminal(note);
+    if (!terminal) return {};
     const fs::path dir = fs::path(directory) / "figures";
     fs::create_directories(dir);
     const std::string script_path = (dir / "figures.gp").string();
