@@ -181,7 +181,9 @@ struct SparseContactSolver::Impl {
     Eigen::VectorXd previous_p, last_p;
 
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
-        : path(options, detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows},
+        : path(options,
+               detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows,
+                                                detail::sparse::current_switches().incremental},
                detail::sparse::current_switches()),
           newton_min_rows(tuning.newton_min_rows) {}
 
@@ -410,6 +412,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
                     format_value(r.natural_residual_m) + " m)";
     }
     if (r.converged) {
+        path.solver.accept();  // the accepted modes: the base of the next step's updates
         im.previous_p = im.last_p;
         im.last_p = p;
     }
