@@ -146,6 +146,16 @@ void compare(sp::ModeSolver& inc, sp::ModeSolver& ref, const ModeWalk& walk, con
     counts.largest = std::max(counts.largest, d2);
 }
 
+/// The incremental solver and the one from scratch on `pr`'s (K, G), both always on the
+/// Schur way (schur_max_rows large).
+struct Solvers {
+    sp::ModeSolver inc{sp::ModeSolverTuning{100000, 0, true}}, ref{sp::ModeSolverTuning{100000, 0, false}};
+    explicit Solvers(const SparseContactProblem& pr) {
+        inc.reset(pr.K, pr.G);
+        ref.reset(pr.K, pr.G);
+    }
+};
+
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random_mode_changes) {
@@ -154,9 +164,8 @@ BOOST_AUTO_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random
     // earlier set every 50th. Both solvers always on the Schur way (schur_max_rows large).
     const SparseContactProblem& pr = stack_problem();
     BOOST_TEST_REQUIRE(pr.size() > 200);
-    sp::ModeSolver inc(sp::ModeSolverTuning{100000, 0, true}), ref(sp::ModeSolverTuning{100000, 0, false});
-    inc.reset(pr.K, pr.G);
-    ref.reset(pr.K, pr.G);
+    Solvers sv(pr);
+    auto& [inc, ref] = sv;
     ModeWalk walk(pr);
     Counts counts;
     double worst = 0.0;
@@ -187,9 +196,8 @@ BOOST_AUTO_TEST_CASE(incremental_solve_does_not_drift_over_ten_thousand_updates)
     // compared with the solve from scratch every 100th set. The error stays within its
     // round-off bound instead of growing with the number of updates.
     const SparseContactProblem& pr = stack_problem();
-    sp::ModeSolver inc(sp::ModeSolverTuning{100000, 0, true}), ref(sp::ModeSolverTuning{100000, 0, false});
-    inc.reset(pr.K, pr.G);
-    ref.reset(pr.K, pr.G);
+    Solvers sv(pr);
+    auto& [inc, ref] = sv;
     ModeWalk walk(pr);
     Counts counts;
     double worst = 0.0;
