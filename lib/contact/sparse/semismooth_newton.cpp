@@ -214,9 +214,11 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
 ///     complement, as for the active-set passes), giving (p1, z1); F is piecewise linear
 ///     in p, so this is the full Newton step p1 - p;
 ///  3. a line search on theta = ||F||^2 along it: s is affine in p, so
-///     s(p + a (p1 - p)) = s + a (s1 - s) and a trial costs O(m), no solve. Where no trial
-///     decreases theta the full step is taken (a non-monotone step; at most
-///     kNewtonNonmonotone of them) rather than stalling.
+///     s(p + a (p1 - p)) = s + a (s1 - s) and theta is piecewise quadratic in a; its exact
+///     minimiser over [2^-12, 1] by one sweep over the sorted kinks (breakpoint_search;
+///     with Switches::incremental off, and where that finds no decrease, the best of a
+///     49-point grid, each trial O(m)). Where no step decreases theta the full step is
+///     taken (a non-monotone step; at most kNewtonNonmonotone of them) rather than stalling.
 /// From rest (p = 0) it starts from the open modes' solution (set_open_modes).
 /// Unlike block principal pivoting, the modes come from p - s / w (forces and gaps
 /// together), and a damped step moves every component part of the way, so many pairs
