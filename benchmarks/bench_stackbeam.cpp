@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <string>
 #include <map>
 #include <memory>
@@ -395,44 +396,57 @@ BENCHMARK(FrictionMeshRatioRuns)
     ->Args({50, 5000, 0, 300, 8})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
-/// Elastic interfaces (issue 18's targets): closed-form runs of friction stacks with every
+/// Elastic interfaces (issue 18's and 27's targets): closed-form runs of friction stacks with every
 /// interface rigid or elastic (layer derived from the leaves), default solver chain, dt = 1 ms.
 /// args: elements per half leaf, stack (0 the paper example, 1 graduated 10 leaves, 2 identical
-/// 10 leaves), elastic (0/1), simulated ms, contact path (0 automatic: sparse from 1000 rows;
-/// 1 sparse). Counters: time per simulated second (set-up plus
-/// stepping), factorisations and Newton iterations per step, failed steps (residual above the
-/// tolerance; the run does not stop), and which step of the sparse path's chain settled each
-/// step: the active-set passes alone, the semismooth Newton method, the smoothing Newton
-/// method, the Tresca fixed point (its answer or the dense fallback).
+/// 10 leaves, 3 graduated 10 leaves bonded, 4 identical 10 leaves bonded), elastic (0/1),
+/// simulated ms, contact path (0 automatic: sparse from 1000 rows; 1 sparse), inc (1 the
+/// incremental solve, the default; 0 the way before it: Switches::incremental), schur (> 0:
+/// SparsePathTuning::schur_max_rows; 0 its default). Counters: wall
+/// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
+/// iterations per step, mode-set solves (factorisations plus updates) per transition step,
+/// failed steps (residual above the tolerance; the run does not stop), and which step of the
+/// sparse path's chain settled each step: the active-set passes alone, the semismooth Newton
+/// method, the smoothing Newton method, the Tresca fixed point (its answer or the dense fallback).
 void ElasticRuns(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const int stack = static_cast<int>(state.range(1));
-    ModelSpec spec = stack == 0   ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
-                     : stack == 1 ? graduated_stack(elements, 10)
-                                  : paper_stack(PaperCase::friction, elements, 10);
+    ModelSpec spec = stack == 0                ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
+                     : stack == 1 || stack == 3 ? graduated_stack(elements, 10)
+                                                : paper_stack(PaperCase::friction, elements, 10);
     if (state.range(2) == 1)
         for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
+    if (stack >= 3)
+        for (auto& f : spec.interfaces) f.law = InterfaceLaw::bonded;
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
-    double total = 0.0, factorizations = 0.0, newton = 0.0;
+    detail::sparse::Switches sw;
+    sw.incremental = state.range(5) != 0;
+    const detail::sparse::ScopedSwitches scoped(sw);
+    double total = 0.0, cpu = 0.0, factorizations = 0.0, newton = 0.0, mode_solves = 0.0;
     long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_tresca = 0;
     long transition_steps = 0;
     int components = 0;
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
         const System s(Model::build(spec));
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.stop_on_nonconvergence = false;
         if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
+        if (state.range(6) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(6));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
-        factorizations = newton = 0.0;
+        factorizations = newton = mode_solves = 0.0;
         failed = by_passes = by_semismooth = by_smoothing = by_tresca = transition_steps = 0;
         for (long i = 0; i < steps; ++i) {
             const int f = st.advance().factorizations;
             factorizations += f;
-            if (f > 0) ++transition_steps;
             const SolveResult& r = st.last_solve();
+            if (f + r.updates > 0) {
+                ++transition_steps;
+                mode_solves += f + r.updates;
+            }
             newton += r.newton_iterations;
             if (!r.converged) ++failed;
             if (r.fell_back || r.tresca_iterations > 0) ++by_tresca;
@@ -441,12 +455,16 @@ void ElasticRuns(benchmark::State& state) {
             else ++by_passes;
         }
         total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         components = s.num_components();
     }
     state.counters["components"] = components;
     state.counters["s_per_sim_s"] = total / t_sim;
+    state.counters["cpu_s_per_sim_s"] = cpu / t_sim;
     state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
-    state.counters["transition_steps"] = static_cast<double>(transition_steps);  // steps with a factorisation
+    state.counters["transition_steps"] = static_cast<double>(transition_steps);  // steps with a factorisation or update
+    state.counters["solves_per_transition"] =
+        transition_steps > 0 ? mode_solves / static_cast<double>(transition_steps) : 0.0;
     state.counters["newton_per_step"] = newton / static_cast<double>(steps);
     state.counters["failed_steps"] = static_cast<double>(failed);
     state.counters["by_passes"] = static_cast<double>(by_passes);
@@ -455,17 +473,25 @@ void ElasticRuns(benchmark::State& state) {
     state.counters["by_tresca"] = static_cast<double>(by_tresca);
 }
 BENCHMARK(ElasticRuns)
-    ->ArgNames({"el", "stack", "elastic", "ms", "sparse"})
+    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur"})
     // the reference: the paper example, rigid and elastic, 1 s
-    ->Args({20, 0, 0, 1000, 0})->Args({20, 0, 1, 1000, 0})
+    ->Args({20, 0, 0, 1000, 0, 1, 0})->Args({20, 0, 1, 1000, 0, 1, 0})
     // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf, 1 s
     // (the target's measure: the first 50 ms, from rest at 2 m/s, are not typical of the second)
-    ->Args({100, 1, 1, 1000, 0})->Args({200, 1, 1, 1000, 0})->Args({400, 1, 1, 1000, 0})
-    ->Args({100, 2, 1, 1000, 0})->Args({200, 2, 1, 1000, 0})->Args({400, 2, 1, 1000, 0})
+    ->Args({100, 1, 1, 1000, 0, 1, 0})->Args({200, 1, 1, 1000, 0, 1, 0})->Args({400, 1, 1, 1000, 0, 1, 0})
+    ->Args({100, 2, 1, 1000, 0, 1, 0})->Args({200, 2, 1, 1000, 0, 1, 0})->Args({400, 2, 1, 1000, 0, 1, 0})
+    // issue 27's targets: 100 ms, graduated / identical 10 x 400 elastic against the same mesh
+    // bonded, the incremental solve and the way before; graduated 50 / 100 / 200 / 400
+    ->Args({400, 1, 1, 100, 0, 1, 0})->Args({400, 1, 1, 100, 0, 0, 0})->Args({400, 3, 0, 100, 0, 1, 0})
+    ->Args({400, 2, 1, 100, 0, 1, 0})->Args({400, 2, 1, 100, 0, 0, 0})->Args({400, 4, 0, 100, 0, 1, 0})
+    ->Args({50, 1, 1, 100, 0, 1, 0})->Args({100, 1, 1, 100, 0, 1, 0})->Args({200, 1, 1, 100, 0, 1, 0})
+    ->Args({50, 1, 1, 100, 0, 0, 0})->Args({100, 1, 1, 100, 0, 0, 0})->Args({200, 1, 1, 100, 0, 0, 0})
+    // the Schur way's limit (SparsePathTuning::schur_max_rows) with the incremental solve
+    ->Args({400, 1, 1, 30, 0, 1, 0})->Args({400, 1, 1, 30, 0, 1, 1200})->Args({400, 1, 1, 30, 0, 1, 2500})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
-    ->Args({100, 1, 1, 300, 1})->Args({100, 2, 1, 300, 1})
-    ->Args({50, 1, 0, 300, 1})->Args({50, 2, 0, 300, 1})->Args({50, 1, 1, 300, 1})->Args({50, 2, 1, 300, 1})
+    ->Args({100, 1, 1, 300, 1, 1, 0})->Args({100, 2, 1, 300, 1, 1, 0})
+    ->Args({50, 1, 0, 300, 1, 1, 0})->Args({50, 2, 0, 300, 1, 1, 0})->Args({50, 1, 1, 300, 1, 1, 0})->Args({50, 2, 1, 300, 1, 1, 0})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

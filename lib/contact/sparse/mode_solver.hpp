@@ -15,6 +15,11 @@
 //  - more: a sparse LU of the saddle-point system (Eigen::SparseLU, COLAMD);
 //  - a held set without slip coupling within `max_border_rows` rows of the last LU's: that
 //    LU bordered by the changed rows (a low-rank update) instead of a new factorisation.
+// The Schur way is incremental (schur_updates): the Schur complement of a new held set is
+// copied from the base's (the last one factorised densely) where rows and columns stay and
+// computed only where they changed, and it is solved by a low-rank update of the base's
+// dense LU (Woodbury: the changed rows and columns, slip couplings included) while few
+// change; accept() makes the current set the base (the caller's accepted step).
 // A factorisation is named by a key (the caller's modes, or a box QP's working set) and
 // reused while the key stays; within one key the solution is affine in the load b, and
 // the back-solves of that map are cached.
@@ -59,6 +64,9 @@ struct SparseStiffness {
 struct ModeSolverTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+    /// the Schur way's incremental build and low-rank update of the dense LU (false: every
+    /// new held set's Schur complement computed and factorised from scratch, as before)
+    bool schur_updates = true;
 };
 
 class ModeSolver {
@@ -77,8 +85,15 @@ public:
     /// Throws SingularModes if the held rows are dependent.
     int solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
               const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// The current set of modes is the caller's accepted answer: on the Schur way, its
+    /// Schur complement is factorised densely (if it was solved by an update) and becomes
+    /// the base of the next updates, so updates never chain (no drift).
+    void accept();
     /// Whether `key` names the current factorisation.
     bool is_current(const std::vector<signed char>& key) const { return key == lu_key_; }
+    /// The reciprocal condition estimate (1-norm) of the dense LU of the Schur way (the
+    /// current held set's, when it was factorised; tests).
+    double schur_rcond() const { return dlu.rcond(); }
     /// Forgets the current factorisation's key (after a singular solve).
     void forget() { lu_key_.clear(); }
     /// Solves by a bordered update since the last reset_updates().
@@ -92,6 +107,9 @@ private:
     void load_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS, Eigen::VectorXd& zf);
     void ensure_columns(const std::vector<int>& rows);
     void factor_schur(const ModeLinearization& lin);
+    int factor_schur_update(const ModeLinearization& lin);
+    void make_schur_base();
+    Eigen::VectorXd schur_inverse(const Eigen::VectorXd& r) const;
     void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
@@ -118,6 +136,23 @@ private:
     Eigen::MatrixXd Mschur;              // the Schur complement (for refinement)
     Eigen::PartialPivLU<Eigen::MatrixXd> dlu;
     std::vector<Eigen::VectorXd> xcol;   // per contact row; empty = not computed
+    std::vector<int> schur_ct;           // per held row (column of M): its coupled slip row, or -1
+    std::vector<double> schur_cc;        //   and the coupling's coefficient
+    std::vector<int> schur_S;            // the held rows of Mschur
+    // the base of the updates: a held set whose Schur complement has a dense LU (dlu_base)
+    bool base_schur = false;
+    std::vector<int> bs_S, bs_ct, bs_index;  // held rows, couplings, row -> index (or -1)
+    std::vector<double> bs_cc;
+    Eigen::MatrixXd bs_M;                // (dlu factorises it while an update is active)
+    // the current set as a low-rank update of the base (Woodbury on the base set plus the
+    // added rows, a removed row's equation replaced by p = 0): U-index of each held row,
+    // the changed rows' and columns' U-indices, Z = A_base^-1 U, the capacitance's LU
+    bool wb_active = false;
+    int wb_nb = 0, wb_nu = 0;
+    std::vector<int> wb_map, wb_rows, wb_cols;
+    Eigen::MatrixXd wb_Drows, wb_Z;
+    Eigen::PartialPivLU<Eigen::MatrixXd> wb_C;
+    double l_nonzeros = 0.0;             // nonzeros of K's Cholesky factor (the cost of a solve)
     std::size_t xcol_count = 0;
     // low-rank updates of the sparse LU (try_border): the base's held set and the border
     bool base_valid = false;

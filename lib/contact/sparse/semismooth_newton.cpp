@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "contact/sparse/transitions.hpp"
 
@@ -26,6 +28,179 @@ void set_open_modes(SparsePath& path) {
         path.modes.make_consistent(path.laws, k);
     }
 }
+
+/// The exact minimiser of theta(a) = ||F(p + a dp, s + a ds)||^2 over [a_min, 1]. Each
+/// component of the natural map (SparsePath::natural_residual) is piecewise linear in a
+/// along the Newton direction (s is affine in p; tau is linear in p_n on each side of its
+/// kink under the current-step rule, constant under the previous-step rule), so theta is
+/// piecewise quadratic with known kinks: a normal row where p_n - s_n / w changes sign, a
+/// tangential row where tau's argument does and where p_t - s_t / w crosses +-mu tau. The
+/// kinks are sorted and swept once, each pair's lines recomputed only at its own kinks, and
+/// the quadratic of each interval minimised in closed form: O(m log m) for the whole search
+/// instead of O(m) per trial point. Returns the minimiser (the caller evaluates F there).
+double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const Eigen::VectorXd& dp,
+                         const Eigen::VectorXd& s, const Eigen::VectorXd& ds, double a_min) {
+    const auto& laws = path.laws;
+    const Eigen::VectorXd& diag = path.diag();
+    const bool prev = laws.tau_rule == TauRule::previous_step;
+    const int np = static_cast<int>(laws.pairs.size());
+    // tau's argument as a line q0 + q1 a (clamp: F_c - p_n; coulomb: -p_n; tau = max(0, q)),
+    // and the limit L = mu tau as a line on the piece where tau's argument has sign of q
+    auto tau_line = [&](int k, double& q0, double& q1) {
+        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+        const double pn0 = c.row_n >= 0 ? p[c.row_n] : 0.0, pn1 = c.row_n >= 0 ? dp[c.row_n] : 0.0;
+        q0 = (c.kind == PairKind::clamp ? c.preload_n : 0.0) - pn0;
+        q1 = -pn1;
+    };
+    auto limit_line = [&](int k, double q, double q0, double q1, double& l0, double& l1) {
+        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+        const double mu = c.friction_coefficient;
+        l0 = l1 = 0.0;
+        const bool carries = c.kind == PairKind::clamp ? (prev || q > 0.0) : (c.row_n >= 0 && q > 0.0);
+        if (!carries) return;
+        if (prev) {
+            l0 = mu * laws.tau_previous_n[static_cast<std::size_t>(k)];
+        } else {
+            l0 = mu * q0;
+            l1 = mu * q1;
+        }
+    };
+    // per pair: the lines (f0 + f1 a) of its normal and tangential components on the piece
+    // containing a (the rows of no pair, and bilateral rows, are s itself: F = s)
+    auto lines = [&](int k, double a, double f[4]) {
+        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+        f[0] = f[1] = f[2] = f[3] = 0.0;
+        if (c.row_n >= 0) {
+            f[0] = s[c.row_n];
+            f[1] = ds[c.row_n];
+            if (c.kind == PairKind::coulomb) {
+                const double w = diag[c.row_n];
+                const double an = (p[c.row_n] - s[c.row_n] / w) + a * (dp[c.row_n] - ds[c.row_n] / w);
+                if (!(an < 0.0)) {  // open branch: F = w p_n
+                    f[0] = w * p[c.row_n];
+                    f[1] = w * dp[c.row_n];
+                }
+            }
+        }
+        if (c.row_t < 0) return;
+        f[2] = s[c.row_t];
+        f[3] = ds[c.row_t];
+        if (c.kind == PairKind::bonded) return;
+        double q0, q1, l0, l1;
+        tau_line(k, q0, q1);
+        limit_line(k, q0 + a * q1, q0, q1, l0, l1);
+        const double w = diag[c.row_t];
+        const double at = (p[c.row_t] - s[c.row_t] / w) + a * (dp[c.row_t] - ds[c.row_t] / w);
+        const double L = l0 + a * l1;
+        if (at > L) {  // F = w (p_t - L)
+            f[2] = w * (p[c.row_t] - l0);
+            f[3] = w * (dp[c.row_t] - l1);
+        } else if (at < -L) {  // F = w (p_t + L)
+            f[2] = w * (p[c.row_t] + l0);
+            f[3] = w * (dp[c.row_t] + l1);
+        }
+    };
+    // the kinks of each pair in (a_min, 1)
+    std::vector<std::pair<double, int>> events;
+    auto add_root = [&](double num, double den, double lo, double hi, int k) {  // root of num + den a in (lo, hi)
+        if (den == 0.0) return;
+        const double a = -num / den;
+        if (a > lo && a < hi) events.emplace_back(a, k);
+    };
+    for (int k = 0; k < np; ++k) {
+        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+        if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
+            const double w = diag[c.row_n];
+            add_root(p[c.row_n] - s[c.row_n] / w, dp[c.row_n] - ds[c.row_n] / w, a_min, 1.0, k);
+        }
+        if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+        const double w = diag[c.row_t];
+        const double t0 = p[c.row_t] - s[c.row_t] / w, t1 = dp[c.row_t] - ds[c.row_t] / w;
+        double q0, q1;
+        tau_line(k, q0, q1);
+        double a_tau = 2.0;  // tau's kink (none in the range: 2)
+        if (q1 != 0.0 && -q0 / q1 > a_min && -q0 / q1 < 1.0) {
+            a_tau = -q0 / q1;
+            events.emplace_back(a_tau, k);
+        }
+        // crossings of a_t = +-L on each piece of L (at most two)
+        const double cuts[3] = {a_min, std::min(a_tau, 1.0), 1.0};
+        for (int piece = 0; piece < (a_tau < 1.0 ? 2 : 1); ++piece) {
+            const double lo = cuts[piece], hi = cuts[piece + 1];
+            const double mid = 0.5 * (lo + hi);
+            double l0, l1;
+            limit_line(k, q0 + mid * q1, q0, q1, l0, l1);
+            add_root(t0 - l0, t1 - l1, lo, hi, k);  // a_t = L
+            add_root(t0 + l0, t1 + l1, lo, hi, k);  // a_t = -L
+        }
+    }
+    std::sort(events.begin(), events.end());
+    // the sweep: theta = A a^2 + B a + C on each interval, each pair's share kept so that
+    // only the pairs with a kink at an interval's end are recomputed
+    const int m = static_cast<int>(s.size());
+    std::vector<char> in_pair(static_cast<std::size_t>(m), 0);
+    std::vector<double> share(static_cast<std::size_t>(np) * 3, 0.0);
+    double A = 0.0, B = 0.0, C = 0.0;
+    auto update = [&](int k, double a) {
+        double f[4];
+        lines(k, a, f);
+        double* q = &share[static_cast<std::size_t>(k) * 3];
+        A -= q[0];
+        B -= q[1];
+        C -= q[2];
+        q[0] = f[1] * f[1] + f[3] * f[3];
+        q[1] = 2.0 * (f[0] * f[1] + f[2] * f[3]);
+        q[2] = f[0] * f[0] + f[2] * f[2];
+        A += q[0];
+        B += q[1];
+        C += q[2];
+    };
+    for (int k = 0; k < np; ++k) {
+        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+        if (c.row_n >= 0) in_pair[static_cast<std::size_t>(c.row_n)] = 1;
+        if (c.row_t >= 0) in_pair[static_cast<std::size_t>(c.row_t)] = 1;
+    }
+    for (int i = 0; i < m; ++i)
+        if (!in_pair[static_cast<std::size_t>(i)]) {
+            A += ds[i] * ds[i];
+            B += 2.0 * s[i] * ds[i];
+            C += s[i] * s[i];
+        }
+    double lo = a_min;
+    {
+        const double hi = events.empty() ? 1.0 : events.front().first;
+        for (int k = 0; k < np; ++k) update(k, 0.5 * (lo + hi));
+    }
+    double best_a = 1.0, best = std::numeric_limits<double>::infinity();
+    auto consider = [&](double a) {
+        const double v = (A * a + B) * a + C;
+        if (v < best) {
+            best = v;
+            best_a = a;
+        }
+    };
+    std::size_t e = 0;
+    while (true) {
+        const double hi = e < events.size() ? events[e].first : 1.0;
+        if (hi > lo) {
+            consider(lo);
+            consider(hi);
+            if (A > 0.0) {
+                const double a = -B / (2.0 * A);
+                if (a > lo && a < hi) consider(a);
+            }
+        }
+        if (e >= events.size()) break;
+        // the pairs with a kink at hi take their lines on the next interval
+        std::size_t f = e;
+        while (f < events.size() && events[f].first == hi) ++f;
+        const double next = f < events.size() ? events[f].first : 1.0;
+        for (std::size_t g = e; g < f; ++g) update(events[g].second, 0.5 * (hi + next));
+        e = f;
+        lo = hi;
+    }
+    return best_a;
+}
 }  // namespace
 
 /// Semismooth Newton method on the natural map (Alart-Curnier / Pang's natural-map
@@ -39,9 +214,11 @@ void set_open_modes(SparsePath& path) {
 ///     complement, as for the active-set passes), giving (p1, z1); F is piecewise linear
 ///     in p, so this is the full Newton step p1 - p;
 ///  3. a line search on theta = ||F||^2 along it: s is affine in p, so
-///     s(p + a (p1 - p)) = s + a (s1 - s) and a trial costs O(m), no solve. Where no trial
-///     decreases theta the full step is taken (a non-monotone step; at most
-///     kNewtonNonmonotone of them) rather than stalling.
+///     s(p + a (p1 - p)) = s + a (s1 - s) and theta is piecewise quadratic in a; its exact
+///     minimiser over [2^-12, 1] by one sweep over the sorted kinks (breakpoint_search;
+///     with Switches::incremental off, and where that finds no decrease, the best of a
+///     49-point grid, each trial O(m)). Where no step decreases theta the full step is
+///     taken (a non-monotone step; at most kNewtonNonmonotone of them) rather than stalling.
 /// From rest (p = 0) it starts from the open modes' solution (set_open_modes).
 /// Unlike block principal pivoting, the modes come from p - s / w (forces and gaps
 /// together), and a damped step moves every component part of the way, so many pairs
@@ -104,7 +281,27 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         // on the first step of 10 leaves x 100 elements). Where no trial lowers theta, the
         // full step is taken (non-monotone; at most kNewtonNonmonotone times).
         double a = 1.0, grid_theta = std::numeric_limits<double>::infinity();
-        for (int j = 0; j <= 4 * kLineSearchOctaves; ++j) {
+        const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
+        bool searched = false;
+        if (path.switches.incremental) {
+            // the exact minimiser over the grid's range (breakpoint_search), checked by one
+            // evaluation of F (the sweep's sums are exact up to their round-off); the full
+            // step where it is as good (p is then the linear solution of its modes)
+            const double ab = breakpoint_search(path, p, p1 - p, sk, s1 - sk, a_min);
+            for (const double aj : {ab, 1.0}) {
+                pa = p + aj * (p1 - p);
+                sa = sk + aj * (s1 - sk);
+                path.natural_residual(pa, sa, F1, false);
+                const double tj = F1.squaredNorm();
+                if (tj < grid_theta || (aj == 1.0 && tj <= grid_theta * (1.0 + 1e-12))) {
+                    grid_theta = tj;
+                    a = aj;
+                }
+                if (ab == 1.0) break;
+            }
+            searched = grid_theta < theta;  // else the grid below decides, as before
+        }
+        for (int j = 0; !searched && j <= 4 * kLineSearchOctaves; ++j) {
             const double aj = std::pow(2.0, -0.25 * j);
             pa = p + aj * (p1 - p);
             sa = sk + aj * (s1 - sk);

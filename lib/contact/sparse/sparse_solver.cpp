@@ -35,9 +35,12 @@
 //    problem by the dense Schur complement of the held rows, M p_S = d_S - G_S z0 with
 //    M = G_S K^-1 (G_S^T + G_slip^T D), on a Cholesky factor of K made once per (K, G).
 //    The columns K^-1 g_i^T are cached per contact row, so a new set of modes costs the
-//    solves of the rows new to the cache and a small dense LU (solve_held, factor_schur).
-//    This is the usual situation of friction runs on identical leaves: most pairs open,
-//    the clamps held.
+//    solves of the rows new to the cache and a small dense LU (factor_schur); incrementally
+//    (Switches::incremental, the default) its Schur complement is copied from the last
+//    factorised set's where it stays and solved by a Woodbury update of that LU, slip
+//    couplings included, and z comes from one solve with K's factor (factor_schur_update,
+//    docs/decisions/020-incremental-mode-solve.md). This is the usual situation of
+//    friction runs on identical leaves: most pairs open, the clamps held.
 //  - Held sets near the last sparse LU's (at most SparsePathTuning::max_border_rows
 //    rows differ, no slip coupling, e.g. the box QP's primal active-set iterations, one
 //    row per iteration): the LU is bordered by the changed rows (a low-rank update: a
@@ -181,7 +184,9 @@ struct SparseContactSolver::Impl {
     Eigen::VectorXd previous_p, last_p;
 
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
-        : path(options, detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows},
+        : path(options,
+               detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows,
+                                                detail::sparse::current_switches().incremental},
                detail::sparse::current_switches()),
           newton_min_rows(tuning.newton_min_rows) {}
 
@@ -410,6 +415,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
                     format_value(r.natural_residual_m) + " m)";
     }
     if (r.converged) {
+        path.solver.accept();  // the accepted modes: the base of the next step's updates
         im.previous_p = im.last_p;
         im.last_p = p;
     }

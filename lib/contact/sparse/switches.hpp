@@ -36,6 +36,11 @@ struct Switches {
     /// passes from the previous modes first, and whatever the problem's size), so its
     /// answers can be checked alone.
     bool newton_first = false;
+    /// The incremental solve (docs/decisions/020): the Schur way's update of the base's
+    /// dense LU (ModeSolverTuning::schur_updates) and the semismooth Newton method's exact
+    /// breakpoint line search. false: every held set's Schur complement from scratch and the
+    /// 49-point line search, the way before (kept for comparison in the benchmark and tests).
+    bool incremental = true;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
