@@ -2,12 +2,17 @@
 /// @file plot.hpp
 /// --plot: PNG figures of a run with gnuplot from its CSV.
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace stackbeam::cli {
 
 /// Displacement, forces, friction force at the probe and the loop (spring force against
 /// w) as PREFIX_*.png. Returns the files written, or none and a note why in `note`.
-std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note);
+/// `fitted_loop`: Fancher's model fitted to the last cycle, (w [m], F [N]) (summary.hpp's
+/// LoopFigures::fancher_loop), drawn over the loop (written to PREFIX_fancher_loop.csv);
+/// empty: none.
+std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
+                                  const std::vector<std::pair<double, double>>& fitted_loop = {});
 
 }  // namespace stackbeam::cli
