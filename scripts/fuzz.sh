@@ -11,7 +11,8 @@
 # a bug too). A crash, hang, out-of-memory or sanitizer report leaves its input in
 # build-fuzz/artifacts/<name>/ and fails the script; make it a regression test by
 # copying it into fuzz/regressions/<name>/ (and a bad-input test, docs/fuzzing.md).
-# STACKBEAM_FUZZ_JOBS=N runs N fuzzing processes per target (default 1: a shared machine).
+# STACKBEAM_FUZZ_JOBS=N runs N fuzzing processes per target (default 1: a shared machine);
+# STACKBEAM_FUZZ_SEED=S fixes libFuzzer's random seed (the CI's run: 1; default: random).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
@@ -46,10 +47,12 @@ for name in "${targets[@]}"; do
   echo "fuzz_$name: ${seconds} s, ${jobs} job(s), corpus $corpus, seeds ${seeds[*]}"
   fuzz_start=$(date +%s)
   # -jobs/-workers: N independent processes (fuzz-N.log each); with 1, run in the foreground
+  seed=()
+  [ -n "${STACKBEAM_FUZZ_SEED:-}" ] && seed=(-seed="$STACKBEAM_FUZZ_SEED")
   parallel=()
   [ "$jobs" -gt 1 ] && parallel=(-jobs="$jobs" -workers="$jobs")
   if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-      "build-fuzz/fuzz/fuzz_$name" "${parallel[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      "build-fuzz/fuzz/fuzz_$name" "${parallel[@]}" "${seed[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="$artifacts/" "${dict[@]}" "$corpus" "${seeds[@]}"; then
     echo "fuzz_$name: FAILED: the input is in $artifacts/ (docs/fuzzing.md: what to do with it)" >&2
     status=1

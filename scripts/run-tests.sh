@@ -3,6 +3,8 @@
 # twice: the Release build in build/, then a second build in build-asan/ under
 # AddressSanitizer and UndefinedBehaviorSanitizer (any report fails the test that
 # made it). STACKBEAM_SANITIZERS=0 skips the second (for a quick local run; CI runs both).
+# Then the readers under libFuzzer for 20 s each (scripts/fuzz.sh, Clang, build-fuzz/;
+# a crash, hang or sanitizer report fails the run; docs/fuzzing.md); STACKBEAM_FUZZ=0 skips it.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
@@ -22,4 +24,9 @@ if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure --timeout 900
   echo "sanitizer build and tests: $(( $(date +%s) - start )) s"
+fi
+
+if [ "${STACKBEAM_FUZZ:-1}" != 0 ]; then
+  # a fixed seed: the same inputs on every CI run (a longer run: docs/fuzzing.md)
+  STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
 fi

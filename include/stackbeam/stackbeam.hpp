@@ -8,7 +8,7 @@
 ///   contact/  the per-step frictional contact problem and its solvers
 ///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
 ///   io/       scenario files (TOML) and CSV output
-///   post/     hysteresis-loop figures of a run
+///   post/     hysteresis-loop figures of a run, the Fancher model fitted to a loop
 #include "stackbeam/conventions.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/model.hpp"
@@ -26,4 +26,5 @@
 #include "stackbeam/time/newmark_stepper.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/io/csv.hpp"
+#include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
