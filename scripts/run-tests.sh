@@ -5,6 +5,8 @@
 # made it); then a third, small one in build-tsan/: the sweep's threads under
 # ThreadSanitizer (the library and test_sweep only). STACKBEAM_SANITIZERS=0 skips the
 # second and third (for a quick local run; CI runs all three).
+# Then the readers under libFuzzer for 20 s each (scripts/fuzz.sh, Clang, build-fuzz/;
+# a crash, hang or sanitizer report fails the run; docs/fuzzing.md); STACKBEAM_FUZZ=0 skips it.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
@@ -28,4 +30,9 @@ if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
   build_tsan
   TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 ctest --test-dir build-tsan --output-on-failure --timeout 900 -R '^test_sweep$'
   echo "thread sanitizer build and test: $(( $(date +%s) - start )) s"
+fi
+
+if [ "${STACKBEAM_FUZZ:-1}" != 0 ]; then
+  # a fixed seed: the same inputs on every CI run (a longer run: docs/fuzzing.md)
+  STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
 fi

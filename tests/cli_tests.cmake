@@ -282,6 +282,13 @@ stackbeam_cli_test(NAME cli_rig_summary
                         --summary ${_cli_out_dir}/cli_rig.json
                    EXPECT_RC 0 EXPECT_TEXT "t 1 to 2 s: area 5.33" OUT ${_cli_out_dir}/cli_rig.json HEADER_PREFIX "{"
                    JSON ${_cli_out_dir}/cli_rig.json JSON_PATH "hysteresis|loop_area_j" JSON_RANGE "5.33|5.34")
+# Fancher's model fitted to the rig loop (docs/reduced-model.md): the summary line and the
+# JSON's relative RMS error (0.47 %: tests/test_fancher.cpp proves the fit).
+stackbeam_cli_test(NAME cli_rig_fancher
+                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --t-end 2 --out ${_cli_out_dir}/cli_rigf.csv
+                        --summary ${_cli_out_dir}/cli_rigf.json
+                   EXPECT_RC 0 EXPECT_TEXT "fancher fit                upper 11950.8 N/m w" OUT ${_cli_out_dir}/cli_rigf.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_rigf.json JSON_PATH "fancher|rms_error_relative" JSON_RANGE "0.0047|0.0048")
 stackbeam_cli_test(NAME cli_pairs_csv
                    ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"

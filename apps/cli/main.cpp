@@ -58,7 +58,7 @@ int run_request(const RunRequest& request) {
         print_summary(request, system, result, loop);
         if (!request.plot.empty()) {
             std::string note;
-            const auto files = plot_run(request.out, request.plot, note);
+            const auto files = plot_run(request.out, request.plot, note, loop.fancher_loop);
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
         }

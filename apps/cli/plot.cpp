@@ -37,7 +37,8 @@ std::optional<std::string> plot_terminal(std::string& note) {
     return terminal;
 }
 
-std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note) {
+std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
+                                  const std::vector<std::pair<double, double>>& fitted_loop) {
     using namespace stackbeam::demo;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
@@ -66,8 +67,20 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
             " using " + std::to_string(t) + ":" + std::to_string(fm) + " with lines dt 3 title 'm d^2w/dt^2'");
     fig("friction", "friction force at the probe pair", "t [s]", "[N]",
         f + " using " + std::to_string(t) + ":" + std::to_string(pf) + " with lines lw 2 title 'p_t'");
+    std::string fitted;
+    if (!fitted_loop.empty()) {
+        const std::string data = prefix + "_fancher_loop.csv";
+        std::ofstream d(data);
+        if (!d) throw ArgumentError("--plot: cannot write '" + data + "'");
+        d.precision(17);
+        for (const auto& [wm, fn] : fitted_loop) d << wm << "," << fn << "\n";
+        d.close();
+        if (!d) throw std::runtime_error("writing '" + data + "' failed");
+        fitted = ", '" + data + "' using (1000*$1):2 with lines dt 2 lw 2 title 'Fancher model, fitted to the last cycle'";
+    }
     fig("loop", "force-deflection loop", "w [mm]", "spring force [N]",
-        f + " using (1000*$" + std::to_string(w) + "):" + std::to_string(sf) + " with lines lw 1.5 notitle");
+        f + " using (1000*$" + std::to_string(w) + "):" + std::to_string(sf) + " with lines lw 1.5 " +
+            (fitted.empty() ? "notitle" : "title 'run'") + fitted);
     g.close();
     if (!g) throw std::runtime_error("writing '" + script_path + "' failed");
     if (std::system(("gnuplot " + shell_quote(script_path)).c_str()) != 0) {

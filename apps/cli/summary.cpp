@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "stackbeam/errors.hpp"
 
@@ -48,6 +49,22 @@ LoopFigures loop_figures(const RunRequest& request, const RunResult& result) {
             loop.metrics = hysteresis_metrics(result.records, cyc.first, cyc.second);
         } catch (const InputError& e) {
             loop.note = e.what();
+        }
+        if (const auto& m = loop.metrics) {
+            // the records hysteresis_metrics read (t in [t_start, t_end], both on the record grid)
+            std::vector<double> w, f;
+            for (const auto& r : result.records)
+                if (r.t_s >= m->t_start_s && r.t_s <= m->t_end_s) {
+                    w.push_back(r.w_m);
+                    f.push_back(r.spring_force_n);
+                }
+            try {
+                loop.fancher = fit_fancher(w, f);
+                const std::vector<double> model = fancher_force(loop.fancher->parameters, w, loop.fancher->start_force_n);
+                for (std::size_t i = 0; i < w.size(); ++i) loop.fancher_loop.emplace_back(w[i], model[i]);
+            } catch (const InputError& e) {
+                loop.fancher_note = e.what();
+            }
         }
     } else {
         loop.note = "no periodic loading: no steady cycle";
@@ -105,6 +122,16 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
                     m->dynamic_rate_n_per_m, m->loss_factor, m->equivalent_damping_ratio);
     } else {
         std::printf("loop                       none (%s)\n", loop.note.c_str());
+    }
+    if (const auto& fit = loop.fancher) {
+        const FancherParameters& p = fit->parameters;
+        std::printf("fancher fit                upper %.6g N/m w + %.6g N, lower %.6g N/m w + %.6g N, beta %.4g m;\n"
+                    "                           RMS error %.4g N = %.3g %% of the force range (%d iterations%s)\n",
+                    p.upper_rate_n_per_m, p.upper_offset_n, p.lower_rate_n_per_m, p.lower_offset_n, p.beta_m,
+                    fit->rms_error_n, 100.0 * fit->rms_error_relative, fit->iterations,
+                    fit->converged ? "" : ", NOT converged");
+    } else if (!loop.fancher_note.empty()) {
+        std::printf("fancher fit                none (%s)\n", loop.fancher_note.c_str());
     }
     if (options.mode == Mode::newmark)
         std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",
@@ -188,6 +215,22 @@ void write_json_summary(const RunRequest& request, const Model& model, const Run
     } else {
         j["hysteresis"] = nullptr;
         j["hysteresis_note"] = loop.note;
+    }
+    if (const auto& fit = loop.fancher) {
+        const FancherParameters& p = fit->parameters;
+        j["fancher"] = {{"upper_rate_n_per_m", p.upper_rate_n_per_m},
+                        {"upper_offset_n", p.upper_offset_n},
+                        {"lower_rate_n_per_m", p.lower_rate_n_per_m},
+                        {"lower_offset_n", p.lower_offset_n},
+                        {"beta_m", p.beta_m},
+                        {"start_force_n", fit->start_force_n},
+                        {"rms_error_n", fit->rms_error_n},
+                        {"rms_error_relative", fit->rms_error_relative},
+                        {"iterations", fit->iterations},
+                        {"converged", fit->converged}};
+    } else {
+        j["fancher"] = nullptr;
+        if (!loop.fancher_note.empty()) j["fancher_note"] = loop.fancher_note;
     }
     j["wall_time_s"] = result.wall_s;
     j["outputs"] = {{"csv", result.csv_file}, {"events", result.events_file}, {"pairs", result.pairs_file}};

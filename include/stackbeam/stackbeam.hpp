@@ -8,7 +8,7 @@
 ///   contact/  the per-step frictional contact problem and its solvers
 ///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
 ///   io/       scenario files (TOML) and CSV output
-///   post/     hysteresis-loop figures of a run
+///   post/     hysteresis-loop figures of a run, the Fancher model fitted to a loop
 ///   study/    sweeps: a base scenario at many points, on threads; the results directory
 #include "stackbeam/conventions.hpp"
 #include "stackbeam/errors.hpp"
@@ -27,6 +27,7 @@
 #include "stackbeam/time/newmark_stepper.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/io/csv.hpp"
+#include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
