@@ -1,8 +1,12 @@
 """The examples of examples/python run to the end (with the interpreter of the tests)."""
+import os
+import pathlib
 import subprocess
 import sys
 
 import pytest
+
+import stackbeam
 
 from conftest import SOURCE_DIR
 
@@ -16,7 +20,8 @@ def test_example_runs(name, tmp_path):
         args.append(str(tmp_path))
     if name == "hand_built_spring.py":
         args.append(str(tmp_path / "spring.toml"))
-    done = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True)
+    env = dict(os.environ, PYTHONPATH=str(pathlib.Path(stackbeam.__file__).resolve().parents[1]), MPLBACKEND="Agg")
+    done = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr
     if name == "rig_loop.py":
         assert sorted(p.name for p in tmp_path.glob("rig_*.png")) == [
