@@ -10,8 +10,10 @@ over the same run by the C++ command line, and two runs on two Python threads ag
      build to the records), and
    - the command line: `stackbeam simulate --case friction` (its summary's wall_time_s: the
      same run writing its CSV; and the child's CPU time, process start included).
-2. Threads: the friction case to t = 3 s, one run alone, then two runs on two threads at once;
-   the ratio of the wall times (two at once / one), and the CPU time of the two.
+2. Threads: the friction case to t = 10 s, one run alone, then two runs on two threads at once;
+   the ratio of the wall times (two at once / one), and of the CPU time per run (two at once
+   / one: above 1 if the runs slowed each other down, e.g. by a lock). The wall ratio needs
+   two idle cores: the load average is printed with it.
 Medians over the repetitions; timings of a shared machine are noisy (compare ratios).
 """
 import argparse
@@ -66,7 +68,7 @@ print("   its C++ run:       wall %.4f s   -> python layer overhead %+.1f %%" % 
 print("   command line:      wall %.4f s (run + CSV), CPU %.4f s (process)   -> python vs CLI: wall %+.1f %%, CPU %+.1f %%" % (
     med(cli_wall), med(cli_cpu), 100 * (med(py_wall) / med(cli_wall) - 1), 100 * (med(py_cpu) / med(cli_cpu) - 1)))
 
-long_run = {"t_end_s": 3.0}
+long_run = {"t_end_s": 10.0}
 
 
 def timed(n_threads):
@@ -90,7 +92,8 @@ for _ in range(max(3, args.repeat // 2)):
     one.append(w), one_cpu.append(c)
     w, c = timed(2)
     two.append(w), two_cpu.append(c)
-print("2. friction case to t = 3 s (3,000 steps); medians of %d; %d cores" % (len(one), os.cpu_count()))
+print("2. friction case to t = 10 s (10,000 steps); medians of %d; %d cores, load average %.1f" % (
+    len(one), os.cpu_count(), os.getloadavg()[0]))
 print("   one run:               wall %.3f s, CPU %.3f s" % (med(one), med(one_cpu)))
-print("   two runs, two threads: wall %.3f s, CPU %.3f s   -> %.3fx the wall time of one" % (
-    med(two), med(two_cpu), med(two) / med(one)))
+print("   two runs, two threads: wall %.3f s, CPU %.3f s   -> %.3fx the wall time of one, %.3fx the CPU time per run" % (
+    med(two), med(two_cpu), med(two) / med(one), med(two_cpu) / 2 / med(one_cpu)))
