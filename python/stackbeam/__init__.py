@@ -41,6 +41,34 @@ __all__ = [
 ]
 
 
+def _fields_repr(obj):
+    """ClassName(key=value, ...) of a scenario's entry: its public attributes, lists by their length."""
+    parts = []
+    for name in dir(obj):
+        if name.startswith("_"):
+            continue
+        value = getattr(obj, name)
+        if callable(value):
+            continue
+        if hasattr(value, "__len__") and not isinstance(value, (str, list)):
+            value = "[%d]" % len(value)
+        elif type(value).__module__.startswith("stackbeam"):
+            value = "..."
+        else:
+            value = repr(value)
+        parts.append("%s=%s" % (name, value))
+    return "%s(%s)" % (type(obj).__name__, ", ".join(parts))
+
+
+for _cls in (Leaf, LeafProfile, LeafEnd, Interface, Clamp, Clip, Probe, TimeFunction, _core.RigidBody, _core.Loading,
+             _core.Mesh, _core.Model, _core.Simulation, _core.Outputs):
+    _cls.__repr__ = _fields_repr
+for _cls in (_core.LeafList, _core.InterfaceList, _core.ClampList, _core.ClipList):
+    _cls.__repr__ = lambda items: "[%s]" % ", ".join(repr(x) for x in items)
+Scenario.__repr__ = lambda s: "<stackbeam.Scenario %s: %d leaves, mode %s, t_end_s %g>" % (
+    s.source, len(s.model.leaves), s.simulation.mode, s.simulation.t_end_s)
+
+
 def _flatten_options(options, prefix=""):
     """simulate's keyword options as {member: value}: nested dicts (cvode={"rtol": 1e-9})
     and dotted names ({"cvode.rtol": 1e-9}) alike."""
@@ -108,6 +136,11 @@ def simulate(scenario, *, pairs=False, **options):
     flat = _flatten_options(options)
     raw = _core._run(scenario, flat, bool(pairs))
     return Result(raw, scenario.copy(), flat)
+
+
+# The sweep (issue 29) binds as simulate does: a `_core._sweep(spec, jobs)` beside `_core._run`
+# in python/src/module.cpp (the GIL released while the points run, the points table returned as
+# a dict of numpy arrays) and a `sweep(spec, jobs=1)` here wrapping it.
 
 
 class Stepper:
