@@ -132,7 +132,7 @@ def simulate(scenario, *, pairs=False, **options):
     the member. ``pairs=True`` keeps every pair at every record (Result.pairs).
 
     The GIL is released while the run steps, so runs on Python threads run in parallel;
-    Ctrl-C raises KeyboardInterrupt within about 20 ms (the run is dropped)."""
+    Ctrl-C raises KeyboardInterrupt at the first record after about 20 ms (the run is dropped)."""
     flat = _flatten_options(options)
     raw = _core._run(scenario, flat, bool(pairs))
     return Result(raw, scenario.copy(), flat)

@@ -18,16 +18,21 @@ def _axes(ax):
     return plt.figure(figsize=(8, 5)).add_subplot()
 
 
+def _finish(ax, title, xlabel, ylabel, legend=True):
+    ax.set(title=title, xlabel=xlabel, ylabel=ylabel)
+    ax.grid(True)
+    if legend:
+        ax.legend(loc="upper right")
+    return ax
+
+
 def displacement(result, ax=None):
     """w (the deflection of R) and w + y_b (absolute, base excitation) against t [mm]."""
     ax = _axes(ax)
     t, w, yb = result["t"], result["w"], result["base_displacement"]
     ax.plot(t, 1000 * w, lw=2, label="w (deflection)")
     ax.plot(t, 1000 * (w + yb), ls="--", label="w + y_b (absolute)")
-    ax.set(title="displacement of R", xlabel="t [s]", ylabel="[mm]")
-    ax.grid(True)
-    ax.legend(loc="upper right")
-    return ax
+    return _finish(ax, "displacement of R", "t [s]", "[mm]")
 
 
 def force(result, ax=None):
@@ -37,20 +42,14 @@ def force(result, ax=None):
     ax.plot(t, result["spring_force"], lw=2, label="spring force")
     ax.plot(t, result["external_force"], ls="--", label="external force")
     ax.plot(t, result["force_on_mass"], ls=":", label="m d$^2$w/dt$^2$")
-    ax.set(title="forces on R", xlabel="t [s]", ylabel="[N]")
-    ax.grid(True)
-    ax.legend(loc="upper right")
-    return ax
+    return _finish(ax, "forces on R", "t [s]", "[N]")
 
 
 def friction(result, ax=None):
     """The friction force p_t at the probe pair against t [N]."""
     ax = _axes(ax)
     ax.plot(result["t"], result["probe_friction_force"], lw=2, label="p$_t$")
-    ax.set(title="friction force at the probe pair", xlabel="t [s]", ylabel="[N]")
-    ax.grid(True)
-    ax.legend(loc="upper right")
-    return ax
+    return _finish(ax, "friction force at the probe pair", "t [s]", "[N]")
 
 
 def loop(result, ax=None):
@@ -58,9 +57,7 @@ def loop(result, ax=None):
     dissipated per cycle, Result.summary["hysteresis"])."""
     ax = _axes(ax)
     ax.plot(1000 * result["w"], result["spring_force"], lw=1.5)
-    ax.set(title="force-deflection loop", xlabel="w [mm]", ylabel="spring force [N]")
-    ax.grid(True)
-    return ax
+    return _finish(ax, "force-deflection loop", "w [mm]", "spring force [N]", legend=False)
 
 
 FIGURES = {"displacement": displacement, "force": force, "friction": friction, "loop": loop}
