@@ -310,8 +310,10 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
     cli::RunResult result;
     PairTable pairs;
     SignalCheck check(in_main_thread());
+    std::chrono::steady_clock::time_point released, reacquired;  // the stepping without the GIL
     {
         py::gil_scoped_release release;
+        released = std::chrono::steady_clock::now();
         const System system(model);
         in_scenario(*ps, [&] {
             choose_contact_path(system, options);  // as the command line: a path the solver cannot take
@@ -326,6 +328,7 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
                 &result.report, on_pairs);
             return 0;
         });
+        reacquired = std::chrono::steady_clock::now();
     }
     result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -339,7 +342,11 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
     out["columns"] = records_dict(result.records);
     out["pairs"] = want_pairs ? py::object(pairs.to_dict()) : py::object(py::none());
     out["events"] = options.mode == Mode::cvode ? py::object(events_dict(result.report.events)) : py::object(py::none());
-    out["report"] = report_dict(result.report);
+    py::dict report = report_dict(result.report);
+    // when the run held no GIL, on the clock of Python's time.monotonic() (CLOCK_MONOTONIC, as steady_clock)
+    report["without_gil_s"] = py::make_tuple(std::chrono::duration<double>(released.time_since_epoch()).count(),
+                                            std::chrono::duration<double>(reacquired.time_since_epoch()).count());
+    out["report"] = report;
     out["summary"] = cli::json_summary(request, model, result, loop);
     return out;
 }

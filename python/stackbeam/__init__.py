@@ -88,7 +88,8 @@ class Result(_Mapping):
     Attributes: ``pairs`` (every contact pair at every record, a dict of arrays with the
     --pairs CSV's columns; None unless simulate(..., pairs=True)), ``events`` (the event
     log of mode cvode, the --events CSV's columns; None in the other modes), ``summary``
-    (the command line's JSON summary as a dict), ``report`` (the run's counters),
+    (the command line's JSON summary as a dict), ``report`` (the run's counters, and
+    ``without_gil_s``: when the run stepped without the GIL, on time.monotonic()'s clock),
     ``scenario`` (a copy of the scenario run) and ``options`` (the options given)."""
 
     def __init__(self, raw, scenario, options):

@@ -3,10 +3,12 @@ and give the results of serial runs; Ctrl-C (SIGINT) stops a run with KeyboardIn
 the process stays usable.
 
 How overlap is proved without a wall-clock threshold (a shared, loaded machine): the main
-thread samples the CPU clocks of the running threads (time.pthread_getcpuclockid). A run
-that held the GIL would keep the main thread from sampling at all while it runs; so a sample
-interval in which both runs' threads used CPU while both were inside simulate() shows both
-stepping at once, with the main thread, which needs the GIL to sample, running too."""
+thread samples the CPU clocks of the two running threads (time.pthread_getcpuclockid) with
+time.monotonic(); each run reports when it stepped without the GIL (report["without_gil_s"],
+on the same clock). A sample interval that lies inside both runs' GIL-free stepping and in
+which both threads used CPU shows both runs stepping in it, while the main thread, which
+needs the GIL to sample, ran too. Runs serialised by the GIL would give no such interval.
+"""
 import os
 import signal
 import threading
@@ -49,24 +51,22 @@ def test_two_runs_on_two_threads_overlap_and_equal_serial():
         r.start()
     while not all(r.inside for r in runs) and any(r.is_alive() for r in runs):
         time.sleep(0.001)
-    # CPU time both threads used at once, inside simulate(), in sample intervals while the
-    # main thread ran Python: the smaller of the two threads' CPU increments, summed
-    overlap_cpu_s = 0.0
-    last = None
+    samples = []  # (time.monotonic() before, CPU time of each thread, time.monotonic() after)
     while all(r.inside for r in runs):
         try:
-            now = [cpu_s(r) for r in runs]
+            before = time.monotonic()
+            samples.append((before, [cpu_s(r) for r in runs], time.monotonic()))
         except (OSError, TypeError):  # a thread ended between the check and the clock
             break
-        if last is not None and all(r.inside for r in runs):
-            overlap_cpu_s += max(0.0, min(n - l for n, l in zip(now, last)))
-        last = now
         time.sleep(0.005)
     for r in runs:
         r.join()
-    # The Python around the call (before and after the C++ run) takes well under 1 ms:
-    # 20 ms of overlap is the C++ runs stepping at once.
-    assert overlap_cpu_s > 0.02, overlap_cpu_s
+    start = max(r.result.report["without_gil_s"][0] for r in runs)
+    end = min(r.result.report["without_gil_s"][1] for r in runs)
+    both_stepping = sum(
+        1 for (t0, c0, _), (_, c1, t1) in zip(samples, samples[1:])
+        if start <= t0 and t1 <= end and all(b > a for a, b in zip(c0, c1)))
+    assert both_stepping >= 1, (len(samples), start, end)
     for r in runs:
         for name in serial:
             np.testing.assert_array_equal(r.result[name], serial[name])
