@@ -144,45 +144,21 @@ def simulate(scenario, *, pairs=False, **options):
 # a dict of numpy arrays) and a `sweep(spec, jobs=1)` here wrapping it.
 
 
-class Stepper:
-    """A run one record at a time (co-simulation loops): ``advance()`` returns the next
-    record (a dict of the CSV's columns), ``pairs()`` the contact pairs at the current one,
-    ``current`` the current record, ``record_index``, ``records`` (to t_end_s), ``dt_s``,
-    ``report()``. Iterating over it advances to the end."""
+Stepper = _core.Stepper  # advance(), pairs(), report(), current, record_index, records, dt_s
 
-    def __init__(self, scenario, **options):
-        self._core = _core.Stepper(scenario, _flatten_options(options))
 
-    def advance(self):
-        return self._core.advance()
+def _stepper_iter(self):
+    """Advances to the end of the run, yielding each record."""
+    while self.record_index < self.records - 1:
+        yield self.advance()
 
-    def pairs(self):
-        return self._core.pairs()
 
-    def report(self):
-        return self._core.report()
-
-    @property
-    def current(self):
-        return self._core.current
-
-    @property
-    def record_index(self):
-        return self._core.record_index
-
-    @property
-    def records(self):
-        return self._core.records
-
-    @property
-    def dt_s(self):
-        return self._core.dt_s
-
-    def __iter__(self):
-        while self._core.record_index < self._core.records - 1:
-            yield self._core.advance()
+Stepper.__iter__ = _stepper_iter
 
 
 def make_stepper(scenario, **options):
-    """A Stepper of `scenario` with options as in simulate()."""
-    return Stepper(scenario, **options)
+    """A run of `scenario` one record at a time (co-simulation loops), options as in simulate():
+    ``advance()`` returns the next record (a dict of the CSV's columns), ``pairs()`` the contact
+    pairs at the current one, ``current`` the current record, ``record_index``, ``records``
+    (to t_end_s), ``dt_s``, ``report()``. Iterating over it advances to the end."""
+    return Stepper(scenario, _flatten_options(options))
