@@ -33,17 +33,74 @@ namespace py = pybind11;
 using namespace pybind11::literals;
 using namespace stackbeam;
 
-PYBIND11_MAKE_OPAQUE(std::vector<stackbeam::LeafSpec>)
-PYBIND11_MAKE_OPAQUE(std::vector<stackbeam::InterfaceSpec>)
-PYBIND11_MAKE_OPAQUE(std::vector<stackbeam::ClampSpec>)
-PYBIND11_MAKE_OPAQUE(std::vector<stackbeam::ClipSpec>)
+PYBIND11_MAKE_OPAQUE(std::vector<std::shared_ptr<stackbeam::LeafSpec>>)
+PYBIND11_MAKE_OPAQUE(std::vector<std::shared_ptr<stackbeam::InterfaceSpec>>)
+PYBIND11_MAKE_OPAQUE(std::vector<std::shared_ptr<stackbeam::ClampSpec>>)
+PYBIND11_MAKE_OPAQUE(std::vector<std::shared_ptr<stackbeam::ClipSpec>>)
 
 namespace {
 
+template <class T>
+using Shared = std::vector<std::shared_ptr<T>>;
+
+/// The model's list `from` copied into `to`; InputError naming `name`[i] for an entry that is None.
+template <class T>
+void pack(const Shared<T>& from, std::vector<T>& to, const std::string& name, const char* type) {
+    to.clear();
+    for (std::size_t i = 0; i < from.size(); ++i) {
+        if (!from[i]) throw InputError(name + "[" + std::to_string(i) + "]", std::string("is None: must be a ") + type);
+        to.push_back(*from[i]);
+    }
+}
+template <class T>
+Shared<T> unpack(const std::vector<T>& from) {
+    Shared<T> to;
+    for (const T& x : from) to.push_back(std::make_shared<T>(x));
+    return to;
+}
+template <class T>
+Shared<T> deep_copy(const Shared<T>& from) {
+    Shared<T> to;
+    for (const auto& x : from) to.push_back(x ? std::make_shared<T>(*x) : nullptr);
+    return to;
+}
+
 /// A scenario and the first line of its summary ("setup", as the command line writes it).
+/// The model's lists and its probe are kept as shared objects, so that a Python reference to
+/// an entry (`leaf = s.model.leaves[0]`) stays valid whatever happens to the list (the
+/// elements of a std::vector move when it grows); synced() copies them into the scenario.
 struct PyScenario {
-    Scenario scenario;
+    Scenario scenario;  ///< its model's leaves, interfaces, clamps, clips and probe: the members below
     std::string setup;
+    Shared<LeafSpec> leaves;
+    Shared<InterfaceSpec> interfaces;
+    Shared<ClampSpec> clamps;
+    Shared<ClipSpec> clips;
+    std::shared_ptr<ProbeSpec> probe;
+
+    PyScenario(Scenario s, std::string first_line) : scenario(std::move(s)), setup(std::move(first_line)) {
+        leaves = unpack(scenario.model.leaves);
+        interfaces = unpack(scenario.model.interfaces);
+        clamps = unpack(scenario.model.clamps);
+        clips = unpack(scenario.model.clips);
+        if (scenario.model.probe) probe = std::make_shared<ProbeSpec>(*scenario.model.probe);
+    }
+    /// A copy shares no entry with the original.
+    PyScenario(const PyScenario& o)
+        : scenario(o.scenario), setup(o.setup), leaves(deep_copy(o.leaves)), interfaces(deep_copy(o.interfaces)),
+          clamps(deep_copy(o.clamps)), clips(deep_copy(o.clips)),
+          probe(o.probe ? std::make_shared<ProbeSpec>(*o.probe) : nullptr) {}
+    PyScenario& operator=(const PyScenario&) = delete;
+
+    /// The scenario with the model's lists and probe as they are now.
+    Scenario& synced() {
+        pack(leaves, scenario.model.leaves, "leaves", "Leaf");
+        pack(interfaces, scenario.model.interfaces, "interfaces", "Interface");
+        pack(clamps, scenario.model.clamps, "clamps", "Clamp");
+        pack(clips, scenario.model.clips, "clips", "Clip");
+        scenario.model.probe = probe ? std::optional<ProbeSpec>(*probe) : std::nullopt;
+        return scenario;
+    }
 };
 using ScenarioPtr = std::shared_ptr<PyScenario>;
 
@@ -303,7 +360,9 @@ private:
 /// the run of the command line (same records, same JSON summary), the GIL released while it steps.
 py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_pairs) {
     // the run's own copy: another thread may change the scenario while this one runs without the GIL
-    const std::shared_ptr<const PyScenario> ps = std::make_shared<PyScenario>(*scenario);
+    const auto copy = std::make_shared<PyScenario>(*scenario);
+    copy->synced();
+    const std::shared_ptr<const PyScenario> ps = copy;
     const SimulationOptions options = options_with(*ps, overrides);
     const Model model = build_checked(*ps, options);
     const auto t0 = std::chrono::steady_clock::now();
@@ -354,10 +413,11 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
 /// A stepper for co-simulation: the model, the options and the mode's Stepper, one record at a time.
 class PyStepper {
 public:
-    PyStepper(const ScenarioPtr& ps, const py::dict& overrides)
-        : options_(options_with(*ps, overrides)),
-          system_(std::make_unique<System>(build_checked(*ps, options_))),
-          stepper_(in_scenario(*ps, [&] { return make_stepper(*system_, options_); })),
+    PyStepper(const ScenarioPtr& scenario, const py::dict& overrides)
+        : ps_(synced_copy(scenario)),
+          options_(options_with(*ps_, overrides)),
+          system_(std::make_unique<System>(build_checked(*ps_, options_))),
+          stepper_(in_scenario(*ps_, [&] { return make_stepper(*system_, options_); })),
           n_(static_cast<long>(std::ceil(options_.t_end_s / options_.dt_s - 1e-9))) {}
 
     py::dict advance() {
@@ -387,18 +447,19 @@ public:
     }
 
 private:
+    static std::shared_ptr<PyScenario> synced_copy(const ScenarioPtr& scenario) {
+        auto copy = std::make_shared<PyScenario>(*scenario);
+        copy->synced();
+        return copy;
+    }
+    std::shared_ptr<PyScenario> ps_;  ///< the scenario as it was made from (for the errors' key paths)
     SimulationOptions options_;
     std::unique_ptr<System> system_;
     std::unique_ptr<Stepper> stepper_;
     long n_;
 };
 
-ScenarioPtr make_scenario(Scenario s, std::string setup) {
-    auto p = std::make_shared<PyScenario>();
-    p->scenario = std::move(s);
-    p->setup = std::move(setup);
-    return p;
-}
+ScenarioPtr make_scenario(Scenario s, std::string setup) { return std::make_shared<PyScenario>(std::move(s), std::move(setup)); }
 
 /// The command line's summary line for a scenario file.
 std::string file_setup(const Scenario& s) {
@@ -406,8 +467,8 @@ std::string file_setup(const Scenario& s) {
 }
 
 /// A string property for an enum member, parsed by `words`, the field named `name`.
-template <class C, class E>
-void enum_property(py::class_<C>& cls, const char* name, E C::*member, const std::vector<std::pair<const char*, E>>& words) {
+template <class Cls, class C, class E>
+void enum_property(Cls& cls, const char* name, E C::*member, const std::vector<std::pair<const char*, E>>& words) {
     cls.def_property(
         name,
         [member, words](const C& c) {
@@ -456,7 +517,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("bushing_x_n_per_m", &LeafEndSpec::bushing_x_n_per_m)
         .def_readwrite("bushing_y_n_per_m", &LeafEndSpec::bushing_y_n_per_m)
         .def_readwrite("bushing_rotation_n_m_per_rad", &LeafEndSpec::bushing_rotation_n_m_per_rad);
-    py::class_<LeafSpec> leaf(m, "Leaf", "[[leaves]]: one leaf, from the top of the stack down");
+    py::class_<LeafSpec, std::shared_ptr<LeafSpec>> leaf(m, "Leaf", "[[leaves]]: one leaf, from the top of the stack down");
     leaf.def(py::init<>())
         .def_readwrite("length_m", &LeafSpec::length_m)
         .def_readwrite("x_start_m", &LeafSpec::x_start_m)
@@ -473,7 +534,7 @@ PYBIND11_MODULE(_core, m) {
     enum_property(leaf, "left_support", &LeafSpec::left_support, kSupports);
     enum_property(leaf, "right_support", &LeafSpec::right_support, kSupports);
 
-    py::class_<InterfaceSpec> interface(m, "Interface", "[[interfaces]]: between leaves i and i+1");
+    py::class_<InterfaceSpec, std::shared_ptr<InterfaceSpec>> interface(m, "Interface", "[[interfaces]]: between leaves i and i+1");
     interface.def(py::init<>())
         .def_property(
             "law", [](const InterfaceSpec& f) { return std::string(f.law == InterfaceLaw::bonded ? "bonded" : "coulomb"); },
@@ -490,12 +551,12 @@ PYBIND11_MODULE(_core, m) {
             [](InterfaceSpec& f, const std::string& text) { f.contact = parse_interface_contact(text, "contact"); })
         .def_readwrite("normal_stiffness_pa_per_m", &InterfaceSpec::normal_stiffness_pa_per_m)
         .def_readwrite("tangential_stiffness_pa_per_m", &InterfaceSpec::tangential_stiffness_pa_per_m);
-    py::class_<ClampSpec>(m, "Clamp", "[[clamps]]: a clamp (band, U-bolt)")
+    py::class_<ClampSpec, std::shared_ptr<ClampSpec>>(m, "Clamp", "[[clamps]]: a clamp (band, U-bolt)")
         .def(py::init<>())
         .def_readwrite("x_m", &ClampSpec::x_m)
         .def_readwrite("preload_n", &ClampSpec::preload_n)
         .def_readwrite("length_m", &ClampSpec::length_m);
-    py::class_<ClipSpec>(m, "Clip", "[[clips]]: a rebound clip")
+    py::class_<ClipSpec, std::shared_ptr<ClipSpec>>(m, "Clip", "[[clips]]: a rebound clip")
         .def(py::init<>())
         .def_readwrite("x_m", &ClipSpec::x_m)
         .def_readwrite("first_leaf", &ClipSpec::first_leaf)
@@ -506,7 +567,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("mass_kg", &RigidBodySpec::mass_kg)
         .def_readwrite("x_m", &RigidBodySpec::x_m)
         .def_readwrite("tied_leaves", &RigidBodySpec::tied_leaves);
-    py::class_<ProbeSpec>(m, "Probe", "[probe]: where the probe friction force is read")
+    py::class_<ProbeSpec, std::shared_ptr<ProbeSpec>>(m, "Probe", "[probe]: where the probe friction force is read")
         .def(py::init<>())
         .def(py::init([](int i, double x) { return ProbeSpec{i, x}; }), "interface_index"_a, "x_m"_a)
         .def_readwrite("interface_index", &ProbeSpec::interface_index)
@@ -521,10 +582,10 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("values", &TimeFunction::values);
     enum_property(tf, "shape", &TimeFunction::shape, kShapes);
 
-    py::bind_vector<std::vector<LeafSpec>>(m, "LeafList");
-    py::bind_vector<std::vector<InterfaceSpec>>(m, "InterfaceList");
-    py::bind_vector<std::vector<ClampSpec>>(m, "ClampList");
-    py::bind_vector<std::vector<ClipSpec>>(m, "ClipList");
+    py::bind_vector<Shared<LeafSpec>>(m, "LeafList");
+    py::bind_vector<Shared<InterfaceSpec>>(m, "InterfaceList");
+    py::bind_vector<Shared<ClampSpec>>(m, "ClampList");
+    py::bind_vector<Shared<ClipSpec>>(m, "ClipList");
 
     py::class_<LoadingView>(m, "Loading", "[loading]: how the run loads the spring, and R's initial conditions")
         .def_property(
@@ -562,20 +623,16 @@ PYBIND11_MODULE(_core, m) {
 
     const auto ref = py::return_value_policy::reference_internal;
     py::class_<ModelView>(m, "Model", "The stack: attributes named as the scenario file's tables")
-        .def_property_readonly("leaves", [](ModelView& v) -> std::vector<LeafSpec>& { return v.s->scenario.model.leaves; }, ref)
-        .def_property_readonly("interfaces", [](ModelView& v) -> std::vector<InterfaceSpec>& { return v.s->scenario.model.interfaces; }, ref)
-        .def_property_readonly("clamps", [](ModelView& v) -> std::vector<ClampSpec>& { return v.s->scenario.model.clamps; }, ref)
-        .def_property_readonly("clips", [](ModelView& v) -> std::vector<ClipSpec>& { return v.s->scenario.model.clips; }, ref)
+        .def_property_readonly("leaves", [](ModelView& v) -> Shared<LeafSpec>& { return v.s->leaves; }, ref)
+        .def_property_readonly("interfaces", [](ModelView& v) -> Shared<InterfaceSpec>& { return v.s->interfaces; }, ref)
+        .def_property_readonly("clamps", [](ModelView& v) -> Shared<ClampSpec>& { return v.s->clamps; }, ref)
+        .def_property_readonly("clips", [](ModelView& v) -> Shared<ClipSpec>& { return v.s->clips; }, ref)
         .def_property_readonly("rigid_body", [](ModelView& v) -> RigidBodySpec& { return v.s->scenario.model.rigid_body; }, ref)
         .def_property_readonly("loading", [](ModelView& v) { return LoadingView{v.s}; })
         .def_property_readonly("mesh", [](ModelView& v) { return MeshView{v.s}; })
         .def_property(
-            "probe",
-            [](ModelView& v) -> py::object {
-                if (!v.s->scenario.model.probe) return py::none();
-                return py::cast(&*v.s->scenario.model.probe, py::return_value_policy::reference_internal, py::cast(v));
-            },
-            [](ModelView& v, std::optional<ProbeSpec> p) { v.s->scenario.model.probe = p; });
+            "probe", [](ModelView& v) { return v.s->probe; },  // None when there is none
+            [](ModelView& v, std::shared_ptr<ProbeSpec> p) { v.s->probe = std::move(p); });
 
     py::class_<OptionsView>(m, "Simulation", "The integrator's options by SimulationOptions member (file: [integrator])")
         .def("__getattr__",
@@ -601,10 +658,9 @@ PYBIND11_MODULE(_core, m) {
 
     py::class_<PyScenario, ScenarioPtr>(m, "Scenario", "A whole run: the stack, the loading, the integrator, the outputs")
         .def(py::init([] {
-            auto p = make_scenario(Scenario{}, "");
-            p->scenario.source = "<python>";
-            p->setup = file_setup(p->scenario);
-            return p;
+            Scenario s;
+            s.source = "<python>";
+            return make_scenario(s, file_setup(s));
         }))
         .def_static(
             "from_toml",
@@ -613,8 +669,8 @@ PYBIND11_MODULE(_core, m) {
                 return make_scenario(s, file_setup(s));
             },
             "text"_a, "source"_a = "<string>", "Parses scenario TOML text (docs/model-and-scenarios.md)")
-        .def("to_toml", [](const PyScenario& p) { return to_toml(p.scenario); }, "The scenario as TOML text")
-        .def("validate", [](const PyScenario& p) { build_checked(p, p.scenario.simulation); },
+        .def("to_toml", [](PyScenario& p) { return to_toml(p.synced()); }, "The scenario as TOML text")
+        .def("validate", [](PyScenario& p) { build_checked(p, p.synced().simulation); },
              "Checks the model and the options as a scenario file is checked; InputError names the key")
         .def("copy", [](const PyScenario& p) { return std::make_shared<PyScenario>(p); })
         .def("__copy__", [](const PyScenario& p) { return std::make_shared<PyScenario>(p); })

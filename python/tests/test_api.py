@@ -292,3 +292,23 @@ def test_stepper_equals_simulate():
     pairs = stepper.pairs()
     assert len(pairs["p_n"]) == len(pairs["state"]) > 0
     assert stepper.report()["steps"] == 30
+
+
+def test_entries_are_shared_objects_and_copies_independent():
+    """An entry taken out of a list stays the scenario's entry when the list grows (no dangling
+    reference), a copy shares nothing, and None in a list is refused by name."""
+    s = stackbeam.paper_example("friction")
+    leaf = s.model.leaves[0]
+    for _ in range(100):
+        s.model.leaves.append(stackbeam.Leaf())
+    leaf.height_m = 0.007
+    assert s.model.leaves[0].height_m == 0.007
+    del s.model.leaves[3:]
+    c = s.copy()
+    c.model.leaves[0].height_m = 0.001
+    c.model.probe.x_m = 0.2
+    assert s.model.leaves[0].height_m == 0.007 and s.model.probe.x_m != 0.2
+    s.model.clamps.append(None)
+    with pytest.raises(stackbeam.InputError) as e:
+        s.validate()
+    assert e.value.field == "clamps[4]"
