@@ -6,6 +6,8 @@ STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)
+# The Python module (python/, docs/python.md) and its tests and figures, for Debian's /usr/bin/python3.
+STACKBEAM_PYTHON_PACKAGES=(python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.
@@ -47,9 +49,12 @@ build() {
 # UndefinedBehaviorSanitizer (every UB report fatal), assertions on (Eigen's index
 # checks too), -O1 -g1 (a third of the compile time of -O2 -g with both
 # sanitizers, line numbers in the reports kept), the library shared (the Release
-# build's is static, so the tests cover both kinds of installed package).
+# build's is static, so the tests cover both kinds of installed package). Without the
+# Python module: an instrumented extension cannot load into the uninstrumented python3
+# (the sanitizer runtime must come first); the Release build tests it.
 build_sanitized() {
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
+    -DSTACKBEAM_BUILD_PYTHON=OFF \
     -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   cmake --build build-asan -j"$(nproc)"
 }

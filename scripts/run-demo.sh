@@ -7,7 +7,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
 source scripts/common.sh
 
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" gnuplot-nox
+install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" "${STACKBEAM_PYTHON_PACKAGES[@]}" gnuplot-nox
 build
 if [ "$#" -eq 0 ]; then set -- --out-dir out; fi
 ./build/demos/paper_demo "$@"

@@ -12,7 +12,8 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
 source scripts/common.sh
 
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" gnuplot-nox  # gnuplot: the CLI test of --plot; MPI: the sweep's
+# gnuplot: the CLI test of --plot; MPI: the sweep's; Python: the module's tests
+install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" "${STACKBEAM_PYTHON_PACKAGES[@]}" gnuplot-nox
 build
 # --timeout: a test that hangs (a sanitizer's abort_on_error was seen to hang a binary for
 # over 16 min instead of failing) fails after 15 min instead of stalling the run; the

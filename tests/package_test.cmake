@@ -1,8 +1,9 @@
 # The installed package, as a user gets it (CTest test package_consumer):
 #   1. install components: `cmake --install --component library` into <prefix>
 #      gives headers, libraries, CMake package and pkg-config files only (no
-#      program), `--component programs` the programs only, and the two together are
-#      the whole install (no install rule without a component);
+#      program), `--component programs` the programs only, and these two with
+#      `--component python` (the Python module, when built; its own test is
+#      python/install_test.cmake) are the whole install (no install rule without a component);
 #   2. no installed public header includes a SUNDIALS or toml11 header (they are
 #      private dependencies; the system include path would hide such a leak from
 #      the compiles below, so it is checked by reading the headers);
@@ -65,6 +66,7 @@ endfunction()
 file(REMOVE_RECURSE "${CONSUMER_BUILD}")
 installed_files(library_files "${PREFIX}" library)
 installed_files(program_files "${PREFIX}-programs" programs)
+installed_files(python_files "${PREFIX}-python" python)
 installed_files(all_files "${PREFIX}-all")
 foreach(f include/stackbeam/model/model.hpp include/stackbeam/io/scenario.hpp ${LIBDIR}/cmake/stackbeam/stackbeamConfig.cmake
           ${LIBDIR}/pkgconfig/stackbeam.pc ${LIBDIR}/pkgconfig/stackbeam-contact.pc)
@@ -91,11 +93,11 @@ list(SORT expected_programs)
 if(NOT program_files STREQUAL expected_programs)
   message(FATAL_ERROR "the component programs installed '${program_files}', expected '${expected_programs}'")
 endif()
-set(union ${library_files} ${program_files})
+set(union ${library_files} ${program_files} ${python_files})
 list(SORT union)
 if(NOT all_files STREQUAL union)
-  message(FATAL_ERROR "the whole install is not the components library and programs together (an install() "
-                      "without COMPONENT?):\n  all: ${all_files}\n  library + programs: ${union}")
+  message(FATAL_ERROR "the whole install is not the components library, programs and python together (an install() "
+                      "without COMPONENT?):\n  all: ${all_files}\n  library + programs + python: ${union}")
 endif()
 message(STATUS "install components: library ${PREFIX}, programs ${PREFIX}-programs (${program_files})")
 

@@ -142,7 +142,7 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
     if (!result.pairs_file.empty()) std::printf("pairs                      %s\n", result.pairs_file.c_str());
 }
 
-void write_json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
+std::string json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
     const SimulationOptions& options = request.options;
     const RunStats& s = result.stats;
     const StepRecord& last = s.last;
@@ -234,11 +234,14 @@ void write_json_summary(const RunRequest& request, const Model& model, const Run
     }
     j["wall_time_s"] = result.wall_s;
     j["outputs"] = {{"csv", result.csv_file}, {"events", result.events_file}, {"pairs", result.pairs_file}};
+    return j.dump(2);
+}
 
+void write_json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
     const std::string partial = request.summary + ".partial";
     std::ofstream out(partial, std::ios::out | std::ios::trunc);
     if (!out) throw ArgumentError("--summary: cannot open '" + partial + "' for writing");
-    out << j.dump(2) << "\n";
+    out << json_summary(request, model, result, loop) << "\n";
     out.close();
     if (out.fail()) throw std::runtime_error("writing '" + partial + "' failed");
     if (std::rename(partial.c_str(), request.summary.c_str()) != 0)

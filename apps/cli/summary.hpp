@@ -29,6 +29,9 @@ LoopFigures loop_figures(const RunRequest& request, const RunResult& result);
 /// The text summary of a finished run on stdout.
 void print_summary(const RunRequest& request, const System& system, const RunResult& result, const LoopFigures& loop);
 
+/// The JSON summary's text (what write_json_summary writes; the Python module's Result.summary).
+std::string json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop);
+
 /// Writes the JSON summary to request.summary (via FILE.partial, renamed when written).
 /// An interrupted run's summary says so ("interrupted": true, the signal, the time
 /// reached, the energies of the last whole record, the .partial files).

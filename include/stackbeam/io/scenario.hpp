@@ -53,6 +53,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
 /// parser reports its own errors.
 [[noreturn]] void rethrow_in_scenario(const Scenario& scenario, const InputError& e);
 
+/// The scenario as TOML text, in the format parse_scenario reads (docs/model-and-scenarios.md):
+/// every key written, each number in the shortest form that reads back to the same double,
+/// so that parse_scenario(to_toml(s), name) gives the same model, options and outputs (not
+/// the key locations, which belong to the text). The scenario is not validated here.
+std::string to_toml(const Scenario& scenario);
+
 /// Reads and parses the scenario file at `path`. Throws InputError (field: the
 /// path) if it cannot be read, and as parse_scenario otherwise.
 Scenario load_scenario(const std::string& path);

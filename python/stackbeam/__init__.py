@@ -1,0 +1,164 @@
+"""stackbeam: vibration of stacked leaf springs with Coulomb friction between the leaves
+(K. Lee & C.-H. Lim 1992), from Python. docs/python.md.
+
+    import stackbeam
+    scenario = stackbeam.load_scenario("scenarios/paper_friction.toml")
+    scenario.model.leaves[0].height_m = 0.006          # the scenario file's key paths
+    result = stackbeam.simulate(scenario, t_end_s=1.0)  # SimulationOptions members
+    result["t"], result["w"]                            # the CSV's columns, numpy arrays
+    result.summary["energy_j"]["dissipated"]            # the JSON summary of the command line
+
+Names: ``scenario.model.<key path>`` is the scenario file's key (``leaves[2].height_m``,
+``loading.force_n.amplitude``, ``mesh.symmetry``); ``scenario.simulation.<member>`` is the
+member of SimulationOptions, the file's ``integrator.<member>`` (``cvode.rtol``).
+"""
+import json as _json
+from collections.abc import Mapping as _Mapping
+
+from ._core import (
+    InputError,
+    SolverError,
+    Scenario,
+    Leaf,
+    LeafProfile,
+    LeafEnd,
+    Interface,
+    Clamp,
+    Clip,
+    Probe,
+    TimeFunction,
+    load_scenario,
+    paper_example,
+    option_table,
+    step_record_columns,
+)
+from . import _core
+
+__all__ = [
+    "InputError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
+    "Probe", "TimeFunction", "load_scenario", "paper_example", "option_table", "simulate", "make_stepper",
+    "Result", "Stepper",
+]
+
+
+def _fields_repr(obj):
+    """ClassName(key=value, ...) of a scenario's entry: its public attributes, lists by their length."""
+    parts = []
+    for name in dir(obj):
+        if name.startswith("_"):
+            continue
+        value = getattr(obj, name)
+        if callable(value):
+            continue
+        if hasattr(value, "__len__") and not isinstance(value, (str, list)):
+            value = "[%d]" % len(value)
+        elif type(value).__module__.startswith("stackbeam"):
+            value = "..."
+        else:
+            value = repr(value)
+        parts.append("%s=%s" % (name, value))
+    return "%s(%s)" % (type(obj).__name__, ", ".join(parts))
+
+
+for _cls in (Leaf, LeafProfile, LeafEnd, Interface, Clamp, Clip, Probe, TimeFunction, _core.RigidBody, _core.Loading,
+             _core.Mesh, _core.Model, _core.Simulation, _core.Outputs):
+    _cls.__repr__ = _fields_repr
+for _cls in (_core.LeafList, _core.InterfaceList, _core.ClampList, _core.ClipList):
+    _cls.__repr__ = lambda items: "[%s]" % ", ".join(repr(x) for x in items)
+Scenario.__repr__ = lambda s: "<stackbeam.Scenario %s: %d leaves, mode %s, t_end_s %g>" % (
+    s.source, len(s.model.leaves), s.simulation.mode, s.simulation.t_end_s)
+
+
+def _flatten_options(options, prefix=""):
+    """simulate's keyword options as {member: value}: nested dicts (cvode={"rtol": 1e-9})
+    and dotted names ({"cvode.rtol": 1e-9}) alike."""
+    flat = {}
+    for key, value in options.items():
+        if isinstance(value, _Mapping):
+            flat.update(_flatten_options(value, prefix + key + "."))
+        else:
+            flat[prefix + key] = value
+    return flat
+
+
+class Result(_Mapping):
+    """A run's results: a mapping from the time-series CSV's column names (``t``, ``w``,
+    ``spring_force``, ...) to numpy arrays, one entry per record (the first: t = 0).
+
+    Attributes: ``pairs`` (every contact pair at every record, a dict of arrays with the
+    --pairs CSV's columns; None unless simulate(..., pairs=True)), ``events`` (the event
+    log of mode cvode, the --events CSV's columns; None in the other modes), ``summary``
+    (the command line's JSON summary as a dict), ``report`` (the run's counters, and
+    ``without_gil_s``: when the run stepped without the GIL, on time.monotonic()'s clock),
+    ``scenario`` (a copy of the scenario run) and ``options`` (the options given)."""
+
+    def __init__(self, raw, scenario, options):
+        self._columns = raw["columns"]
+        self.pairs = raw["pairs"]
+        self.events = raw["events"]
+        self.report = raw["report"]
+        self.summary = _json.loads(raw["summary"])
+        self.scenario = scenario
+        self.options = options
+
+    def __getitem__(self, name):
+        return self._columns[name]
+
+    def __iter__(self):
+        return iter(self._columns)
+
+    def __len__(self):
+        return len(self._columns)
+
+    def __repr__(self):
+        n = len(self._columns["t"])
+        return "<stackbeam.Result: %d records to t = %g s, columns %s>" % (
+            n, self._columns["t"][-1] if n else 0.0, ", ".join(self._columns))
+
+    def to_pandas(self):
+        """The records as a pandas DataFrame (needs pandas)."""
+        try:
+            import pandas
+        except ImportError as e:  # pragma: no cover - pandas is optional
+            raise ImportError("Result.to_pandas needs pandas (Debian: apt-get install python3-pandas)") from e
+        return pandas.DataFrame(dict(self._columns))
+
+
+def simulate(scenario, *, pairs=False, **options):
+    """Runs `scenario` (a Scenario) from t = 0 to t_end_s and returns a Result.
+
+    ``options``: SimulationOptions members over the scenario's, e.g. ``t_end_s=1.0,
+    mode="cvode"``; nested ones as a dict (``cvode={"rtol": 1e-9}``) or dotted
+    (``**{"cvode.rtol": 1e-9}``). Each is checked by the option table: InputError naming
+    the member. ``pairs=True`` keeps every pair at every record (Result.pairs).
+
+    The GIL is released while the run steps, so runs on Python threads run in parallel;
+    Ctrl-C raises KeyboardInterrupt at the first record after about 20 ms (the run is dropped)."""
+    flat = _flatten_options(options)
+    raw = _core._run(scenario, flat, bool(pairs))
+    return Result(raw, scenario.copy(), flat)
+
+
+# The sweep (issue 29) binds as simulate does: a `_core._sweep(spec, jobs)` beside `_core._run`
+# in python/src/module.cpp (the GIL released while the points run, the points table returned as
+# a dict of numpy arrays) and a `sweep(spec, jobs=1)` here wrapping it.
+
+
+Stepper = _core.Stepper  # advance(), pairs(), report(), current, record_index, records, dt_s
+
+
+def _stepper_iter(self):
+    """Advances to the end of the run, yielding each record."""
+    while self.record_index < self.records - 1:
+        yield self.advance()
+
+
+Stepper.__iter__ = _stepper_iter
+
+
+def make_stepper(scenario, **options):
+    """A run of `scenario` one record at a time (co-simulation loops), options as in simulate():
+    ``advance()`` returns the next record (a dict of the CSV's columns), ``pairs()`` the contact
+    pairs at the current one, ``current`` the current record, ``record_index``, ``records``
+    (to t_end_s), ``dt_s``, ``report()``. Iterating over it advances to the end."""
+    return Stepper(scenario, _flatten_options(options))
