@@ -24,6 +24,9 @@
 /// succeeded; SIGINT / SIGTERM stop the run cleanly (run.hpp). Exit status: 0 success,
 /// 2 bad input, 3 solver failure, 130 / 143 stopped by SIGINT / SIGTERM, 1 other errors.
 ///
+/// `stackbeam sweep SPEC.toml` runs a base scenario at many points (docs/sweep.md):
+/// sweep.cpp over the library's stackbeam/study/, sweep_plot.cpp, sweep_mpi.cpp (mpirun).
+///
 /// The files: options.cpp (arguments -> ModelSpec + SimulationOptions; the integrator's
 /// flags come from the library's option table, option_table.hpp), run.cpp (the run, its
 /// files, progress, interruption), summary.cpp (text and JSON summary), plot.cpp (--plot).
@@ -109,6 +112,7 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     app.require_subcommand(1);
     app.footer("Examples:\n  stackbeam simulate --case friction --t-end 2 --out friction.csv\n"
                "  stackbeam simulate --scenario scenarios/paper_friction.toml\n"
+               "  stackbeam sweep map.toml --jobs 2 --out-dir map   (a map over scenario keys: docs/sweep.md)\n"
                "Exit status: 0 success, 2 bad input, 3 solver failure, 130 / 143 stopped by SIGINT / SIGTERM\n"
                "(the rows so far stay in FILE.partial), 1 other errors.");
 
@@ -135,7 +139,7 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "stackbeam: error: " << e.what() << "\n(run 'stackbeam --help' or 'stackbeam simulate --help')\n";
+        std::cerr << "stackbeam: error: " << e.what() << "\n(run 'stackbeam --help', 'stackbeam simulate --help' or 'stackbeam sweep --help')\n";
         return exit_input;
     }
     for (const CLI::Option* option : sim->get_options())

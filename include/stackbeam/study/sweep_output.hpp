@@ -47,7 +47,8 @@ public:
     /// Opens (creates) `directory` for `spec` and its `points`. With `restart`, the results of
     /// an earlier run there are removed; otherwise a directory holding another spec's results
     /// is refused (InputError naming the difference and --restart) and the finished points are
-    /// read back. Writes spec.json and every point's scenario.
+    /// read back. Writes spec.json and every point's scenario. Keeps references to `spec` and
+    /// `points`: they must outlive it.
     SweepDirectory(std::string directory, const SweepSpec& spec, const std::vector<SweepPoint>& points,
                    bool restart, bool keep_series);
 
