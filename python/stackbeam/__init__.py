@@ -13,6 +13,7 @@ Names: ``scenario.model.<key path>`` is the scenario file's key (``leaves[2].hei
 member of SimulationOptions, the file's ``integrator.<member>`` (``cvode.rtol``).
 """
 import json as _json
+import os as _os
 from collections.abc import Mapping as _Mapping
 
 from ._core import (
@@ -37,6 +38,7 @@ from . import _core
 __all__ = [
     "InputError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
     "Probe", "TimeFunction", "load_scenario", "paper_example", "option_table", "simulate", "make_stepper",
+    "sweep", "SweepResult",
     "Result", "Stepper",
 ]
 
@@ -139,9 +141,57 @@ def simulate(scenario, *, pairs=False, **options):
     return Result(raw, scenario.copy(), flat)
 
 
-# The sweep (issue 29) binds as simulate does: a `_core._sweep(spec, jobs)` beside `_core._run`
-# in python/src/module.cpp (the GIL released while the points run, the points table returned as
-# a dict of numpy arrays) and a `sweep(spec, jobs=1)` here wrapping it.
+class SweepResult:
+    """The points table of a sweep (stackbeam.sweep): a mapping from points.csv's column names
+    to numpy arrays, one entry per point in point order: ``point``, one column per axis named
+    exactly as its key, ``status`` ("ok", "failed", "input-error"), ``message``, the figures
+    (``loop_area_j``, ``dynamic_rate_n_per_m``, ``loss_factor``, ...; NaN where a point has
+    no loop) and ``wall_time_s``. ``.axes``: the axis keys; ``.figures``: the figure names."""
+
+    def __init__(self, raw):
+        self._columns = raw["columns"]
+        self.axes = list(raw["axes"])
+        self.figures = list(raw["figures"])
+        self.scenario_path = raw["scenario_path"]
+        self.wall_time_s = raw["wall_time_s"]
+        self.jobs = raw["jobs"]
+
+    def __getitem__(self, name):
+        return self._columns[name]
+
+    def __iter__(self):
+        return iter(self._columns)
+
+    def __len__(self):
+        return len(self._columns)
+
+    def __repr__(self):
+        n = len(self._columns["point"])
+        ok = int((self._columns["status"] == "ok").sum())
+        return "<stackbeam.SweepResult: %d points (%d ok) over %s>" % (n, ok, ", ".join(self.axes))
+
+    def to_pandas(self):
+        """The table as a pandas DataFrame (needs pandas)."""
+        try:
+            import pandas
+        except ImportError as e:  # pragma: no cover - pandas is optional
+            raise ImportError("SweepResult.to_pandas needs pandas (Debian: apt-get install python3-pandas)") from e
+        return pandas.DataFrame(dict(self._columns))
+
+
+def sweep(spec, *, jobs=None, out_dir=None, restart=False, keep_series=False):
+    """Runs the sweep spec file `spec` (docs/sweep.md) as `stackbeam sweep` does and returns its
+    points table (a SweepResult), figure for figure the command line's points.csv.
+
+    ``jobs``: threads (default: the machine's cores). Every point's scenario is read and checked
+    before any run: a bad spec raises InputError naming the spec file's line, the key and the
+    point. ``out_dir``: also keep the results in that directory as the command line does
+    (journal, points.csv, sweep.json, loops; ``keep_series`` the records; an interrupted sweep
+    is resumed by the same call, ``restart=True`` starts over); without it nothing is written.
+    The GIL is released while the points run; Ctrl-C stops the sweep (KeyboardInterrupt)."""
+    raw = _core._sweep(_os.fspath(spec), int(jobs or 0), _os.fspath(out_dir) if out_dir else "", bool(restart),
+                       bool(keep_series))
+    return SweepResult(raw)
 
 
 Stepper = _core.Stepper  # advance(), pairs(), report(), current, record_index, records, dt_s
