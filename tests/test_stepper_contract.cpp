@@ -153,7 +153,7 @@ BOOST_AUTO_TEST_CASE(closed_form_sparse) { check_contract(closed_form(ContactPat
 BOOST_AUTO_TEST_CASE(cvode_massless) { check_contract(cvode(PaperCase::friction, 0.0)); }
 BOOST_AUTO_TEST_CASE(newmark_massless) { check_contract(newmark(0.0)); }
 BOOST_AUTO_TEST_CASE(newmark_steel) { check_contract(newmark(7850.0)); }
-// leaf mass on a bonded stack: held-for-good contact (CvodeInertiaStepper)
+// leaf mass on a bonded stack: held-for-good contact (CvodeHeldStepper)
 BOOST_AUTO_TEST_CASE(cvode_leaf_mass_bonded) { check_contract(cvode(PaperCase::bonded, 7850.0)); }
 // leaf mass with friction: modal inertia with events (CvodeModalStepper)
 BOOST_AUTO_TEST_CASE(cvode_leaf_mass_friction) { check_contract(cvode(PaperCase::friction, 7850.0)); }

@@ -6,7 +6,9 @@
 
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
+#include "time/static_stages.hpp"
 
 namespace stackbeam {
 

@@ -8,7 +8,12 @@
 
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
+#include "time/reduced_load.hpp"
+#include "time/rig_reaction.hpp"
+#include "time/stack_properties.hpp"
+#include "time/static_stages.hpp"
 #include "fe/tied_shape.hpp"
 
 namespace stackbeam {
