@@ -28,29 +28,37 @@ detail::StaticState detail::static_equilibrium_dense(const System& system, const
     return out;
 }
 
-Eigen::VectorXd detail::static_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
-                                     double w_held_m, const SimulationOptions& options, Eigen::VectorXd& p,
-                                     Eigen::VectorXd& d, const std::string& what, SolveResult* result) {
+SparseContactProblem detail::sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
+                                            const Eigen::VectorXd& d, double w_held_m) {
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();
-    const int nz = static_cast<int>(K.rows()), w_dof = nz - 1;
-    const bool held = !std::isnan(w_held_m);
+    const int w_dof = static_cast<int>(K.rows()) - 1;
     SparseContactProblem st;
-    if (held) {  // K_rr z_r = G_r^T p + b_r - K_rw w,  s = G_r z_r + G_w w + c_L p - d
+    if (!std::isnan(w_held_m)) {  // K_rr z_r = G_r^T p + b_r - K_rw w,  s = G_r z_r + G_w w + c_L p - d
         st.K = K.topLeftCorner(w_dof, w_dof);
         st.G = G.leftCols(w_dof);
-        st.b = b.head(w_dof) - Eigen::VectorXd(K.block(0, w_dof, w_dof, 1)) * w_held_m;
+        const Eigen::VectorXd krw_w = Eigen::VectorXd(K.block(0, w_dof, w_dof, 1)) * w_held_m;
+        st.b = b.size() > 0 ? Eigen::VectorXd(b.head(w_dof) - krw_w) : Eigen::VectorXd(-krw_w);
         st.d = d - Eigen::VectorXd(G.col(w_dof)) * w_held_m;
     } else {
         st.K = K;
         st.G = G;
-        st.b = b;
+        st.b = b.size() > 0 ? b : Eigen::VectorXd::Zero(K.rows());
         st.d = d;
     }
     st.layer_compliance = sparse_layer(system);
     st.pairs = laws.pairs;
     st.tau_rule = laws.tau_rule;
     st.tau_previous_n = laws.tau_previous_n;
+    return st;
+}
+
+Eigen::VectorXd detail::static_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
+                                     double w_held_m, const SimulationOptions& options, Eigen::VectorXd& p,
+                                     Eigen::VectorXd& d, const std::string& what, SolveResult* result) {
+    const int nz = system.num_reduced_dofs(), w_dof = nz - 1;
+    const bool held = !std::isnan(w_held_m);
+    SparseContactProblem st = sparse_problem(system, laws, b, d, w_held_m);
     if (system.num_components() == 0) {  // no contact: K z = b (R held: on z_r)
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(st.K);
         Eigen::VectorXd z = Eigen::VectorXd::Constant(nz, held ? w_held_m : 0.0);

@@ -11,6 +11,15 @@
 
 namespace stackbeam::detail {
 
+/// The sparse contact problem of the stack under a load b on the reduced DOFs [N, N m per DOF]
+/// (w last; empty: none) with the offsets d [m] and `laws`' pairs, tau rule and previous-step
+/// limits: with R free (w_held_m NaN) K z = G^T p + b, s = G z + c_L p - d on every DOF; with R
+/// held at w_held_m [m] on z_r alone, K_rr z_r = G_r^T p + b_r - K_rw w, s = G_r z_r + G_w w +
+/// c_L p - d. Every quasi-static solve of the sparse path poses it (static_state below, the
+/// initial contact state and the rig's steps of the massless modes).
+SparseContactProblem sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
+                                    const Eigen::VectorXd& d, double w_held_m);
+
 /// The quasi-static state of the stack under a load b on the reduced DOFs [N, N m per DOF]
 /// (w last), one load step with friction from the warm start p with `laws`' pairs and tau rule
 /// and the offsets d: with R free (w_held_m NaN) K z = G^T p + b on every DOF; with R held at
