@@ -249,29 +249,29 @@ stackbeam_cli_test(NAME cli_scenario_parabolic_two_leaf  # profiles, eyes, a sha
                    ARGS simulate --scenario ${_scenarios}/parabolic_two_leaf.toml --quiet --out ${_cli_out_dir}/cli_parabolic.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_parabolic.csv MIN_LINES 1001)
 stackbeam_cli_test(NAME cli_scenario_with_case
-                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --case bonded --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "--case excludes --scenario" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --case bonded --out ${_cli_out_dir}/cli_x_cli_scenario_with_case.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--case excludes --scenario" OUT ${_cli_out_dir}/cli_x_cli_scenario_with_case.csv)
 stackbeam_cli_test(NAME cli_scenario_with_elements
-                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --elements 5 --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "excludes --elements" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --elements 5 --out ${_cli_out_dir}/cli_x_cli_scenario_with_elements.csv
+                   EXPECT_RC 2 EXPECT_TEXT "excludes --elements" OUT ${_cli_out_dir}/cli_x_cli_scenario_with_elements.csv)
 stackbeam_cli_test(NAME cli_scenario_bad_override
-                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --dt nan --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "--dt: value 'nan' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --scenario ${_scenarios}/paper_bonded.toml --dt nan --out ${_cli_out_dir}/cli_x_cli_scenario_bad_override.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--dt: value 'nan' is not allowed" OUT ${_cli_out_dir}/cli_x_cli_scenario_bad_override.csv)
 # A file's value that an override makes invalid is named by its key and line, a flag's by the flag.
 stackbeam_cli_test(NAME cli_scenario_value_by_key
-                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --mode cvode --out ${_cli_out_dir}/cli_x.csv
+                   ARGS simulate --scenario ${_scenarios}/rig_friction.toml --mode cvode --out ${_cli_out_dir}/cli_x_cli_scenario_value_by_key.csv
                    EXPECT_RC 2 EXPECT_TEXT "rig_friction.toml:71:8: loading.kind: value 'prescribed-displacement' is not available in mode cvode"
-                   OUT ${_cli_out_dir}/cli_x.csv)
+                   OUT ${_cli_out_dir}/cli_x_cli_scenario_value_by_key.csv)
 stackbeam_cli_test(NAME cli_scenario_override_by_flag
-                   ARGS simulate --scenario ${_scenarios}/paper_friction.toml --restitution 0.5 --out ${_cli_out_dir}/cli_x.csv
+                   ARGS simulate --scenario ${_scenarios}/paper_friction.toml --restitution 0.5 --out ${_cli_out_dir}/cli_x_cli_scenario_override_by_flag.csv
                    EXPECT_RC 2 EXPECT_TEXT "--restitution: value 0.5 is not used by mode closed-form"
-                   OUT ${_cli_out_dir}/cli_x.csv)
+                   OUT ${_cli_out_dir}/cli_x_cli_scenario_override_by_flag.csv)
 stackbeam_cli_test(NAME cli_scenario_missing_file
-                   ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x_cli_scenario_missing_file.csv
+                   EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x_cli_scenario_missing_file.csv)
 stackbeam_cli_test(NAME cli_neither_case_nor_scenario
-                   ARGS simulate --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "--case or --scenario: one of them is required" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --out ${_cli_out_dir}/cli_x_cli_neither_case_nor_scenario.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--case or --scenario: one of them is required" OUT ${_cli_out_dir}/cli_x_cli_neither_case_nor_scenario.csv)
 
 # Loadings and outputs (issue 6): the rig test's loop figures in the summary and in the
 # JSON file (loop area 5.33 J per cycle: tests/test_loadings.cpp proves it equals the
@@ -299,8 +299,8 @@ stackbeam_cli_test(NAME cli_gravity
                    EXPECT_RC 0 EXPECT_TEXT "gravity 9.81" OUT ${_cli_out_dir}/cli_g.csv
                    JSON ${_cli_out_dir}/cli_g.json JSON_PATH "loading|gravity_m_per_s2" JSON_RANGE "9.81|9.81")
 stackbeam_cli_test(NAME cli_bad_gravity
-                   ARGS simulate --case bonded --gravity -1 --out ${_cli_out_dir}/cli_x.csv
-                   EXPECT_RC 2 EXPECT_TEXT "--gravity: value '-1' is not allowed" OUT ${_cli_out_dir}/cli_x.csv)
+                   ARGS simulate --case bonded --gravity -1 --out ${_cli_out_dir}/cli_x_cli_bad_gravity.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--gravity: value '-1' is not allowed" OUT ${_cli_out_dir}/cli_x_cli_bad_gravity.csv)
 stackbeam_cli_test(NAME cli_base_cvode
                    ARGS simulate --scenario ${_scenarios}/base_friction.toml --t-end 0.25 --quiet --out ${_cli_out_dir}/cli_base.csv
                         --summary ${_cli_out_dir}/cli_base.json --events ${_cli_out_dir}/cli_base_events.csv

@@ -39,7 +39,8 @@ Run run_cvode(PaperCase c, double t_end_s, double rtol, bool root_finding = true
     }
     detail::CvodeTesting testing;  // the per-step check alone (lib/time/cvode/cvode_testing.hpp)
     testing.root_finding = false;
-    CvodeStepper st(s, o, testing);
+    const detail::ScopedCvodeTesting scope(testing);
+    CvodeStepper st(s, o);
     r.records.push_back(st.current());
     while (st.record_index() < st.num_outputs()) r.records.push_back(st.advance());
     r.report = st.report();

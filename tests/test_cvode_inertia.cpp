@@ -1,4 +1,4 @@
-// Mode cvode with leaf inertia, first part (lib/time/cvode/cvode_inertia.hpp, docs/time-integration.md): the
+// Mode cvode with leaf inertia, first part (lib/time/cvode/cvode_held.hpp, docs/time-integration.md): the
 // bonded and frictionless stacks with steel leaves, a stiff linear ODE integrated by BDF
 // (order <= 2) in the held stack's modal coordinates. Checked against the eigen-solve, the Newmark
 // reference as its dt -> 0, and the energy balance against rtol.

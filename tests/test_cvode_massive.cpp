@@ -3,7 +3,12 @@
 // (BDF, Newton), events on every transition. Checked against the massless cvode mode with the
 // same elastic interface as the density falls, against mode newmark on the same model as dt
 // falls, by the energy balance (friction and structural damping booked), and for the input it
-// refuses.
+// refuses. The three convergence studies (to the massless mode, and newmark against cvode
+// free and under base excitation and gravity: 85 % of the program's time, 3 min under the
+// sanitizers) carry the label "slow" and run in the Release build only (tests/CMakeLists.txt);
+// the sanitizer build runs the massive stepper through the energy balance, Rayleigh damping,
+// the applied force and the refusals here, and base excitation, gravity and the rig on it in
+// test_leaf_mass_loadings.
 #define BOOST_TEST_MODULE cvode_massive
 #include <boost/test/unit_test.hpp>
 #include <algorithm>
@@ -63,7 +68,7 @@ BOOST_AUTO_TEST_CASE(massive_stepper_is_chosen_where_every_row_is_elastic) {
     BOOST_TEST(rep.cvode.jacobian_evaluations > 0);  // BDF with Newton
 }
 
-BOOST_AUTO_TEST_CASE(converges_to_the_massless_mode_as_density_falls) {
+BOOST_AUTO_TEST_CASE(converges_to_the_massless_mode_as_density_falls, *boost::unit_test::label("slow")) {
     // 5 ms of the friction case against the massless cvode run with the same elastic layer. The
     // leaves' mass enters R's motion linearly (their inertia against R's 20 kg), so 10x less
     // density gives about 10x less deviation; the stick-slip event times move with the density,
@@ -148,7 +153,7 @@ BOOST_AUTO_TEST_CASE(structural_damping_is_refused_where_it_is_not_taken) {
     }
 }
 
-BOOST_AUTO_TEST_CASE(newmark_converges_to_the_massive_cvode_run) {
+BOOST_AUTO_TEST_CASE(newmark_converges_to_the_massive_cvode_run, *boost::unit_test::label("slow")) {
     // Two integrators of the same massive model on the elastic layer: mode newmark (average
     // acceleration at fixed dt; the layer's force enters as the step's implicit contact
     // impulse, first order in dt: newmark_stepper.cpp) against the massive cvode run at
@@ -176,7 +181,7 @@ BOOST_AUTO_TEST_CASE(newmark_converges_to_the_massive_cvode_run) {
     BOOST_TEST(prev < 4e-9);
 }
 
-BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation) {
+BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation, *boost::unit_test::label("slow")) {
     // The friction case on supports moving 5 mm at 8 Hz (every mass feels its inertial force in
     // their frame, loading.hpp), on top of R's initial velocity: mode newmark against the massive
     // cvode run at rtol 1e-10, as in the case above. Measured max |w - w_cvode| at dt = 25, 12.5,

@@ -2,6 +2,10 @@
 // the dense one (W = C' + (gamma/k) c c^T): both pose the same problem (simulation.hpp
 // derives the rigid body's spring k_R = k (1 - gamma)/gamma), so runs must agree to
 // round-off, step by step, on the paper example's three cases and on a graduated stack.
+// The cases on the finer and ten-leaf stacks (each transition method on 1,000+ rows, 85 %
+// of the program's time) carry the label "slow": they run in the Release build only
+// (tests/CMakeLists.txt); each method keeps its case on the paper example in the tier the
+// sanitizer build runs.
 #define BOOST_TEST_MODULE sparse_path
 #include <boost/test/unit_test.hpp>
 #include <cmath>
@@ -468,7 +472,7 @@ BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_the_paper_friction_case) {
     newton_equals_dense(paper_example(PaperCase::friction), 300, kRel);
 }
 
-BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_a_finer_friction_stack) {
+BOOST_AUTO_TEST_CASE(newton_equals_dense_exact_on_a_finer_friction_stack, *boost::unit_test::label("slow")) {
     // 3 leaves x 160 elements (636 rows), 20 steps from rest: the first steps are the
     // degenerate transition (most pairs open at once). Tolerance 1e-7 relative, as
     // sparse_equals_dense_on_a_finer_stack: cond(W) grows ~ elements^2 (64x the
@@ -487,7 +491,7 @@ BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_the_paper_friction_case) {
     newton_equals_dense(paper_example(PaperCase::friction), 300, kRel, TransitionMethod::smoothing);
 }
 
-BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_a_finer_friction_stack) {
+BOOST_AUTO_TEST_CASE(smoothing_equals_dense_exact_on_a_finer_friction_stack, *boost::unit_test::label("slow")) {
     // 3 x 160 from rest, 20 steps (the degenerate transition), smoothing method alone;
     // tolerance as for the semismooth method on this stack (cond(W) ~ 64x the example's).
     PaperExampleOptions o;
@@ -505,7 +509,7 @@ BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_the_paper_frict
     newton_equals_dense(paper_example(PaperCase::friction), 300, kRel, TransitionMethod::tresca);
 }
 
-BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_a_finer_friction_stack) {
+BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_a_finer_friction_stack, *boost::unit_test::label("slow")) {
     // 3 x 160 from rest, 20 steps (the degenerate transition: pairs with force and gap both
     // ~0, where pivoting changes few rows per factorisation), interior-point box QPs;
     // tolerance as for the Newton methods on this stack (cond(W) ~ 64x the example's).
@@ -514,7 +518,7 @@ BOOST_AUTO_TEST_CASE(interior_point_tresca_equals_dense_exact_on_a_finer_frictio
     newton_equals_dense(paper_example(PaperCase::friction, o), 20, 1e-7, TransitionMethod::tresca);
 }
 
-BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack) {
+BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack, *boost::unit_test::label("slow")) {
     // 10 graduated leaves x 100 elements per half leaf (1,080 rows; leaf k shorter by
     // 8 % of L per leaf, free ends, clamps at 0.2 and 0.3 m: the benchmark's graduated
     // stack), 25 steps from rest recorded from a default sparse run (semismooth Newton at

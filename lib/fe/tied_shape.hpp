@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the static shape of the stack with some contact components held, used for
-// the initial state of the modes with leaf inertia (newmark_stepper.cpp, cvode_inertia.cpp).
+// the initial state of the modes with leaf inertia (newmark_stepper.cpp, cvode_held.cpp).
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <vector>

@@ -11,12 +11,6 @@
 
 namespace stackbeam {
 
-std::string format_value(double value) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.10g", value);
-    return buf;
-}
-
 const char* to_string(SupportKind kind) {
     switch (kind) {
         case SupportKind::free: return "free";

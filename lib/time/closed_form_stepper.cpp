@@ -6,7 +6,9 @@
 
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
+#include "time/static_stages.hpp"
 
 namespace stackbeam {
 
@@ -105,16 +107,9 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
         const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
         sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
         if (z_.size() == 0) z_ = system_.reduced_displacements(p_, w_);
-        SparseContactProblem held;  // R held at w: the problem on z_r
-        held.K = K.topLeftCorner(w_dof_, w_dof_);
-        held.G = G.leftCols(w_dof_);
-        held.layer_compliance = detail::sparse_layer(system_);
-        held.pairs = problem_.pairs;
-        held.tau_rule = problem_.tau_rule;
-        held.tau_previous_n = problem_.tau_previous_n;
+        // R held at w(0): the problem on z_r (the rig's steps pose it at w_p(t))
+        SparseContactProblem held = detail::sparse_problem(system_, problem_, {}, d_, w_start);
         if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
-            held.b = -krw_ * w_start;
-            held.d = d_ - gw_ * w_start;
             SparseContactSolver initial(options_.solver, options_.sparse_tuning);
             Eigen::VectorXd zr;
             solve_ = initial.solve(held, p_, zr);
@@ -126,17 +121,11 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
         if (rig_) {
             sparse_problem_ = std::move(held);
         } else {
-            Eigen::SparseMatrix<double> Kaug = K;
+            // R free on the augmented stiffness K_aug = K + k_R e_w e_w^T
+            sparse_problem_ = detail::sparse_problem(system_, problem_, {}, d_, std::nan(""));
             k_r_ = k * one_minus_gamma / gamma_;
-            Kaug.coeffRef(w_dof_, w_dof_) += k_r_;
-            Kaug.makeCompressed();
-            sparse_problem_.K = std::move(Kaug);
-            sparse_problem_.G = G;
-            sparse_problem_.b = Eigen::VectorXd::Zero(nz);
-            sparse_problem_.layer_compliance = detail::sparse_layer(system_);
-            sparse_problem_.pairs = problem_.pairs;
-            sparse_problem_.tau_rule = problem_.tau_rule;
-            sparse_problem_.tau_previous_n = problem_.tau_previous_n;
+            sparse_problem_.K.coeffRef(w_dof_, w_dof_) += k_r_;
+            sparse_problem_.K.makeCompressed();
         }
         sparse_problem_.d = d_;
         rel_ = detail::relative_positions(system_, z_, p_);

@@ -8,7 +8,12 @@
 
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
+#include "time/reduced_load.hpp"
+#include "time/rig_reaction.hpp"
+#include "time/stack_properties.hpp"
+#include "time/static_stages.hpp"
 #include "fe/tied_shape.hpp"
 
 namespace stackbeam {
@@ -83,15 +88,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
             held.q = system_.coupling() * w0 - d_;
             solve_ = make_solver(options_.solver)->solve(held, p_);
         } else {
-            SparseContactProblem held;
-            held.K = K_.topLeftCorner(w_dof, w_dof);
-            held.G = G.leftCols(w_dof);
-            held.b = -Eigen::VectorXd(K_.block(0, w_dof, w_dof, 1)) * w0;
-            held.d = d_ - Eigen::VectorXd(G.col(w_dof)) * w0;
-            held.layer_compliance = detail::sparse_layer(system_);
-            held.pairs = problem_.pairs;
-            held.tau_rule = problem_.tau_rule;
-            held.tau_previous_n = problem_.tau_previous_n;
+            const SparseContactProblem held = detail::sparse_problem(system_, problem_, {}, d_, w0);
             SparseContactSolver initial(options_.solver, options_.sparse_tuning);
             Eigen::VectorXd zr;
             solve_ = initial.solve(held, p_, zr);

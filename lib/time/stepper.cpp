@@ -4,7 +4,10 @@
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/newmark_stepper.hpp"
-#include "time/cvode/cvode_inertia.hpp"
+#include "time/cvode/cvode_held.hpp"
+#include "time/cvode/cvode_massive.hpp"
+#include "time/cvode/cvode_modal.hpp"
+#include "time/stack_properties.hpp"
 
 namespace stackbeam {
 
@@ -30,7 +33,7 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
                     (li == LeafInertia::automatic && elastic && (changes || assembled || !options.loading.is_free())))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
                 if (changes) return std::make_unique<detail::CvodeModalStepper>(system, options);
-                return std::make_unique<detail::CvodeInertiaStepper>(system, options);
+                return std::make_unique<detail::CvodeHeldStepper>(system, options);
             }
     }
     return std::make_unique<ClosedFormStepper>(system, options);

@@ -58,10 +58,6 @@
 #include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
-namespace detail {
-struct CvodeTesting;  // internal: test-only switches (lib/time/cvode/cvode_testing.hpp)
-}
-
 /// The CVODE integration (mode "cvode"). Outputs come on the grid t = i * dt_s
 /// (SimulationOptions::dt_s is the output interval here, not a step).
 class CvodeStepper final : public Stepper {
@@ -69,8 +65,6 @@ public:
     /// Throws InputError for bad options (e.g. rtol <= 0), SolverError if the initial
     /// contact state cannot be resolved.
     CvodeStepper(const System& system, const SimulationOptions& options);
-    /// Internal, for tests: with the test-only switches of detail::CvodeTesting.
-    CvodeStepper(const System& system, const SimulationOptions& options, const detail::CvodeTesting& testing);
     ~CvodeStepper() override;
 
     /// Integrates to the next output time and returns its record. Throws SolverError

@@ -1,5 +1,5 @@
 // Mode "cvode" with leaf inertia on stacks with friction and elastic interfaces: the whole
-// massive stack in CVODE (cvode_inertia.hpp, docs/time-integration.md "Mode cvode with
+// massive stack in CVODE (cvode_massive.hpp, docs/time-integration.md "Mode cvode with
 // leaf mass", docs/decisions/015-massive-stack-under-cvode.md).
 //
 // With an elastic layer on every contact row (system.hpp: s = G z + C_L p - d) each contact
@@ -61,10 +61,15 @@
 #include "contact/active_set.hpp"
 #include "fe/tied_shape.hpp"
 #include "stackbeam/errors.hpp"
-#include "time/cvode/cvode_inertia.hpp"
+#include "time/cvode/cvode_massive.hpp"
+#include "time/stack_properties.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/event_driver.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
+#include "time/reduced_load.hpp"
+#include "time/rig_reaction.hpp"
+#include "time/static_stages.hpp"
 
 namespace stackbeam::detail {
 

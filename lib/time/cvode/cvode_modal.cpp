@@ -1,5 +1,5 @@
 // Mode "cvode" with leaf inertia on stacks with friction: modal inertia with a massless
-// contact layer (cvode_inertia.hpp, docs/time-integration.md "Mode cvode with leaf mass",
+// contact layer (cvode_modal.hpp, docs/time-integration.md "Mode cvode with leaf mass",
 // stacks with friction).
 //
 // The motion is split (mode-acceleration method) into the retained modes of the
@@ -30,11 +30,11 @@
 #include <string>
 
 #include "contact/active_set.hpp"
-#include "time/cvode/cvode_inertia.hpp"
+#include "time/cvode/cvode_modal.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/event_driver.hpp"
 #include "stackbeam/errors.hpp"
-#include "time/step_record.hpp"
+#include "time/record.hpp"
 #include "fe/tied_shape.hpp"
 
 namespace stackbeam::detail {

@@ -11,9 +11,9 @@
 
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
-#include "time/cvode/cvode_testing.hpp"
 #include "time/cvode/event_driver.hpp"
-#include "time/step_record.hpp"
+#include "time/record.hpp"
+#include "time/static_stages.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -226,12 +226,8 @@ struct CvodeStepper::Impl final : detail::EventDriver {
 };
 
 CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options)
-    : CvodeStepper(system, options, detail::CvodeTesting{}) {}
-
-CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options, const detail::CvodeTesting& testing)
     : impl_(std::make_unique<Impl>(system, options)) {
     Impl& s = *impl_;
-    s.root_finding = testing.root_finding;
     s.opt.validate();
     require_massless_leaves(system, Mode::cvode);
     require_no_assembly(system.model().spec(), Mode::cvode);

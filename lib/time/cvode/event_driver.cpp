@@ -1,7 +1,6 @@
 // The event driver of the event-driven cvode steppers (event_driver.hpp; the method in
 // cvode_stepper.hpp).
 #include "time/cvode/event_driver.hpp"
-#include "time/cvode/cvode_inertia.hpp"
 #include "fe/tied_shape.hpp"
 #include "stackbeam/model/loading.hpp"
 
@@ -11,7 +10,9 @@
 
 #include "model/mesh_note.hpp"
 #include "stackbeam/errors.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/cvode/cvode_testing.hpp"
+#include "time/record.hpp"
 
 namespace stackbeam::detail {
 
@@ -25,7 +26,8 @@ EventDriver::EventDriver(const System& system, const SimulationOptions& options,
       w_dof(system.num_reduced_dofs() - 1),
       f(system.model().whole_spring_factor()),
       m_body(system.model().spec().rigid_body.mass_kg),
-      d(system.initial_offsets_m()) {}
+      d(system.initial_offsets_m()),
+      root_finding(cvode_testing().root_finding) {}
 
 EventDriver::~EventDriver() = default;
 

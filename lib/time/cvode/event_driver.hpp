@@ -9,7 +9,8 @@
 //    problem driven by R's displacement, s = C'p + c w - d;
 //  - the modal one with leaf inertia (cvode_modal.cpp): y = [q, q', D], driven by the
 //    retained modes, s = W p + G Phi q - d.
-// A stepper derives from EventDriver and implements the hooks below.
+// A stepper derives from EventDriver and implements the hooks below; its Stepper face is an
+// EventStepper (below) that owns the driver.
 #include <Eigen/Dense>
 #include <chrono>
 #include <deque>
@@ -22,6 +23,7 @@
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/run_report.hpp"
+#include "stackbeam/time/stepper.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/sundials.hpp"
 
@@ -77,7 +79,7 @@ public:
     StepRecord record;          ///< of the current output
     Vec p_out, rel_out;         ///< its forces [N] and (modal) relative positions [m]
     double e0 = 0.0;            ///< initial energy [J]
-    bool root_finding = true;   ///< CVODE's root-finding on the witnesses (off only in tests: CvodeTesting)
+    bool root_finding = true;   ///< CVODE's root-finding on the witnesses (off only in tests: cvode_testing.hpp)
     long iters_since = 0, facts_since = 0;  ///< contact iterations and factorisations since the last record
     double last_check_residual = 0.0;
     std::vector<ContactEvent> events;
@@ -204,6 +206,32 @@ private:
     bool modes_hold(const State& y, double& residual, bool* witnesses_ok = nullptr);
     void restart(double te, const Vec& y);
     bool step_once();
+};
+
+/// The Stepper face of the event-driven steppers with leaf inertia (modal and massive): every
+/// call forwards to their EventDriver.
+class EventStepper : public Stepper {
+public:
+    ~EventStepper() override;
+    /// Integrates to the next output time (t = i dt_s) and returns its record.
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output (contact_forces(), relative_positions()).
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
+    RunReport report() const override;
+    const CvodeStats& stats() const noexcept;
+    /// Every mode transition, in time order (cause "start", "root" or "check").
+    const std::vector<ContactEvent>& events() const noexcept;
+    /// Contact forces p [N] (all rows, conventions.hpp) at the last output.
+    const Eigen::VectorXd& contact_forces() const noexcept;
+    /// Relative positions s + d [m] (all rows) at the last output.
+    const Eigen::VectorXd& relative_positions() const noexcept;
+
+protected:
+    explicit EventStepper(std::unique_ptr<EventDriver> driver);
+    std::unique_ptr<EventDriver> driver_;
 };
 
 }  // namespace stackbeam::detail

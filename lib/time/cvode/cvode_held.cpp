@@ -1,5 +1,5 @@
-// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_inertia.hpp, docs/time-integration.md).
-#include "time/cvode/cvode_inertia.hpp"
+// Mode "cvode" with leaf inertia, bonded and frictionless stacks (cvode_held.hpp, docs/time-integration.md).
+#include "time/cvode/cvode_held.hpp"
 
 #include <sunmatrix/sunmatrix_band.h>
 
@@ -9,25 +9,14 @@
 #include <string>
 
 #include "stackbeam/errors.hpp"
-#include "time/step_record.hpp"
+#include "time/contact_state.hpp"
+#include "time/record.hpp"
 #include "fe/tied_shape.hpp"
 #include "time/cvode/sundials.hpp"
 
 namespace stackbeam::detail {
 
-bool has_leaf_mass(const System& system) {
-    for (const auto& leaf : system.model().spec().leaves)
-        if (leaf.density_kg_per_m3 != 0.0) return true;
-    return false;
-}
-
-bool has_mode_changes(const System& system) {
-    for (const auto& pr : system.pairs())
-        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0) return true;
-    return false;
-}
-
-struct CvodeInertiaStepper::Impl {
+struct CvodeHeldStepper::Impl {
     Impl(const System& system, const SimulationOptions& options) : sys(system), opt(options) {}
     Impl(const Impl&) = delete;
     Impl& operator=(const Impl&) = delete;
@@ -136,9 +125,9 @@ struct CvodeInertiaStepper::Impl {
     }
 };
 
-CvodeInertiaStepper::~CvodeInertiaStepper() = default;
+CvodeHeldStepper::~CvodeHeldStepper() = default;
 
-CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationOptions& options)
+CvodeHeldStepper::CvodeHeldStepper(const System& system, const SimulationOptions& options)
     : impl_(std::make_unique<Impl>(system, options)) {
     Impl& s = *impl_;
     s.opt.validate();
@@ -265,7 +254,7 @@ CvodeInertiaStepper::CvodeInertiaStepper(const System& system, const SimulationO
     s.rec.energy_balance_error_j = 0.0;
 }
 
-const StepRecord& CvodeInertiaStepper::advance() {
+const StepRecord& CvodeHeldStepper::advance() {
     Impl& s = *impl_;
     ++s.out_index;
     const double tout = s.out_index * s.opt.dt_s;
@@ -280,13 +269,13 @@ const StepRecord& CvodeInertiaStepper::advance() {
     return s.rec;
 }
 
-const StepRecord& CvodeInertiaStepper::current() const noexcept { return impl_->rec; }
-const CvodeStats& CvodeInertiaStepper::stats() const noexcept { return impl_->st; }
-long CvodeInertiaStepper::record_index() const noexcept { return impl_->out_index; }
-std::vector<PairRecord> CvodeInertiaStepper::pairs() const {
+const StepRecord& CvodeHeldStepper::current() const noexcept { return impl_->rec; }
+const CvodeStats& CvodeHeldStepper::stats() const noexcept { return impl_->st; }
+long CvodeHeldStepper::record_index() const noexcept { return impl_->out_index; }
+std::vector<PairRecord> CvodeHeldStepper::pairs() const {
     return pair_records(impl_->sys, impl_->laws, impl_->p_out, impl_->rel_out);
 }
-RunReport CvodeInertiaStepper::report() const {
+RunReport CvodeHeldStepper::report() const {
     RunReport rep;
     rep.mode = Mode::cvode;
     rep.cvode = impl_->st;

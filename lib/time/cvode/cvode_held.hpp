@@ -1,0 +1,47 @@
+#pragma once
+// Internal: mode "cvode" with leaves of density > 0 (docs/time-integration.md), first part: a
+// stack whose contact components are held for good, so the contact mode never changes:
+// every kept pair bonded (both components held) or frictionless (mu = 0: the normal
+// component held, which a unilateral pair allows while it stays compressed; a tension
+// above 1e-6 of the force scale at an output is a SolverError: the release event is
+// not built yet). The motion lies in the null space of the held rows G_C,
+// G_C (z - z_p) = 0, z = z_p + N q with N an orthonormal basis of null(G_C):
+//     (N^T M N) q'' + N^T K N q = -N^T K z_p,
+// a stiff linear ODE (leaf bending modes up to ~1e5..1e6 rad/s next to the 70 rad/s
+// body mode) integrated by CVODE's BDF at order <= 2 (higher orders are unstable on
+// the lightly damped oscillatory modes), Newton with a direct solver and the
+// analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N; in the modal
+// coordinates of B it is block diagonal (2 x 2 blocks), so the direct solver is a band one
+// (half-bandwidths 1, 1).
+// Stacks with friction (pairs that may stick or slip) run CvodeModalStepper (cvode_modal.hpp);
+// called directly with one, this stepper refuses it (InputError naming `mode`).
+#include <Eigen/Dense>
+#include <memory>
+#include <vector>
+
+#include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
+
+namespace stackbeam::detail {
+
+class CvodeHeldStepper final : public Stepper {
+public:
+    CvodeHeldStepper(const System& system, const SimulationOptions& options);
+    ~CvodeHeldStepper() override;
+    /// Integrates to the next output time (t = i dt_s) and returns its record.
+    const StepRecord& advance() override;
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
+    /// The pairs at the last output: the held components' forces, relative positions G z.
+    std::vector<PairRecord> pairs() const override;
+    /// CVODE's steps and counters (no contact iterations, no events: the modes never change).
+    RunReport report() const override;
+    const CvodeStats& stats() const noexcept;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace stackbeam::detail
