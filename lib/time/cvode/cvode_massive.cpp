@@ -465,11 +465,7 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     Y[2 * s.ndof] = Y[2 * s.ndof + 1] = Y[2 * s.ndof + 2] = 0.0;
 
     // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
-    {
-        s.ev_problem.q = G * z0 - s.d;
-        const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p_init);
-        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
-    }
+    s.solve_initial_forces(G * z0, p_init);
     modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.build_mode();
     s.decide_modes(0.0, Y, p_init, "start");

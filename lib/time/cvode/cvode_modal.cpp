@@ -287,11 +287,7 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
 
     // initial modes: from the contact problem at q(0), then decided a look-ahead on
     Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
-    {
-        s.ev_problem.q = s.GPhi * Eigen::VectorXd(Y.head(s.r)) - s.d;
-        const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p_init);
-        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
-    }
+    s.solve_initial_forces(s.GPhi * Eigen::VectorXd(Y.head(s.r)), p_init);
     modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.build_mode();
     s.decide_modes(0.0, Y, p_init, "start");

@@ -283,11 +283,7 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
         w0 += w_static;
     }
     // Initial contact state with R held at w(0) (as the closed-form mode), then the modes.
-    if (w0 != w_static && s.n > 0) {
-        s.ev_problem.q = s.c * w0 - s.d;
-        const SolveResult r0 = s.ev_solver->solve(s.ev_problem, p0);
-        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
-    }
+    if (w0 != w_static && s.n > 0) s.solve_initial_forces(s.c * w0, p0);
     detail::modes_from_solution(s.chk_problem, p0, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.cvode = std::make_unique<detail::CvodeSession>(s.who, s.nstate);
     auto y0 = s.cvode->y();

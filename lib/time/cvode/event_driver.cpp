@@ -121,6 +121,12 @@ StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) 
     return rec;
 }
 
+void EventDriver::solve_initial_forces(const Vec& motion0, Vec& p) {
+    ev_problem.q = motion0 - d;
+    const SolveResult r0 = ev_solver->solve(ev_problem, p);
+    if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
+}
+
 void EventDriver::start_record(const Vec& y0) {
     record = record_at(0.0, y0, p_out, rel_out);
     e0 = record.kinetic_energy_j + record.strain_energy_j;

@@ -118,6 +118,12 @@ public:
     /// `stiff`), the user's limits, stop time t_final, the witnesses as roots (if
     /// root-finding is on).
     void start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff = nullptr);
+    /// The contact forces at t = 0 (the initial contact state of every event stepper): the event
+    /// problem at s = motion0 - d [m] (motion0: the motion's part of s at t = 0) solved by the
+    /// event solver from the warm start p, the forces [N] left in p; throws SolverError
+    /// ("initial contact state") when the solve fails. The modes follow from p (the stepper then
+    /// decides them a look-ahead on: decide_modes).
+    void solve_initial_forces(const Vec& motion0, Vec& p);
     /// The initial record: `make_record` at t = 0, its balance error 0, e0 from it.
     void start_record(const Vec& y0);
 
