@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -565,10 +566,56 @@ void check_nesting(const std::string& text, const std::string& source_name) {
     }
 }
 
+/// TOML text must be UTF-8, and the TOML parser's own check of strings reads out of
+/// bounds when it reports a bad sequence in a literal string (toml11 3.7.1, found by
+/// fuzz/fuzz_scenario: fuzz/regressions/scenario/invalid-utf8-*): refuse any invalid
+/// UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF) before parsing.
+void check_utf8(const std::string& text, const std::string& source_name) {
+    int line = 1;
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        std::size_t n = 0;  // continuation bytes
+        unsigned lo = 0x80, hi = 0xBF;  // the allowed range of the first continuation byte
+        if (c < 0x80) n = 0;
+        else if (c >= 0xC2 && c <= 0xDF) n = 1;
+        else if (c == 0xE0) n = 2, lo = 0xA0;
+        else if (c >= 0xE1 && c <= 0xEC) n = 2;
+        else if (c == 0xED) n = 2, hi = 0x9F;
+        else if (c >= 0xEE && c <= 0xEF) n = 2;
+        else if (c == 0xF0) n = 3, lo = 0x90;
+        else if (c >= 0xF1 && c <= 0xF3) n = 3;
+        else if (c == 0xF4) n = 3, hi = 0x8F;
+        else n = 99;  // 0x80-0xC1, 0xF5-0xFF: never a first byte
+        bool ok = n != 99;
+        for (std::size_t k = 1; ok && k <= n; ++k) {
+            if (i + k >= text.size()) {
+                ok = false;
+                break;
+            }
+            const auto b = static_cast<unsigned char>(text[i + k]);
+            ok = k == 1 ? b >= lo && b <= hi : b >= 0x80 && b <= 0xBF;
+        }
+        if (!ok) {
+            char byte[8];
+            std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned>(c));
+            throw InputError(source_name, "TOML syntax error: not UTF-8 text: byte " + std::string(byte) + " at line " +
+                                              std::to_string(line) + ", column " + std::to_string(i - line_start + 1) +
+                                              " is not a valid UTF-8 sequence (a TOML file must be UTF-8)");
+        }
+        if (c == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+        i += n + 1;
+    }
+}
+
 }  // namespace
 
 Scenario parse_scenario(const std::string& text, const std::string& source_name) {
     Context ctx(source_name);
+    check_utf8(text, source_name);
     check_nesting(text, source_name);
     toml::value root;
     try {
