@@ -286,6 +286,7 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
         throw InputError("axes", "at least one [[axes]] table is required (key and values)",
                          top.count("axes") ? line_of(source_name, top.at("axes")) : source_name);
     const auto& axes = top.at("axes").as_array();
+    std::size_t total_values = 0;
     for (std::size_t a = 0; a < axes.size(); ++a) {
         const std::string base = "axes[" + std::to_string(a) + "]";
         const auto& t = axes[a];
@@ -365,6 +366,11 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
                 else axis.values.push_back(x);
             }
         }
+        // the values themselves are held: many long axes (a zip of them) must not exhaust memory
+        // before point_count's limit is checked
+        total_values += axis.values.size();
+        if (total_values > 10000000)
+            throw InputError(base, "more than 10 million values over the axes (axis " + axis.key + ")", where);
         spec.axes.push_back(std::move(axis));
     }
     point_count(spec);  // empty axis, unequal zip
