@@ -40,12 +40,17 @@ simulate)
         row=$(awk -F, -v i=$i '$1 == i' "$out/points.csv")
         [ "$(echo "$row" | cut -d, -f$(col status))" = ok ] || fail "point $i is not ok: $row"
         hyst=$(sed -n '/"hysteresis": {/,/}/p' "$dir/single.json")
+        fancher=$(sed -n '/"fancher": {/,/}/p' "$dir/single.json")
         for name in loop_area_j friction_work_j secant_stiffness_n_per_m dynamic_rate_n_per_m loss_factor \
-                    equivalent_damping_ratio force_min_n force_max_n w_min_m w_max_m energy_balance_error_j; do
+                    equivalent_damping_ratio force_min_n force_max_n w_min_m w_max_m \
+                    fancher_upper_rate_n_per_m fancher_upper_offset_n fancher_lower_rate_n_per_m \
+                    fancher_lower_offset_n fancher_beta_m fancher_rms_error_relative energy_balance_error_j; do
             key=$name
             [ $name = energy_balance_error_j ] && key=balance_error_max_abs
             if [ $name = energy_balance_error_j ]; then
                 json=$(grep "\"$key\":" "$dir/single.json" | head -1 | sed 's/.*: *//; s/,$//')
+            elif [ "${name#fancher_}" != "$name" ]; then  # simulate's "fancher" object, without the prefix
+                json=$(echo "$fancher" | grep "\"${name#fancher_}\":" | sed 's/.*: *//; s/,$//')
             else
                 json=$(echo "$hyst" | grep "\"$key\":" | sed 's/.*: *//; s/,$//')
             fi
@@ -55,6 +60,12 @@ simulate)
             awk -v a="$cell" -v b="$json" 'BEGIN { exit !(a + 0 == b + 0) }' ||
                 fail "point $i: $name is $cell in the table, $json from simulate"
         done
+        # the fitted loop beside the loop: the same samples (t, w), the model's force
+        loop=$(printf '%s/loops/point-%04d.csv' "$out" $i)
+        fitted=$(printf '%s/loops/point-%04d-fancher.csv' "$out" $i)
+        [ -f "$fitted" ] || fail "point $i: no $fitted"
+        diff <(cut -d, -f1,2 "$loop" | tail -n +2) <(cut -d, -f1,2 "$fitted" | tail -n +2) >/dev/null ||
+            fail "point $i: the fitted loop is not along the loop's samples"
     done
     echo "every point equals its single simulate run"
     ;;

@@ -51,17 +51,12 @@ LoopFigures loop_figures(const RunRequest& request, const RunResult& result) {
             loop.note = e.what();
         }
         if (const auto& m = loop.metrics) {
-            // the records hysteresis_metrics read (t in [t_start, t_end], both on the record grid)
-            std::vector<double> w, f;
-            for (const auto& r : result.records)
-                if (r.t_s >= m->t_start_s && r.t_s <= m->t_end_s) {
-                    w.push_back(r.w_m);
-                    f.push_back(r.spring_force_n);
-                }
+            // the records hysteresis_metrics read (t in [t_start, t_end]); the sweep's point
+            // figures (lib/study/sweep.cpp) make the same call
             try {
-                loop.fancher = fit_fancher(w, f);
-                const std::vector<double> model = fancher_force(loop.fancher->parameters, w, loop.fancher->start_force_n);
-                for (std::size_t i = 0; i < w.size(); ++i) loop.fancher_loop.emplace_back(w[i], model[i]);
+                const FancherLoopFit fit = fit_fancher_loop(result.records, m->t_start_s, m->t_end_s);
+                loop.fancher = fit.fit;
+                for (std::size_t i = 0; i < fit.w_m.size(); ++i) loop.fancher_loop.emplace_back(fit.w_m[i], fit.model_force_n[i]);
             } catch (const InputError& e) {
                 loop.fancher_note = e.what();
             }

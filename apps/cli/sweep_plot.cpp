@@ -79,10 +79,21 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
     g << "set datafile separator ','\nset terminal " << *terminal << " size 1000,760 noenhanced\nset grid\nset key below\n";
     std::vector<std::string> files;
     auto has_loop = [&](int i) { return fs::exists(point_file(directory, "loops", i, "csv")); };
-    auto loop_curve = [&](int i, const std::string& title) {
-        return "'" + point_file(directory, "loops", i, "csv") + "' using (1000*$2):3 skip 1 with lines lw 1.5 title '" +
-               title + "'";
+    // the k-th loop of a figure in colour k; Fancher's fitted loop (when there is one) over it,
+    // thin and dashed in the same colour, without a key entry (the title says what dashed is)
+    bool fitted = false;
+    auto loop_curve = [&](int i, int k, const std::string& title) {
+        const std::string colour = " lc " + std::to_string(k + 1);
+        std::string c = "'" + point_file(directory, "loops", i, "csv") + "' using (1000*$2):3 skip 1 with lines lw 1.5" +
+                        colour + " title '" + title + "'";
+        const std::string fit = point_file(directory, "loops", i, "csv", "-fancher");
+        if (fs::exists(fit)) {
+            c += ", '" + fit + "' using (1000*$2):3 skip 1 with lines lw 0.8 dt 2" + colour + " notitle";
+            fitted = true;
+        }
+        return c;
     };
+    auto fitted_note = [&] { return fitted ? std::string("\\n(dashed: Fancher's model fitted to each loop)") : std::string(); };
     const std::size_t n_axes = spec.axes.size();
     // 1. loop families
     if (spec.combine == Combine::product) {
@@ -91,6 +102,8 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
         for (std::size_t a = 0; a < n_axes; ++a) {
             if (spec.axes[a].values.size() < 2) continue;
             std::string curves, fixed;
+            fitted = false;
+            int k_curve = 0;
             for (std::size_t b = 0; b < n_axes; ++b)
                 if (b != a) fixed += (fixed.empty() ? "" : ", ") + spec.axes[b].key + " = " + to_string(spec.axes[b].values[middle[b]]);
             for (std::size_t k = 0; k < spec.axes[a].values.size(); ++k) {
@@ -98,25 +111,29 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
                 at[a] = k;
                 const int i = product_index(spec, at);
                 if (!has_loop(i)) continue;
-                curves += (curves.empty() ? "" : ", ") + loop_curve(i, spec.axes[a].key + " = " + to_string(spec.axes[a].values[k]));
+                curves += (curves.empty() ? "" : ", ") +
+                          loop_curve(i, k_curve++, spec.axes[a].key + " = " + to_string(spec.axes[a].values[k]));
             }
             if (curves.empty()) continue;
             files.push_back((dir / ("loops_along_" + file_part(spec.axes[a].key) + ".png")).string());
             g << "set output '" << files.back() << "'\nset title \"loops along " << spec.axes[a].key
-              << (fixed.empty() ? "" : "\\n(" + fixed + ")") << "\"\nset xlabel 'w [mm]'\nset ylabel 'spring force [N]'\nplot "
+              << (fixed.empty() ? "" : "\\n(" + fixed + ")") << fitted_note()
+              << "\"\nset xlabel 'w [mm]'\nset ylabel 'spring force [N]'\nplot "
               << curves << "\n";
         }
     } else {
         std::string curves;
+        fitted = false;
+        int k_curve = 0;
         for (const SweepPoint& p : points) {
             if (!has_loop(p.index)) continue;
             std::string title;
             for (std::size_t a = 0; a < n_axes; ++a) title += (a ? ", " : "") + to_string(p.values[a]);
-            curves += (curves.empty() ? "" : ", ") + loop_curve(p.index, title);
+            curves += (curves.empty() ? "" : ", ") + loop_curve(p.index, k_curve++, title);
         }
         if (!curves.empty()) {
             files.push_back((dir / "loops.png").string());
-            g << "set output '" << files.back() << "'\nset title 'loops'\nset xlabel 'w [mm]'\n"
+            g << "set output '" << files.back() << "'\nset title \"loops" << fitted_note() << "\"\nset xlabel 'w [mm]'\n"
               << "set ylabel 'spring force [N]'\nplot " << curves << "\n";
         }
     }

@@ -248,15 +248,33 @@ FancherFit fit_fancher(const std::vector<double>& w_m, const std::vector<double>
     return fit;
 }
 
-FancherFit fit_fancher(const std::vector<StepRecord>& records, double t_start_s, double t_end_s) {
+namespace {
+
+/// w and F of the records with t in [t_start_s, t_end_s] (hysteresis_metrics' selection).
+void loop_samples(const std::vector<StepRecord>& records, double t_start_s, double t_end_s, std::vector<double>& w,
+                  std::vector<double>& f) {
     const double eps = 1e-9 * std::max(1.0, std::abs(t_end_s));
-    std::vector<double> w, f;
     for (const auto& r : records)
         if (r.t_s >= t_start_s - eps && r.t_s <= t_end_s + eps) {
             w.push_back(r.w_m);
             f.push_back(r.spring_force_n);
         }
+}
+
+}  // namespace
+
+FancherFit fit_fancher(const std::vector<StepRecord>& records, double t_start_s, double t_end_s) {
+    std::vector<double> w, f;
+    loop_samples(records, t_start_s, t_end_s, w, f);
     return fit_fancher(w, f);
+}
+
+FancherLoopFit fit_fancher_loop(const std::vector<StepRecord>& records, double t_start_s, double t_end_s) {
+    FancherLoopFit loop;
+    loop_samples(records, t_start_s, t_end_s, loop.w_m, loop.force_n);
+    loop.fit = fit_fancher(loop.w_m, loop.force_n);
+    loop.model_force_n = fancher_force(loop.fit.parameters, loop.w_m, loop.fit.start_force_n);
+    return loop;
 }
 
 }  // namespace stackbeam

@@ -20,6 +20,7 @@
 
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/model/model.hpp"
+#include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 
 namespace stackbeam {
@@ -222,6 +223,12 @@ const char* to_string(PointStatus status) {
 }
 
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
+    return parse_sweep_spec(text, source_name, [](const std::string& path, const std::string& location) {
+        return read_file(path, "scenario", location, "the base scenario file");
+    });
+}
+
+SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name, const ScenarioReader& read_scenario) {
     SweepSpec spec;
     spec.source = source_name;
     toml::value root;
@@ -251,7 +258,7 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
                          spec.scenario_location);
     const std::string& name = sc.as_string().str;
     spec.scenario_path = name[0] == '/' ? name : directory_of(source_name) + name;
-    spec.scenario_text = read_file(spec.scenario_path, "scenario", spec.scenario_location, "the base scenario file");
+    spec.scenario_text = read_scenario(spec.scenario_path, spec.scenario_location);
     if (top.count("combine")) {
         const auto& c = top.at("combine");
         const std::string word = c.is_string() ? c.as_string().str : "";
@@ -279,6 +286,7 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
         throw InputError("axes", "at least one [[axes]] table is required (key and values)",
                          top.count("axes") ? line_of(source_name, top.at("axes")) : source_name);
     const auto& axes = top.at("axes").as_array();
+    std::size_t total_values = 0;
     for (std::size_t a = 0; a < axes.size(); ++a) {
         const std::string base = "axes[" + std::to_string(a) + "]";
         const auto& t = axes[a];
@@ -358,6 +366,11 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
                 else axis.values.push_back(x);
             }
         }
+        // the values themselves are held: many long axes (a zip of them) must not exhaust memory
+        // before point_count's limit is checked
+        total_values += axis.values.size();
+        if (total_values > 10000000)
+            throw InputError(base, "more than 10 million values over the axes (axis " + axis.key + ")", where);
         spec.axes.push_back(std::move(axis));
     }
     point_count(spec);  // empty axis, unequal zip
@@ -454,7 +467,11 @@ const std::vector<std::string>& point_figure_columns() {
     static const std::vector<std::string> columns = {
         "loop_area_j",   "friction_work_j", "secant_stiffness_n_per_m", "dynamic_rate_n_per_m",
         "loss_factor",   "equivalent_damping_ratio", "force_min_n",     "force_max_n",
-        "w_min_m",       "w_max_m",         "energy_balance_error_j",
+        "w_min_m",       "w_max_m",
+        // Fancher's model fitted to the last loop (post/fancher.hpp), as simulate's summary "fancher"
+        "fancher_upper_rate_n_per_m", "fancher_upper_offset_n", "fancher_lower_rate_n_per_m",
+        "fancher_lower_offset_n", "fancher_beta_m", "fancher_rms_error_relative",
+        "energy_balance_error_j",
     };
     return columns;
 }
@@ -479,6 +496,18 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
             f[7] = m.force_max_n;
             f[8] = m.w_min_m;
             f[9] = m.w_max_m;
+            // the call simulate's summary makes (apps/cli/summary.cpp): the same figures
+            try {
+                const FancherFit fit = fit_fancher_loop(records, m.t_start_s, m.t_end_s).fit;
+                f[10] = fit.parameters.upper_rate_n_per_m;
+                f[11] = fit.parameters.upper_offset_n;
+                f[12] = fit.parameters.lower_rate_n_per_m;
+                f[13] = fit.parameters.lower_offset_n;
+                f[14] = fit.parameters.beta_m;
+                f[15] = fit.rms_error_relative;
+            } catch (const InputError& e) {
+                note = std::string("no Fancher fit: ") + e.what();
+            }
         } catch (const InputError& e) {
             note = e.what();
         }
@@ -488,7 +517,7 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
     // the largest |energy balance error| over the run, as simulate's summary (balance_error_max_abs)
     double balance = 0.0;
     for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
-    f[10] = records.empty() ? nan : balance;
+    f[16] = records.empty() ? nan : balance;
     return f;
 }
 

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <stdexcept>
 
 #include "stackbeam/io/csv.hpp"
+#include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 
 #ifndef STACKBEAM_VERSION
@@ -145,10 +147,11 @@ const char* kJournal = "finished.csv";
 
 }  // namespace
 
-std::string point_file(const std::string& directory, const std::string& kind, int index, const std::string& ext) {
+std::string point_file(const std::string& directory, const std::string& kind, int index, const std::string& ext,
+                       const std::string& suffix) {
     char name[40];
-    std::snprintf(name, sizeof name, "point-%04d.", index);
-    return (fs::path(directory) / kind / (name + ext)).string();
+    std::snprintf(name, sizeof name, "point-%04d", index);
+    return (fs::path(directory) / kind / (name + suffix + "." + ext)).string();
 }
 
 std::string point_table_header(const SweepSpec& spec) {
@@ -307,11 +310,37 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                 const auto cycle = last_cycle(records, period);
                 std::ostringstream loop;
                 loop << "t_s,w_m,spring_force_n\n";
+                std::vector<double> t, w;
                 for (const StepRecord& s : records)
-                    if (s.t_s >= cycle.first && s.t_s <= cycle.second)
+                    if (s.t_s >= cycle.first && s.t_s <= cycle.second) {
                         loop << number_cell(s.t_s) << ',' << number_cell(s.w_m) << ',' << number_cell(s.spring_force_n)
                              << '\n';
+                        t.push_back(s.t_s);
+                        w.push_back(s.w_m);
+                    }
                 write_whole(point_file(directory, "loops", r.index, "csv"), loop.str());
+                // the fitted Fancher loop along the same path, from the row's parameters: the
+                // model in its periodic state, as fit_fancher_loop's model_force_n
+                const auto& columns = point_figure_columns();
+                auto figure = [&](const char* name) {
+                    const auto i = std::find(columns.begin(), columns.end(), name) - columns.begin();
+                    return static_cast<std::size_t>(i) < r.figures.size() ? r.figures[static_cast<std::size_t>(i)]
+                                                                           : std::nan("");
+                };
+                FancherParameters p;
+                p.upper_rate_n_per_m = figure("fancher_upper_rate_n_per_m");
+                p.upper_offset_n = figure("fancher_upper_offset_n");
+                p.lower_rate_n_per_m = figure("fancher_lower_rate_n_per_m");
+                p.lower_offset_n = figure("fancher_lower_offset_n");
+                p.beta_m = figure("fancher_beta_m");
+                if (!std::isnan(p.beta_m) && w.size() >= 2) {
+                    const std::vector<double> model = fancher_force(p, w, fancher_periodic_start_force(p, w));
+                    std::ostringstream fitted;
+                    fitted << "t_s,w_m,fancher_force_n\n";
+                    for (std::size_t i = 0; i < w.size(); ++i)
+                        fitted << number_cell(t[i]) << ',' << number_cell(w[i]) << ',' << number_cell(model[i]) << '\n';
+                    write_whole(point_file(directory, "loops", r.index, "csv", "-fancher"), fitted.str());
+                }
             } catch (const InputError&) {
                 // no whole cycle: the row's message says so, no loop file
             }

@@ -81,4 +81,18 @@ FancherFit fit_fancher(const std::vector<double>& w_m, const std::vector<double>
 /// takes them): w = StepRecord::w_m, F = StepRecord::spring_force_n.
 FancherFit fit_fancher(const std::vector<StepRecord>& records, double t_start_s, double t_end_s);
 
+/// A run's loop, its fit and the fitted model's loop along the same path: what
+/// `stackbeam simulate`'s summary and a sweep's point (study/sweep.hpp) report, from
+/// this one call so that they agree figure for figure.
+struct FancherLoopFit {
+    FancherFit fit;
+    std::vector<double> w_m;            ///< the loop's deflections (the records with t in [t_start_s, t_end_s])
+    std::vector<double> force_n;        ///< the loop's spring forces
+    std::vector<double> model_force_n;  ///< fancher_force(fit.parameters, w_m, fit.start_force_n)
+};
+
+/// fit_fancher(records, t_start_s, t_end_s) with the loop's samples and the model's
+/// force along them. Throws InputError as fit_fancher.
+FancherLoopFit fit_fancher_loop(const std::vector<StepRecord>& records, double t_start_s, double t_end_s);
+
 }  // namespace stackbeam

@@ -77,6 +77,15 @@ struct SweepSpec {
 /// the points (expand_points).
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name);
 
+/// Supplies the base scenario's TOML text for its resolved path (SweepSpec::scenario_path);
+/// throws InputError("scenario", ..., location) when it has none.
+using ScenarioReader = std::function<std::string(const std::string& path, const std::string& location)>;
+
+/// parse_sweep_spec with the base scenario's text from `read_scenario` instead of the file
+/// system: a program holding its scenarios in memory, and the spec reader's fuzz target
+/// (fuzz/fuzz_sweep_spec.cpp), which must not read files the fuzzed text names.
+SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name, const ScenarioReader& read_scenario);
+
 /// Reads and parses the spec file at `path`.
 SweepSpec load_sweep_spec(const std::string& path);
 

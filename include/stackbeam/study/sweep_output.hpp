@@ -12,6 +12,8 @@
 ///   DIR/sweep.json         the spec, the program's version, counts, times (finish())
 ///   DIR/scenarios/point-NNNN.toml   each point's scenario (`stackbeam simulate --scenario` runs it)
 ///   DIR/loops/point-NNNN.csv        each ok point's last loop (t, w, spring force) when it has one
+///   DIR/loops/point-NNNN-fancher.csv   Fancher's model fitted to it along the same path
+///                                   (t, w, fancher_force_n) when the fit succeeded
 ///   DIR/series/point-NNNN.csv       each point's records (only with keep_series)
 ///
 /// Resume: opening DIR again reads the journal; its whole rows are the finished points
@@ -85,7 +87,9 @@ private:
 void write_point_files(const std::string& directory, const SweepPoint& point, const PointResult& result,
                        bool keep_series);
 
-/// The file of point `index` under DIR's `kind` folder: DIR/kind/point-NNNN.ext.
-std::string point_file(const std::string& directory, const std::string& kind, int index, const std::string& ext);
+/// The file of point `index` under DIR's `kind` folder: DIR/kind/point-NNNN<suffix>.ext
+/// (the fitted loop: kind "loops", suffix "-fancher").
+std::string point_file(const std::string& directory, const std::string& kind, int index, const std::string& ext,
+                       const std::string& suffix = "");
 
 }  // namespace stackbeam
