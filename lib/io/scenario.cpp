@@ -1,6 +1,7 @@
 // Scenario files (TOML, read with toml11): every key checked, errors name the
 // key's path in the file. Format: docs/model-and-scenarios.md.
 #include "stackbeam/io/scenario.hpp"
+#include "toml_text.hpp"
 
 #include <toml.hpp>
 
@@ -565,11 +566,46 @@ void check_nesting(const std::string& text, const std::string& source_name) {
     }
 }
 
+/// The line (1-based) of the first byte of `text` that is not part of valid UTF-8, 0 if none.
+int first_bad_utf8_line(const std::string& text) {
+    int line = 1;
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c == '\n') ++line;
+        std::size_t n = 0;
+        unsigned int cp = 0;
+        if (c < 0x80) n = 1, cp = c;
+        else if ((c & 0xE0) == 0xC0) n = 2, cp = c & 0x1Fu;
+        else if ((c & 0xF0) == 0xE0) n = 3, cp = c & 0x0Fu;
+        else if ((c & 0xF8) == 0xF0) n = 4, cp = c & 0x07u;
+        else return line;
+        if (i + n > text.size()) return line;
+        for (std::size_t k = 1; k < n; ++k) {
+            const auto d = static_cast<unsigned char>(text[i + k]);
+            if ((d & 0xC0) != 0x80) return line;
+            cp = (cp << 6) | (d & 0x3Fu);
+        }
+        // overlong forms, surrogates and code points above U+10FFFF are not UTF-8
+        if ((n == 2 && cp < 0x80) || (n == 3 && cp < 0x800) || (n == 4 && cp < 0x10000) || cp > 0x10FFFF ||
+            (cp >= 0xD800 && cp <= 0xDFFF))
+            return line;
+        i += n;
+    }
+    return 0;
+}
+
 }  // namespace
+
+void detail::check_toml_text(const std::string& text, const std::string& source_name) {
+    if (const int line = first_bad_utf8_line(text))
+        throw InputError(source_name, "TOML syntax error: bytes that are not UTF-8 at line " + std::to_string(line) +
+                                          " (a TOML file is UTF-8 text)");
+    check_nesting(text, source_name);
+}
 
 Scenario parse_scenario(const std::string& text, const std::string& source_name) {
     Context ctx(source_name);
-    check_nesting(text, source_name);
+    detail::check_toml_text(text, source_name);
     toml::value root;
     try {
         std::istringstream in(text);
