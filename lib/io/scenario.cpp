@@ -1,6 +1,7 @@
 // Scenario files (TOML, read with toml11): every key checked, errors name the
 // key's path in the file. Format: docs/model-and-scenarios.md.
 #include "stackbeam/io/scenario.hpp"
+#include "toml_text.hpp"
 
 #include <toml.hpp>
 
@@ -613,10 +614,14 @@ void check_utf8(const std::string& text, const std::string& source_name) {
 
 }  // namespace
 
-Scenario parse_scenario(const std::string& text, const std::string& source_name) {
-    Context ctx(source_name);
+void detail::check_toml_text(const std::string& text, const std::string& source_name) {
     check_utf8(text, source_name);
     check_nesting(text, source_name);
+}
+
+Scenario parse_scenario(const std::string& text, const std::string& source_name) {
+    Context ctx(source_name);
+    detail::check_toml_text(text, source_name);
     toml::value root;
     try {
         std::istringstream in(text);

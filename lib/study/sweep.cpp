@@ -1,6 +1,7 @@
 // Sweeps: the spec file, the points (the base scenario's TOML document edited at the
 // axes' key paths, then read by parse_scenario), one point's run, the thread scheduler.
 #include "stackbeam/study/sweep.hpp"
+#include "../io/toml_text.hpp"
 
 #include <toml.hpp>
 
@@ -232,6 +233,7 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
     SweepSpec spec;
     spec.source = source_name;
     toml::value root;
+    detail::check_toml_text(text, source_name);
     try {
         std::istringstream in(text);
         root = toml::parse(in, source_name);
@@ -410,6 +412,7 @@ std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
     const int n = point_count(spec);
     Document base;
     try {
+        detail::check_toml_text(spec.scenario_text, spec.scenario_path);
         std::istringstream in(spec.scenario_text);
         base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
     } catch (const std::exception& e) {
