@@ -83,7 +83,28 @@ def _flatten_options(options, prefix=""):
     return flat
 
 
-class Result(_Mapping):
+class _Columns(_Mapping):
+    """A mapping from column names to numpy arrays (self._columns), with to_pandas()."""
+
+    def __getitem__(self, name):
+        return self._columns[name]
+
+    def __iter__(self):
+        return iter(self._columns)
+
+    def __len__(self):
+        return len(self._columns)
+
+    def to_pandas(self):
+        """The columns as a pandas DataFrame (needs pandas)."""
+        try:
+            import pandas
+        except ImportError as e:  # pragma: no cover - pandas is optional
+            raise ImportError("to_pandas needs pandas (Debian: apt-get install python3-pandas)") from e
+        return pandas.DataFrame(dict(self._columns))
+
+
+class Result(_Columns):
     """A run's results: a mapping from the time-series CSV's column names (``t``, ``w``,
     ``spring_force``, ...) to numpy arrays, one entry per record (the first: t = 0).
 
@@ -103,27 +124,10 @@ class Result(_Mapping):
         self.scenario = scenario
         self.options = options
 
-    def __getitem__(self, name):
-        return self._columns[name]
-
-    def __iter__(self):
-        return iter(self._columns)
-
-    def __len__(self):
-        return len(self._columns)
-
     def __repr__(self):
         n = len(self._columns["t"])
         return "<stackbeam.Result: %d records to t = %g s, columns %s>" % (
             n, self._columns["t"][-1] if n else 0.0, ", ".join(self._columns))
-
-    def to_pandas(self):
-        """The records as a pandas DataFrame (needs pandas)."""
-        try:
-            import pandas
-        except ImportError as e:  # pragma: no cover - pandas is optional
-            raise ImportError("Result.to_pandas needs pandas (Debian: apt-get install python3-pandas)") from e
-        return pandas.DataFrame(dict(self._columns))
 
 
 def simulate(scenario, *, pairs=False, **options):
@@ -141,7 +145,7 @@ def simulate(scenario, *, pairs=False, **options):
     return Result(raw, scenario.copy(), flat)
 
 
-class SweepResult:
+class SweepResult(_Columns):
     """The points table of a sweep (stackbeam.sweep): a mapping from points.csv's column names
     to numpy arrays, one entry per point in point order: ``point``, one column per axis named
     exactly as its key, ``status`` ("ok", "failed", "input-error"), ``message``, the figures
@@ -156,27 +160,10 @@ class SweepResult:
         self.wall_time_s = raw["wall_time_s"]
         self.jobs = raw["jobs"]
 
-    def __getitem__(self, name):
-        return self._columns[name]
-
-    def __iter__(self):
-        return iter(self._columns)
-
-    def __len__(self):
-        return len(self._columns)
-
     def __repr__(self):
         n = len(self._columns["point"])
         ok = int((self._columns["status"] == "ok").sum())
         return "<stackbeam.SweepResult: %d points (%d ok) over %s>" % (n, ok, ", ".join(self.axes))
-
-    def to_pandas(self):
-        """The table as a pandas DataFrame (needs pandas)."""
-        try:
-            import pandas
-        except ImportError as e:  # pragma: no cover - pandas is optional
-            raise ImportError("SweepResult.to_pandas needs pandas (Debian: apt-get install python3-pandas)") from e
-        return pandas.DataFrame(dict(self._columns))
 
 
 def sweep(spec, *, jobs=None, out_dir=None, restart=False, keep_series=False):
