@@ -77,9 +77,13 @@ parallel)
     diff <(table "$dir/jobs1") <(table "$dir/jobs2") || fail "--jobs 1 and --jobs 2 tables differ"
     if [ -n "$mpirun" ]; then
         rm -rf "$dir/mpi"
-        # (as root OpenMPI wants the two ALLOW variables; LSAN_OPTIONS: OpenMPI's own allocations
-        # in the sanitizer build; vader's single copy needs ptrace rights containers often lack)
-        LSAN_OPTIONS="${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=$src/sweep/lsan_mpi.supp:print_suppressions=0" \
+        # (as root OpenMPI wants the two ALLOW variables; vader's single copy needs ptrace rights
+        # containers often lack.) In the sanitizer build the ranks run without leak checking:
+        # OpenMPI's components are plugins it dlopens and dlcloses before exit, so the leak
+        # report's stacks of its start-up allocations name no module and no suppression can
+        # match them (seen: 116 kB in 3,339 allocations, every frame "<unknown module>"). The
+        # sweep's own code is leak-checked by the --jobs runs above; memory errors stay fatal.
+        ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
         OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
             "$mpirun" -n 2 --oversubscribe "$cli" sweep "$spec" --out-dir "$dir/mpi" --no-plot || fail "mpirun: exit status $?"
         grep -q '"processes": 2' "$dir/mpi/sweep.json" || fail "sweep.json does not say 2 processes"
