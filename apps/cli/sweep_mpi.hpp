@@ -5,11 +5,16 @@
 /// points out one at a time, on request (points differ in cost by orders of magnitude):
 /// its main thread serves the other ranks' requests while a thread of its own runs
 /// points too; every other rank asks for a point, runs it (run_point), writes its files
-/// and sends its row back with the next request. Only rank 0's main thread calls MPI
-/// (MPI_THREAD_FUNNELED). The table is the one a serial run writes: each point's row is
-/// computed by the same code, rows are put in point order at the end.
+/// and sends its row back with the next request. MPI starts on a thread of its own while
+/// every rank reads and checks the spec (the two take about the same time, and MPI_Init is
+/// mostly waiting); that thread also finalizes MPI (MPI-3.1 12.4.3: the thread that
+/// initialised it). MPI is called by one thread at a time (MPI_THREAD_SERIALIZED): the
+/// process's main thread once MPI is up; rank 0's point-running thread never calls it.
+/// The table is the one a serial run writes: each point's row is computed by the same
+/// code, rows are put in point order at the end.
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,18 +23,25 @@
 
 namespace stackbeam::cli {
 
+struct MpiHost;  // the thread that initialises and finalizes MPI (sweep_mpi.cpp)
+
 /// MPI_COMM_WORLD as this process sees it.
 struct MpiWorld {
-    bool active = false;  ///< MPI initialised (started by mpirun with more than one rank)
-    int rank = 0;
+    bool active = false;  ///< started by mpirun: MPI initialised, or being initialised by `host`
+    int rank = 0;         ///< from the launcher's variables; checked against MPI's once it is up
     int size = 1;
+    std::shared_ptr<MpiHost> host;
 };
 
-/// Initialises MPI when the process was started by mpirun/mpiexec (OpenMPI's, or a PMI
-/// launcher's variables); a plain command never touches MPI. Throws if started by a
-/// launcher with several ranks and this program was built without MPI.
+/// Starts initialising MPI, on a thread of its own, when the process was started by
+/// mpirun/mpiexec (OpenMPI's, or a PMI launcher's variables; rank and size are read from
+/// them at once); a plain command never touches MPI. Throws if started by a launcher with
+/// several ranks and this program was built without MPI.
 MpiWorld mpi_start(int& argc, char**& argv);
-/// MPI_Finalize (when active).
+/// Waits until MPI is initialised (before the first MPI call); throws if it could not be,
+/// or if it gives another rank or size than the launcher's variables.
+void mpi_ready(const MpiWorld& world);
+/// MPI_Finalize on the thread that initialised MPI (when active).
 void mpi_finish(const MpiWorld& world);
 /// Aborts every rank (a rank's error the others cannot see).
 [[noreturn]] void mpi_abort(const MpiWorld& world, int status);
