@@ -588,6 +588,13 @@ void enum_property(Cls& cls, const char* name, E C::*member, const std::vector<s
 PYBIND11_MODULE(_core, m) {
     m.doc() = "stackbeam's C++ core; use the package stackbeam (docs/python.md)";
 
+    // numpy's C API now, while the import holds the GIL on one thread: pybind11 2.10 looks it up
+    // in a function-local static on the first array made, importing numpy inside the static's
+    // guard, and two runs finishing at once on two threads deadlocked there (one thread holding
+    // the guard and waiting for the GIL, the other holding the GIL and waiting for the guard)
+    py::array_t<double> first_array(0);
+    (void)first_array;
+
     // --- exceptions: InputError(ValueError) with .field and .location; SolverError(RuntimeError)
     static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
     static py::exception<SolverError> solver_error(m, "SolverError", PyExc_RuntimeError);

@@ -93,3 +93,30 @@ def test_keyboard_interrupt_stops_a_run_and_leaves_the_process_usable():
     again = stackbeam.simulate(scenario, t_end_s=0.05)
     for name in reference:
         np.testing.assert_array_equal(again[name], reference[name])
+
+
+FIRST_RUNS_AT_ONCE = """
+import threading, stackbeam
+scenario = stackbeam.paper_example("friction")
+start = threading.Barrier(2)
+def work():
+    start.wait()
+    stackbeam.simulate(scenario, t_end_s=0.05)
+threads = [threading.Thread(target=work) for _ in range(2)]
+for t in threads: t.start()
+for t in threads: t.join()
+print("done")
+"""
+
+
+def test_first_runs_of_a_process_on_two_threads_at_once():
+    # the first arrays a process makes look up numpy's C API; two runs finishing together on
+    # two threads deadlocked there (pybind11 2.10's lookup in a function-local static, importing
+    # numpy under the static's guard) in 10 tries of 10 before the module looked it up at import
+    import subprocess
+    import sys
+    for _ in range(3):
+        done = subprocess.run([sys.executable, "-c", FIRST_RUNS_AT_ONCE], capture_output=True, text=True,
+                              timeout=120, env=os.environ)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.strip() == "done"
