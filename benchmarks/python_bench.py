@@ -10,7 +10,8 @@ over the same run by the C++ command line, and two runs on two Python threads ag
      build to the records), and
    - the command line: `stackbeam simulate --case friction` (its summary's wall_time_s: the
      same run writing its CSV; and the child's CPU time, process start included).
-2. Threads: the friction case to t = 10 s, one run alone, then two runs on two threads at once;
+2. Threads: the friction case to t = 10 s, one run alone, then two runs on two threads at once,
+   in interleaved rounds with a control (the same run in one and two Python processes at once);
    the ratio of the wall times (two at once / one), and of the CPU time per run (two at once
    / one: above 1 if the runs slowed each other down, e.g. by a lock). The wall ratio needs
    two idle cores: the load average is printed with it.
@@ -22,6 +23,7 @@ import os
 import resource
 import statistics
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -86,14 +88,50 @@ def timed(n_threads):
     return time.perf_counter() - w0, time.process_time() - c0
 
 
-one, two, one_cpu, two_cpu = [], [], [], []
-for _ in range(max(3, args.repeat // 2)):
-    w, c = timed(1)
-    one.append(w), one_cpu.append(c)
-    w, c = timed(2)
-    two.append(w), two_cpu.append(c)
-print("2. friction case to t = 10 s (10,000 steps); medians of %d; %d cores, load average %.1f" % (
-    len(one), os.cpu_count(), os.getloadavg()[0]))
-print("   one run:               wall %.3f s, CPU %.3f s" % (med(one), med(one_cpu)))
+CHILD = """
+import sys, time, stackbeam
+scenario = stackbeam.paper_example("friction")
+stackbeam.simulate(scenario, t_end_s=0.1)  # warm up, as the threads' process is
+while time.time() < float(sys.argv[1]):  # start together
+    time.sleep(0.0005)
+w0 = time.perf_counter()
+stackbeam.simulate(scenario, t_end_s=10.0)
+print(time.perf_counter() - w0)
+"""
+
+
+def processes(n_procs, tmp):
+    """The control: the same run in n_procs Python processes at once (no shared process, no
+    shared GIL), started together; the longest run's wall time, as a round of threads waits for
+    its slower run."""
+    del tmp
+    at = time.time() + 1.0
+    procs = [subprocess.Popen([sys.executable, "-c", CHILD, repr(at)], stdout=subprocess.PIPE, text=True)
+             for _ in range(n_procs)]
+    walls = []
+    for p in procs:
+        out, _ = p.communicate()
+        if p.returncode != 0:
+            raise RuntimeError("the control process failed")
+        walls.append(float(out))
+    return max(walls)
+
+
+rounds = {"one": [], "two": [], "one_cpu": [], "two_cpu": [], "p1": [], "p2": []}
+with tempfile.TemporaryDirectory() as tmp:
+    for _ in range(args.repeat):  # interleaved rounds: the machine's speed drifts between them
+        w, c = timed(1)
+        rounds["one"].append(w), rounds["one_cpu"].append(c)
+        w, c = timed(2)
+        rounds["two"].append(w), rounds["two_cpu"].append(c)
+        rounds["p1"].append(processes(1, tmp))
+        rounds["p2"].append(processes(2, tmp))
+ratio = lambda a, b: med([y / x for x, y in zip(rounds[a], rounds[b])])
+print("2. friction case to t = 10 s (10,000 steps); medians of %d interleaved rounds; %d cores, load average %.1f" % (
+    args.repeat, os.cpu_count(), os.getloadavg()[0]))
+print("   one run:               wall %.3f s, CPU %.3f s" % (med(rounds["one"]), med(rounds["one_cpu"])))
 print("   two runs, two threads: wall %.3f s, CPU %.3f s   -> %.3fx the wall time of one, %.3fx the CPU time per run" % (
-    med(two), med(two_cpu), med(two) / med(one), med(two_cpu) / 2 / med(one_cpu)))
+    med(rounds["two"]), med(rounds["two_cpu"]), ratio("one", "two"),
+    med([c2 / 2 / c1 for c1, c2 in zip(rounds["one_cpu"], rounds["two_cpu"])])))
+print("   control, two Python processes at once (no shared process, no GIL): %.3fx the wall time of one run"
+      " (the machine's own two-core scaling)" % ratio("p1", "p2"))
