@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
-#include <stdexcept>
 #include <string>
 
 #include "fe/leaf_sections.hpp"
@@ -344,8 +343,8 @@ Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) c
 
 std::vector<LeafNodes> System::leaf_nodes(const Eigen::VectorXd& z) const {
     if (z.size() != P_.cols())
-        throw std::invalid_argument("System::leaf_nodes: z has " + std::to_string(z.size()) + " entries, the system " +
-                                    std::to_string(P_.cols()) + " reduced DOFs");
+        throw InputError("z", "has " + std::to_string(z.size()) + " entries: System::leaf_nodes needs one per reduced DOF, " +
+                                  std::to_string(P_.cols()) + " (num_reduced_dofs())");
     const Eigen::VectorXd u = P_ * z;
     const auto& xs = model_.nodes_x();
     const bool half = model_.spec().symmetry == Symmetry::half;

@@ -116,7 +116,8 @@ public:
     /// displacements are from the leaf's free (unstressed) shape, which is flat unless the leaf
     /// has a free camber. On the half model the meshed left half is mirrored about the
     /// attachment x_R to the whole leaf (the motion is symmetric there: v(2 x_R - x) = v(x),
-    /// theta(2 x_R - x) = -theta(x)); the node at x_R appears once.
+    /// theta(2 x_R - x) = -theta(x)); the node at x_R appears once. InputError naming z when it
+    /// has not num_reduced_dofs() entries.
     std::vector<LeafNodes> leaf_nodes(const Eigen::VectorXd& z) const;
 
 private:
