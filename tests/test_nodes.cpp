@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "single_leaf.hpp"
+#include "test_support.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/stepper.hpp"
@@ -123,14 +124,8 @@ struct Case {
 /// at every record every leaf whole (the paper example is the half model: 2 x 20 elements) and
 /// the node at R's seat (every leaf is tied there) at the record's w.
 void check_seat_follows_w(const Case& c) {
-    PaperExampleOptions po;
-    if (c.massive_stack) po.elements_per_half_leaf = 10;
-    ModelSpec spec = paper_example(c.paper_case, po);
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = c.density;
-    if (c.massive_stack) {
-        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
-        for (auto& cl : spec.clamps) cl.length_m = 0.01;
-    }
+    const ModelSpec spec = testing::paper_with_mass(c.paper_case, c.density, c.massive_stack);
+    const int elements_per_half_leaf = c.massive_stack ? 10 : PaperExampleOptions{}.elements_per_half_leaf;
     const System system(Model::build(spec));
     SimulationOptions o;
     o.mode = c.mode;
@@ -159,7 +154,7 @@ void check_seat_follows_w(const Case& c) {
         for (std::size_t l = 0; l < spec.leaves.size(); ++l) {
             const LeafNodes& leaf = seen[i][l];
             BOOST_TEST(leaf.leaf == static_cast<int>(l));
-            BOOST_TEST_REQUIRE(leaf.x_m.size() == static_cast<std::size_t>(2 * po.elements_per_half_leaf + 1));
+            BOOST_TEST_REQUIRE(leaf.x_m.size() == static_cast<std::size_t>(2 * elements_per_half_leaf + 1));
             const std::size_t seat = leaf.x_m.size() / 2;
             BOOST_TEST(std::abs(leaf.x_m[seat] - x_r) <= 1e-12);
             BOOST_TEST(leaf.theta_rad[seat] == 0.0);  // the symmetry plane
