@@ -6,8 +6,9 @@ STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)
-# The Python module (python/, docs/python.md) and its tests and figures, for Debian's /usr/bin/python3.
-STACKBEAM_PYTHON_PACKAGES=(python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib)
+# The Python module (python/, docs/python.md) and its tests and figures, for Debian's /usr/bin/python3
+# (python3-pil: the GIF writer of stackbeam.plot.animate_stack).
+STACKBEAM_PYTHON_PACKAGES=(python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib python3-pil)
 
 # install_packages PKG...: apt-get installs the packages that are not installed yet.
 # Skips apt entirely (fast) when all of them are installed already.

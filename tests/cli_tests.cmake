@@ -213,6 +213,17 @@ stackbeam_cli_test(NAME cli_bad_events_from_file_in_newmark
                    ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/scenarios/base_friction.toml --mode newmark
                         --beam-density 7850 --t-end 0.01 --out ${_cli_out_dir}/cli_newmark_base_bad.csv
                    EXPECT_RC 2 EXPECT_TEXT "outputs.events_path" OUT ${_cli_out_dir}/cli_newmark_base_bad.csv)
+# --nodes (decision 028): the long-format file of every leaf's nodes at every record (the half
+# model mirrored: 3 leaves x 41 nodes x 6 records + the header), and a name of its own
+stackbeam_cli_test(NAME cli_ok_nodes
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_nodes_run.csv
+                        --nodes ${_cli_out_dir}/cli_nodes.csv
+                   EXPECT_RC 0 EXPECT_TEXT "nodes" OUT ${_cli_out_dir}/cli_nodes.csv HEADER_PREFIX "t,leaf,x,w,theta"
+                   MIN_LINES 739)
+stackbeam_cli_test(NAME cli_bad_nodes_is_out
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_nodes_bad.csv
+                        --nodes ${_cli_out_dir}/cli_nodes_bad.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--nodes: value" OUT ${_cli_out_dir}/cli_nodes_bad.csv)
 stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
                    ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv

@@ -11,6 +11,7 @@
 
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "test_support.hpp"
 
 using namespace stackbeam;
 
@@ -91,14 +92,7 @@ Config cvode_massive() {
 }
 
 void check_contract(const Config& cfg) {
-    PaperExampleOptions po;
-    if (cfg.massive_stack) po.elements_per_half_leaf = 10;
-    ModelSpec spec = paper_example(cfg.paper_case, po);
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = cfg.density_kg_per_m3;
-    if (cfg.massive_stack) {
-        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
-        for (auto& cl : spec.clamps) cl.length_m = 0.01;
-    }
+    const ModelSpec spec = testing::paper_with_mass(cfg.paper_case, cfg.density_kg_per_m3, cfg.massive_stack);
     const System system(Model::build(spec));
     const SimulationOptions& o = cfg.options;
     const long n = static_cast<long>(std::ceil(o.t_end_s / o.dt_s - 1e-9));

@@ -26,6 +26,21 @@ inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_
     return simulate(s, so);
 }
 
+/// The paper example's case `c` with every leaf of density `density_kg_per_m3`; `massive_stack`:
+/// set up for the whole massive stack under cvode (CvodeMassiveStepper): every interface elastic,
+/// the clamps 10 mm long (an elastic layer over them), 10 elements per half leaf.
+inline ModelSpec paper_with_mass(PaperCase c, double density_kg_per_m3, bool massive_stack) {
+    PaperExampleOptions po;
+    if (massive_stack) po.elements_per_half_leaf = 10;
+    ModelSpec spec = paper_example(c, po);
+    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = density_kg_per_m3;
+    if (massive_stack) {
+        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
+        for (auto& cl : spec.clamps) cl.length_m = 0.01;
+    }
+    return spec;
+}
+
 /// The paper example's case `c` with `leaves` identical leaves of `elements` per half
 /// leaf (its last leaf and interface repeated below, or the lowest ones dropped).
 inline ModelSpec paper_stack(PaperCase c, int elements, int leaves) {

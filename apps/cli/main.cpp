@@ -64,6 +64,11 @@ int run_request(const RunRequest& request) {
             const auto files = plot_run(request.out, request.plot, note, loop.fancher_loop);
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
+            if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)
+                const auto stack = plot_stack(system, result, request.plot, note);
+                for (const auto& f : stack) std::printf("figure                     %s\n", f.c_str());
+                if (stack.empty()) std::printf("figure (stack)             none: %s\n", note.c_str());
+            }
         }
     }
     if (!request.summary.empty()) {

@@ -163,6 +163,10 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
     sim.add_option("--summary", a.summary, "write a JSON summary (file key outputs.summary_path)")->type_name("FILE");
     sim.add_option("--pairs", a.pairs, "write every contact pair at every output time (file key outputs.pairs_path)")
         ->type_name("FILE");
+    sim.add_option("--nodes", a.nodes,
+                   "write every leaf's nodal displacements (t, leaf, x, w, theta; the half model mirrored to whole "
+                   "leaves) at every output time (file key outputs.nodes_path)")
+        ->type_name("FILE.csv");
     sim.add_option("--plot", a.plot, "draw PNG figures with gnuplot: PREFIX_*.png (file key outputs.plot_prefix)")
         ->type_name("PREFIX");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
@@ -174,6 +178,7 @@ RunRequest make_request(const SimulateArgs& a) {
     r.events = a.events;
     r.summary = a.summary;
     r.pairs = a.pairs;
+    r.nodes = a.nodes;
     r.plot = a.plot;
     r.quiet = a.quiet;
     const bool density_given = a.given.count("--beam-density") > 0;
@@ -193,6 +198,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (r.events.empty()) r.events = scenario.outputs.events_path;
         if (r.summary.empty()) r.summary = scenario.outputs.summary_path;
         if (r.pairs.empty()) r.pairs = scenario.outputs.pairs_path;
+        if (r.nodes.empty()) r.nodes = scenario.outputs.nodes_path;
         if (r.plot.empty()) r.plot = scenario.outputs.plot_prefix;
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
@@ -220,6 +226,14 @@ RunRequest make_request(const SimulateArgs& a) {
         throw ArgumentError((a.events.empty() ? "outputs.events_path (file " + a.scenario + ")" : std::string("--events")) +
                             ": value '" + r.events + "': the event log exists in mode cvode only (mode " +
                             std::string(to_string(r.options.mode)) + "): remove it, or use mode cvode");
+    if (!r.nodes.empty()) {  // the nodes' rows would overwrite (or interleave with) another output
+        const std::string what = a.nodes.empty() ? "outputs.nodes_path (file " + a.scenario + ")" : std::string("--nodes");
+        for (const auto& [other, file] : {std::pair<const char*, const std::string*>{"--out", &r.out},
+                                          {"--pairs", &r.pairs}, {"--events", &r.events}, {"--summary", &r.summary}})
+            if (*file == r.nodes)
+                throw ArgumentError(what + ": value '" + r.nodes + "' is also the " + other +
+                                    " file: give the nodal displacements a file of their own");
+    }
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }

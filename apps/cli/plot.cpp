@@ -1,8 +1,11 @@
 // --plot: PNG figures of a run with gnuplot (demos/gnuplot.hpp) from its CSV.
 #include "plot.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "gnuplot.hpp"
@@ -88,6 +91,108 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
         return {};
     }
     return files;
+}
+
+double stack_figure_scale(double stack_height_m, double max_abs_w_m) {
+    if (!(max_abs_w_m > 0.0)) return 1.0;
+    const double target = 2.0 * stack_height_m / max_abs_w_m;
+    const double decade = std::pow(10.0, std::floor(std::log10(target)));
+    for (double m : {5.0, 2.0, 1.0})
+        if (m * decade <= target * (1.0 + 1e-12)) return m * decade;
+    return decade;
+}
+
+namespace {
+
+/// y of a leaf's drawn axis at x [m] (linear between its nodes).
+double drawn_axis_m(const LeafNodes& leaf, double height_m, double scale, double x_m) {
+    const auto& xs = leaf.x_m;
+    if (xs.empty()) return height_m;
+    const auto it = std::lower_bound(xs.begin(), xs.end(), x_m);
+    std::size_t j = static_cast<std::size_t>(it - xs.begin());
+    if (j == 0) return height_m + scale * leaf.w_m.front();
+    if (j >= xs.size()) return height_m + scale * leaf.w_m.back();
+    const double a = (x_m - xs[j - 1]) / (xs[j] - xs[j - 1]);
+    return height_m + scale * ((1.0 - a) * leaf.w_m[j - 1] + a * leaf.w_m[j]);
+}
+
+}  // namespace
+
+std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
+                                    std::string& note) {
+    using namespace stackbeam::demo;
+    const auto terminal = plot_terminal(note);
+    if (!terminal) return {};
+    const Model& model = system.model();
+    const auto& leaves = model.spec().leaves;
+    const auto& heights = model.centroid_heights_m();
+    const double x_r = model.nodes_x()[model.attachment_node()];
+    const bool half = model.spec().symmetry == Symmetry::half;
+    double stack_height = 0.0, max_w = 0.0;
+    for (const auto& leaf : leaves) stack_height += leaf_thickness_m(leaf, x_r);
+    const StackSnapshot* shots[2] = {&result.stack_at_w_max, &result.stack_at_w_min};
+    for (const StackSnapshot* s : shots)
+        for (const auto& leaf : s->nodes)
+            for (double w : leaf.w_m) max_w = std::max(max_w, std::abs(w));
+    const double scale = stack_figure_scale(stack_height, max_w);
+
+    const std::string axes_path = prefix + "_stack_axes.dat", pairs_path = prefix + "_stack_pairs.dat";
+    std::ofstream axes(axes_path), pairs(pairs_path);
+    if (!axes) throw ArgumentError("--plot: cannot write '" + axes_path + "'");
+    if (!pairs) throw ArgumentError("--plot: cannot write '" + pairs_path + "'");
+    axes << "# x [mm], y [mm]: each leaf's axis at its height plus " << scale
+         << " x its deflection; one block per leaf, one index per figure (w max, w min)\n";
+    pairs << "# x [mm], y [mm] (midway between the two leaves' drawn axes), state (0 stick, 1 slip, 2 open)\n";
+    for (const StackSnapshot* s : shots) {
+        for (const auto& leaf : s->nodes) {
+            for (std::size_t j = 0; j < leaf.x_m.size(); ++j)
+                axes << 1000.0 * leaf.x_m[j] << ' ' << 1000.0 * (heights[leaf.leaf] + scale * leaf.w_m[j]) << '\n';
+            axes << '\n';
+        }
+        axes << "\n";  // two blank lines: the next index
+        for (const auto& p : s->pairs) {
+            const int upper = p.interface_index, lower = upper + 1;
+            if (lower >= static_cast<int>(s->nodes.size())) continue;
+            const int code = p.state == PairState::stick ? 0 : p.state == PairState::slip ? 1 : 2;
+            for (int side = 0; side < (half && std::abs(p.x_m - x_r) > model.x_tolerance_m() ? 2 : 1); ++side) {
+                const double x = side == 0 ? p.x_m : 2.0 * x_r - p.x_m;
+                const double y = 0.5 * (drawn_axis_m(s->nodes[upper], heights[upper], scale, x) +
+                                        drawn_axis_m(s->nodes[lower], heights[lower], scale, x));
+                pairs << 1000.0 * x << ' ' << 1000.0 * y << ' ' << code << '\n';
+            }
+        }
+        pairs << "\n\n";
+    }
+    axes.close();
+    pairs.close();
+    if (!axes || !pairs) throw std::runtime_error("writing the deformed stack's data '" + axes_path + "' failed");
+
+    const std::string script_path = prefix + "_stack.gp", png = prefix + "_stack.png";
+    std::ofstream g(script_path);
+    if (!g) throw ArgumentError("--plot: cannot write '" + script_path + "'");
+    std::ostringstream scale_text;
+    scale_text << scale;
+    g << "set terminal " << *terminal << " size 1000,900\nset output '" << png << "'\nset grid\nset key outside bottom center horizontal\n"
+      << "set multiplot layout 2,1 title 'deformed stack: the deflection drawn x " << scale_text.str()
+      << " (the leaves at their heights in the stack)'\n";
+    for (int i = 0; i < 2; ++i) {
+        std::ostringstream title;
+        title << (i == 0 ? "largest" : "smallest") << " w = " << 1000.0 * shots[i]->w_m << " mm at t = " << shots[i]->t_s << " s";
+        g << "set title '" << title.str() << "'\nset xlabel 'x [mm]'\nset ylabel 'height + " << scale_text.str()
+          << " x deflection [mm]'\n";
+        g << "plot '" << axes_path << "' index " << i << " using 1:2 with lines lw 2 lc rgb 'black' title 'leaf axes', '"
+          << pairs_path << "' index " << i << " using 1:($3==0?$2:1/0) with points pt 7 ps 0.8 lc rgb '#1a9850' title 'stick', '"
+          << pairs_path << "' index " << i << " using 1:($3==1?$2:1/0) with points pt 7 ps 0.8 lc rgb '#d73027' title 'slip', '"
+          << pairs_path << "' index " << i << " using 1:($3==2?$2:1/0) with points pt 6 ps 0.8 lc rgb '#4575b4' title 'open'\n";
+    }
+    g << "unset multiplot\n";
+    g.close();
+    if (!g) throw std::runtime_error("writing '" + script_path + "' failed");
+    if (std::system(("gnuplot " + shell_quote(script_path)).c_str()) != 0) {
+        note = "gnuplot failed on " + script_path;
+        return {};
+    }
+    return {png};
 }
 
 }  // namespace stackbeam::cli

@@ -2,16 +2,14 @@
 /// @file plot.hpp
 /// --plot: PNG figures of a run with gnuplot from its CSV.
 #include <optional>
-#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-namespace stackbeam::cli {
+#include "run.hpp"
+#include "stackbeam/fe/system.hpp"
 
-/// gnuplot's PNG terminal ("pngcairo" or "png"), or none and why in `note` (no gnuplot on
-/// PATH, no PNG terminal).
-std::optional<std::string> plot_terminal(std::string& note);
+namespace stackbeam::cli {
 
 /// gnuplot's PNG terminal ("pngcairo" or "png"), or none and why in `note` (no gnuplot on
 /// PATH, no PNG terminal).
@@ -24,5 +22,20 @@ std::optional<std::string> plot_terminal(std::string& note);
 /// empty: none.
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
                                   const std::vector<std::pair<double, double>>& fitted_loop = {});
+
+/// The deformed stack at the run's extreme deflections (the records of the largest and the
+/// smallest w, RunResult::stack_at_w_max / _min), PREFIX_stack.png: each leaf's axis at its height
+/// in the stack plus its deflection times a scale (stack_figure_scale, printed on the figure),
+/// every pair a point coloured by its state (stick, slip, open); the half model mirrored. The
+/// data in PREFIX_stack_axes.dat and PREFIX_stack_pairs.dat (mm). Returns the file written, or
+/// none and a note why in `note`.
+std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
+                                    std::string& note);
+
+/// The deflection's scale of the deformed stack figure: the number 1, 2 or 5 times a power of
+/// ten at or below 2 H / max |w|, H the stack's height at the seat (the leaves' thicknesses) and
+/// max |w| the largest nodal deflection drawn (1 if it is 0), so that the drawn deflection is up
+/// to twice the stack's height (docs/python.md gives the same rule for stackbeam.plot).
+double stack_figure_scale(double stack_height_m, double max_abs_w_m);
 
 }  // namespace stackbeam::cli

@@ -121,38 +121,68 @@ RunResult run(const RunRequest& request, const System& system) {
     const SimulationOptions& options = request.options;
     PartialFile csv(request.out, "--out");
     PartialFile pairs_csv(request.pairs, "--pairs");
+    PartialFile nodes_csv(request.nodes, "--nodes");
     write_csv_header(csv.stream());
     if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
     pairs_csv.stream().precision(17);
+    if (nodes_csv.active()) nodes_csv.stream() << "t,leaf,x,w,theta\n";
+    nodes_csv.stream().precision(17);
+    // --plot: the stack at the extreme deflections, kept as the run finds them (a new max or min of w
+    // marks the record in on_step; its pairs and nodes follow in on_pairs, on_nodes)
+    const bool snapshots = !request.plot.empty();
+    std::vector<StackSnapshot*> marked;  // the snapshots the current record replaces
 
     RunResult result;
     Progress progress(!request.quiet, options.t_end_s);
     PairObserver on_pairs;
-    if (pairs_csv.active())
+    if (pairs_csv.active() || snapshots)
         on_pairs = [&](double t, const std::vector<PairRecord>& prs) {
+            for (StackSnapshot* s : marked) s->pairs = prs;
+            if (!pairs_csv.active()) return;
             auto& o = pairs_csv.stream();
             for (const auto& p : prs)
                 o << t << ',' << p.pair << ',' << p.interface_index << ',' << p.x_m << ',' << to_string(p.state) << ','
                   << p.p_n_n << ',' << p.p_t_n << ',' << p.gap_m << ',' << p.slip_m << '\n';
+        };
+    NodeObserver on_nodes;
+    if (nodes_csv.active() || snapshots)
+        on_nodes = [&](double t, const std::vector<LeafNodes>& leaves) {
+            for (StackSnapshot* s : marked) s->nodes = leaves;
+            if (!nodes_csv.active()) return;
+            auto& o = nodes_csv.stream();
+            for (const auto& leaf : leaves)
+                for (std::size_t j = 0; j < leaf.x_m.size(); ++j)
+                    o << t << ',' << leaf.leaf << ',' << leaf.x_m[j] << ',' << leaf.w_m[j] << ',' << leaf.theta_rad[j] << '\n';
         };
     // A record's pairs follow it (simulate calls on_pairs after on_step): stopping before
     // a record is written leaves the CSV and the pairs at the same last whole record.
     auto on_step = [&](const StepRecord& r) {
         if (g_stop_signal != 0) throw Interrupted{};
         write_csv_row(csv.stream(), r);
+        marked.clear();
+        if (snapshots) {
+            if (result.stats.records == 0 || r.w_m > result.stats.w_max_m) marked.push_back(&result.stack_at_w_max);
+            if (result.stats.records == 0 || r.w_m < result.stats.w_min_m) marked.push_back(&result.stack_at_w_min);
+            for (StackSnapshot* s : marked) {
+                s->t_s = r.t_s;
+                s->w_m = r.w_m;
+            }
+        }
         result.stats.add(r);
         progress.update(r.t_s);
     };
     try {
-        result.records = simulate(system, options, on_step, &result.report, on_pairs);
+        result.records = simulate(system, options, on_step, &result.report, on_pairs, on_nodes);
         progress.finish();
     } catch (const Interrupted&) {
         progress.finish();
         result.signal = g_stop_signal;
         csv.close();
         pairs_csv.close();
+        nodes_csv.close();
         result.csv_file = csv.partial();
         if (pairs_csv.active()) result.pairs_file = pairs_csv.partial();
+        if (nodes_csv.active()) result.nodes_file = nodes_csv.partial();
         result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         std::cerr << "stackbeam: interrupted by signal " << result.signal << " at t = " << result.stats.last.t_s
                   << " s; the rows up to it are in " << csv.partial() << "\n";
@@ -162,11 +192,13 @@ RunResult run(const RunRequest& request, const System& system) {
         progress.finish();
         csv.discard();
         pairs_csv.discard();
+        nodes_csv.discard();
         throw;
     } catch (...) {
         progress.finish();
         csv.stream().flush();
         pairs_csv.stream().flush();
+        nodes_csv.stream().flush();
         std::cerr << "stackbeam: note: " << request.out << " was not written; the rows up to the failure are in "
                   << csv.partial() << "\n";
         throw;
@@ -179,8 +211,10 @@ RunResult run(const RunRequest& request, const System& system) {
     }
     csv.commit();
     pairs_csv.commit();
+    nodes_csv.commit();
     result.csv_file = request.out;
     result.pairs_file = request.pairs;
+    result.nodes_file = request.nodes;
     result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return result;
 }

@@ -5,8 +5,8 @@
 ///
 /// Interruption: the signal handler only sets a flag (async-signal-safe); the run
 /// checks it before writing each record (simulate's per-record callback), drops the
-/// record in progress and stops. Every file then ends on a whole row: the CSV and the
-/// --pairs file hold the records before it, and they keep their .partial names, so
+/// record in progress and stops. Every file then ends on a whole row: the CSV, the
+/// --pairs and the --nodes files hold the records before it, and they keep their .partial names, so
 /// that nobody mistakes them for a complete run. The --events log is not written
 /// (the library hands it over at the end of a run). The --summary is written, marked
 /// "interrupted", with the time reached and the energies of the last whole record.
@@ -32,6 +32,13 @@ struct RunStats {
     void add(const StepRecord& r);
 };
 
+/// The stack at one record: every leaf's nodes and every pair (the deformed stack figure).
+struct StackSnapshot {
+    double t_s = 0.0, w_m = 0.0;
+    std::vector<LeafNodes> nodes;
+    std::vector<PairRecord> pairs;
+};
+
 struct RunResult {
     RunStats stats;
     std::vector<StepRecord> records;  ///< every record (empty when interrupted)
@@ -40,6 +47,9 @@ struct RunResult {
     double wall_s = 0.0;              ///< wall time of the build and the run [s]
     std::string csv_file;             ///< where the rows are (FILE, or FILE.partial when interrupted)
     std::string pairs_file;           ///< likewise for --pairs ("" none)
+    std::string nodes_file;           ///< likewise for --nodes ("" none)
+    /// With --plot: the stack at the records of the largest and the smallest w (the first such record).
+    StackSnapshot stack_at_w_max, stack_at_w_min;
     std::string events_file;          ///< the event log written ("" none)
 };
 

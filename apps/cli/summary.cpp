@@ -135,6 +135,7 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
     std::printf("output                     %s\n", result.csv_file.c_str());
     if (!result.events_file.empty()) std::printf("event log                  %s\n", result.events_file.c_str());
     if (!result.pairs_file.empty()) std::printf("pairs                      %s\n", result.pairs_file.c_str());
+    if (!result.nodes_file.empty()) std::printf("nodes                      %s\n", result.nodes_file.c_str());
 }
 
 std::string json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
@@ -228,7 +229,7 @@ std::string json_summary(const RunRequest& request, const Model& model, const Ru
         if (!loop.fancher_note.empty()) j["fancher_note"] = loop.fancher_note;
     }
     j["wall_time_s"] = result.wall_s;
-    j["outputs"] = {{"csv", result.csv_file}, {"events", result.events_file}, {"pairs", result.pairs_file}};
+    j["outputs"] = {{"csv", result.csv_file}, {"events", result.events_file}, {"pairs", result.pairs_file}, {"nodes", result.nodes_file}};
     return j.dump(2);
 }
 

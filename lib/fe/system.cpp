@@ -341,4 +341,39 @@ Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) c
     return P_ * reduced_displacements(p, w);
 }
 
+std::vector<LeafNodes> System::leaf_nodes(const Eigen::VectorXd& z) const {
+    if (z.size() != P_.cols())
+        throw InputError("z", "has " + std::to_string(z.size()) + " entries: System::leaf_nodes needs one per reduced DOF, " +
+                                  std::to_string(P_.cols()) + " (num_reduced_dofs())");
+    const Eigen::VectorXd u = P_ * z;
+    const auto& xs = model_.nodes_x();
+    const bool half = model_.spec().symmetry == Symmetry::half;
+    const double x_r = xs[model_.attachment_node()];
+    const int nleaf = static_cast<int>(model_.spec().leaves.size());
+    std::vector<LeafNodes> out(nleaf);
+    for (int l = 0; l < nleaf; ++l) {
+        LeafNodes& leaf = out[l];
+        leaf.leaf = l;
+        const int first = model_.first_node(l), last = model_.last_node(l);
+        const std::size_t count = static_cast<std::size_t>(last - first + 1);
+        const std::size_t total = half ? 2 * count - 1 : count;  // the half model: the leaf ends at x_R
+        leaf.x_m.reserve(total);
+        leaf.w_m.reserve(total);
+        leaf.theta_rad.reserve(total);
+        for (int j = first; j <= last; ++j) {
+            const int b = 3 * node_dof(l, j);
+            leaf.x_m.push_back(xs[j]);
+            leaf.w_m.push_back(u[b + 1]);
+            leaf.theta_rad.push_back(u[b + 2]);
+        }
+        if (half)  // the mirror image of the half, from the node next to x_R outwards
+            for (std::size_t i = count - 1; i-- > 0;) {
+                leaf.x_m.push_back(2.0 * x_r - leaf.x_m[i]);
+                leaf.w_m.push_back(leaf.w_m[i]);
+                leaf.theta_rad.push_back(-leaf.theta_rad[i]);
+            }
+    }
+    return out;
+}
+
 }  // namespace stackbeam

@@ -518,7 +518,7 @@ void parse_integrator(const Table& top, SimulationOptions& o) {
 
 void parse_outputs(const Table& top, ScenarioOutputs& out) {
     if (!top.has("outputs")) return;
-    const Table t = top.table("outputs", {"csv_path", "events_path", "summary_path", "pairs_path", "plot_prefix"});
+    const Table t = top.table("outputs", {"csv_path", "events_path", "summary_path", "pairs_path", "nodes_path", "plot_prefix"});
     auto path = [&](const char* key, const char* what) {
         if (!t.has(key)) return std::string();
         const std::string p = t.string(key, what);
@@ -529,6 +529,7 @@ void parse_outputs(const Table& top, ScenarioOutputs& out) {
     out.events_path = path("events_path", "the event log");
     out.summary_path = path("summary_path", "the JSON summary");
     out.pairs_path = path("pairs_path", "the per-pair CSV");
+    out.nodes_path = path("nodes_path", "the nodal displacements' CSV");
     out.plot_prefix = path("plot_prefix", "the prefix of the PNG figures");
 }
 

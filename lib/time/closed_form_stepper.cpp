@@ -173,6 +173,10 @@ std::vector<PairRecord> ClosedFormStepper::pairs() const {
     return detail::pair_records(system_, problem_, p_, rel_);
 }
 
+std::vector<LeafNodes> ClosedFormStepper::nodes() const {
+    return system_.leaf_nodes(path_ == ContactPath::sparse ? z_ : system_.reduced_displacements(p_, w_));
+}
+
 const StepRecord& ClosedFormStepper::advance() {
     const double k = system_.stiffness_n_per_m();
     const double dt = options_.dt_s;

@@ -179,7 +179,7 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading) {
 
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
                                  const std::function<void(const StepRecord&)>& on_step, RunReport* report,
-                                 const PairObserver& on_pairs) {
+                                 const PairObserver& on_pairs, const NodeObserver& on_nodes) {
     options.validate();
     const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
     const std::unique_ptr<Stepper> stepper = make_stepper(system, options);
@@ -189,6 +189,7 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
         out.push_back(i == 0 ? stepper->current() : stepper->advance());
         if (on_step) on_step(out.back());
         if (on_pairs) on_pairs(out.back().t_s, stepper->pairs());
+        if (on_nodes) on_nodes(out.back().t_s, stepper->nodes());
     }
     if (report) *report = stepper->report();
     return out;

@@ -293,6 +293,51 @@ struct PairTable {
     }
 };
 
+/// Every leaf's nodes at record times, as the --nodes CSV's columns: t, leaf, x, w, theta.
+struct NodeTable {
+    std::vector<double> t, x, w, theta;
+    std::vector<int> leaf;
+    void add(double t_s, const std::vector<LeafNodes>& leaves) {
+        for (const auto& l : leaves)
+            for (std::size_t j = 0; j < l.x_m.size(); ++j) {
+                t.push_back(t_s);
+                leaf.push_back(l.leaf);
+                x.push_back(l.x_m[j]);
+                w.push_back(l.w_m[j]);
+                theta.push_back(l.theta_rad[j]);
+            }
+    }
+    py::dict to_dict() const {
+        py::dict d;
+        d["t"] = py::array_t<double>(t.size(), t.data());
+        d["leaf"] = py::array_t<int>(leaf.size(), leaf.data());
+        d["x"] = py::array_t<double>(x.size(), x.data());
+        d["w"] = py::array_t<double>(w.size(), w.data());
+        d["theta"] = py::array_t<double>(theta.size(), theta.data());
+        return d;
+    }
+};
+
+/// The stack's geometry for stackbeam.plot's deformed stack: each leaf's axis height in the stack
+/// [m] (Model::centroid_heights_m), the stack's height at the seat [m], the seat's x [m], whether
+/// the model is the half one (its pairs are then mirrored about the seat).
+py::dict stack_geometry(const ScenarioPtr& scenario) {
+    PyScenario& ps = *scenario;
+    const Model model = build_checked(ps, ps.synced().simulation);
+    const double x_r = model.nodes_x()[model.attachment_node()];
+    double height = 0.0;
+    for (const auto& leaf : model.spec().leaves) height += leaf_thickness_m(leaf, x_r);
+    py::dict d;
+    py::list heights;
+    for (double y : model.centroid_heights_m()) heights.append(y);
+    d["axis_height_m"] = heights;
+    d["stack_height_m"] = height;
+    d["seat_x_m"] = x_r;
+    d["half"] = model.spec().symmetry == Symmetry::half;
+    d["x_tolerance_m"] = model.x_tolerance_m();
+    return d;
+}
+
 /// The event log as the --events CSV's columns: t, interface, x, pair, from, to, cause, w, w_dot.
 py::dict events_dict(const std::vector<ContactEvent>& events) {
     std::vector<double> t, x, w, w_dot;
@@ -363,7 +408,7 @@ private:
 
 /// simulate(scenario, options, pairs) -> dict(columns, pairs, events, report, summary):
 /// the run of the command line (same records, same JSON summary), the GIL released while it steps.
-py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_pairs) {
+py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_pairs, bool want_nodes) {
     // the run's own copy: another thread may change the scenario while this one runs without the GIL
     const auto copy = std::make_shared<PyScenario>(*scenario);
     copy->synced();
@@ -373,6 +418,7 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
     const auto t0 = std::chrono::steady_clock::now();
     cli::RunResult result;
     PairTable pairs;
+    NodeTable nodes;
     SignalCheck check(in_main_thread());
     std::chrono::steady_clock::time_point released, reacquired;  // the stepping without the GIL
     {
@@ -383,13 +429,15 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
             choose_contact_path(system, options);  // as the command line: a path the solver cannot take
             PairObserver on_pairs;
             if (want_pairs) on_pairs = [&](double t, const std::vector<PairRecord>& prs) { pairs.add(t, prs); };
+            NodeObserver on_nodes;
+            if (want_nodes) on_nodes = [&](double t, const std::vector<LeafNodes>& leaves) { nodes.add(t, leaves); };
             result.records = simulate(
                 system, options,
                 [&](const StepRecord& r) {
                     check();
                     result.stats.add(r);
                 },
-                &result.report, on_pairs);
+                &result.report, on_pairs, on_nodes);
             return 0;
         });
         reacquired = std::chrono::steady_clock::now();
@@ -405,6 +453,7 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, bool want_p
     py::dict out;
     out["columns"] = records_dict(result.records);
     out["pairs"] = want_pairs ? py::object(pairs.to_dict()) : py::object(py::none());
+    out["nodes"] = want_nodes ? py::object(nodes.to_dict()) : py::object(py::none());
     out["events"] = options.mode == Mode::cvode ? py::object(events_dict(result.report.events)) : py::object(py::none());
     py::dict report = report_dict(result.report);
     // when the run held no GIL, on the clock of Python's time.monotonic() (CLOCK_MONOTONIC, as steady_clock)
@@ -539,6 +588,13 @@ public:
     py::dict pairs() const {
         PairTable t;
         t.add(stepper_->current().t_s, stepper_->pairs());
+        py::dict d = t.to_dict();
+        d.attr("pop")("t");
+        return d;
+    }
+    py::dict nodes() const {
+        NodeTable t;
+        t.add(stepper_->current().t_s, stepper_->nodes());
         py::dict d = t.to_dict();
         d.attr("pop")("t");
         return d;
@@ -765,6 +821,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("events_path", &ScenarioOutputs::events_path)
         .def_readwrite("summary_path", &ScenarioOutputs::summary_path)
         .def_readwrite("pairs_path", &ScenarioOutputs::pairs_path)
+        .def_readwrite("nodes_path", &ScenarioOutputs::nodes_path)
         .def_readwrite("plot_prefix", &ScenarioOutputs::plot_prefix);
 
     py::class_<PyScenario, ScenarioPtr>(m, "Scenario", "A whole run: the stack, the loading, the integrator, the outputs")
@@ -819,7 +876,8 @@ PYBIND11_MODULE(_core, m) {
         },
         "case"_a, "elements_per_half_leaf"_a = PaperExampleOptions{}.elements_per_half_leaf, "full_model"_a = false);
 
-    m.def("_run", &run, "scenario"_a, "options"_a, "pairs"_a);
+    m.def("_run", &run, "scenario"_a, "options"_a, "pairs"_a, "nodes"_a);
+    m.def("_stack_geometry", &stack_geometry, "scenario"_a);
     m.def("_sweep", &sweep, "spec"_a, "jobs"_a, "out_dir"_a, "restart"_a, "keep_series"_a);
     m.def("step_record_columns", &step_record_columns);
     m.def(
@@ -841,5 +899,6 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly("records", &PyStepper::records, "records of the whole run to t_end_s (the first: t = 0)")
         .def_property_readonly("dt_s", &PyStepper::dt_s)
         .def("pairs", &PyStepper::pairs, "Every contact pair at the current record (the --pairs columns but t)")
+        .def("nodes", &PyStepper::nodes, "Every leaf's nodes at the current record (the --nodes columns but t)")
         .def("report", &PyStepper::report);
 }

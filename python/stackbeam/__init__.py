@@ -71,6 +71,14 @@ Scenario.__repr__ = lambda s: "<stackbeam.Scenario %s: %d leaves, mode %s, t_end
     s.source, len(s.model.leaves), s.simulation.mode, s.simulation.t_end_s)
 
 
+def _input_error(field, message):
+    """An InputError raised from Python, as the C++ ones: ``field`` the name given, ``location`` empty."""
+    error = InputError("%s: %s" % (field, message))
+    error.field = field
+    error.location = ""
+    return error
+
+
 def _flatten_options(options, prefix=""):
     """simulate's keyword options as {member: value}: nested dicts (cvode={"rtol": 1e-9})
     and dotted names ({"cvode.rtol": 1e-9}) alike."""
@@ -109,7 +117,10 @@ class Result(_Columns):
     ``spring_force``, ...) to numpy arrays, one entry per record (the first: t = 0).
 
     Attributes: ``pairs`` (every contact pair at every record, a dict of arrays with the
-    --pairs CSV's columns; None unless simulate(..., pairs=True)), ``events`` (the event
+    --pairs CSV's columns; None unless simulate(..., pairs=True)), ``nodes`` (every leaf's
+    nodal displacements at every record, a dict of arrays with the --nodes CSV's columns t,
+    leaf, x, w, theta, the half model mirrored to whole leaves; None unless
+    simulate(..., nodes=True)), ``events`` (the event
     log of mode cvode, the --events CSV's columns; None in the other modes), ``summary``
     (the command line's JSON summary as a dict), ``report`` (the run's counters, and
     ``without_gil_s``: when the run stepped without the GIL, on time.monotonic()'s clock),
@@ -118,6 +129,7 @@ class Result(_Columns):
     def __init__(self, raw, scenario, options):
         self._columns = raw["columns"]
         self.pairs = raw["pairs"]
+        self.nodes = raw["nodes"]
         self.events = raw["events"]
         self.report = raw["report"]
         self.summary = _json.loads(raw["summary"])
@@ -130,18 +142,23 @@ class Result(_Columns):
             n, self._columns["t"][-1] if n else 0.0, ", ".join(self._columns))
 
 
-def simulate(scenario, *, pairs=False, **options):
+def simulate(scenario, *, pairs=False, nodes=False, **options):
     """Runs `scenario` (a Scenario) from t = 0 to t_end_s and returns a Result.
 
     ``options``: SimulationOptions members over the scenario's, e.g. ``t_end_s=1.0,
     mode="cvode"``; nested ones as a dict (``cvode={"rtol": 1e-9}``) or dotted
     (``**{"cvode.rtol": 1e-9}``). Each is checked by the option table: InputError naming
-    the member. ``pairs=True`` keeps every pair at every record (Result.pairs).
+    the member. ``pairs=True`` keeps every pair at every record (Result.pairs); ``nodes=True``
+    every leaf's nodal displacements at every record (Result.nodes; off by default: a run of
+    N records on a mesh of n nodes keeps 5 N n numbers).
 
     The GIL is released while the run steps, so runs on Python threads run in parallel;
     Ctrl-C raises KeyboardInterrupt at the first record after about 20 ms (the run is dropped)."""
     flat = _flatten_options(options)
-    raw = _core._run(scenario, flat, bool(pairs))
+    for name, value in (("pairs", pairs), ("nodes", nodes)):
+        if not isinstance(value, bool):
+            raise _input_error(name, "value %r is not a bool: give True to keep them, False (the default) not to" % (value,))
+    raw = _core._run(scenario, flat, pairs, nodes)
     return Result(raw, scenario.copy(), flat)
 
 
@@ -181,7 +198,7 @@ def sweep(spec, *, jobs=None, out_dir=None, restart=False, keep_series=False):
     return SweepResult(raw)
 
 
-Stepper = _core.Stepper  # advance(), pairs(), report(), current, record_index, records, dt_s
+Stepper = _core.Stepper  # advance(), pairs(), nodes(), report(), current, record_index, records, dt_s
 
 
 def _stepper_iter(self):
@@ -196,6 +213,6 @@ Stepper.__iter__ = _stepper_iter
 def make_stepper(scenario, **options):
     """A run of `scenario` one record at a time (co-simulation loops), options as in simulate():
     ``advance()`` returns the next record (a dict of the CSV's columns), ``pairs()`` the contact
-    pairs at the current one, ``current`` the current record, ``record_index``, ``records``
+    pairs at the current one, ``nodes()`` every leaf's nodes there, ``current`` the current record, ``record_index``, ``records``
     (to t_end_s), ``dt_s``, ``report()``. Iterating over it advances to the end."""
     return Stepper(scenario, _flatten_options(options))

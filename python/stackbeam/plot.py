@@ -6,8 +6,15 @@ friction force at the probe, force-deflection loop), each on an Axes you may giv
     stackbeam.plot.loop(result)
     stackbeam.plot.save_all(result, "rig")   # rig_displacement.png, rig_force.png, ...
 
+The deformed stack (each leaf's deflected axis, every pair coloured by its state) needs the
+nodes and the pairs of the run: simulate(..., nodes=True, pairs=True), then
+deformed_stack(result, times=[...]) or animate_stack(result, "run.gif").
+
 Units on the axes: mm for displacements, N for forces, s for time (the columns are SI).
 """
+import math as _math
+
+import numpy as _np
 
 
 def _axes(ax):
@@ -65,7 +72,9 @@ FIGURES = {"displacement": displacement, "force": force, "friction": friction, "
 
 def save_all(result, prefix, dpi=100):
     """Writes PREFIX_displacement.png, PREFIX_force.png, PREFIX_friction.png, PREFIX_loop.png
-    (the command line's --plot files) and returns their names."""
+    and, when the result has the nodes (simulate(..., nodes=True)), PREFIX_stack.png (the
+    deformed stack at the extreme deflections): the command line's --plot files. Returns their
+    names."""
     import matplotlib.pyplot as plt
 
     files = []
@@ -74,4 +83,212 @@ def save_all(result, prefix, dpi=100):
         files.append("%s_%s.png" % (prefix, name))
         ax.figure.savefig(files[-1], dpi=dpi)
         plt.close(ax.figure)
+    if getattr(result, "nodes", None) is not None:
+        fig = deformed_stack(result)
+        files.append("%s_stack.png" % prefix)
+        fig.savefig(files[-1], dpi=dpi)
+        plt.close(fig)
     return files
+
+
+# ---- the deformed stack -------------------------------------------------------------------
+
+STATE_COLOURS = {"stick": "#1a9850", "slip": "#d73027", "open": "#4575b4"}
+
+
+def _error(field, message):
+    from . import _input_error
+
+    return _input_error(field, message)
+
+
+def stack_scale(stack_height_m, max_abs_w_m):
+    """The deflection's scale of the deformed stack when none is given: the number 1, 2 or 5
+    times a power of ten at or below 2 H / max |w| (H the stack's height at the seat, max |w|
+    the largest nodal deflection drawn), so that the drawn deflection is up to twice the stack's
+    height; the command line's --plot takes the same rule."""
+    if not max_abs_w_m > 0.0:
+        return 1.0
+    target = 2.0 * stack_height_m / max_abs_w_m
+    decade = 10.0 ** _math.floor(_math.log10(target))
+    for m in (5.0, 2.0, 1.0):
+        if m * decade <= target * (1.0 + 1e-12):
+            return m * decade
+    return decade
+
+
+class _Stack:
+    """The nodes and pairs of a run by record, and the stack's geometry (the drawing's data)."""
+
+    def __init__(self, result):
+        if getattr(result, "nodes", None) is None:
+            raise _error("nodes", "the result has no nodes: run simulate(..., nodes=True) (and pairs=True for the "
+                                  "pairs' states)")
+        from . import _core
+
+        geometry = _core._stack_geometry(result.scenario)
+        self.heights = _np.asarray(geometry["axis_height_m"])
+        self.stack_height = geometry["stack_height_m"]
+        self.seat_x = geometry["seat_x_m"]
+        self.half = geometry["half"]
+        self.x_tolerance = geometry["x_tolerance_m"]
+        self.times = _np.asarray(result["t"])
+        self.w_record = _np.asarray(result["w"])
+        nodes = result.nodes
+        self._node_t, self._leaf = nodes["t"], nodes["leaf"]
+        self._x, self._w = nodes["x"], nodes["w"]
+        self.pairs = result.pairs
+        self.leaves = sorted(set(int(leaf) for leaf in self._leaf))
+
+    def record(self, t_s):
+        """Index of the record nearest to t_s; InputError outside the run."""
+        t = float(t_s)
+        if not (self.times[0] - 1e-12 <= t <= self.times[-1] + 1e-12):
+            raise _error("times", "value %g s is outside the run (0 to %g s)" % (t, self.times[-1]))
+        return int(_np.argmin(_np.abs(self.times - t)))
+
+    def leaf_axes(self, i):
+        """{leaf: (x [m], w [m])} at record i."""
+        at = self._node_t == self.times[i]
+        return {leaf: (self._x[at & (self._leaf == leaf)], self._w[at & (self._leaf == leaf)]) for leaf in self.leaves}
+
+    def max_abs_w(self, records):
+        at = _np.isin(self._node_t, self.times[records])
+        return float(_np.max(_np.abs(self._w[at]))) if at.any() else 0.0
+
+    def pair_points(self, i, axes, scale):
+        """[(x [m], y [m], state)] of the pairs at record i: midway between the drawn axes of the
+        interface's two leaves, the half model's pairs mirrored about the seat."""
+        if self.pairs is None:
+            return []
+        at = _np.nonzero(self.pairs["t"] == self.times[i])[0]
+        points = []
+        for k in at:
+            upper = int(self.pairs["interface"][k])
+            lower = upper + 1
+            if upper not in axes or lower not in axes:
+                continue
+            x0 = float(self.pairs["x"][k])
+            xs = [x0]
+            if self.half and abs(x0 - self.seat_x) > self.x_tolerance:
+                xs.append(2.0 * self.seat_x - x0)
+            for x in xs:
+                y = 0.5 * sum(self.heights[leaf] + scale * _np.interp(x, *axes[leaf]) for leaf in (upper, lower))
+                points.append((x, y, str(self.pairs["state"][k])))
+        return points
+
+
+def _draw_stack(ax, stack, i, scale):
+    """Draws record i of `stack` on ax; returns the artists."""
+    axes = stack.leaf_axes(i)
+    artists = []
+    for leaf, (x, w) in axes.items():
+        artists += ax.plot(1000 * x, 1000 * (stack.heights[leaf] + scale * w), color="black", lw=1.8)
+    points = stack.pair_points(i, axes, scale)
+    for state, colour in STATE_COLOURS.items():
+        chosen = [(x, y) for x, y, s in points if s == state]
+        if chosen:
+            xy = 1000 * _np.asarray(chosen)
+            artists.append(ax.scatter(xy[:, 0], xy[:, 1], s=14, color=colour, label=state, zorder=3,
+                                      facecolors="none" if state == "open" else colour))
+    return artists
+
+
+def deformed_stack(result, times=None, scale=None, ax=None):
+    """The deformed stack at the records nearest to `times` [s] (default: the records of the
+    largest and the smallest w, as the command line's --plot): each leaf's axis at its height in
+    the stack plus its deflection times `scale` (default: stack_scale's rule; the scale is printed
+    on the figure), every pair a point midway between its two leaves coloured by its state
+    (stick green, slip red, open hollow blue), the half model mirrored to the whole stack.
+    Needs simulate(..., nodes=True) (and pairs=True for the states). One Axes per time, stacked;
+    `ax` (one time only) draws on that Axes. Returns the Figure."""
+    stack = _Stack(result)
+    if times is None:
+        records = [int(_np.argmax(stack.w_record)), int(_np.argmin(stack.w_record))]
+    else:
+        records = [stack.record(t) for t in _np.atleast_1d(times)]
+    if not records:
+        raise _error("times", "is empty: give at least one time")
+    if scale is None:
+        scale = stack_scale(stack.stack_height, stack.max_abs_w(records))
+    elif not (isinstance(scale, (int, float)) and _math.isfinite(scale) and scale > 0):
+        raise _error("scale", "value %r is not allowed: must be a number > 0 (the drawn deflection per deflection)"
+                     % (scale,))
+    if ax is not None and len(records) != 1:
+        raise _error("ax", "is given with %d times: give one time per Axes" % len(records))
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, axs = plt.subplots(len(records), 1, figsize=(9, 3.2 * len(records)), squeeze=False)
+        axs = axs[:, 0]
+    else:
+        fig, axs = ax.figure, [ax]
+    for a, i in zip(axs, records):
+        _draw_stack(a, stack, i, scale)
+        a.set(title="t = %.4g s, w = %.4g mm" % (stack.times[i], 1000 * stack.w_record[i]),
+              xlabel="x [mm]", ylabel="height + %g x deflection [mm]" % scale)
+        a.grid(True)
+        if stack.pairs is not None:
+            a.legend(loc="upper right", fontsize="small")
+    fig.suptitle("deformed stack: deflection drawn x %g" % scale)
+    fig.tight_layout()
+    return fig
+
+
+def animate_stack(result, path, scale=None, fps=25, every=1, dpi=80):
+    """An animation of the deformed stack over the run (deformed_stack's drawing at every
+    `every`-th record, one scale for the whole run, printed on it) written to `path`: a .gif with
+    Pillow (Debian python3-pil) or an .mp4 with ffmpeg (where it is installed). Needs
+    simulate(..., nodes=True) (and pairs=True for the states). Returns path."""
+    import os
+
+    from matplotlib import animation
+    import matplotlib.pyplot as plt
+
+    stack = _Stack(result)
+    path = os.fspath(path)
+    kind = os.path.splitext(path)[1].lower()
+    if kind == ".gif":
+        try:
+            import PIL  # noqa: F401  (Pillow, matplotlib's GIF writer)
+        except ImportError as e:  # pragma: no cover - Debian's matplotlib depends on it
+            raise ImportError("a GIF needs Pillow (Debian: apt-get install python3-pil)") from e
+        writer = animation.PillowWriter(fps=fps)
+    elif kind == ".mp4":
+        if not animation.FFMpegWriter.isAvailable():
+            raise _error("path", "value '%s': an MP4 needs ffmpeg, which is not installed (apt-get install ffmpeg), "
+                                 "or write a .gif" % path)
+        writer = animation.FFMpegWriter(fps=fps)
+    else:
+        raise _error("path", "value '%s' has neither the extension .gif nor .mp4" % path)
+    if not (isinstance(every, int) and every >= 1):
+        raise _error("every", "value %r is not allowed: must be an integer >= 1" % (every,))
+    records = list(range(0, len(stack.times), every))
+    if scale is None:
+        scale = stack_scale(stack.stack_height, stack.max_abs_w(records))
+    elif not (isinstance(scale, (int, float)) and _math.isfinite(scale) and scale > 0):
+        raise _error("scale", "value %r is not allowed: must be a number > 0" % (scale,))
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    # fixed limits over the run: every frame's drawing on one frame of reference
+    lo, hi = _math.inf, -_math.inf
+    for i in records:
+        for leaf, (x, w) in stack.leaf_axes(i).items():
+            y = 1000 * (stack.heights[leaf] + scale * w)
+            lo, hi = min(lo, y.min()), max(hi, y.max())
+    pad = 0.05 * (hi - lo) + 1.0
+
+    def frame(k):
+        ax.clear()
+        i = records[k]
+        _draw_stack(ax, stack, i, scale)
+        ax.set(ylim=(lo - pad, hi + pad), title="t = %.4g s, w = %.4g mm  (deflection drawn x %g)"
+               % (stack.times[i], 1000 * stack.w_record[i], scale), xlabel="x [mm]", ylabel="[mm]")
+        ax.grid(True)
+        if stack.pairs is not None:
+            ax.legend(loc="upper right", fontsize="small")
+        return []
+
+    anim = animation.FuncAnimation(fig, frame, frames=len(records), blit=False)
+    anim.save(path, writer=writer, dpi=dpi)
+    plt.close(fig)
+    return path

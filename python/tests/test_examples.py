@@ -25,4 +25,5 @@ def test_example_runs(name, tmp_path):
     assert done.returncode == 0, done.stderr
     if name == "rig_loop.py":
         assert sorted(p.name for p in tmp_path.glob("rig_*.png")) == [
-            "rig_displacement.png", "rig_force.png", "rig_friction.png", "rig_loop.png"]
+            "rig_displacement.png", "rig_force.png", "rig_friction.png", "rig_loop.png", "rig_stack.png"]
+        assert (tmp_path / "rig_stack.gif").stat().st_size > 0

@@ -23,6 +23,16 @@
 namespace stackbeam {
 
 class System;
+
+/// The deflected axis of one leaf at one time: its nodes, whole leaf (System::leaf_nodes).
+/// SI units, signs of conventions.hpp.
+struct LeafNodes {
+    int leaf = 0;                   ///< index in ModelSpec::leaves (0: the top leaf)
+    std::vector<double> x_m;        ///< x of each node [m], increasing, the leaf's whole length
+    std::vector<double> w_m;        ///< transverse displacement v of the axis at each node [m], +y
+    std::vector<double> theta_rad;  ///< rotation of the cross-section, dv/dx [rad], counter-clockwise
+};
+
 namespace detail {
 bool compliance_held_built(const System& system) noexcept;  // internal (lib/fe/system_internal.hpp)
 }
@@ -101,6 +111,14 @@ public:
     Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
     /// Offset of (leaf, node) in leaf_displacements() / 3, or -1 if the leaf has no such node.
     int node_dof(int leaf, int node) const;
+    /// Every leaf's nodes (x, v, theta) for reduced displacements z = [z_r; w] (w last,
+    /// num_reduced_dofs() entries), one entry per leaf in ModelSpec::leaves order. The
+    /// displacements are from the leaf's free (unstressed) shape, which is flat unless the leaf
+    /// has a free camber. On the half model the meshed left half is mirrored about the
+    /// attachment x_R to the whole leaf (the motion is symmetric there: v(2 x_R - x) = v(x),
+    /// theta(2 x_R - x) = -theta(x)); the node at x_R appears once. InputError naming z when it
+    /// has not num_reduced_dofs() entries.
+    std::vector<LeafNodes> leaf_nodes(const Eigen::VectorXd& z) const;
 
 private:
     friend bool detail::compliance_held_built(const System& system) noexcept;

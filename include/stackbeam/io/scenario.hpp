@@ -25,6 +25,7 @@ struct ScenarioOutputs {
     std::string events_path;  ///< `[outputs] events_path`: the event log (mode cvode), optional
     std::string summary_path; ///< `[outputs] summary_path`: the JSON summary, optional
     std::string pairs_path;   ///< `[outputs] pairs_path`: every pair at every output time (CSV), optional
+    std::string nodes_path;   ///< `[outputs] nodes_path`: every leaf's nodal displacements at every output time (CSV), optional
     std::string plot_prefix;  ///< `[outputs] plot_prefix`: PNG figures PREFIX_*.png (gnuplot), optional
 };
 

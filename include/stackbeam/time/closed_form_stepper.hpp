@@ -41,6 +41,9 @@ public:
     const StepRecord& current() const noexcept override { return record_; }
     long record_index() const noexcept override { return step_; }
     std::vector<PairRecord> pairs() const override;
+    /// The leaves' nodes: z of the sparse path, or of the forces and w on the dense path
+    /// (System::reduced_displacements: the massless leaves are in equilibrium with p and w).
+    std::vector<LeafNodes> nodes() const override;
     /// Steps, and the contact iterations and factorisations summed over the records.
     RunReport report() const override { return report_; }
 

@@ -76,6 +76,9 @@ public:
     long record_index() const noexcept override;
     /// The pairs at the last output time (forces, relative positions C'p + c w).
     std::vector<PairRecord> pairs() const override;
+    /// The leaves' nodes at the last output time, of its forces and w (the massless leaves are
+    /// in equilibrium with them: System::reduced_displacements).
+    std::vector<LeafNodes> nodes() const override;
     /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
     RunReport report() const override;
     /// Number of output intervals to t_end, as in the closed-form mode.

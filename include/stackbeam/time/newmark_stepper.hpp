@@ -90,6 +90,8 @@ public:
     const StepRecord& current() const noexcept override { return record_; }
     long record_index() const noexcept override { return step_; }
     std::vector<PairRecord> pairs() const override;
+    /// The leaves' nodes of displacements() (System::leaf_nodes).
+    std::vector<LeafNodes> nodes() const override { return system_.leaf_nodes(z_); }
     /// Steps, and the contact iterations and factorisations summed over the records.
     RunReport report() const override { return report_; }
 

@@ -205,13 +205,19 @@ struct PairRecord {
 /// Receives the pairs at each record's time (t [s], one entry per System::pairs()).
 using PairObserver = std::function<void(double t_s, const std::vector<PairRecord>&)>;
 
+/// Receives every leaf's nodes at each record's time (t [s], one entry per leaf; Stepper::nodes()).
+using NodeObserver = std::function<void(double t_s, const std::vector<LeafNodes>&)>;
+
 /// Runs from t = 0 to options.t_end_s in options.mode; the first record is the
 /// initial state, then one per dt_s (a step of the closed-form mode, an output time
 /// of the cvode mode). `on_step` (optional) sees every record as it is made;
 /// `report` (optional) receives the counters and, in mode cvode, the event log;
-/// `on_pairs` (optional) sees every pair at every record's time.
+/// `on_pairs` (optional) sees every pair at every record's time; `on_nodes` (optional)
+/// every leaf's nodal displacements there (off by default: they cost a solve per record in
+/// the massless modes and memory if kept). Per record: on_step, on_pairs, on_nodes.
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
                                  const std::function<void(const StepRecord&)>& on_step = {},
-                                 RunReport* report = nullptr, const PairObserver& on_pairs = {});
+                                 RunReport* report = nullptr, const PairObserver& on_pairs = {},
+                                 const NodeObserver& on_nodes = {});
 
 }  // namespace stackbeam

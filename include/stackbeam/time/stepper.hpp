@@ -33,6 +33,10 @@ public:
     /// The contact state at the current record: one PairRecord per System::pairs(), in
     /// that order (meshed part, signs of conventions.hpp).
     virtual std::vector<PairRecord> pairs() const = 0;
+    /// Every leaf's deflected axis at the current record: per leaf its nodes' x [m], transverse
+    /// displacement v [m] and rotation [rad], whole leaves (the half model mirrored),
+    /// System::leaf_nodes. The node at R's attachment on a tied leaf moves by the record's w_m.
+    virtual std::vector<LeafNodes> nodes() const = 0;
     /// The counters so far (steps, contact iterations, factorisations; mode cvode: its
     /// CvodeStats and event log).
     virtual RunReport report() const = 0;

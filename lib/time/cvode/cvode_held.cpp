@@ -275,6 +275,12 @@ long CvodeHeldStepper::record_index() const noexcept { return impl_->out_index; 
 std::vector<PairRecord> CvodeHeldStepper::pairs() const {
     return pair_records(impl_->sys, impl_->laws, impl_->p_out, impl_->rel_out);
 }
+std::vector<LeafNodes> CvodeHeldStepper::nodes() const {
+    const Impl& s = *impl_;
+    Eigen::VectorXd xi, xid;
+    s.modal(xi, xid);
+    return s.sys.leaf_nodes(s.zp + s.NPhi * xi);
+}
 RunReport CvodeHeldStepper::report() const {
     RunReport rep;
     rep.mode = Mode::cvode;

@@ -35,6 +35,8 @@ public:
     long record_index() const noexcept override;
     /// The pairs at the last output: the held components' forces, relative positions G z.
     std::vector<PairRecord> pairs() const override;
+    /// The leaves' nodes at the last output: z = z_p + N Phi xi.
+    std::vector<LeafNodes> nodes() const override;
     /// CVODE's steps and counters (no contact iterations, no events: the modes never change).
     RunReport report() const override;
     const CvodeStats& stats() const noexcept;

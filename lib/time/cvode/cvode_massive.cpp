@@ -347,6 +347,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R), strain
     /// z^T K z / 2 + p^T C_L p / 2 (leaves and layer), whole spring.
+    /// z is the state's first part.
+    Vec displacements(const State& Y, const Vec&) const override { return Y.head(ndof); }
+
     StepRecord make_record(double tau, const State& Y, Vec& p, Vec& rel) const override {
         const auto z = Y.head(ndof);
         const auto v = Y.segment(ndof, ndof);

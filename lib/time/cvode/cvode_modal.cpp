@@ -189,6 +189,19 @@ struct CvodeModalStepper::Impl final : EventDriver {
     /// The record at time tau of state Y: w = Phi_w q + rw . p; energies: kinetic
     /// |q'|^2 / 2 (mass-normalised modes; the contact layer is massless), strain
     /// (q^T Omega^2 q + p^T W p) / 2 (the cross terms vanish: Phi^T K R = 0).
+    /// The split above, z = Phi q + R G^T p with R = K^-1 - Phi Omega^-2 Phi^T: the retained
+    /// modes' motion plus the quasi-static response of the modes above the cut to the contact
+    /// forces (its row w is w = phiw . q + rw . p of make_record). K's factor is made on the
+    /// first call (only a run that asks for the nodes pays for it).
+    Vec displacements(const State& Y, const Vec& p) const override {
+        if (!stiffness_factor)
+            stiffness_factor = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(sys.stiffness_reduced());
+        const Vec gtp = sys.contact_rows().transpose() * p;  // G^T p [N, N m]
+        const Vec phi_gtp = Phi.transpose() * gtp;
+        return Phi * Vec(Y.head(r) - phi_gtp.cwiseQuotient(om.cwiseProduct(om))) + stiffness_factor->solve(gtp);
+    }
+    mutable std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> stiffness_factor;
+
     StepRecord make_record(double, const State& Y, Vec& p, Vec& rel) const override {
         const auto q = Y.head(r);
         const auto qd = Y.segment(r, r);

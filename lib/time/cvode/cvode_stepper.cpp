@@ -189,6 +189,10 @@ struct CvodeStepper::Impl final : detail::EventDriver {
         wd = y[1];
     }
 
+    /// The massless leaves in equilibrium with the forces p and R at w = y[0] (the leaves carry no
+    /// load of their own: gravity acts on R only).
+    Vec displacements(const State& y, const Vec& p) const override { return sys.reduced_displacements(p, y[0]); }
+
     void after_event(const std::string&, const Vec& p_cur, const Vec& p_new) override {
         if (n > 0) stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
     }
@@ -309,6 +313,7 @@ std::vector<PairRecord> CvodeStepper::pairs() const {
     const Impl& s = *impl_;
     return s.pair_records_at(s.p_out.size() > 0 ? Eigen::VectorXd(s.C * s.p_out + s.c * s.record.w_m) : Eigen::VectorXd());
 }
+std::vector<LeafNodes> CvodeStepper::nodes() const { return impl_->nodes_at_output(); }
 RunReport CvodeStepper::report() const { return impl_->report(); }
 const Eigen::VectorXd& CvodeStepper::contact_forces() const noexcept { return impl_->p_out; }
 const std::vector<ContactEvent>& CvodeStepper::events() const noexcept { return impl_->events; }

@@ -129,6 +129,7 @@ void EventDriver::solve_initial_forces(const Vec& motion0, Vec& p) {
 
 void EventDriver::start_record(const Vec& y0) {
     record = record_at(0.0, y0, p_out, rel_out);
+    y_out = y0;
     e0 = record.kinetic_energy_j + record.strain_energy_j;
     record.energy_balance_error_j = 0.0;
 }
@@ -374,6 +375,7 @@ void EventDriver::emit_until(double upto) {
         cvode->dense_output(tau);
         Output o;
         o.rec = record_at(tau, cvode->ydky(), o.p, o.rel);
+        o.y = cvode->ydky();
         pending.push_back(std::move(o));
         ++next;
     }
@@ -481,6 +483,7 @@ const StepRecord& EventDriver::advance() {
     record = std::move(pending.front().rec);
     p_out = std::move(pending.front().p);
     rel_out = std::move(pending.front().rel);
+    y_out = std::move(pending.front().y);
     pending.pop_front();
     ++out_index;
     return record;
@@ -499,6 +502,7 @@ const StepRecord& EventStepper::advance() {
 const StepRecord& EventStepper::current() const noexcept { return driver_->current(); }
 long EventStepper::record_index() const noexcept { return driver_->record_index(); }
 std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records_at(driver_->rel_out); }
+std::vector<LeafNodes> EventStepper::nodes() const { return driver_->nodes_at_output(); }
 RunReport EventStepper::report() const { return driver_->report(); }
 const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats; }
 const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events; }

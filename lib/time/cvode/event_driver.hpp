@@ -47,6 +47,8 @@ public:
     /// The pairs at the current output from its forces and relative positions (rel:
     /// s + d, all rows).
     std::vector<PairRecord> pair_records_at(const Vec& rel) const;
+    /// Every leaf's nodes at the current output (Stepper::nodes()): displacements() at its state.
+    std::vector<LeafNodes> nodes_at_output() const { return sys.leaf_nodes(displacements(y_out, p_out)); }
     RunReport report() const { return event_report(stats, events); }
 
     // ---- what the steppers share, set up by their constructors ---------------------------
@@ -78,6 +80,7 @@ public:
     long n_out = 0, out_index = 0;
     StepRecord record;          ///< of the current output
     Vec p_out, rel_out;         ///< its forces [N] and (modal) relative positions [m]
+    Vec y_out;                  ///< its state (CVODE's y at the output time)
     double e0 = 0.0;            ///< initial energy [J]
     bool root_finding = true;   ///< CVODE's root-finding on the witnesses (off only in tests: cvode_testing.hpp)
     long iters_since = 0, facts_since = 0;  ///< contact iterations and factorisations since the last record
@@ -196,9 +199,12 @@ protected:
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
     /// the driver sets t, the counters and the residual.
     virtual StepRecord make_record(double tau, const State& y, Vec& p, Vec& rel) const = 0;
+    /// The reduced displacements z = [z_r; w] [m, rad] at state y with the forces p [N] of its
+    /// record (System::leaf_nodes makes the nodes of them).
+    virtual Vec displacements(const State& y, const Vec& p) const = 0;
 
 private:
-    struct Output { StepRecord rec; Vec p, rel; };
+    struct Output { StepRecord rec; Vec p, rel, y; };
     std::deque<Output> pending;
     double last_event_t = -1.0;
     int events_at_this_time = 0;
@@ -225,6 +231,8 @@ public:
     long record_index() const noexcept override;
     /// The pairs at the last output (contact_forces(), relative_positions()).
     std::vector<PairRecord> pairs() const override;
+    /// The leaves' nodes at the last output (EventDriver::displacements at its state).
+    std::vector<LeafNodes> nodes() const override;
     /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
     RunReport report() const override;
     const CvodeStats& stats() const noexcept;
