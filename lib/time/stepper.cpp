@@ -22,9 +22,9 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
             // modal stepper (every loading but the rig, the assembly; cheap: the contact layer is
             // massless, so transitions excite no mesh-scale ringing) unless the whole massive stack
             // is asked for, or needed for what only it takes (structural damping, the rig) and every
-            // row is elastic; without friction the held-for-good stepper under the paper's initial
-            // conditions, else the massive stack on elastic rows (no transitions: cheap) or the
-            // modal one
+            // row is elastic, and wherever it is asked for; without friction the held-for-good
+            // stepper under the paper's initial conditions, else the massive stack on elastic rows
+            // (no transitions: cheap) or the modal one
             {
                 const LeafInertia li = options.cvode.leaf_inertia;
                 const bool elastic = detail::first_rigid_pair(system) < 0;
@@ -34,7 +34,7 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
                 const bool massive_only = options.damping.active() || rig;
                 if (li == LeafInertia::massive || (li == LeafInertia::automatic && elastic && massive_only))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
-                if (changes) return std::make_unique<detail::CvodeModalStepper>(system, options);
+                if (changes || li == LeafInertia::modal) return std::make_unique<detail::CvodeModalStepper>(system, options);
                 if (assembled || !options.loading.is_free()) {
                     if (li == LeafInertia::automatic && elastic)
                         return std::make_unique<detail::CvodeMassiveStepper>(system, options);
