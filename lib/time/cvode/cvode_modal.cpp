@@ -331,14 +331,16 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
 
     // initial state: the assembly and gravity's static state, R held at w(0), the leaves moving
     // with R in the tied shape (modal_load.hpp; z = 0 on the paper example), projected on the
-    // retained modes (q = Phi^T M z, mass-normalised)
+    // retained modes: q = Omega^-2 Phi^T K z (= Phi^T M z for exact eigenvectors; this one makes
+    // Phi q + R K z = z exactly whatever the eigen-solve's residual, so a static state stays
+    // static), q' = Phi^T M z' (mass-normalised)
     Eigen::VectorXd z0, v0, p_init = Eigen::VectorXd::Zero(s.n);
     modal_initial_state(system, s.chk_problem, s.opt, s.load->weight(), z0, v0, p_init, s.d);
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
     auto Y = s.cvode->y();
     Y.setZero();
-    Y.head(s.r) = s.Phi.transpose() * (M * z0);
+    Y.head(s.r) = (s.Phi.transpose() * (K * z0)).cwiseQuotient(s.om.cwiseProduct(s.om));
     Y.segment(s.r, s.r) = s.Phi.transpose() * (M * v0);
 
     // initial modes: from the contact problem at q(0), then decided a look-ahead on
