@@ -10,11 +10,12 @@
 # run's max |w - w_newmark(2.5e-5 s)| over the 1e-4 s outputs, as a fraction of newmark's peak
 # |w| (w: R's deflection relative to the supports; R's absolute motion w + y_b deviates alike)
 # and of the peak of its motion |w - w(0)|. docs/performance.md, "Leaf mass".
-#   benchmarks/modal_base_excitation.sh [build dir (default build)] [work dir (default /tmp/modal_bench)]
+#   benchmarks/modal_base_excitation.sh [build dir (default build)] [work dir (default /tmp/modal_bench)] [t_end s (default 1)]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 cli=${1:-build}/apps/cli/stackbeam
 work=${2:-/tmp/modal_bench}
+t_end=${3:-1}
 file=scenarios/base_steel_elastic.toml
 mkdir -p "$work"
 TIMEFORMAT='%U %S'
@@ -22,7 +23,7 @@ run() {  # run NAME ARGS...: prints "NAME cpu_s"
     local name=$1
     shift
     local t
-    t=$( { time "$cli" simulate --scenario "$file" --t-end 1 --quiet --out "$work/$name.csv" \
+    t=$( { time "$cli" simulate --scenario "$file" --t-end "$t_end" --quiet --out "$work/$name.csv" \
            --summary "$work/$name.json" "$@" >"$work/$name.txt" 2>&1; } 2>&1 )
     read -r user sys <<<"$t"
     echo "$name $(echo "$user + $sys" | bc -l)"
