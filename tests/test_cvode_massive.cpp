@@ -44,6 +44,7 @@ SimulationOptions cvode_options(double t_end_s, double rtol, double beta_s = 0.0
     so.cvode.rtol = rtol;
     so.damping.rayleigh_beta_s = beta_s;
     so.solver.tolerance_m = 1e-9;
+    so.cvode.leaf_inertia = LeafInertia::massive;  // auto takes the modal stepper with friction
     return so;
 }
 

@@ -27,6 +27,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/time/stepper.hpp"
 #include "test_support.hpp"
+#include "tied_modal_reference.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -57,118 +58,6 @@ SimulationOptions options(Mode mode, double t_end_s, double dt_s) {
     so.cvode.leaf_inertia = LeafInertia::massive;
     so.solver.tolerance_m = 1e-12;
     return so;
-}
-
-/// The linear stack with every held row tied by its layer spring: normal rows always, tangential
-/// rows where the pair is bonded or carries friction (as the steppers' initial tied shape).
-struct Linear {
-    Eigen::MatrixXd M, K;  // [kg], [N/m] (reduced DOFs, w last)
-    Eigen::VectorXd l;     // System::vertical_inertia_kg
-    int w = 0;
-    double f = 1.0;        // whole-spring factor
-    double m_half = 0.0;   // R's mass on the meshed part [kg]
-};
-
-Linear linear(const System& s) {
-    Linear L;
-    L.M = Eigen::MatrixXd(s.mass_reduced());
-    L.K = Eigen::MatrixXd(s.stiffness_reduced());
-    const Eigen::MatrixXd G(s.contact_rows());
-    const Eigen::VectorXd& c = s.layer_compliance_m_per_n();
-    for (const auto& pr : s.pairs()) {
-        std::vector<int> rows;
-        if (pr.row_n >= 0) rows.push_back(pr.row_n);
-        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0)) rows.push_back(pr.row_t);
-        for (int r : rows) {
-            BOOST_REQUIRE(c[r] > 0.0);
-            L.K += G.row(r).transpose() * G.row(r) / c[r];
-        }
-    }
-    L.l = s.vertical_inertia_kg();
-    L.w = static_cast<int>(L.K.rows()) - 1;
-    L.f = s.model().whole_spring_factor();
-    L.m_half = s.mass_kg();
-    return L;
-}
-
-/// Loading q(t) = a + b cos(Omega t) + c sin(Omega t) [N per DOF].
-struct Forcing {
-    Eigen::VectorXd a, b, c;
-    double omega = 0.0;  // [rad/s]
-};
-
-/// Exact response of M z'' + K z = q(t) from z0, v0 (modal superposition; every mode's
-/// forcing frequency kept away from its own). Returns z(t) and z''(t) at the times asked.
-struct Modal {
-    Eigen::VectorXd omega;  // [rad/s]
-    Eigen::MatrixXd phi;    // M-orthonormal
-    Eigen::VectorXd eta0, etad0, fa, fb, fc;
-    double Om = 0.0;
-    StructuralDamping damping;  // Rayleigh: mode i has zeta_i = alpha / (2 omega_i) + beta omega_i / 2 (free response only)
-    Modal(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, const Eigen::VectorXd& z0, const Eigen::VectorXd& v0,
-          const Forcing& q, const StructuralDamping& c = {})
-        : damping(c) {
-        Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(K, M);
-        BOOST_REQUIRE(es.info() == Eigen::Success);
-        omega = es.eigenvalues().cwiseSqrt();
-        phi = es.eigenvectors();
-        eta0 = phi.transpose() * M * z0;
-        etad0 = phi.transpose() * M * v0;
-        const Eigen::Index n = z0.size();
-        fa = phi.transpose() * (q.a.size() ? q.a : Eigen::VectorXd::Zero(n));
-        fb = phi.transpose() * (q.b.size() ? q.b : Eigen::VectorXd::Zero(n));
-        fc = phi.transpose() * (q.c.size() ? q.c : Eigen::VectorXd::Zero(n));
-        Om = q.omega;
-    }
-    void at(double t, Eigen::VectorXd& z, Eigen::VectorXd& acc) const {
-        Eigen::VectorXd eta(omega.size()), etadd(omega.size());
-        for (Eigen::Index i = 0; i < omega.size(); ++i) {
-            const double w = omega[i], d = w * w - Om * Om;
-            if (damping.active()) {  // free damped response: the roots of s^2 + 2 zeta w s + w^2
-                const double zeta = damping.rayleigh_alpha_per_s / (2.0 * w) + damping.rayleigh_beta_s * w / 2.0;
-                const double x0 = eta0[i], v0 = etad0[i];
-                double x = 0.0, v = 0.0;
-                if (zeta < 1.0) {
-                    const double wd = w * std::sqrt(1.0 - zeta * zeta), e = std::exp(-zeta * w * t);
-                    const double B = (v0 + zeta * w * x0) / wd;
-                    x = e * (x0 * std::cos(wd * t) + B * std::sin(wd * t));
-                    v = e * (-zeta * w * (x0 * std::cos(wd * t) + B * std::sin(wd * t)) +
-                             wd * (-x0 * std::sin(wd * t) + B * std::cos(wd * t)));
-                } else {  // overdamped: x = c1 e^{s1 t} + c2 e^{s2 t}
-                    const double r = w * std::sqrt(zeta * zeta - 1.0), s1 = -zeta * w + r, s2 = -zeta * w - r;
-                    const double c1 = (v0 - s2 * x0) / (s1 - s2), c2 = x0 - c1;
-                    x = c1 * std::exp(s1 * t) + c2 * std::exp(s2 * t);
-                    v = c1 * s1 * std::exp(s1 * t) + c2 * s2 * std::exp(s2 * t);
-                }
-                eta[i] = x;
-                etadd[i] = -w * w * x - 2.0 * zeta * w * v;
-                continue;
-            }
-            // particular: fa/w^2 + fb/d cos(Om t) + fc/d sin(Om t); its value and rate at 0
-            const double p = fa[i] / (w * w) + fb[i] / d * std::cos(Om * t) + fc[i] / d * std::sin(Om * t);
-            const double p0 = fa[i] / (w * w) + fb[i] / d, pd0 = fc[i] * Om / d;
-            const double h = (eta0[i] - p0) * std::cos(w * t) + (etad0[i] - pd0) / w * std::sin(w * t);
-            eta[i] = p + h;
-            const double force = fa[i] + fb[i] * std::cos(Om * t) + fc[i] * std::sin(Om * t);
-            etadd[i] = force - w * w * eta[i];
-        }
-        z = phi * eta;
-        acc = phi * etadd;
-    }
-};
-
-/// Largest |a_i - b_i| over the records, with `ref(t)` the reference.
-double max_deviation(const std::vector<StepRecord>& r, const std::function<double(const StepRecord&)>& got,
-                     const std::function<double(double)>& ref) {
-    double e = 0.0;
-    for (const auto& rec : r) e = std::max(e, std::abs(got(rec) - ref(rec.t_s)));
-    return e;
-}
-
-double max_abs(const std::vector<StepRecord>& r, const std::function<double(double)>& ref) {
-    double e = 0.0;
-    for (const auto& rec : r) e = std::max(e, std::abs(ref(rec.t_s)));
-    return e;
 }
 
 /// Every pair held over the run (none slipped or opened), and the balance closed to `tol_j`.
@@ -222,23 +111,6 @@ void check_case(const std::string& name, const System& system, const Loading& lo
 
 double w_of(const StepRecord& r) { return r.w_m; }
 
-/// The reference's w(t) for a Modal response.
-std::function<double(double)> w_reference(const Modal& ref, int w) {
-    return [&ref, w](double t) {
-        Eigen::VectorXd z, a;
-        ref.at(t, z, a);
-        return z[w];
-    };
-}
-
-/// z0 with R held at w0 and the leaves in the static shape there: [-K_rr^-1 K_rw w0; w0] (+ z_load).
-Eigen::VectorXd held_shape(const Linear& L, double w0) {
-    const int w = L.w;
-    Eigen::VectorXd z0 = Eigen::VectorXd::Zero(w + 1);
-    z0.head(w) = -L.K.topLeftCorner(w, w).ldlt().solve(L.K.block(0, w, w, 1)) * w0;
-    z0[w] = w0;
-    return z0;
-}
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(free_response_follows_the_eigen_solve) {
@@ -414,7 +286,8 @@ BOOST_AUTO_TEST_CASE(the_assembled_stack_starts_at_the_nip_and_stays_there) {
     //     P = delta / (L2^3 / 3 (1/EI1 + 1/EI2) + c_tip),
     // c_tip the tip pair's layer compliance (0 on a rigid interface: P = 101.3 N), and the seat
     // sits P L2^2 (3 L1 - L2) / (6 EI1) below the upper leaf's pins. Mode newmark on the rigid
-    // interface and both integrators on the elastic one: the initial tip force and w to 1e-8
+    // interface and both integrators on the elastic one, and mode cvode's modal stepper on both
+    // (its static state is the whole stack's): the initial tip force and w to 1e-8
     // (cubic elements are exact for tip loads; the solver's tolerance is 1e-12 m), and with no
     // loading the stack stays there (it starts in equilibrium): w within 1e-9 of it for 2 ms.
     const double L1 = kTwoLeafL1_m, L2 = kTwoLeafL2_m, R1 = 5.0, R2 = 3.0;
@@ -435,13 +308,16 @@ BOOST_AUTO_TEST_CASE(the_assembled_stack_starts_at_the_nip_and_stays_there) {
         BOOST_REQUIRE(tip >= 0);
         const double P = delta / (L2 * L2 * L2 / 3.0 * (1.0 / EI1 + 1.0 / EI2) + c_tip);
         const double w = -P * L2 * L2 * (3.0 * L1 - L2) / (6.0 * EI1);
-        for (Mode mode : {Mode::newmark, Mode::cvode}) {
-            if (mode == Mode::cvode && !elastic) continue;  // the massive stack needs the elastic layer
+        for (int variant = 0; variant < 3; ++variant) {  // newmark, cvode massive, cvode modal
+            const Mode mode = variant == 0 ? Mode::newmark : Mode::cvode;
+            if (variant == 1 && !elastic) continue;  // the massive stack needs the elastic layer
             SimulationOptions so = options(mode, 2e-3, mode == Mode::cvode ? 1e-4 : 1e-5);
+            if (variant == 2) so.cvode.leaf_inertia = LeafInertia::modal;
             const auto st = make_stepper(sys, so);
             const double p_tip = -st->pairs()[static_cast<std::size_t>(tip)].p_n_n;
             const double w0 = st->current().w_m;
-            BOOST_TEST_MESSAGE((elastic ? "elastic, " : "rigid, ") << to_string(mode) << ": tip force " << p_tip
+            BOOST_TEST_MESSAGE((elastic ? "elastic, " : "rigid, ") << to_string(mode) << (variant == 2 ? " (modal)" : "")
+                                                                  << ": tip force " << p_tip
                                                                   << " N (closed form " << P << "), w(0) " << w0 << " m (" << w << ")");
             BOOST_TEST(p_tip == P, tt::tolerance(1e-8));
             BOOST_TEST(w0 == w, tt::tolerance(1e-8));

@@ -18,21 +18,28 @@ std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOpti
         case Mode::newmark: return std::make_unique<NewmarkStepper>(system, options);
         case Mode::cvode:
             if (!detail::has_leaf_mass(system)) return std::make_unique<CvodeStepper>(system, options);
-            // leaf inertia (docs/time-integration.md): the whole massive stack where every contact
-            // row has an elastic layer and the stack has friction, an assembly or a loading (or when
-            // asked for); else, when a pair may stick or slip, the modal stepper, and the
-            // held-for-good one for bonded and frictionless stacks under the paper's initial
-            // conditions (it takes no assembly and no other loading)
+            // leaf inertia (docs/time-integration.md "Which leaf-inertia stepper"): with friction the
+            // modal stepper (every loading but the rig, the assembly; cheap: the contact layer is
+            // massless, so transitions excite no mesh-scale ringing) unless the whole massive stack
+            // is asked for, or needed for what only it takes (structural damping, the rig) and every
+            // row is elastic, and wherever it is asked for; without friction the held-for-good
+            // stepper under the paper's initial conditions, else the massive stack on elastic rows
+            // (no transitions: cheap) or the modal one
             {
                 const LeafInertia li = options.cvode.leaf_inertia;
                 const bool elastic = detail::first_rigid_pair(system) < 0;
                 const bool changes = detail::has_mode_changes(system);
-                const ModelSpec& spec = system.model().spec();
-                const bool assembled = needs_assembly(spec);
-                if (li == LeafInertia::massive ||
-                    (li == LeafInertia::automatic && elastic && (changes || assembled || !options.loading.is_free())))
+                const bool assembled = needs_assembly(system.model().spec());
+                const bool rig = options.loading.kind == LoadingKind::prescribed_displacement;
+                const bool massive_only = options.damping.active() || rig;
+                if (li == LeafInertia::massive || (li == LeafInertia::automatic && elastic && massive_only))
                     return std::make_unique<detail::CvodeMassiveStepper>(system, options);
-                if (changes) return std::make_unique<detail::CvodeModalStepper>(system, options);
+                if (changes || li == LeafInertia::modal) return std::make_unique<detail::CvodeModalStepper>(system, options);
+                if (assembled || !options.loading.is_free()) {
+                    if (li == LeafInertia::automatic && elastic)
+                        return std::make_unique<detail::CvodeMassiveStepper>(system, options);
+                    return std::make_unique<detail::CvodeModalStepper>(system, options);
+                }
                 return std::make_unique<detail::CvodeHeldStepper>(system, options);
             }
     }

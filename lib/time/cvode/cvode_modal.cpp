@@ -21,6 +21,16 @@
 // newmark), at the price of the contact layer's high-frequency chatter.
 // The retained modes are resolved by the integrator (non-stiff up to omega_cut), so
 // CVODE runs Adams-Moulton with fixed-point iteration, as the massless mode.
+//
+// Loadings (modal_load.hpp, docs/decisions/026-loaded-modal-stepper.md): q(t) = B u(t) (gravity
+// and the base's inertial force on every mass, a force on R) loads the retained modes, Fq u(t),
+// and the quasi-static rest, whose motion G R B u(t) = Hq u(t) enters the contact problem:
+//     s = W p + G Phi q + Hq u(t) - d,    q'' + Omega^2 q = Phi^T G^T p + Fq u(t)
+// so for a set of modes p = P q + p0 + Pu u(t). The right-hand side then depends on t: under a
+// loading the state carries the clock, y = [q, q', D, X, t] (t' = 1, integrated exactly; the
+// witnesses and the look-ahead read t from the state), and X' = q'(t)^T z the loading's work
+// int q^T dz = [q^T z] - X (modal_load.hpp). Gravity and the assembly start from the static
+// state of the whole stack (as mode newmark and the massive stack).
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
@@ -32,10 +42,10 @@
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modal.hpp"
 #include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/modal_load.hpp"
 #include "time/cvode/event_driver.hpp"
 #include "stackbeam/errors.hpp"
 #include "time/record.hpp"
-#include "fe/tied_shape.hpp"
 
 namespace stackbeam::detail {
 
@@ -53,7 +63,13 @@ struct CvodeModalStepper::Impl final : EventDriver {
     Eigen::MatrixXd P, Hs, A1;
     Eigen::VectorXd p0, bs, a0;
     std::vector<int> slip_rows;
-
+    // the loading (modal_load.hpp): p gets Pu u(t), s + d gets Hsu u(t), q'' gets Au u(t);
+    // state indices of the loading's work X and the clock t (-1: no loading)
+    std::unique_ptr<ModalLoad> load;
+    Eigen::MatrixXd Pu, Hsu, Au;
+    int i_work = -1, i_clock = -1;
+    double qz0 = 0.0;  // q^T z at t = 0 [J, meshed part]
+    ModalLoad::Values u_of(const State& y) const { return i_clock < 0 ? ModalLoad::Values{} : load->at(y[i_clock]); }
 
     // ---- modes ------------------------------------------------------------------
 
@@ -74,35 +90,41 @@ struct CvodeModalStepper::Impl final : EventDriver {
         Eigen::MatrixXd WT = Eigen::MatrixXd::Zero(n, ms);
         for (const auto& l : T) WT.col(l.col) += l.coef * W.col(l.row);
         const Eigen::VectorXd We = W * lin.e;
-        Eigen::MatrixXd A(ms, ms), B1(ms, r);
+        Eigen::MatrixXd A(ms, ms), B1(ms, r), Bu(ms, 2);
         Eigen::VectorXd b0(ms);
         for (int i = 0; i < ms; ++i) {
             A.row(i) = WT.row(S[i]);
             B1.row(i) = -GPhi.row(S[i]);
+            Bu.row(i) = -load->Hq.row(S[i]);
             b0[i] = d[S[i]] - We[S[i]];
         }
-        Eigen::MatrixXd X1 = Eigen::MatrixXd::Zero(ms, r);
+        Eigen::MatrixXd X1 = Eigen::MatrixXd::Zero(ms, r), Xu = Eigen::MatrixXd::Zero(ms, 2);
         Eigen::VectorXd x0 = Eigen::VectorXd::Zero(ms);
         if (ms > 0) {
             Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
             X1 = lu.solve(B1);
             x0 = lu.solve(b0);
-            if (!X1.allFinite() || !x0.allFinite())
+            Xu = lu.solve(Bu);
+            if (!X1.allFinite() || !x0.allFinite() || !Xu.allFinite())
                 throw SolverError("cvode mode (leaf inertia): the contact conditions of the current modes are singular "
                                   "at t = " + format_value(t) + " s",
                                   stats.steps, t, 0.0);
         }
         P = Eigen::MatrixXd::Zero(n, r);
+        Pu = Eigen::MatrixXd::Zero(n, 2);
         p0 = lin.e;
         for (const auto& l : T) {
             P.row(l.row) += l.coef * X1.row(l.col);
+            Pu.row(l.row) += l.coef * Xu.row(l.col);
             p0[l.row] += l.coef * x0[l.col];
         }
         Hs = W * P + GPhi;
         bs = W * p0 - d;
+        Hsu = W * Pu + load->Hq;
         A1 = GPhi.transpose() * P;
         A1.diagonal() -= om.cwiseProduct(om);
         a0 = GPhi.transpose() * p0;
+        Au = GPhi.transpose() * Pu + load->Fq;
         slip_rows.clear();
         for (int kk = 0; kk < np; ++kk) {
             const int rt = pairs()[kk].row_t;
@@ -112,18 +134,24 @@ struct CvodeModalStepper::Impl final : EventDriver {
         ++facts_since;
     }
 
-    Eigen::VectorXd forces_q(const Eigen::Ref<const Eigen::VectorXd>& q) const { return P * q + p0; }
-    Vec forces(const State& y) const override { return forces_q(y.head(r)); }
-    Vec relative(const State& y) const override { return Hs * y.head(r) + bs + d; }
-    Vec relative_at_event(const State& y, const Vec& p_cur) const override { return W * p_cur + GPhi * y.head(r); }
-    Vec motion(const State& y) const override { return GPhi * y.head(r); }
-    void witnesses(const State& y, double* g) const override { witnesses(y.head(r), y.segment(r, r), g); }
-
-    void witnesses(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
-                   double* g) const {
+    Eigen::VectorXd forces_q(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Vector2d& u) const {
+        return P * q + p0 + Pu * u;
+    }
+    Vec forces(const State& y) const override { return forces_q(y.head(r), u_of(y).u); }
+    Vec relative(const State& y) const override { return Hs * y.head(r) + bs + d + Hsu * u_of(y).u; }
+    Vec relative_at_event(const State& y, const Vec& p_cur) const override { return W * p_cur + motion(y); }
+    Vec motion(const State& y) const override { return GPhi * y.head(r) + load->Hq * u_of(y).u; }
+    void witnesses(const State& y, double* g) const override {
+        const auto q = y.head(r);
+        const auto qd = y.segment(r, r);
+        const ModalLoad::Values u = u_of(y);
         witnesses_from(
-            forces_q(q), [&](int row) { return Hs.row(row).dot(q) + bs[row]; },
-            [&](int row) { return Hs.row(row).dot(qd); }, g);
+            forces_q(q, u.u), [&](int row) { return Hs.row(row).dot(q) + bs[row] + Hsu.row(row).dot(u.u); },
+            [&](int row) { return Hs.row(row).dot(qd) + Hsu.row(row).dot(u.ud); }, g);
+    }
+    /// q'' of the current modes at (q, u(t)).
+    Eigen::VectorXd modal_acceleration(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Vector2d& u) const {
+        return A1 * q + a0 + Au * u;
     }
 
     /// The look-ahead: the contact points move by ~kLookahead L_ref (the fastest row) and
@@ -132,32 +160,35 @@ struct CvodeModalStepper::Impl final : EventDriver {
     Vec look_ahead(double, const State& y, const Vec&) const override {
         const auto q = y.head(r);
         const auto qd = y.segment(r, r);
-        const Eigen::VectorXd qdd = P.size() > 0 ? Eigen::VectorXd(A1 * q + a0) : Eigen::VectorXd::Zero(r);
+        const ModalLoad::Values u = u_of(y);
+        const Eigen::VectorXd qdd = P.size() > 0 ? modal_acceleration(q, u.u) : Eigen::VectorXd::Zero(r);
         const double target = kLookahead * L_ref;
-        const double vmax = (GPhi * qd).lpNorm<Eigen::Infinity>(), amax = (GPhi * qdd).lpNorm<Eigen::Infinity>();
+        const double vmax = (GPhi * qd + load->Hq * u.ud).lpNorm<Eigen::Infinity>();
+        const double amax = (GPhi * qdd + load->Hq * u.udd).lpNorm<Eigen::Infinity>();
         double delta = std::numeric_limits<double>::infinity();
         if (vmax > 0.0) delta = std::min(delta, target / vmax);
         if (amax > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / amax));
         if (P.size() > 0) {
-            const double prate = (P * qd).lpNorm<Eigen::Infinity>();
+            const double prate = (P * qd + Pu * u.ud).lpNorm<Eigen::Infinity>();
             if (prate > 0.0) delta = std::min(delta, kLookahead * F_ref / prate);
         }
         if (!std::isfinite(delta)) delta = 0.0;
         Vec yl = y;
         yl.head(r) = q + delta * qd + 0.5 * delta * delta * qdd;
         yl.segment(r, r) = qd + delta * qdd;
+        if (i_clock >= 0) yl[i_clock] += delta;
         return yl;
     }
 
     void body_motion(const State& y, const Vec& p_cur, double& w, double& wd) const override {
-        w = phiw.dot(y.head(r)) + rw.dot(p_cur);
+        w = phiw.dot(y.head(r)) + rw.dot(p_cur) + load->wq.dot(u_of(y).u);
         wd = phiw.dot(y.segment(r, r));
     }
 
     /// A slipping pair slips against its slip rate at (q, q') (EventDriver::signs_follow_slip_rates).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {
-        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(r, r)); });
+        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(r, r) + Hsu * u_of(y).ud); });
     }
 
     /// A force jump (a slip that reverses where sticking is not admissible: the friction
@@ -177,43 +208,68 @@ struct CvodeModalStepper::Impl final : EventDriver {
         double* D = N_VGetArrayPointer(ydot);
         const Eigen::Map<const Eigen::VectorXd> q(Y, r), qd(Y + r, r);
         Eigen::Map<Eigen::VectorXd>(D, r) = qd;
-        Eigen::Map<Eigen::VectorXd>(D + r, r) = s->A1 * q + s->a0;
-        double pw = 0.0;  // friction power -sum_slip p_t ds_t/dt >= 0
-        for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(q) + s->p0[rt]) * s->Hs.row(rt).dot(qd);
+        if (s->i_clock < 0) {  // initial conditions only: y = [q, q', D]
+            Eigen::Map<Eigen::VectorXd>(D + r, r) = s->A1 * q + s->a0;
+            double pw = 0.0;  // friction power -sum_slip p_t ds_t/dt >= 0
+            for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(q) + s->p0[rt]) * s->Hs.row(rt).dot(qd);
+            D[2 * r] = pw;
+            return 0;
+        }
+        const ModalLoad::Values u = s->load->at(Y[s->i_clock]);
+        Eigen::Map<Eigen::VectorXd>(D + r, r) = s->modal_acceleration(q, u.u);
+        const Eigen::VectorXd p = s->forces_q(q, u.u);
+        double pw = 0.0;
+        for (int rt : s->slip_rows) pw -= p[rt] * (s->Hs.row(rt).dot(qd) + s->Hsu.row(rt).dot(u.ud));
         D[2 * r] = pw;
+        D[s->i_work] = s->load->q_dot_z(q, p, u.u, u.ud);  // X' = q'(t)^T z (modal_load.hpp)
+        D[s->i_clock] = 1.0;
         return 0;
     }
 
     // ---- records ----------------------------------------------------------------
 
-    /// The record at time tau of state Y: w = Phi_w q + rw . p; energies: kinetic
-    /// |q'|^2 / 2 (mass-normalised modes; the contact layer is massless), strain
-    /// (q^T Omega^2 q + p^T W p) / 2 (the cross terms vanish: Phi^T K R = 0).
-    /// The split above, z = Phi q + R G^T p with R = K^-1 - Phi Omega^-2 Phi^T: the retained
-    /// modes' motion plus the quasi-static response of the modes above the cut to the contact
-    /// forces (its row w is w = phiw . q + rw . p of make_record). K's factor is made on the
-    /// first call (only a run that asks for the nodes pays for it).
+    /// The split above, z = Phi q + R (G^T p + B u) with R = K^-1 - Phi Omega^-2 Phi^T: the
+    /// retained modes' motion plus the quasi-static response of the modes above the cut to the
+    /// contact forces and the loading (modal_load.hpp; its row w is make_record's w). K's factor
+    /// is made on the first call (only a run that asks for the nodes pays for it).
     Vec displacements(const State& Y, const Vec& p) const override {
         if (!stiffness_factor)
             stiffness_factor = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(sys.stiffness_reduced());
         const Vec gtp = sys.contact_rows().transpose() * p;  // G^T p [N, N m]
         const Vec phi_gtp = Phi.transpose() * gtp;
-        return Phi * Vec(Y.head(r) - phi_gtp.cwiseQuotient(om.cwiseProduct(om))) + stiffness_factor->solve(gtp);
+        Vec z = Phi * Vec(Y.head(r) - phi_gtp.cwiseQuotient(om.cwiseProduct(om))) + stiffness_factor->solve(gtp);
+        if (i_clock >= 0) z += load->RB * u_of(Y).u;
+        return z;
     }
     mutable std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> stiffness_factor;
 
-    StepRecord make_record(double, const State& Y, Vec& p, Vec& rel) const override {
+    /// The record at time tau of state Y: w = Phi_w q + rw . p + wq . u; energies: kinetic
+    /// |q'|^2 / 2 (mass-normalised modes; the contact layer is massless), strain z^T K z / 2 +
+    /// p^T C_L p / 2 = (q^T Omega^2 q + f^T R f + p^T C_L p) / 2 with f = G^T p + B u (the cross
+    /// terms vanish: Phi^T K R = 0, R K R = R), i.e. q^T Omega^2 q / 2 + p^T W p / 2 + p^T Hq u +
+    /// u^T Rqq u / 2; the loading's work [q^T z] - X (modal_load.hpp).
+    StepRecord make_record(double tau, const State& Y, Vec& p, Vec& rel) const override {
         const auto q = Y.head(r);
         const auto qd = Y.segment(r, r);
-        p = forces_q(q);
-        rel = W * p + GPhi * q;
-        const Eigen::VectorXd qdd = A1 * q + a0;
-        const double w = phiw.dot(q) + rw.dot(p);
-        const double wd = phiw.dot(qd) + rw.dot(P * qd);
-        const double wdd = phiw.dot(qdd) + rw.dot(P * qdd);
-        const double strain = 0.5 * f * (q.dot(om.cwiseProduct(om).cwiseProduct(q)) + p.dot(W * p));
+        const ModalLoad::Values u = u_of(Y);
+        p = forces_q(q, u.u);
+        rel = W * p + motion(Y);
+        const Eigen::VectorXd qdd = modal_acceleration(q, u.u);
+        const double w = phiw.dot(q) + rw.dot(p) + load->wq.dot(u.u);
+        const double wd = phiw.dot(qd) + rw.dot(P * qd + Pu * u.ud) + load->wq.dot(u.ud);
+        const double wdd = phiw.dot(qdd) + rw.dot(P * qdd + Pu * u.udd) + load->wq.dot(u.udd);
+        const double strain = 0.5 * f *
+                              (q.dot(om.cwiseProduct(om).cwiseProduct(q)) + p.dot(W * p) +
+                               2.0 * p.dot(load->Hq * u.u) + u.u.dot(load->Rqq * u.u));
+        LoadState ls;  // the loading's force on R and its work, whole spring
+        if (i_clock >= 0) {
+            const Loading& L = opt.loading;
+            ls.external_force_n = L.external_force_n(tau, m_body);
+            ls.external_work_j = f * (load->q_dot_z(q, p, u.u, u.u) - qz0 - Y[i_work]);
+            ls.base_displacement_m = L.base_displacement_m(tau);
+        }
         StepRecord rec;
-        fill_state(sys, chk_problem, p, w, wd, strain, f * Y[2 * r] + jump_dissipation, e0, LoadState{}, rec);
+        fill_state(sys, chk_problem, p, w, wd, strain, f * Y[2 * r] + jump_dissipation, e0, ls, rec);
         finish_inertia_record(rec, 0.5 * f * qd.squaredNorm(), m_body * wdd);
         return rec;
     }
@@ -223,11 +279,14 @@ struct CvodeModalStepper::Impl final : EventDriver {
 CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptions& options)
     : EventStepper(std::make_unique<Impl>(system, options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(false);
+    s.require_leaf_inertia_options(true);  // every loading but the rig (below), the assembly
+    require_no_damping(s.opt, "mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal')");
+    require_modal_loading(s.opt.loading);
+    s.opt.loading.prepare(true);
+    require_loading_fits(system.model().spec(), s.opt.loading);
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double> M = system.mass_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();
-    const auto& body = system.model().spec().rigid_body;
 
     // modes of the unconnected stack (K, M), dense: n is a few hundred on the example
     const Eigen::MatrixXd Kd(K), Md(M);
@@ -261,15 +320,19 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.W.diagonal() += system.layer_compliance_m_per_n();  // the elastic layer, massless (system.hpp)
     s.phiw = s.Phi.row(s.w_dof).transpose();
     s.rw = KiGt.row(s.w_dof).transpose() - s.GPhi * s.om.cwiseProduct(s.om).cwiseInverse().cwiseProduct(s.phiw);
+    s.load = std::make_unique<ModalLoad>(system, s.opt.loading, s.Phi, s.om, kf);
+    if (!s.load->none()) {  // the loading's work X and the clock t (file comment)
+        s.i_work = 2 * s.r + 1;
+        s.i_clock = 2 * s.r + 2;
+        s.nstate = 2 * s.r + 3;
+    }
 
-    // scales (cvode_stepper.cpp): R's amplitude on the tied stack, its frequency
-    const double omega_t = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
-    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t;
-    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
-    s.V_ref = omega_t * s.L_ref;
-    double preload = 0.0;
-    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
-    s.F_ref = std::max(preload, system.tied_stiffness_n_per_m() / s.f * s.L_ref);
+    // scales: R's amplitude on the tied stack and the loading's, its frequency
+    const EventScales sc = loaded_event_scales(system, s.opt.loading, system.vertical_inertia_kg());
+    const double omega_t = sc.omega_t;
+    s.L_ref = sc.L_ref;
+    s.V_ref = sc.V_ref;
+    s.F_ref = sc.F_ref;
 
     // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual
     // compliance (its entries are far smaller than C''s: most of the leaves'
@@ -281,29 +344,27 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
     s.init_slots();  // as the massless mode
 
-    // initial state: the leaves at rest in the static shape of w(0) (z = 0 on the
-    // paper example) moving with R: the tied shape per unit w times w'(0), projected
-    // on the retained modes (q = Phi^T M z, mass-normalised)
-    std::vector<int> tied;
-    for (const auto& pr : system.pairs()) {
-        if (pr.row_n >= 0) tied.push_back(pr.row_n);
-        if (pr.row_t >= 0 && (pr.kind == PairKind::bonded || pr.friction_coefficient > 0.0)) tied.push_back(pr.row_t);
-    }
-    const Eigen::VectorXd z0 = tied_shape(K, G, tied, body.initial_displacement_m, s.d);
-    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s * tied_shape(K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
+    // initial state: the assembly and gravity's static state, R held at w(0), the leaves moving
+    // with R in the tied shape (modal_load.hpp; z = 0 on the paper example), projected on the
+    // retained modes: q = Omega^-2 Phi^T K z (= Phi^T M z for exact eigenvectors; this one makes
+    // Phi q + R K z = z exactly whatever the eigen-solve's residual, so a static state stays
+    // static), q' = Phi^T M z' (mass-normalised)
+    Eigen::VectorXd z0, v0, p_init = Eigen::VectorXd::Zero(s.n);
+    modal_initial_state(system, s.chk_problem, s.opt, s.load->weight(), z0, v0, p_init, s.d);
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
     auto Y = s.cvode->y();
-    Y.head(s.r) = s.Phi.transpose() * (M * z0);
+    Y.setZero();
+    Y.head(s.r) = (s.Phi.transpose() * (K * z0)).cwiseQuotient(s.om.cwiseProduct(s.om));
     Y.segment(s.r, s.r) = s.Phi.transpose() * (M * v0);
-    Y[2 * s.r] = 0.0;
 
     // initial modes: from the contact problem at q(0), then decided a look-ahead on
-    Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
-    s.solve_initial_forces(s.GPhi * Eigen::VectorXd(Y.head(s.r)), p_init);
+    s.solve_initial_forces(s.motion(Y), p_init);
     modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.build_mode();
     s.decide_modes(0.0, Y, p_init, "start");
+    const ModalLoad::Values u0 = s.u_of(Y);
+    s.qz0 = s.load->q_dot_z(Y.head(s.r), s.forces(Y), u0.u, u0.u);
 
     // tolerances: the modal coordinates carry energy (q' in sqrt(J)/..., mass-normalised):
     // the same absolute tolerance on every coordinate, from the user's atol on w as an
@@ -319,6 +380,10 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
             A[s.r + i] = a_e;      // q_i'
         }
         A[2 * s.r] = a_e * a_e;    // D [J, meshed part]
+        if (s.i_clock >= 0) {
+            A[s.i_work] = a_e * a_e;                                   // X [J, meshed part]
+            A[s.i_clock] = 1e-12 * std::max(1.0, s.opt.t_end_s);       // t [s]: t' = 1 is integrated exactly
+        }
     }
     s.start_record(Y);
     s.start_cvode(&Impl::rhs);

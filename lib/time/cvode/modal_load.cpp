@@ -1,0 +1,110 @@
+// The loadings of the modal leaf-inertia stepper (modal_load.hpp).
+#include "time/cvode/modal_load.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "fe/tied_shape.hpp"
+#include "stackbeam/errors.hpp"
+#include "time/contact_state.hpp"
+#include "time/static_stages.hpp"
+
+namespace stackbeam::detail {
+
+ModalLoad::ModalLoad(const System& system, const Loading& prepared, const Eigen::MatrixXd& Phi,
+                     const Eigen::VectorXd& omega, const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& kf)
+    : load_(prepared), l_(system.vertical_inertia_kg()), f_(system.model().whole_spring_factor()) {
+    none_ = load_.gravity_m_per_s2 == 0.0 &&
+            (load_.kind == LoadingKind::initial_conditions || load_.kind == LoadingKind::prescribed_displacement);
+    const Eigen::Index ndof = l_.size();
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(ndof, 2);
+    B.col(0) = l_;
+    B(ndof - 1, 1) = 1.0;
+    // R B = K^-1 B - Phi Omega^-2 Phi^T B: the quasi-static response of the modes above the cut
+    Fq = Phi.transpose() * B;
+    RB = Eigen::MatrixXd(kf.solve(B)) - Phi * omega.cwiseProduct(omega).cwiseInverse().asDiagonal() * Fq;
+    const Eigen::MatrixXd G(system.contact_rows());
+    Hq = G * RB;
+    wq = RB.row(ndof - 1).transpose();
+    Rqq = B.transpose() * RB;
+    Rqq = (0.5 * (Rqq + Rqq.transpose())).eval();
+}
+
+ModalLoad::Values ModalLoad::at(double t_s) const {
+    Values v;
+    if (none_) return v;
+    // channel 0: -(g + y_b''); its rates by central differences of y_b'' (TimeFunction gives up to
+    // the second derivative; y_b is C2 and smooth between a table's points). The steps balance
+    // truncation (h^2 y_b^(5) / 6) against round-off (eps y_b'' / h, eps y_b'' / h^2): at 8 Hz
+    // u' to ~1e-9 of itself (it enters the work and the witnesses' rates), u'' to ~1e-6 (only
+    // the record's m w'' uses it).
+    const bool base = load_.kind == LoadingKind::base_excitation;
+    v.u[0] = -load_.gravity_m_per_s2;
+    if (base) {
+        const TimeFunction& y = load_.displacement_m;
+        const double h1 = 1e-6, h2 = 1e-4;  // [s]
+        const double a = y.second_derivative(t_s);
+        v.u[0] -= a;
+        v.ud[0] = -(y.second_derivative(t_s + h1) - y.second_derivative(t_s - h1)) / (2.0 * h1);
+        v.udd[0] = -(y.second_derivative(t_s + h2) - 2.0 * a + y.second_derivative(t_s - h2)) / (h2 * h2);
+    }
+    // channel 1: F(t)/f
+    if (load_.kind == LoadingKind::applied_force) {
+        const TimeFunction& F = load_.force_n;
+        v.u[1] = F.value(t_s) / f_;
+        v.ud[1] = F.derivative(t_s) / f_;
+        v.udd[1] = F.second_derivative(t_s) / f_;
+    }
+    return v;
+}
+
+void require_modal_loading(const Loading& loading) {
+    if (loading.kind == LoadingKind::prescribed_displacement)
+        throw InputError("loading.kind", std::string("value '") + to_string(loading.kind) +
+                                             "': mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal') "
+                                             "takes every loading but the rig; use mode newmark, or "
+                                             "cvode.leaf_inertia = 'massive' on elastic interfaces");
+}
+
+void modal_initial_state(const System& system, const ContactProblem& laws, const SimulationOptions& options,
+                         const Eigen::VectorXd& weight, Eigen::VectorXd& z0, Eigen::VectorXd& v0, Eigen::VectorXd& p,
+                         Eigen::VectorXd& d) {
+    const auto& body = system.model().spec().rigid_body;
+    const Loading& L = options.loading;
+    const int w_dof = system.num_reduced_dofs() - 1;
+    z0 = Eigen::VectorXd::Zero(system.num_reduced_dofs());
+    static_stages(system, laws, weight, options, z0, p, d);  // the assembly, then gravity
+    const double w_start = z0[w_dof] + body.initial_displacement_m;
+    const double wd_start = body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
+    if (w_start != z0[w_dof])
+        z0 = static_state(system, laws, weight, w_start, options, p, d, "initial contact state");
+    const std::vector<int> tied = closed_rows(laws.pairs, relative_positions(system, z0, p), d);
+    v0 = wd_start * tied_shape(system.stiffness_reduced(), system.contact_rows(), tied, 1.0,
+                               Eigen::VectorXd::Zero(system.contact_rows().rows()));
+}
+
+EventScales loaded_event_scales(const System& system, const Loading& L, const Eigen::VectorXd& inertia_kg) {
+    const auto& body = system.model().spec().rigid_body;
+    const double k_t = system.tied_stiffness_n_per_m(), f = system.model().whole_spring_factor();
+    auto largest = [](const TimeFunction& F) {
+        double v = std::abs(F.mean) + F.amplitude;
+        for (double x : F.values) v = std::max(v, std::abs(x));
+        return v;
+    };
+    EventScales s;
+    s.omega_t = std::sqrt(k_t / body.mass_kg);
+    const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
+                               f * L.gravity_m_per_s2 * inertia_kg.sum();
+    const double motion_scale = L.kind == LoadingKind::base_excitation ? largest(L.displacement_m) : 0.0;
+    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / s.omega_t +
+              force_scale / k_t + motion_scale;
+    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
+    s.V_ref = s.omega_t * s.L_ref;
+    double preload = 0.0;
+    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
+    s.F_ref = std::max(preload, k_t / f * s.L_ref);
+    return s;
+}
+
+}  // namespace stackbeam::detail

@@ -1,0 +1,90 @@
+#pragma once
+// Internal: the loadings of the modal leaf-inertia stepper (cvode_modal.cpp): the loading's
+// terms of its right-hand side and contact problem, the quasi-static rest of the modes above
+// the cut under the loading, the start from the static state, and the event scales
+// (docs/decisions/026-loaded-modal-stepper.md).
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/fe/system.hpp"
+#include "stackbeam/model/loading.hpp"
+#include "stackbeam/time/simulation.hpp"
+
+namespace stackbeam::detail {
+
+/// A loading with the leaves' own inertia (loading.hpp), q(t) = e_w F(t)/f - (g + y_b''(t)) l on
+/// the reduced DOFs, written as two channels q(t) = B u(t):
+///     u_0(t) = -(g + y_b''(t)) [m/s^2]   on  b_0 = l = System::vertical_inertia_kg() [kg]
+///     u_1(t) = F(t) / f [N]              on  b_1 = e_w
+/// (gravity on every mass, the base's inertial force in the supports' frame, the force on R),
+/// projected on the retained modes Phi (mass-normalised, circular frequencies omega) and on the
+/// residual flexibility R = K^-1 - Phi Omega^-2 Phi^T of the modes above the cut. With the
+/// mode-acceleration split z = Phi eta + R (G^T p + q):
+///     eta'' + Omega^2 eta = Phi^T G^T p + Fq u(t)                       Fq = Phi^T B       (r x 2)
+///     s = W p + G Phi eta + Hq u(t) - d                                 Hq = G R B         (n x 2)
+///     w = Phi_w eta + (R G^T)_w p + wq^T u(t)                          wq = (R B)_w       (2)
+/// and the loading's work int q^T dz = [q^T z] - int q'^T z dt with
+///     q^T z = u^T (Fq^T eta + Hq^T p + Rqq u),                         Rqq = B^T R B      (2 x 2)
+/// so the work needs u' but never p' (the quasi-static rest jumps with p at an event).
+/// The rig (a prescribed displacement) is not a channel: see the decision note.
+class ModalLoad {
+public:
+    /// The loading `prepared` (Loading::prepare(true)) on `system` with the retained modes Phi,
+    /// omega [rad/s] and K's factorisation `kf`.
+    ModalLoad(const System& system, const Loading& prepared, const Eigen::MatrixXd& Phi, const Eigen::VectorXd& omega,
+              const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& kf);
+
+    /// The channels' values u(t) and their first and second time derivatives.
+    struct Values {
+        Eigen::Vector2d u = Eigen::Vector2d::Zero(), ud = Eigen::Vector2d::Zero(), udd = Eigen::Vector2d::Zero();
+    };
+    Values at(double t_s) const;
+    /// True when q is zero at every t (initial conditions only).
+    bool none() const noexcept { return none_; }
+    /// The weight of the stack and R on the reduced DOFs, -g l [N per DOF, meshed part] (the static stage's load).
+    Eigen::VectorXd weight() const { return -load_.gravity_m_per_s2 * l_; }
+
+    Eigen::MatrixXd Fq;   ///< Phi^T B, r x 2
+    Eigen::MatrixXd Hq;   ///< G R B [m per unit u], n x 2
+    Eigen::Vector2d wq;   ///< (R B)_w [m per unit u]
+    Eigen::Matrix2d Rqq;  ///< B^T R B
+    Eigen::MatrixXd RB;   ///< R B [m per unit u], ndof x 2 (the nodes' quasi-static part)
+
+    /// (B v)^T z at (eta, p, u) [J, meshed part, per unit of v / u], z = Phi eta + R (G^T p + B u):
+    /// v = u gives q^T z, v = u' the rate q'^T z of the work's integral.
+    double q_dot_z(const Eigen::Ref<const Eigen::VectorXd>& eta, const Eigen::Ref<const Eigen::VectorXd>& p,
+                   const Eigen::Vector2d& u, const Eigen::Vector2d& v) const {
+        return v.dot(Fq.transpose() * eta + Hq.transpose() * p + Rqq * u);
+    }
+
+private:
+    Loading load_;
+    Eigen::VectorXd l_;
+    double f_ = 1.0;
+    bool none_ = true;
+};
+
+/// The loadings the modal stepper takes: all but the rig; throws InputError naming loading.kind
+/// for a prescribed displacement.
+void require_modal_loading(const Loading& loading);
+
+/// The start of the modal stepper under a loading (as mode newmark and the massive stack): the
+/// assembly and gravity's static equilibrium of the whole stack with R free (static_stages, the
+/// leaves' weight `weight` [N per DOF]), then R held at w(0) if it is not there; the leaves move
+/// with R in the tied shape of the rows closed there times w'(0) (base excitation: relative to
+/// the supports). `laws` the contact problem's pairs and tau rule; p [N] and d [m] (anchors
+/// re-set) on exit. Returns z(0) in z0 and z'(0) in v0.
+void modal_initial_state(const System& system, const ContactProblem& laws, const SimulationOptions& options,
+                         const Eigen::VectorXd& weight, Eigen::VectorXd& z0, Eigen::VectorXd& v0, Eigen::VectorXd& p,
+                         Eigen::VectorXd& d);
+
+/// The event scales of a stack under a loading: L_ref [m] R's amplitude on the tied stack from
+/// its initial conditions plus the loading's static deflection and the base's travel, V_ref
+/// [m/s] = omega_t L_ref, F_ref [N] the largest preload or the tied stack's force at L_ref.
+struct EventScales {
+    double L_ref = 1e-3, V_ref = 1.0, F_ref = 1.0, omega_t = 1.0;
+};
+EventScales loaded_event_scales(const System& system, const Loading& loading, const Eigen::VectorXd& inertia_kg);
+
+}  // namespace stackbeam::detail
