@@ -207,10 +207,9 @@ struct CvodeModalStepper::Impl final : EventDriver {
 
 };
 
-CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptions& options)
-    : EventStepper(std::make_unique<Impl>(system, options)) {
+CvodeModalStepper::CvodeModalStepper(const System& system, const InitialState& start)
+    : EventStepper(std::make_unique<Impl>(system, start.options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(false);
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double> M = system.mass_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();
