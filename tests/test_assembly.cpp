@@ -1,5 +1,5 @@
 // Free camber and the assembly of the stack (model.hpp LeafSpec::free_camber_m,
-// simulation.hpp require_no_assembly): the two-leaf nip against its closed form, the
+// simulation.hpp "assembly"): the two-leaf nip against its closed form, the
 // static rate unchanged by the preload, the friction loop grown by it, and a graduated
 // spring's rate against the leaf-end contact theory and the SAE formula.
 #define BOOST_TEST_MODULE assembly

@@ -48,15 +48,4 @@ Eigen::VectorXd tied_shape(const Eigen::SparseMatrix<double>& K, const Eigen::Sp
     return z;
 }
 
-
-void require_uniform_leaf_mass(const System& system, const char* mode_name) {
-    const auto& leaves = system.model().spec().leaves;
-    for (std::size_t i = 1; i < leaves.size(); ++i)
-        if ((leaves[i].density_kg_per_m3 > 0.0) != (leaves[0].density_kg_per_m3 > 0.0))
-            throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
-                             "value " + format_value(leaves[i].density_kg_per_m3) + " with leaves[0] at " +
-                                 format_value(leaves[0].density_kg_per_m3) + ": mode " + mode_name +
-                                 " needs every leaf massive (> 0) or every leaf massless (0)");
-}
-
 }  // namespace stackbeam::detail

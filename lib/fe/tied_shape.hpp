@@ -20,8 +20,4 @@ namespace stackbeam::detail {
 Eigen::VectorXd tied_shape(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& G,
                            const std::vector<int>& tied, double w, const Eigen::VectorXd& d);
 
-/// Every leaf massive (density > 0) or every leaf massless: throws InputError naming the
-/// first leaf that differs from leaves[0] (mode `mode_name` cannot run a mix).
-void require_uniform_leaf_mass(const System& system, const char* mode_name);
-
 }  // namespace stackbeam::detail

@@ -219,17 +219,6 @@ double Loading::base_velocity_m_per_s(double t) const {
     return kind == LoadingKind::base_excitation ? displacement_m.derivative(t) : 0.0;
 }
 
-void require_initial_conditions_only(const Loading& loading, const std::string& context) {
-    if (loading.kind != LoadingKind::initial_conditions)
-        throw InputError("loading.kind", std::string("value '") + to_string(loading.kind) + "' is not available in " +
-                                             context + " yet (leaves with mass): only 'initial-conditions'; "
-                                             "use massless leaves (modes closed-form, cvode) for this loading");
-    if (loading.gravity_m_per_s2 != 0.0)
-        throw InputError("loading.gravity_m_per_s2", "value " + format_value(loading.gravity_m_per_s2) +
-                                                         " is not available in " + context +
-                                                         " yet (leaves with mass): give 0, or use massless leaves");
-}
-
 double Loading::period_s() const {
     switch (kind) {
         case LoadingKind::applied_force: return force_n.period_s();

@@ -8,91 +8,34 @@
 #include "model/mesh_note.hpp"
 #include "time/contact_state.hpp"
 #include "time/record.hpp"
+#include "time/initial_state.hpp"
 #include "time/static_stages.hpp"
 
 namespace stackbeam {
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
-    : system_(system), options_(options) {
-    options_.validate();
-    require_massless_leaves(system_, Mode::closed_form);
-    require_no_damping(options_, "mode closed-form");
-    options_.loading.prepare();
+    : ClosedFormStepper(system, detail::initial_state("closed-form", system, options)) {}
+
+ClosedFormStepper::ClosedFormStepper(const System& system, const detail::InitialState& start)
+    : system_(system), options_(start.options), path_(start.path), problem_(start.laws), z_(start.z),
+      solve_(start.solve), p_(start.p), d_(start.d), w_(start.w0_m), wd_(start.wd0_m_per_s), rig_(start.rig) {
     const Loading& load = options_.loading;
-    rig_ = load.kind == LoadingKind::prescribed_displacement;
-    require_loading_fits(system_.model().spec(), load);
-    path_ = choose_contact_path(system_, options_);
     const int n = system_.num_components();
     const double k = system_.stiffness_n_per_m();
-    const double m = system_.mass_kg();
     f_ = system_.model().whole_spring_factor();
     m_whole_ = system_.model().spec().rigid_body.mass_kg;
     report_.mode = Mode::closed_form;
-    omega_ = std::sqrt(k / m);
+    omega_ = std::sqrt(k / system_.mass_kg());
     const double x = omega_ * options_.dt_s;
     cos_ = std::cos(x);
     sin_ = std::sin(x);
     // gamma = 1 - sin(x)/x, by its series where the subtraction would cancel
     gamma_ = x < 1e-3 ? x * x / 6.0 - x * x * x * x / 120.0 : 1.0 - sin_ / x;
-
-    problem_.pairs = system_.pairs();
-    problem_.tau_rule = options_.tau_rule;
-    problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
-    const auto& c = system_.coupling();
-    d_ = system_.initial_offsets_m();
-    p_ = Eigen::VectorXd::Zero(n);
-    const auto& rb = system_.model().spec().rigid_body;
-    const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
-    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    const int nz = static_cast<int>(K.rows());
-    w_dof_ = nz - 1;
-    if (path_ == ContactPath::sparse) {
-        krw_ = Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1));
-        gw_ = Eigen::VectorXd(G.col(w_dof_));
-    }
-
-    // 0. Assembly (free camber, clips): the leaves bolted from their free shapes, one quasi-static
-    //    step with no force on R (the interference of the offsets d resolved, with friction;
-    //    simulation.hpp, "assembly"), its sticking forces the initial state.
-    // 1. Gravity: the static equilibrium under R's weight, one quasi-static load step
-    //    from the unloaded (assembled) stack (loading.hpp): k w - c^T p = F_e, s = C'p + c w - d.
-    w_ = 0.0;
-    if (path_ == ContactPath::dense) {
-        const bool assemble = needs_assembly(system_.model().spec()) && n > 0;
-        for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
-            if (stage == 0 ? !assemble : !(load.gravity_m_per_s2 > 0.0)) continue;
-            const double Fs = stage == 0 ? 0.0 : -m * load.gravity_m_per_s2;  // [N] on the meshed part
-            const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
-            auto solver = make_solver(options_.solver);
-            const detail::StaticState st = detail::static_equilibrium_dense(system_, problem_, Fs, *solver, p_, d_, what);
-            w_ = st.w_m;
-            solve_ = st.solve;
-        }
-    } else {
-        // the same stages on the whole sparse system, as the leaf-mass steppers take them (massless
-        // leaves: the weight is R's, -m g on w)
-        Eigen::VectorXd weight = Eigen::VectorXd::Zero(nz);
-        weight[w_dof_] = -m * load.gravity_m_per_s2;
-        if (detail::static_stages(system_, problem_, weight, options_, z_, p_, d_, &solve_)) w_ = z_[w_dof_];
-    }
-    // 2. The initial state: w(0), w'(0) (rig: the prescribed motion; base excitation:
-    //    relative to the supports, whose velocity the initial absolute velocity excludes).
-    double w_start = w_ + rb.initial_displacement_m;
-    wd_ = rb.initial_velocity_m_per_s - load.base_velocity_m_per_s(0.0);
-    if (rig_) {
-        w_start = load.displacement_m.value(0.0);
-        wd_ = load.displacement_m.derivative(0.0);
-    }
-
+    const Eigen::VectorXd& c = system_.coupling();
+    w_dof_ = system_.num_reduced_dofs() - 1;
+    // The initial state (the assembly, gravity, R held at w(0): initial_state.hpp) is the start's.
     if (path_ == ContactPath::dense) {
         solver_ = make_solver(options_.solver);
-        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
-            problem_.W = system_.compliance_held();
-            problem_.q = c * w_start - d_;
-            solve_ = solver_->solve(problem_, p_);
-            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
-        }
-        w_ = w_start;
         // The rig holds R: each step is quasi-static with R held (W = C'); otherwise eq. 16.
         problem_.W = rig_ ? system_.compliance_held()
                           : Eigen::MatrixXd(system_.compliance_held() + (gamma_ / k) * c * c.transpose());
@@ -106,23 +49,12 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
                                        " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
         const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
         sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
-        if (z_.size() == 0) z_ = system_.reduced_displacements(p_, w_);
-        // R held at w(0): the problem on z_r (the rig's steps pose it at w_p(t))
-        SparseContactProblem held = detail::sparse_problem(system_, problem_, {}, d_, w_start);
-        if (w_start != w_ && n > 0) {  // initial contact state with R held at w(0)
-            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
-            Eigen::VectorXd zr;
-            solve_ = initial.solve(held, p_, zr);
-            if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
-            z_.head(w_dof_) = zr;
-            z_[w_dof_] = w_start;
-        }
-        w_ = w_start;
-        if (rig_) {
-            sparse_problem_ = std::move(held);
-        } else {
-            // R free on the augmented stiffness K_aug = K + k_R e_w e_w^T
-            sparse_problem_ = detail::sparse_problem(system_, problem_, {}, d_, std::nan(""));
+        const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
+        krw_ = Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1));
+        gw_ = Eigen::VectorXd(system_.contact_rows().col(w_dof_));
+        // the rig: R held at w_p(t) on z_r; otherwise R free on K_aug = K + k_R e_w e_w^T
+        sparse_problem_ = detail::sparse_problem(system_, problem_, {}, d_, rig_ ? w_ : std::nan(""));
+        if (!rig_) {
             k_r_ = k * one_minus_gamma / gamma_;
             sparse_problem_.K.coeffRef(w_dof_, w_dof_) += k_r_;
             sparse_problem_.K.makeCompressed();

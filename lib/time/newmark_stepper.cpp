@@ -13,7 +13,7 @@
 #include "time/reduced_load.hpp"
 #include "time/rig_reaction.hpp"
 #include "time/stack_properties.hpp"
-#include "time/static_stages.hpp"
+#include "time/initial_state.hpp"
 #include "fe/tied_shape.hpp"
 
 namespace stackbeam {
@@ -27,111 +27,68 @@ struct NewmarkStepper::Factor {
 NewmarkStepper::~NewmarkStepper() = default;
 
 NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
-    : system_(system), options_(options), factor_(std::make_unique<Factor>()) {
-    options_.validate();
+    : NewmarkStepper(system, detail::initial_state(system.model().spec().leaves.empty() ||
+                                                           !(system.model().spec().leaves[0].density_kg_per_m3 > 0.0)
+                                                       ? "newmark-massless"
+                                                       : "newmark-massive",
+                                                   system, options)) {}
+
+NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState& start)
+    : system_(system), options_(start.options), path_(start.path), factor_(std::make_unique<Factor>()),
+      problem_(start.laws), solve_(start.solve), z_(start.z), v_(start.v0), p_(start.p), d_(start.d), rig_(start.rig) {
     report_.mode = Mode::newmark;
-    detail::require_uniform_leaf_mass(system_, "newmark");
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
-    if (!massive_leaves_) require_no_damping(options_, "mode newmark with massless leaves");
-    options_.loading.prepare(massive_leaves_);
-    require_loading_fits(system_.model().spec(), options_.loading);
-    const Loading& L = options_.loading;
-    rig_ = L.kind == LoadingKind::prescribed_displacement;
-    if (rig_ && !massive_leaves_)
-        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode newmark with "
-                                         "massless leaves (the leaves have no inertia to integrate): use mode "
-                                         "closed-form, or give the leaves a density > 0");
-    if (rig_ && detail::first_rigid_pair(system_) >= 0)
-        throw InputError("loading.kind", "value 'prescribed-displacement' with massive leaves and rigid contact is not "
-                                         "available in mode newmark (the impact law would move the rig's seat): give the "
-                                         "interfaces an elastic layer (interfaces[i].contact = 'elastic')");
-    load_ = std::make_unique<detail::ReducedLoad>(system_, L);
-    path_ = choose_contact_path(system_, options_);
-    const double dt = options_.dt_s;
-    const int m = system_.num_components();
+    load_ = std::make_unique<detail::ReducedLoad>(system_, options_.loading);
     K_ = system_.stiffness_reduced();
     M_ = system_.mass_reduced();
     if (options_.damping.active()) {  // structural damping C = alpha M + beta K (massive leaves)
         C_ = options_.damping.rayleigh_alpha_per_s * M_ + options_.damping.rayleigh_beta_s * K_;
         C_.makeCompressed();
     }
-    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    const int n = static_cast<int>(K_.rows());
-    const int w_dof = n - 1;
-    const auto& body = system_.model().spec().rigid_body;
-
-    problem_.pairs = system_.pairs();
-    problem_.tau_rule = options_.tau_rule;
-    problem_.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(problem_.pairs.size()));
-    d_ = system_.initial_offsets_m();
-    p_ = Eigen::VectorXd::Zero(m);
-    // Gravity: the static equilibrium of the whole stack under its weight (the leaves' and R's,
-    // loading.hpp) first, from the unloaded stack; then R held at w(0) plus that sag (the rig:
-    // w_p(0)) with the weight on. Base excitation: the velocity relative to the supports.
-    // The assembly (free camber, clips: detail::static_stages) comes before gravity.
-    const Eigen::VectorXd weight = -L.gravity_m_per_s2 * load_->inertia_kg();
-    const bool pre_stressed = detail::static_stages(system_, problem_, weight, options_, z_, p_, d_, &solve_);
-    const double w_static = pre_stressed ? z_[w_dof] : 0.0;
-    const double w0 = rig_ ? L.displacement_m.value(0.0) : w_static + body.initial_displacement_m;
-    const double wd0 = rig_ ? L.displacement_m.derivative(0.0) : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
-
-    // Initial contact state with R held at w(0), as in the closed-form mode; the leaves
-    // start at that static shape.
-    if (pre_stressed) {
-        if (w0 != w_static)
-            z_ = detail::static_state(system_, problem_, weight, w0, options_, p_, d_, "initial contact state", &solve_);
-    } else if (w0 != 0.0 && m > 0) {
-        if (path_ == ContactPath::dense) {
-            ContactProblem held = problem_;
-            held.W = system_.compliance_held();
-            held.q = system_.coupling() * w0 - d_;
-            solve_ = make_solver(options_.solver)->solve(held, p_);
-        } else {
-            const SparseContactProblem held = detail::sparse_problem(system_, problem_, {}, d_, w0);
-            SparseContactSolver initial(options_.solver, options_.sparse_tuning);
-            Eigen::VectorXd zr;
-            solve_ = initial.solve(held, p_, zr);
-        }
-        if (!solve_.converged) throw SolverError("initial contact state: " + solve_.message, 0, 0.0, solve_.residual_m);
-    }
-    if (!pre_stressed) z_ = system_.reduced_displacements(p_, w0);
+    // The initial state (the assembly, gravity, R held at w(0), the leaves moving with R in the
+    // tied shape: initial_state.hpp) is the start's.
     rel_ = detail::relative_positions(system_, z_, p_);
+    if (massive_leaves_) {
+        factor_->mass.compute(M_);
+        if (factor_->mass.info() != Eigen::Success)
+            throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
+    }
+    initial_accelerations();
+    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
+    // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
+    if (massive_leaves_ && system_.num_components() > 0 && path_ == ContactPath::dense) {
+        Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
+        const Eigen::MatrixXd A = G * Z_;
+        A_ = 0.5 * (A + A.transpose());
+    }
+    factorise_step();
+    solve_ = SolveResult{};
+    solve_.converged = true;
+    fill_record(0, 0);
+    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
+    record_.energy_balance_error_j = 0.0;
+}
 
+void NewmarkStepper::initial_accelerations() {
     // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.
+    const int n = static_cast<int>(K_.rows());
     massless_.assign(static_cast<std::size_t>(n), 0);
     std::vector<int> massive;
     for (int i = 0; i < n; ++i) {
         if (M_.coeff(i, i) > 0.0) massive.push_back(i);
         else massless_[i] = 1;
     }
-
-    // Leaves all massive (contact between massive points: impacts, velocity projection) or
-    // all massless (the paper's statically condensed contact): a mix was refused above.
-    if (!massive_leaves_ && options_.restitution > 0.0)
-        throw InputError("restitution", "value " + format_value(options_.restitution) +
-                                            " is not used with massless leaves (no impacts: the contact points are "
-                                            "condensed statically): give 0, or a leaf density > 0");
-
-    // Initial velocity: w'(0) times the static shape per unit w with the closed contact
-    // components tied (bilateral ones always; unilateral ones whose gap is closed; their
-    // tangential component too when it carries friction or is bonded).
-    v_ = Eigen::VectorXd::Zero(n);
-    if (wd0 != 0.0) v_ = wd0 * detail::tied_shape(K_, G, detail::closed_rows(problem_.pairs, rel_, d_), 1.0, Eigen::VectorXd::Zero(m));
-    // Initial acceleration from the equations of motion on the massive DOFs:
-    // M_SS a_S = (G^T p0 - K z0 + q(0))_S (the massless rows of the residual are zero: static
-    // shape); the rig's reaction keeps w'' = w_p''(0) (accelerations_with_rig).
-    a_ = Eigen::VectorXd::Zero(n);
+    // From the equations of motion on the massive DOFs: M_SS a_S = (G^T p0 - K z0 + q(0))_S (the
+    // massless rows of the residual are zero: static shape); the rig's reaction keeps
+    // w'' = w_p''(0) (accelerations_with_rig).
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     const Eigen::VectorXd r0 = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0) -
                                (C_.nonZeros() > 0 ? Eigen::VectorXd(C_ * v_) : Eigen::VectorXd::Zero(n));
-    if (massive_leaves_) {
-        factor_->mass.compute(M_);
-        if (factor_->mass.info() != Eigen::Success)
-            throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
-    }
     if (rig_) {  // M^-1 e_w, once: the rig's reaction per unit force
         Eigen::VectorXd ew = Eigen::VectorXd::Zero(n);
-        ew[w_dof] = 1.0;
+        ew[n - 1] = 1.0;
         u_w_ = factor_->mass.solve(ew);
         a_ = accelerations_with_rig(0.0, r0, &rig_force_);
     } else {
@@ -148,22 +105,17 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
     }
     for (int i = 0; i < n; ++i)
         if (massless_[i]) v_[i] = a_[i] = 0.0;
+}
 
-    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
-    // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
-    if (massive_leaves_) {
-        if (m > 0 && path_ == ContactPath::dense) {
-            Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
-            const Eigen::MatrixXd A = G * Z_;
-            A_ = 0.5 * (A + A.transpose());
-        }
-    }
-
+void NewmarkStepper::factorise_step() {
     // K_eff = K + 4 M / dt^2, factorised once. The contact force enters the step as
     // kappa G^T p1: kappa = 1 (massless leaves: the trapezoidal rule) or 2 (massive leaves:
     // the contact impulse over the step is dt p1, newmark_stepper.hpp).
     // The rig: w1 = w_p(t1) is given, so the step solves the rows of z_r only (the "free" DOFs F:
     // K_eff,rr z_r1 = r_r - K_eff,rw w1 + kappa G_r^T p1, s = G_r z_r1 + G_w w1 + c_L p1 - d).
+    const double dt = options_.dt_s;
+    const int n = static_cast<int>(K_.rows()), w_dof = n - 1, m = system_.num_components();
+    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     const double kappa = massive_leaves_ ? 2.0 : 1.0;
     Eigen::SparseMatrix<double> Keff = K_ + (4.0 / (dt * dt)) * M_;
     if (C_.nonZeros() > 0) Keff += (2.0 / dt) * C_;  // the trapezoidal damping force -C (z1 - z0) / dt
@@ -196,11 +148,6 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
         sparse_problem_.tau_rule = problem_.tau_rule;
         sparse_problem_.tau_previous_n = problem_.tau_previous_n;
     }
-    solve_ = SolveResult{};
-    solve_.converged = true;
-    fill_record(0, 0);
-    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
-    record_.energy_balance_error_j = 0.0;
 }
 
 Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {

@@ -124,45 +124,6 @@ void SimulationOptions::validate() const {
                                              to_string(solver.kind) + "')");
 }
 
-void require_massless_leaves(const System& system, Mode mode) {
-    const auto& leaves = system.model().spec().leaves;
-    for (std::size_t i = 0; i < leaves.size(); ++i)
-        if (leaves[i].density_kg_per_m3 != 0.0)
-            throw InputError("leaves[" + std::to_string(i) + "].density_kg_per_m3",
-                             "value " + format_value(leaves[i].density_kg_per_m3) + " is not used by mode " +
-                                 to_string(mode) + ", which treats the leaves as massless (the paper): give 0 "
-                                 "(mode newmark integrates the leaves' inertia)");
-}
-
-void require_no_assembly(const ModelSpec& model, Mode mode) {
-    const std::string only = std::string(" is not available in mode ") + to_string(mode) +
-                             " yet: the assembly and the clips' limit are honoured in mode closed-form, in mode newmark "
-                             "and, with leaf mass on elastic interfaces, in mode cvode's massive stack";
-    const std::string why = only + " (use one of them)";
-    for (std::size_t i = 0; i < model.leaves.size(); ++i)
-        for (const auto& [key, v] : {std::pair<const char*, double>{"free_camber_m", model.leaves[i].free_camber_m},
-                                     {"free_radius_m", model.leaves[i].free_radius_m}})
-            if (v != 0.0)
-                throw InputError("leaves[" + std::to_string(i) + "]." + key, "value " + format_value(v) + ": a free camber" + why);
-    if (!model.clips.empty()) throw InputError("clips[0]", "a rebound clip" + why);
-    for (std::size_t i = 0; i < model.interfaces.size(); ++i)
-        if (model.interfaces[i].initial_gap_m < 0.0)
-            throw InputError("interfaces[" + std::to_string(i) + "].initial_gap_m",
-                             "value " + format_value(model.interfaces[i].initial_gap_m) + ": an interference (a gap < 0)" + only +
-                                 " (use one of them, or a gap >= 0)");
-}
-
-void require_no_damping(const SimulationOptions& options, const std::string& stepper) {
-    const StructuralDamping& c = options.damping;
-    if (!c.active()) return;
-    const bool alpha = c.rayleigh_alpha_per_s > 0.0;
-    throw InputError(alpha ? "damping.rayleigh_alpha_per_s" : "damping.rayleigh_beta_s",
-                     "value " + format_value(alpha ? c.rayleigh_alpha_per_s : c.rayleigh_beta_s) +
-                         ": structural damping is taken by the leaf-mass integrators only (mode newmark with "
-                         "massive leaves; mode cvode with the whole massive stack: leaves with mass and an elastic "
-                         "layer on every contact row), not by " + stepper + " (give 0)");
-}
-
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     const auto& rb = model.rigid_body;
     if (loading.kind == LoadingKind::prescribed_displacement) {
@@ -180,9 +141,8 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading) {
 std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
                                  const std::function<void(const StepRecord&)>& on_step, RunReport* report,
                                  const PairObserver& on_pairs, const NodeObserver& on_nodes) {
-    options.validate();
+    const std::unique_ptr<Stepper> stepper = make_stepper(system, options);  // validates the options
     const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
-    const std::unique_ptr<Stepper> stepper = make_stepper(system, options);
     std::vector<StepRecord> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
     for (long i = 0; i <= n; ++i) {

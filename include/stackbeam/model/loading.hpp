@@ -117,9 +117,5 @@ struct Loading {
     double period_s() const;
 };
 
-/// For integrators that take only the paper's initial conditions (the leaf-inertia
-/// modes so far): throws InputError naming loading.kind or loading.gravity_m_per_s2,
-/// with `context` (e.g. "mode newmark") in the message, when anything else acts.
-void require_initial_conditions_only(const Loading& loading, const std::string& context);
 
 }  // namespace stackbeam

@@ -249,7 +249,7 @@ private:
 double free_curvature_per_m(const LeafSpec& leaf);
 /// Whether any leaf has a free camber.
 bool has_free_camber(const ModelSpec& spec);
-/// Whether a run of the model starts with the assembly (simulation.hpp, require_no_assembly): a
+/// Whether a run of the model starts with the assembly (simulation.hpp, "assembly"): a
 /// free camber, a rebound clip or an interference (an interface's initial_gap_m < 0).
 bool needs_assembly(const ModelSpec& spec);
 

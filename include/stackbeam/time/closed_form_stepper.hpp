@@ -21,6 +21,9 @@
 #include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
+namespace detail {
+struct InitialState;  // internal: the shared set-up stage (lib/time/initial_state.hpp)
+}
 
 /// The paper's closed-form stepping (mode "closed-form").
 ///
@@ -33,7 +36,11 @@ namespace stackbeam {
 /// k + k_R = k/gamma). So both paths solve the same problem, to round-off.
 class ClosedFormStepper final : public Stepper {
 public:
+    /// Checks `options` (SimulationOptions::validate and what the mode takes: InputError) and
+    /// starts from the shared initial state (the assembly, gravity, R held at w(0)).
     ClosedFormStepper(const System& system, const SimulationOptions& options);
+    /// From the shared set-up stage's state (make_stepper).
+    ClosedFormStepper(const System& system, const detail::InitialState& start);
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
     /// contact solve fails and options.stop_on_nonconvergence.

@@ -76,12 +76,17 @@
 namespace stackbeam {
 namespace detail {
 class ReducedLoad;
+struct InitialState;  // internal: the shared set-up stage (lib/time/initial_state.hpp)
 }
 
 class NewmarkStepper final : public Stepper {
 public:
-    /// Throws InputError for bad options (and on the sparse path with a solver other than exact).
+    /// Throws InputError for bad options (SimulationOptions::validate and what the mode takes with
+    /// the stack's leaf mass; on the sparse path a solver other than exact); starts from the
+    /// shared initial state (the assembly, gravity, R held at w(0)).
     NewmarkStepper(const System& system, const SimulationOptions& options);
+    /// From the shared set-up stage's state (make_stepper).
+    NewmarkStepper(const System& system, const detail::InitialState& start);
     ~NewmarkStepper() override;
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
@@ -139,6 +144,10 @@ private:
     Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)
     double damping_energy_ = 0.0;              // its work [J, meshed part]
     void fill_record(int iterations, int factorizations);
+    /// The accelerations at t = 0 from the equations of motion (the massless DOFs condensed).
+    void initial_accelerations();
+    /// K_eff factorised and the step's contact problem (W, or the sparse problem on K_eff / kappa).
+    void factorise_step();
     /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
     Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;
     double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);

@@ -156,36 +156,29 @@ struct SimulationOptions {
 /// dense otherwise. Throws InputError for the sparse path with a solver other than exact.
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options);
 
-/// The assembly of a spring that needs it (needs_assembly: a leaf with a free camber,
-/// LeafSpec::free_camber_m, an interference, InterfaceSpec::initial_gap_m < 0, or rebound clips,
-/// which close initial gaps wider than their clearance): every run of mode
-/// closed-form, newmark and cvode's massive stack starts from the assembled, pre-stressed stack. The leaves start in their
-/// free shapes, anchored there (d_t = 0), touching wherever their offsets d_n (interface gap plus
-/// the free shapes' difference, PairSpec::initial_gap_m) are <= 0; the centre bolt (the rigid
-/// body's seat) and the clamps pull them together in one quasi-static, monotonic load step with
-/// no force on R: the contact problem of that step (the interfaces' Coulomb friction included,
-/// incremental from the free shapes) resolves the interference; pairs that stick keep their
-/// anchors and tangential forces as the initial sticking state, the others are re-anchored where
-/// they slid to. Gravity's static step then follows from the assembled state, then w(0), w'(0).
-/// The steppers that do not assemble (mode cvode with massless leaves, its modal and
-/// held-for-good leaf-inertia steppers) call require_no_assembly, which throws InputError naming
-/// leaves[i].free_camber_m (or free_radius_m), clips[0] or interfaces[i].initial_gap_m when the
-/// model needs the assembly.
-void require_no_assembly(const ModelSpec& model, Mode mode);
-
-/// Structural damping (SimulationOptions::damping) is taken by mode newmark with massive leaves
-/// and mode cvode with the massive stack only: every other stepper calls this, which throws InputError naming
-/// damping.rayleigh_alpha_per_s (or _beta_s) when damping is set, `stepper` in the message.
-void require_no_damping(const SimulationOptions& options, const std::string& stepper);
+// The assembly of a spring that needs it (needs_assembly: a leaf with a free camber,
+// LeafSpec::free_camber_m, an interference, InterfaceSpec::initial_gap_m < 0, or rebound clips,
+// which close initial gaps wider than their clearance): every run of mode
+// closed-form, newmark and cvode's massive stack starts from the assembled, pre-stressed stack. The leaves start in their
+// free shapes, anchored there (d_t = 0), touching wherever their offsets d_n (interface gap plus
+// the free shapes' difference, PairSpec::initial_gap_m) are <= 0; the centre bolt (the rigid
+// body's seat) and the clamps pull them together in one quasi-static, monotonic load step with
+// no force on R: the contact problem of that step (the interfaces' Coulomb friction included,
+// incremental from the free shapes) resolves the interference; pairs that stick keep their
+// anchors and tangential forces as the initial sticking state, the others are re-anchored where
+// they slid to. Gravity's static step then follows from the assembled state, then w(0), w'(0).
+// A stepper that does not assemble (mode cvode with massless leaves, its modal and
+// held-for-good leaf-inertia steppers) refuses such a model where it is chosen (make_stepper):
+// an InputError naming leaves[i].free_camber_m (or free_radius_m), clips[0] or
+// interfaces[i].initial_gap_m, and the steppers that take the assembly.
+//
+// Structural damping (SimulationOptions::damping) is taken by mode newmark with massive leaves
+// and mode cvode with the massive stack only; elsewhere make_stepper refuses it (InputError
+// naming damping.rayleigh_alpha_per_s or _beta_s).
 
 /// Throws InputError when the model's initial conditions contradict the loading
 /// (a prescribed displacement fixes w(0) and w'(0) itself).
 void require_loading_fits(const ModelSpec& model, const Loading& loading);
-
-/// The closed-form and cvode modes treat the leaves as massless (the paper). A leaf
-/// with a density > 0 would be silently ignored there: this throws InputError naming
-/// it (leaves[i].density_kg_per_m3) instead. modal.hpp uses the density.
-void require_massless_leaves(const System& system, Mode mode);
 
 struct RunReport;  // run_report.hpp
 

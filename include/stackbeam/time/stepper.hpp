@@ -46,7 +46,10 @@ public:
 /// ClosedFormStepper; newmark -> NewmarkStepper; cvode -> CvodeStepper with massless
 /// leaves, and with leaf mass (a density > 0) the leaf-inertia variants (docs/time-integration.md):
 /// held-for-good contact on bonded and frictionless stacks, modal inertia with events
-/// when a pair has friction. Throws InputError for options the mode refuses.
+/// when a pair has friction, the whole massive stack on elastic interfaces. Validates `options`
+/// (SimulationOptions::validate) and throws InputError for what the chosen stepper does not take,
+/// naming the field, its value and the steppers that take it (one check against the stepper's
+/// capabilities: lib/time/stepper_registry.hpp, docs/time-integration.md).
 std::unique_ptr<Stepper> make_stepper(const System& system, const SimulationOptions& options);
 
 }  // namespace stackbeam

@@ -13,6 +13,7 @@
 #include "time/record.hpp"
 #include "fe/tied_shape.hpp"
 #include "time/cvode/sundials.hpp"
+#include "time/initial_state.hpp"
 
 namespace stackbeam::detail {
 
@@ -47,6 +48,89 @@ struct CvodeHeldStepper::Impl {
     long out_index = 0, num_out = 0;
     StepRecord rec;
     CvodeStats st;
+
+    /// The held rows (bonded: both components; frictionless: the normal one): rigid ones held
+    /// (Gd, dC), those with an elastic layer springs in K (K = K_leaves + G_L^T D G_L).
+    void split_rows() {
+        const auto& pairs = sys.pairs();
+        for (std::size_t j = 0; j < pairs.size(); ++j) {
+            const auto& pr = pairs[j];
+            const Eigen::VectorXd& layer = sys.layer_compliance_m_per_n();
+            for (int row : {pr.row_n, pr.kind == PairKind::bonded ? pr.row_t : -1}) {
+                if (row < 0) continue;
+                (layer[row] > 0.0 ? springs : held).push_back(row);
+            }
+        }
+        K = sys.stiffness_reduced();
+        {
+            const int ns = static_cast<int>(springs.size());
+            const Eigen::SparseMatrix<double, Eigen::RowMajor> Grow = sys.contact_rows();
+            std::vector<Eigen::Triplet<double>> t;
+            DL.resize(ns);
+            dL.resize(ns);
+            for (int k = 0; k < ns; ++k) {
+                const int row = springs[k];
+                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Grow, row); it; ++it)
+                    t.emplace_back(k, static_cast<int>(it.col()), it.value());
+                DL[k] = 1.0 / sys.layer_compliance_m_per_n()[row];
+                dL[k] = sys.initial_offsets_m()[row];
+            }
+            GL.resize(ns, K.cols());
+            GL.setFromTriplets(t.begin(), t.end());
+            const Eigen::SparseMatrix<double> GLt = GL.transpose();
+            if (ns > 0) K = (K + GLt * DL.asDiagonal() * GL).pruned();  // rigid stacks: K as it was
+            fL = GLt * DL.cwiseProduct(dL);
+        }
+        M = sys.mass_reduced();
+        n = static_cast<int>(K.rows());
+        const int m = static_cast<int>(held.size());
+        {
+            const Eigen::MatrixXd Gall(sys.contact_rows());
+            Gd.resize(m, n);
+            dC.resize(m);
+            for (int k = 0; k < m; ++k) {
+                Gd.row(k) = Gall.row(held[k]);
+                dC[k] = sys.initial_offsets_m()[held[k]];
+            }
+        }
+        laws.pairs = pairs;
+        laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    }
+
+    /// The null space N of the held rows, the particular solution z_p and the modes (Phi, om)
+    /// of (N^T K N, N^T M N); throws InputError when the held stack has no free motion.
+    void null_space_modes() {
+        // null(G) from a QR of G^T: its last n - rank columns of Q
+        const int m = static_cast<int>(held.size());
+        const Eigen::VectorXd& d = dC;
+        if (m > 0) {
+            Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Gd.transpose());
+            const int rank = static_cast<int>(qr.rank());
+            r = n - rank;
+            const Eigen::MatrixXd Q = qr.householderQ();
+            N = Q.rightCols(r);
+            GGt.compute(Gd * Gd.transpose());
+            zp = Gd.transpose() * GGt.solve(d);
+        } else {  // no contact pair: every DOF free
+            r = n;
+            N = Eigen::MatrixXd::Identity(n, n);
+            zp = Eigen::VectorXd::Zero(n);
+        }
+        if (r < 1) throw InputError("mode", "value 'cvode' with leaf inertia: the held stack has no free motion");
+        Mt = N.transpose() * (M * N);
+        const Eigen::MatrixXd Kt = N.transpose() * (K * N);
+        if (Eigen::LLT<Eigen::MatrixXd>(Mt).info() != Eigen::Success)
+            throw InputError("leaves[].density_kg_per_m3", "mode cvode with leaf inertia needs every leaf massive (> 0)");
+        Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kt, Mt);
+        if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() <= 0.0)
+            throw SolverError("cvode mode (leaf inertia): the modal analysis of the held stack failed", 0, 0.0, 0.0);
+        Phi = eig.eigenvectors();
+        om = eig.eigenvalues().cwiseSqrt();
+        g = springs.empty() ? Eigen::VectorXd(-Phi.transpose() * Eigen::VectorXd(N.transpose() * (K * zp)))
+                            : Eigen::VectorXd(Phi.transpose() * Eigen::VectorXd(N.transpose() * (fL - K * zp)));
+        NPhi = N * Phi;
+    }
+    Eigen::MatrixXd Mt;        // N^T M N
 
     std::unique_ptr<CvodeSession> cvode;
 
@@ -127,104 +211,21 @@ struct CvodeHeldStepper::Impl {
 
 CvodeHeldStepper::~CvodeHeldStepper() = default;
 
-CvodeHeldStepper::CvodeHeldStepper(const System& system, const SimulationOptions& options)
-    : impl_(std::make_unique<Impl>(system, options)) {
+CvodeHeldStepper::CvodeHeldStepper(const System& system, const InitialState& start)
+    : impl_(std::make_unique<Impl>(system, start.options)) {
     Impl& s = *impl_;
-    s.opt.validate();
-    require_uniform_leaf_mass(system, "cvode");
-    require_initial_conditions_only(s.opt.loading, "mode cvode with leaf mass");
-    require_no_assembly(system.model().spec(), Mode::cvode);
-    require_no_damping(s.opt, "mode cvode with a bonded or frictionless stack");
-    const auto& pairs = system.pairs();
-    for (std::size_t j = 0; j < pairs.size(); ++j) {
-        const auto& pr = pairs[j];
-        if (pr.kind != PairKind::bonded && pr.friction_coefficient != 0.0)
-            throw InputError("mode", std::string("value 'cvode' with leaves of density > 0 handles bonded and frictionless "
-                                                 "stacks only so far (pair ") + std::to_string(j) + " is " +
-                                         to_string(pr.kind) + " with mu = " + format_value(pr.friction_coefficient) +
-                                         ": contact events between massive leaves are not built yet): use mode newmark");
-        const Eigen::VectorXd& layer = system.layer_compliance_m_per_n();
-        for (int row : {pr.row_n, pr.kind == PairKind::bonded ? pr.row_t : -1}) {
-            if (row < 0) continue;
-            (layer[row] > 0.0 ? s.springs : s.held).push_back(row);
-        }
-    }
-    s.K = system.stiffness_reduced();
-    {
-        const int ns = static_cast<int>(s.springs.size());
-        const Eigen::SparseMatrix<double, Eigen::RowMajor> Grow = system.contact_rows();
-        std::vector<Eigen::Triplet<double>> t;
-        s.DL.resize(ns);
-        s.dL.resize(ns);
-        for (int k = 0; k < ns; ++k) {
-            const int row = s.springs[k];
-            for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Grow, row); it; ++it)
-                t.emplace_back(k, static_cast<int>(it.col()), it.value());
-            s.DL[k] = 1.0 / system.layer_compliance_m_per_n()[row];
-            s.dL[k] = system.initial_offsets_m()[row];
-        }
-        s.GL.resize(ns, s.K.cols());
-        s.GL.setFromTriplets(t.begin(), t.end());
-        const Eigen::SparseMatrix<double> GLt = s.GL.transpose();
-        if (ns > 0) s.K = (s.K + GLt * s.DL.asDiagonal() * s.GL).pruned();  // rigid stacks: K as it was
-        s.fL = GLt * s.DL.cwiseProduct(s.dL);
-    }
-    s.M = system.mass_reduced();
-    s.n = static_cast<int>(s.K.rows());
-    const int m = static_cast<int>(s.held.size());
-    {
-        const Eigen::MatrixXd Gall(system.contact_rows());
-        s.Gd.resize(m, s.n);
-        s.dC.resize(m);
-        for (int k = 0; k < m; ++k) {
-            s.Gd.row(k) = Gall.row(s.held[k]);
-            s.dC[k] = system.initial_offsets_m()[s.held[k]];
-        }
-    }
-    s.laws.pairs = pairs;
-    s.laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
-    // null(G) from a QR of G^T: its last n - rank columns of Q
-    const Eigen::VectorXd& d = s.dC;
-    if (m > 0) {
-        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(s.Gd.transpose());
-        const int rank = static_cast<int>(qr.rank());
-        s.r = s.n - rank;
-        const Eigen::MatrixXd Q = qr.householderQ();
-        s.N = Q.rightCols(s.r);
-        s.GGt.compute(s.Gd * s.Gd.transpose());
-        s.zp = s.Gd.transpose() * s.GGt.solve(d);
-    } else {  // no contact pair: every DOF free
-        s.r = s.n;
-        s.N = Eigen::MatrixXd::Identity(s.n, s.n);
-        s.zp = Eigen::VectorXd::Zero(s.n);
-    }
-    if (s.r < 1) throw InputError("mode", "value 'cvode' with leaf inertia: the held stack has no free motion");
-    const Eigen::MatrixXd Mt = s.N.transpose() * (s.M * s.N);
-    const Eigen::MatrixXd Kt = s.N.transpose() * (s.K * s.N);
-    if (Eigen::LLT<Eigen::MatrixXd>(Mt).info() != Eigen::Success)
-        throw InputError("leaves[].density_kg_per_m3", "mode cvode with leaf inertia needs every leaf massive (> 0)");
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kt, Mt);
-    if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() <= 0.0)
-        throw SolverError("cvode mode (leaf inertia): the modal analysis of the held stack failed", 0, 0.0, 0.0);
-    s.Phi = eig.eigenvectors();
-    s.om = eig.eigenvalues().cwiseSqrt();
-    s.g = s.springs.empty() ? Eigen::VectorXd(-s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.K * s.zp)))
-                            : Eigen::VectorXd(s.Phi.transpose() * Eigen::VectorXd(s.N.transpose() * (s.fL - s.K * s.zp)));
-    s.NPhi = s.N * s.Phi;
+    s.split_rows();
+    s.null_space_modes();
 
     // initial state: the tied static shape at w(0), the tied shape per unit w times w'(0)
-    const auto& body = system.model().spec().rigid_body;
-    const Eigen::VectorXd z0 =
-        tied_shape(s.K, system.contact_rows(), s.held, body.initial_displacement_m, system.initial_offsets_m());
-    const Eigen::VectorXd v0 = body.initial_velocity_m_per_s *
-                               tied_shape(s.K, system.contact_rows(), s.held, 1.0,
-                                          Eigen::VectorXd::Zero(system.num_components()));
-
+    const Eigen::VectorXd z0 = tied_shape(s.K, system.contact_rows(), s.held, start.w0_m, system.initial_offsets_m());
+    const Eigen::VectorXd v0 = start.wd0_m_per_s * tied_shape(s.K, system.contact_rows(), s.held, 1.0,
+                                                              Eigen::VectorXd::Zero(system.num_components()));
     s.cvode = std::make_unique<CvodeSession>("cvode mode (leaf inertia)", 2 * s.r);
     {
         // xi = Phi^T Mt q (Phi^T Mt Phi = I), q = N^T (z - z_p)
-        const Eigen::VectorXd xi = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * (z0 - s.zp)));
-        const Eigen::VectorXd xid = s.Phi.transpose() * (Mt * Eigen::VectorXd(s.N.transpose() * v0));
+        const Eigen::VectorXd xi = s.Phi.transpose() * (s.Mt * Eigen::VectorXd(s.N.transpose() * (z0 - s.zp)));
+        const Eigen::VectorXd xid = s.Phi.transpose() * (s.Mt * Eigen::VectorXd(s.N.transpose() * v0));
         auto Y = s.cvode->y();
         for (int i = 0; i < s.r; ++i) {
             Y[2 * i] = s.om[i] * xi[i];
@@ -236,6 +237,7 @@ CvodeHeldStepper::CvodeHeldStepper(const System& system, const SimulationOptions
     // energy (a leaf mode carrying 1e-8 of the energy is not resolved to rtol of its own
     // amplitude: BDF damps it), and at least the user's atol on w as an energy-norm
     // amplitude of the body's mode, sqrt(m) omega atol_m.
+    const auto& body = system.model().spec().rigid_body;
     const double omega = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
     s.F_ref = system.tied_stiffness_n_per_m() / system.model().whole_spring_factor() *
               std::max(std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega, 1e-6);

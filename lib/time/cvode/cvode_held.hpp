@@ -14,7 +14,7 @@
 // coordinates of B it is block diagonal (2 x 2 blocks), so the direct solver is a band one
 // (half-bandwidths 1, 1).
 // Stacks with friction (pairs that may stick or slip) run CvodeModalStepper (cvode_modal.hpp);
-// called directly with one, this stepper refuses it (InputError naming `mode`).
+// its row of the registry (stepper_registry.hpp) takes no friction.
 #include <Eigen/Dense>
 #include <memory>
 #include <vector>
@@ -22,12 +22,14 @@
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "time/initial_state.hpp"
 
 namespace stackbeam::detail {
 
 class CvodeHeldStepper final : public Stepper {
 public:
-    CvodeHeldStepper(const System& system, const SimulationOptions& options);
+    /// From the shared set-up stage's state (initial_state.hpp; the options checked there).
+    CvodeHeldStepper(const System& system, const InitialState& start);
     ~CvodeHeldStepper() override;
     /// Integrates to the next output time (t = i dt_s) and returns its record.
     const StepRecord& advance() override;

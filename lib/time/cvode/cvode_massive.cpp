@@ -78,18 +78,6 @@ namespace {
 using SpMat = Eigen::SparseMatrix<double>;
 using RowSpMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-/// The scenario field that makes contact row `row` of pair kk rigid, for the message.
-std::string rigid_row_field(const System& system, int kk) {
-    const PairSpec& ps = system.pair_spec(kk);
-    const auto& spec = system.model().spec();
-    if (ps.kind == PairKind::clamp) {
-        for (std::size_t j = 0; j < spec.clamps.size(); ++j)
-            if (std::abs(spec.clamps[j].x_m - ps.x_m) <= system.model().x_tolerance_m())
-                return "clamps[" + std::to_string(j) + "].length_m";
-    }
-    return "interfaces[" + std::to_string(ps.interface_index) + "].contact";
-}
-
 }  // namespace
 
 struct CvodeMassiveStepper::Impl final : EventDriver {
@@ -113,6 +101,42 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     // the Newton matrix M + gamma C + gamma^2 K_eff of the current modes
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> nlu;
     double gamma_lu = -1.0;
+
+    /// The witness scales (as the modal stepper): R's amplitude on the tied stack and its
+    /// frequency, with the loading's scales: the applied force's largest value [N, whole spring],
+    /// the weight of everything [N, whole spring], the base's or the rig's largest displacement [m].
+    void set_scales() {
+        const auto& body = sys.model().spec().rigid_body;
+        const Loading& L = opt.loading;
+        omega_t = std::sqrt(sys.tied_stiffness_n_per_m() / body.mass_kg);
+        auto largest = [](const TimeFunction& F) {
+            double v = std::abs(F.mean) + F.amplitude;
+            for (double x : F.values) v = std::max(v, std::abs(x));
+            return v;
+        };
+        const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
+                                   f * L.gravity_m_per_s2 * load->inertia_kg().sum();
+        const double motion_scale = L.kind == LoadingKind::base_excitation || rig ? largest(L.displacement_m) : 0.0;
+        L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t +
+                force_scale / sys.tied_stiffness_n_per_m() + motion_scale;
+        if (!(L_ref > 0.0)) L_ref = 1e-3;
+        V_ref = omega_t * L_ref;
+        double preload = 0.0;
+        for (const auto& cp : sys.pairs()) preload = std::max(preload, cp.preload_n);
+        F_ref = std::max(preload, sys.tied_stiffness_n_per_m() / f * L_ref);
+    }
+    double omega_t = 1.0;  // R's frequency on the tied stack [rad/s]
+
+    /// CVODE's tolerances: displacements and rotations to atol_m, velocities to omega_t atol_m,
+    /// the dissipated energy to rtol of the initial energy (z0, v0: the initial state).
+    void set_tolerances(const Eigen::VectorXd& z0, const Eigen::VectorXd& v0) {
+        auto A = cvode->atol();
+        A.head(ndof).setConstant(opt.cvode.atol_m);
+        A.segment(ndof, ndof).setConstant(omega_t * opt.cvode.atol_m);
+        const double e_meshed = 0.5 * v0.dot(M * v0) + 0.5 * z0.dot(K * z0) +
+                                0.5 * sys.tied_stiffness_n_per_m() / f * L_ref * L_ref;
+        A[2 * ndof] = A[2 * ndof + 1] = A[2 * ndof + 2] = std::max(1e-300, opt.cvode.rtol * e_meshed);
+    }
 
     // ---- modes ------------------------------------------------------------------
 
@@ -374,33 +398,15 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
 };
 
-CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationOptions& options)
-    : EventStepper(std::make_unique<Impl>(system, options)) {
+CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const InitialState& start)
+    : EventStepper(std::make_unique<Impl>(system, start.options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(true);  // every loading; damping
-    s.opt.loading.prepare(true);
-    require_loading_fits(system.model().spec(), s.opt.loading);
-    if (!has_leaf_mass(system))
-        throw InputError("leaves[0].density_kg_per_m3", "value 0: the massive-stack cvode stepper needs leaves with mass");
-    const Eigen::VectorXd& cL = system.layer_compliance_m_per_n();
-    if (const int kk = first_rigid_pair(system); kk >= 0) {
-        const auto& cp = system.pairs()[kk];
-        const std::string field = rigid_row_field(system, kk);
-        const bool clamp = cp.kind == PairKind::clamp && field.rfind("clamps", 0) == 0;
-        throw InputError(field, std::string("value ") + (clamp ? "0" : "'rigid'") +
-                                    ": mode cvode integrates the whole massive stack (cvode.leaf_inertia 'massive') only "
-                                    "with an elastic layer on every contact row (a rigid contact point with mass has no "
-                                    "force law: every transition would be an impulse). Give " +
-                                    (clamp ? field + " > 0 on an elastic interface" : field + " = 'elastic'") +
-                                    ", or cvode.leaf_inertia = 'modal'");
-    }
     s.K = system.stiffness_reduced();
     s.M = system.mass_reduced();
     const SpMat& G = system.contact_rows();
     s.Grow = G;
     s.Gt = G.transpose();
-    s.cL = cL;
-    const auto& body = system.model().spec().rigid_body;
+    s.cL = system.layer_compliance_m_per_n();
     if (s.damped()) {
         s.C = s.opt.damping.rayleigh_alpha_per_s * s.M + s.opt.damping.rayleigh_beta_s * s.K;
         s.C.makeCompressed();
@@ -408,81 +414,39 @@ CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const SimulationO
     s.mass.compute(s.M);
     if (s.mass.info() != Eigen::Success || !(s.mass.vectorD().minCoeff() > 0.0))
         throw SolverError(s.who + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
-    const Loading& L = s.opt.loading;
-    s.load = std::make_unique<ReducedLoad>(system, L);
-    s.rig = L.kind == LoadingKind::prescribed_displacement;
+    s.load = std::make_unique<ReducedLoad>(system, s.opt.loading);
+    s.rig = start.rig;
     if (s.rig) {
         Eigen::VectorXd ew = Eigen::VectorXd::Zero(s.ndof);
         ew[s.w_dof] = 1.0;
         s.u_w = s.mass.solve(ew);
     }
-
-    // scales (as the modal stepper): R's amplitude on the tied stack and its frequency
-    const double omega_t = std::sqrt(system.tied_stiffness_n_per_m() / body.mass_kg);
-    // the loading's scales: the applied force's largest value [N, whole spring], the weight of
-    // everything [N, whole spring], the base's or the rig's largest displacement [m]
-    auto largest = [](const TimeFunction& F) {
-        double v = std::abs(F.mean) + F.amplitude;
-        for (double x : F.values) v = std::max(v, std::abs(x));
-        return v;
-    };
-    const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
-                               s.f * L.gravity_m_per_s2 * s.load->inertia_kg().sum();
-    const double motion_scale =
-        L.kind == LoadingKind::base_excitation || s.rig ? largest(L.displacement_m) : 0.0;
-    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t +
-              force_scale / system.tied_stiffness_n_per_m() + motion_scale;
-    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
-    s.V_ref = omega_t * s.L_ref;
-    double preload = 0.0;
-    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
-    s.F_ref = std::max(preload, system.tied_stiffness_n_per_m() / s.f * s.L_ref);
-
+    s.set_scales();
     // the instantaneous compliance: only the layer (z is held by the leaves' inertia)
-    const Eigen::MatrixXd W = cL.asDiagonal();
-    s.init_problems(W, 1e-9 * s.F_ref * cL.maxCoeff());
+    const Eigen::MatrixXd W = s.cL.asDiagonal();
+    s.init_problems(W, 1e-9 * s.F_ref * s.cL.maxCoeff());
     s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
     s.init_slots();
 
-    // initial state (as mode newmark): under gravity the static equilibrium of the whole stack
-    // under its weight and R's first (loading.hpp); then the leaves in the static shape with R
-    // held at w(0) (the rig: w_p(0)) and the leaves' weight on, moving with R in the tied shape
-    // per unit w times w'(0) (base excitation: relative to the supports; the rig: w_p'(0))
-    Eigen::VectorXd p_init = Eigen::VectorXd::Zero(s.n);
-    const Eigen::VectorXd weight = -L.gravity_m_per_s2 * s.load->inertia_kg();
-    Eigen::VectorXd z0 = Eigen::VectorXd::Zero(s.ndof);
-    static_stages(system, s.chk_problem, weight, s.opt, z0, p_init, s.d);  // the assembly, then gravity
-    const double w_start = s.rig ? L.displacement_m.value(0.0) : z0[s.w_dof] + body.initial_displacement_m;
-    const double wd_start = s.rig ? L.displacement_m.derivative(0.0)
-                                  : body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
-    if (w_start != z0[s.w_dof])
-        z0 = static_state(system, s.chk_problem, weight, w_start, s.opt, p_init, s.d, "initial contact state");
-    const std::vector<int> tied = closed_rows(system.pairs(), detail::relative_positions(system, z0, p_init), s.d);
-    const Eigen::VectorXd v0 = wd_start * tied_shape(s.K, G, tied, 1.0, Eigen::VectorXd::Zero(s.n));
+    // the initial state (as mode newmark, initial_state.hpp): the assembly and the static
+    // equilibrium under the weight of everything, the leaves in the static shape with R held at
+    // w(0) (the rig: w_p(0)), moving with R in the tied shape per unit w times w'(0)
+    s.d = start.d;
     s.nstate = 2 * s.ndof + 3;
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
     auto Y = s.cvode->y();
-    Y.head(s.ndof) = z0;
-    Y.segment(s.ndof, s.ndof) = v0;
+    Y.head(s.ndof) = start.z;
+    Y.segment(s.ndof, s.ndof) = start.v0;
     Y[2 * s.ndof] = Y[2 * s.ndof + 1] = Y[2 * s.ndof + 2] = 0.0;
 
     // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
-    s.solve_initial_forces(G * z0, p_init);
+    Eigen::VectorXd p_init = start.p;
+    s.solve_initial_forces(G * start.z, p_init);
     modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.build_mode();
     s.decide_modes(0.0, Y, p_init, "start");
-
-    // tolerances: displacements and rotations to atol_m, velocities to omega_t atol_m, the
-    // dissipated energy to rtol of the initial energy
-    {
-        auto A = s.cvode->atol();
-        A.head(s.ndof).setConstant(s.opt.cvode.atol_m);
-        A.segment(s.ndof, s.ndof).setConstant(omega_t * s.opt.cvode.atol_m);
-        const double e_meshed = 0.5 * v0.dot(s.M * v0) + 0.5 * z0.dot(s.K * z0) +
-                                0.5 * system.tied_stiffness_n_per_m() / s.f * s.L_ref * s.L_ref;
-        A[2 * s.ndof] = A[2 * s.ndof + 1] = A[2 * s.ndof + 2] = std::max(1e-300, s.opt.cvode.rtol * e_meshed);
-    }
+    s.set_tolerances(start.z, start.v0);
     s.start_record(Y);
     const EventDriver::StiffIntegrator stiff{2, &Impl::psetup, &Impl::psolve};
     s.start_cvode(&Impl::rhs, &stiff);

@@ -276,14 +276,9 @@ struct CvodeModalStepper::Impl final : EventDriver {
 
 };
 
-CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptions& options)
-    : EventStepper(std::make_unique<Impl>(system, options)) {
+CvodeModalStepper::CvodeModalStepper(const System& system, const InitialState& start)
+    : EventStepper(std::make_unique<Impl>(system, start.options)) {
     Impl& s = static_cast<Impl&>(*driver_);
-    s.require_leaf_inertia_options(true);  // every loading but the rig (below), the assembly
-    require_no_damping(s.opt, "mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal')");
-    require_modal_loading(s.opt.loading);
-    s.opt.loading.prepare(true);
-    require_loading_fits(system.model().spec(), s.opt.loading);
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
     const Eigen::SparseMatrix<double> M = system.mass_reduced();
     const Eigen::SparseMatrix<double>& G = system.contact_rows();
@@ -349,8 +344,10 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const SimulationOptio
     // retained modes: q = Omega^-2 Phi^T K z (= Phi^T M z for exact eigenvectors; this one makes
     // Phi q + R K z = z exactly whatever the eigen-solve's residual, so a static state stays
     // static), q' = Phi^T M z' (mass-normalised)
-    Eigen::VectorXd z0, v0, p_init = Eigen::VectorXd::Zero(s.n);
-    modal_initial_state(system, s.chk_problem, s.opt, s.load->weight(), z0, v0, p_init, s.d);
+    const Eigen::VectorXd& z0 = start.z;  // the shared stage (initial_state.hpp: whole_stack_static)
+    const Eigen::VectorXd& v0 = start.v0;
+    Eigen::VectorXd p_init = start.p;
+    s.d = start.d;
     s.init_grid();
     s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
     auto Y = s.cvode->y();

@@ -3,6 +3,7 @@
 // (cvode_modal.cpp, docs/time-integration.md).
 #include "stackbeam/time/simulation.hpp"
 #include "time/cvode/event_driver.hpp"
+#include "time/initial_state.hpp"
 
 namespace stackbeam::detail {
 
@@ -13,7 +14,8 @@ namespace stackbeam::detail {
 /// massless cvode mode (docs/time-integration.md).
 class CvodeModalStepper final : public EventStepper {
 public:
-    CvodeModalStepper(const System& system, const SimulationOptions& options);
+    /// From the shared set-up stage's state (initial_state.hpp; the options checked there).
+    CvodeModalStepper(const System& system, const InitialState& start);
 
 private:
     struct Impl;

@@ -13,7 +13,7 @@
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/event_driver.hpp"
 #include "time/record.hpp"
-#include "time/static_stages.hpp"
+#include "time/initial_state.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
@@ -230,28 +230,17 @@ struct CvodeStepper::Impl final : detail::EventDriver {
 };
 
 CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options)
-    : impl_(std::make_unique<Impl>(system, options)) {
+    : CvodeStepper(system, detail::initial_state("cvode-massless", system, options)) {}
+
+CvodeStepper::CvodeStepper(const System& system, const detail::InitialState& start)
+    : impl_(std::make_unique<Impl>(system, start.options)) {
     Impl& s = *impl_;
-    s.opt.validate();
-    require_massless_leaves(system, Mode::cvode);
-    require_no_assembly(system.model().spec(), Mode::cvode);
-    require_no_damping(s.opt, "mode cvode with massless leaves");
-    if (s.opt.loading.kind == LoadingKind::prescribed_displacement)
-        throw InputError("loading.kind", "value 'prescribed-displacement' is not available in mode cvode with massless "
-                                         "leaves: with w(t) imposed there is no equation of motion to integrate, each "
-                                         "step is quasi-static (use mode closed-form, whose step is then exact)");
-    s.require_current_tau_rule();
     s.c = system.coupling();
     s.k = system.stiffness_n_per_m();
     s.m = system.mass_kg();
-    s.load = s.opt.loading;
-    s.load.prepare();
-    require_loading_fits(system.model().spec(), s.load);
+    s.load = start.options.loading;
     s.m_whole = system.model().spec().rigid_body.mass_kg;
     s.nstate = s.load.is_free() ? 3 : 4;
-    double w0 = system.model().spec().rigid_body.initial_displacement_m;
-    // base excitation: w is relative to the supports, the initial velocity absolute (loading.hpp)
-    const double wd0 = system.model().spec().rigid_body.initial_velocity_m_per_s - s.load.base_velocity_m_per_s(0.0);
     // The largest external force over the run (sampled; table points included) sets a
     // displacement scale F_e/k for the witnesses (gravity: the static deflection).
     double fe_max = 0.0;
@@ -263,7 +252,8 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     const double k_tied = system.num_components() > 0 ? system.tied_stiffness_n_per_m() / s.f : s.k;
     const double omega_free = std::sqrt(s.k / s.m);
     s.omega_ref = std::sqrt(std::max(k_tied, s.k) / s.m);
-    s.L_ref = std::abs(w0) + std::abs(wd0) / omega_free + fe_max / s.k;
+    s.L_ref = std::abs(system.model().spec().rigid_body.initial_displacement_m) +
+              std::abs(start.wd0_m_per_s) / omega_free + fe_max / s.k;
     if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;  // at rest: nothing moves; any scale will do
     double preload = 0.0;
     for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
@@ -276,24 +266,14 @@ CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& option
     // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
     s.init_problems(system.compliance_held(), 1e-10 * s.L_ref);
 
-    // Gravity: the static equilibrium under R's weight first (as the closed-form mode):
-    // k w - c^T p = -m g, s = C'p + c w - d, then the non-stuck pairs re-anchored.
-    Eigen::VectorXd p0 = Eigen::VectorXd::Zero(s.n);
-    double w_static = 0.0;
-    if (s.load.gravity_m_per_s2 > 0.0) {
-        w_static = detail::static_equilibrium_dense(system, s.ev_problem, -s.m * s.load.gravity_m_per_s2, *s.ev_solver,
-                                                    p0, s.d, "static equilibrium under gravity")
-                       .w_m;
-        w0 += w_static;
-    }
-    // Initial contact state with R held at w(0) (as the closed-form mode), then the modes.
-    if (w0 != w_static && s.n > 0) s.solve_initial_forces(s.c * w0, p0);
-    detail::modes_from_solution(s.chk_problem, p0, 1e-12 * s.F_ref, s.nmode, s.tmode);
+    // The initial state (gravity's static step, R held at w(0): initial_state.hpp), then the modes.
+    s.d = start.d;
+    detail::modes_from_solution(s.chk_problem, start.p, 1e-12 * s.F_ref, s.nmode, s.tmode);
     s.cvode = std::make_unique<detail::CvodeSession>(s.who, s.nstate);
     auto y0 = s.cvode->y();
-    y0[0] = w0;
-    y0[1] = wd0;
-    s.decide_modes(0.0, y0, p0, "start");
+    y0[0] = start.w0_m;
+    y0[1] = start.wd0_m_per_s;
+    s.decide_modes(0.0, y0, start.p, "start");
     auto at = s.cvode->atol();
     at[0] = s.opt.cvode.atol_m;                 // w [m]
     at[1] = s.opt.cvode.atol_m * s.omega_ref;   // w' [m/s]

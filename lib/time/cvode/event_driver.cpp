@@ -35,23 +35,6 @@ double EventDriver::seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-void EventDriver::require_current_tau_rule() const {
-    if (opt.tau_rule != TauRule::current)
-        throw InputError("tau_rule", "mode cvode takes the friction limit from the current normal force "
-                                     "(tau rule 'current'); 'previous-step' is a fixed-step device of the paper");
-}
-
-void EventDriver::require_leaf_inertia_options(bool massive_stack) const {
-    opt.validate();
-    require_uniform_leaf_mass(sys, "cvode");
-    if (!massive_stack) {  // the massive stack takes the assembly, every loading and structural damping
-        require_no_assembly(sys.model().spec(), Mode::cvode);
-        require_initial_conditions_only(opt.loading, "mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal')");
-        require_no_damping(opt, "mode cvode with modal leaf inertia");
-    }
-    require_current_tau_rule();
-}
-
 void EventDriver::finish_inertia_record(StepRecord& rec, double kinetic_j, double force_on_mass_n,
                                         double damping_energy_j) const {
     rec.leaf_kinetic_energy_j = kinetic_j - rec.kinetic_energy_j;

@@ -90,12 +90,6 @@ public:
 
     const std::vector<ContactPair>& pairs() const { return chk_problem.pairs; }
 
-    /// Throws InputError unless the tau rule is 'current'.
-    void require_current_tau_rule() const;
-    /// The checks of the steppers with leaf inertia: the options valid, uniform leaf density,
-    /// the tau rule 'current'; no assembly, initial conditions as the only loading and no
-    /// structural damping unless `massive_stack` (the massive stack takes them all).
-    void require_leaf_inertia_options(bool massive_stack) const;
     /// Completes a record of a stepper with leaf inertia: the kinetic energy [J] of the leaves
     /// and R (the leaves' share apart), m w'' [N], the damping energy [J] and the balance
     /// with the record's external work, strain energy and dissipation.

@@ -59,31 +59,6 @@ ModalLoad::Values ModalLoad::at(double t_s) const {
     return v;
 }
 
-void require_modal_loading(const Loading& loading) {
-    if (loading.kind == LoadingKind::prescribed_displacement)
-        throw InputError("loading.kind", std::string("value '") + to_string(loading.kind) +
-                                             "': mode cvode with modal leaf inertia (cvode.leaf_inertia = 'modal') "
-                                             "takes every loading but the rig; use mode newmark, or "
-                                             "cvode.leaf_inertia = 'massive' on elastic interfaces");
-}
-
-void modal_initial_state(const System& system, const ContactProblem& laws, const SimulationOptions& options,
-                         const Eigen::VectorXd& weight, Eigen::VectorXd& z0, Eigen::VectorXd& v0, Eigen::VectorXd& p,
-                         Eigen::VectorXd& d) {
-    const auto& body = system.model().spec().rigid_body;
-    const Loading& L = options.loading;
-    const int w_dof = system.num_reduced_dofs() - 1;
-    z0 = Eigen::VectorXd::Zero(system.num_reduced_dofs());
-    static_stages(system, laws, weight, options, z0, p, d);  // the assembly, then gravity
-    const double w_start = z0[w_dof] + body.initial_displacement_m;
-    const double wd_start = body.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
-    if (w_start != z0[w_dof])
-        z0 = static_state(system, laws, weight, w_start, options, p, d, "initial contact state");
-    const std::vector<int> tied = closed_rows(laws.pairs, relative_positions(system, z0, p), d);
-    v0 = wd_start * tied_shape(system.stiffness_reduced(), system.contact_rows(), tied, 1.0,
-                               Eigen::VectorXd::Zero(system.contact_rows().rows()));
-}
-
 EventScales loaded_event_scales(const System& system, const Loading& L, const Eigen::VectorXd& inertia_kg) {
     const auto& body = system.model().spec().rigid_body;
     const double k_t = system.tied_stiffness_n_per_m(), f = system.model().whole_spring_factor();

@@ -65,20 +65,6 @@ private:
     bool none_ = true;
 };
 
-/// The loadings the modal stepper takes: all but the rig; throws InputError naming loading.kind
-/// for a prescribed displacement.
-void require_modal_loading(const Loading& loading);
-
-/// The start of the modal stepper under a loading (as mode newmark and the massive stack): the
-/// assembly and gravity's static equilibrium of the whole stack with R free (static_stages, the
-/// leaves' weight `weight` [N per DOF]), then R held at w(0) if it is not there; the leaves move
-/// with R in the tied shape of the rows closed there times w'(0) (base excitation: relative to
-/// the supports). `laws` the contact problem's pairs and tau rule; p [N] and d [m] (anchors
-/// re-set) on exit. Returns z(0) in z0 and z'(0) in v0.
-void modal_initial_state(const System& system, const ContactProblem& laws, const SimulationOptions& options,
-                         const Eigen::VectorXd& weight, Eigen::VectorXd& z0, Eigen::VectorXd& v0, Eigen::VectorXd& p,
-                         Eigen::VectorXd& d);
-
 /// The event scales of a stack under a loading: L_ref [m] R's amplitude on the tied stack from
 /// its initial conditions plus the loading's static deflection and the base's travel, V_ref
 /// [m/s] = omega_t L_ref, F_ref [N] the largest preload or the tied stack's force at L_ref.

@@ -1,0 +1,141 @@
+// The shared set-up stage of the steppers (initial_state.hpp).
+#include "time/initial_state.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "stackbeam/errors.hpp"
+#include "fe/tied_shape.hpp"
+#include "time/contact_state.hpp"
+#include "time/cvode/cvode_modes.hpp"
+#include "time/reduced_load.hpp"
+#include "time/static_stages.hpp"
+
+namespace stackbeam::detail {
+
+namespace {
+
+void require_converged(const SolveResult& r) {
+    if (!r.converged) throw SolverError("initial contact state: " + r.message, 0, 0.0, r.residual_m);
+}
+
+/// The massless stack: the assembly and R's weight -m g as static steps (dense: on C' with `solver`;
+/// sparse: on the whole stack), then the contact state with R held at w0 (no re-anchoring).
+void start_massless(const System& sys, InitialState& st, ContactSolver& solver) {
+    const int n = sys.num_components(), w_dof = sys.num_reduced_dofs() - 1;
+    const Loading& L = st.options.loading;
+    const double m = sys.mass_kg();
+    if (st.path == ContactPath::dense) {
+        const bool assemble = needs_assembly(sys.model().spec()) && n > 0;
+        for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
+            if (stage == 0 ? !assemble : !(L.gravity_m_per_s2 > 0.0)) continue;
+            const double Fs = stage == 0 ? 0.0 : -m * L.gravity_m_per_s2;  // [N] on the meshed part
+            const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
+            const StaticState s = static_equilibrium_dense(sys, st.laws, Fs, solver, st.p, st.d, what);
+            st.w_static_m = s.w_m;
+            st.solve = s.solve;
+            st.pre_stressed = true;
+        }
+    } else {
+        Eigen::VectorXd weight = Eigen::VectorXd::Zero(w_dof + 1);
+        weight[w_dof] = -m * L.gravity_m_per_s2;
+        st.pre_stressed = static_stages(sys, st.laws, weight, st.options, st.z, st.p, st.d, &st.solve);
+        if (st.pre_stressed) st.w_static_m = st.z[w_dof];
+        else st.z = sys.reduced_displacements(st.p, 0.0);
+    }
+    const auto& rb = sys.model().spec().rigid_body;
+    st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
+    if (st.w0_m == st.w_static_m || n == 0) return;
+    // the contact state with R held at w(0)
+    if (st.path == ContactPath::dense) {
+        ContactProblem held = st.laws;
+        held.W = sys.compliance_held();
+        held.q = sys.coupling() * st.w0_m - st.d;
+        st.solve = solver.solve(held, st.p);
+        require_converged(st.solve);
+    } else {
+        SparseContactSolver initial(st.options.solver, st.options.sparse_tuning);
+        Eigen::VectorXd zr;
+        st.solve = initial.solve(sparse_problem(sys, st.laws, {}, st.d, st.w0_m), st.p, zr);
+        require_converged(st.solve);
+        st.z.head(w_dof) = zr;
+        st.z[w_dof] = st.w0_m;
+    }
+}
+
+/// The whole stack with leaf mass: the assembly and the weight of everything as static steps, then
+/// R held at w0 with the weight on, the leaves' velocity the tied shape of the closed rows times w'(0).
+void start_whole_stack(const System& sys, InitialState& st, bool always_static) {
+    const int n = sys.num_components(), w_dof = sys.num_reduced_dofs() - 1;
+    const Loading& L = st.options.loading;
+    const Eigen::VectorXd weight = -L.gravity_m_per_s2 * ReducedLoad(sys, L).inertia_kg();
+    st.pre_stressed = static_stages(sys, st.laws, weight, st.options, st.z, st.p, st.d, &st.solve);
+    if (st.z.size() == 0) st.z = Eigen::VectorXd::Zero(w_dof + 1);
+    st.w_static_m = st.pre_stressed ? st.z[w_dof] : 0.0;
+    const auto& rb = sys.model().spec().rigid_body;
+    st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
+    if (st.pre_stressed || always_static) {
+        if (st.w0_m != st.w_static_m)
+            st.z = static_state(sys, st.laws, weight, st.w0_m, st.options, st.p, st.d, "initial contact state", &st.solve);
+    } else {
+        if (st.w0_m != 0.0 && n > 0) {
+            if (st.path == ContactPath::dense) {
+                ContactProblem held = st.laws;
+                held.W = sys.compliance_held();
+                held.q = sys.coupling() * st.w0_m - st.d;
+                st.solve = make_solver(st.options.solver)->solve(held, st.p);
+            } else {
+                SparseContactSolver initial(st.options.solver, st.options.sparse_tuning);
+                Eigen::VectorXd zr;
+                st.solve = initial.solve(sparse_problem(sys, st.laws, {}, st.d, st.w0_m), st.p, zr);
+            }
+            require_converged(st.solve);
+        }
+        st.z = sys.reduced_displacements(st.p, st.w0_m);
+    }
+    st.v0 = Eigen::VectorXd::Zero(w_dof + 1);
+    if (st.wd0_m_per_s != 0.0) {
+        const std::vector<int> tied = closed_rows(st.laws.pairs, relative_positions(sys, st.z, st.p), st.d);
+        st.v0 = st.wd0_m_per_s * tied_shape(sys.stiffness_reduced(), sys.contact_rows(), tied, 1.0, Eigen::VectorXd::Zero(n));
+    }
+}
+
+}  // namespace
+
+InitialState initial_state(const StepperCapabilities& stepper, const System& system, const SimulationOptions& options) {
+    InitialState st;
+    st.options = options;
+    st.options.loading.prepare(stepper.massive_leaves);  // validates the loading for the leaves' mass first
+    check_capabilities(stepper, system, st.options);
+    const Loading& L = st.options.loading;
+    st.path = stepper.mode == Mode::cvode ? ContactPath::dense : choose_contact_path(system, st.options);
+    st.laws.pairs = system.pairs();
+    st.laws.tau_rule = st.options.tau_rule;
+    st.laws.tau_previous_n = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(st.laws.pairs.size()));
+    st.p = Eigen::VectorXd::Zero(system.num_components());
+    st.d = system.initial_offsets_m();
+    st.solve.converged = true;
+    st.rig = L.kind == LoadingKind::prescribed_displacement;
+    const auto& rb = system.model().spec().rigid_body;
+    // base excitation: R's velocity relative to the supports, the initial velocity absolute (loading.hpp)
+    st.wd0_m_per_s = st.rig ? L.displacement_m.derivative(0.0) : rb.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
+    switch (stepper.start) {
+        case StartKind::massless_stack: {
+            const auto solver = make_solver(stepper.exact_start ? event_solver_options(options.solver, options.solver.tolerance_m)
+                                                                : options.solver);
+            start_massless(system, st, *solver);
+            break;
+        }
+        case StartKind::whole_stack: start_whole_stack(system, st, false); break;
+        case StartKind::whole_stack_static: start_whole_stack(system, st, true); break;
+        case StartKind::tied_shape: st.w0_m = rb.initial_displacement_m; break;
+    }
+    return st;
+}
+
+InitialState initial_state(const char* name, const System& system, const SimulationOptions& options) {
+    options.validate();
+    return initial_state(registered_stepper(name), system, options);
+}
+
+}  // namespace stackbeam::detail
