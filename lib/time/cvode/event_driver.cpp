@@ -134,6 +134,7 @@ void EventDriver::enter(const Vec& rel, const std::vector<signed char>& nm, cons
 void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
 
 bool EventDriver::settle_at_state() const { return false; }
+bool EventDriver::settle_after_missed_event() const { return false; }
 
 void EventDriver::in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm,
                                      const std::vector<signed char>& tm, bool build, const std::function<void()>& body) {
@@ -250,20 +251,22 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         ++stats.contact_iterations;
         ++iters_since;
     }
-    if (!decided) {
-        Vec p_la = p_cur;
+    // The modes of the exact solution of ev_problem (its q set), slip signs corrected.
+    const auto decide_by_solving = [&](const std::string& where) {
+        Vec p_sol = p_cur;
         const auto t_solve = Clock::now();
-        const SolveResult res = ev_solver->solve(ev_problem, p_la);
+        const SolveResult res = ev_solver->solve(ev_problem, p_sol);
         stats.contact_time_s += seconds_since(t_solve);
         stats.contact_iterations += res.iterations;
         iters_since += res.iterations;
         if (!res.converged)
-            throw SolverError(who + ": the contact iteration deciding the modes at t = " + format_value(t) + " s (" +
-                                  cause + ") did not converge: " + res.message + mesh_note(sys.model()),
+            throw SolverError(who + ": the contact iteration " + where + " at t = " + format_value(t) + " s (" + cause +
+                                  ") did not converge: " + res.message + mesh_note(sys.model()),
                               stats.steps, t, res.residual_m);
-        modes_from_solution(chk_problem, p_la, 1e-12 * F_ref, nm, tm);
+        modes_from_solution(chk_problem, p_sol, 1e-12 * F_ref, nm, tm);
         correct_decision(y, rel, nm, tm);
-    }
+    };
+    if (!decided) decide_by_solving("deciding the modes");
 
     // A stepper whose state decides every pair by itself (settle_at_state: the massive stack,
     // where only the layer is instantaneous) restarts only in modes that hold at y itself: a
@@ -272,7 +275,10 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     // that root-finding, not the per-step check, finds the next one. Each such transition makes
     // its witness positive at y (closed in tension -> open with the gap c p; penetrating ->
     // closed in compression; over the cone -> slipping; a reversing slip -> sticking at its force).
-    if (settle_at_state() && !slots.empty()) {
+    // The modal stepper does this only at a missed event (settle_after_missed_event): there the
+    // look-ahead's decision can leave a witness negative at y (a force grazing its cone, back
+    // inside a look-ahead later), and root-finding, seeing no sign change, would never leave it.
+    if ((settle_at_state() || (settle_after_missed_event() && cause == "check")) && !slots.empty()) {
         std::vector<double> g(slots.size());
         for (int pass = 0; pass < kSettlePasses; ++pass) {
             bool changed = false;
@@ -284,6 +290,24 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
             if (!changed) break;
             decided = false;  // (nm, tm) changed after the last factorisation
             ++stats.settled_transitions;
+        }
+        // Not settled in kSettlePasses (a coupled contact layer, the modal stepper's W = G R G^T:
+        // one pair's transition moves the others' forces): the modes of the contact problem at y
+        // itself (stuck pairs at their anchors, the others anchored where they are), which hold
+        // at y by construction, slip signs from the rates as after the look-ahead's decision.
+        if (!decided) {
+            bool holds = false;
+            in_candidate_modes(rel, nm, tm, true, [&] {
+                witnesses(y, g.data());
+                holds = std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+            });
+            decided = true;
+            if (!holds) {
+                ev_problem.q = motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
+                decide_by_solving("at the state");
+                decided = false;
+                ++stats.settled_transitions;
+            }
         }
     }
 

@@ -162,6 +162,10 @@ protected:
     /// True when the state y alone decides every pair's modes (no instantaneous coupling but
     /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
     virtual bool settle_at_state() const;
+    /// As settle_at_state, only at the events the per-step check found (cause "check"): a
+    /// decision at the look-ahead that leaves a witness negative at the state would restart
+    /// into the same missed event (default false).
+    virtual bool settle_after_missed_event() const;
     /// Runs `body` in the candidate modes (nm, tm): entered (pairs that start to stick anchored
     /// at rel), factorised if `build`, then the current modes and anchors restored.
     void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
