@@ -30,8 +30,8 @@ enum class StartKind {
     whole_stack,
     /// As whole_stack, R held at w(0) always by a static step (exact, re-anchored).
     whole_stack_static,
-    /// None: the stepper starts its leaves in its own tied shape at w(0) (held-for-good and
-    /// modal leaf inertia, which take initial conditions only).
+    /// None: the stepper starts its leaves in its own tied shape at w(0) (the held-for-good
+    /// stepper, which takes initial conditions only).
     tied_shape,
 };
 
