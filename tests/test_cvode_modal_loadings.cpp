@@ -31,17 +31,9 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
 constexpr double kPi = 3.14159265358979323846;
 
-System stack(PaperCase c, double w0 = 0.0) {
-    ModelSpec spec = with_elastic_interfaces(paper_stack(c, 10, 3));
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = kSteel;
-    for (auto& cl : spec.clamps) cl.length_m = 0.01;
-    spec.rigid_body.initial_displacement_m = w0;
-    spec.rigid_body.initial_velocity_m_per_s = 0.0;
-    return System(Model::build(spec));
-}
+System stack(PaperCase c, double w0 = 0.0) { return System(Model::build(steel_elastic_stack(c, w0))); }
 
 SimulationOptions modal(double t_end_s, double cut_rad_per_s, double rtol = 1e-8) {
     SimulationOptions so;

@@ -39,14 +39,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 /// The paper's bonded (or frictionless) stack of 3 leaves at 10 elements per half leaf, steel
 /// density, elastic interfaces (derived layer), 10 mm clamps (an elastic layer over them).
-System stack(PaperCase c) {
-    ModelSpec spec = with_elastic_interfaces(paper_stack(c, 10, 3));
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = kSteel;
-    for (auto& cl : spec.clamps) cl.length_m = 0.01;
-    spec.rigid_body.initial_displacement_m = 0.0;  // each case sets its own (the paper's R starts at 2 m/s)
-    spec.rigid_body.initial_velocity_m_per_s = 0.0;
-    return System(Model::build(spec));
-}
+System stack(PaperCase c) { return System(Model::build(steel_elastic_stack(c))); }
 
 SimulationOptions options(Mode mode, double t_end_s, double dt_s) {
     SimulationOptions so;

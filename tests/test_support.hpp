@@ -67,6 +67,18 @@ inline ModelSpec with_elastic_interfaces(ModelSpec spec, double k_n_pa_per_m = 0
 /// A graduated spring from the paper's leaf (friction case, mu = 0.5): the main leaf pinned
 /// at both ends, leaf k below it shorter by 72 % of L x k / (leaves - 1) (0.5 m down to
 /// 0.14 m), centred, free ends; two clamps of 1000 N at x = 0.2 and 0.3 m (inside every leaf).
+/// The paper's stack of 3 leaves at 10 elements per half leaf with steel density [kg/m^3],
+/// elastic interfaces (derived layer) and 10 mm clamps (an elastic layer over them); R starts at
+/// w0 [m], at rest (each case sets its own initial conditions or loading).
+inline ModelSpec steel_elastic_stack(PaperCase c, double w0_m = 0.0) {
+    ModelSpec spec = with_elastic_interfaces(paper_stack(c, 10, 3));
+    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = 7850.0;
+    for (auto& cl : spec.clamps) cl.length_m = 0.01;
+    spec.rigid_body.initial_displacement_m = w0_m;
+    spec.rigid_body.initial_velocity_m_per_s = 0.0;
+    return spec;
+}
+
 inline ModelSpec graduated_stack(int elements, int leaves) {
     ModelSpec spec = paper_stack(PaperCase::friction, elements, leaves);
     const double L = spec.leaves[0].length_m;
