@@ -29,11 +29,8 @@
 #include <string>
 #include <map>
 #include <memory>
-#include <random>
 #include <vector>
 
-#include "contact/sparse/mode_solver.hpp"  // the primal route's factor (PrimalFactor below)
-#include "contact/sparse/sparse_path.hpp"
 #include "contact/sparse/switches.hpp"  // the sparse path's internal switches (lib/)
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
@@ -406,8 +403,8 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// simulated ms, contact path (0 automatic: sparse from 1000 rows; 1 sparse), inc (1 the
 /// incremental solve, the default; 0 the way before it: Switches::incremental), schur (> 0:
 /// SparsePathTuning::schur_max_rows; 0 its default), primal (SparsePathTuning::primal_min_rows:
-/// -1 its default, 0 off: the large held sets on the sparse LU, the way before
-/// docs/decisions/027; > 0 that many rows). Counters: wall
+/// -1 its default (0: off), 0 off: the large held sets on the sparse LU; > 0 the primal
+/// route from that many held rows, docs/decisions/027). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -492,10 +489,10 @@ BENCHMARK(ElasticRuns)
     ->Args({400, 2, 1, 100, 0, 1, 0, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1})
     ->Args({50, 1, 1, 100, 0, 1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1})
     ->Args({50, 1, 1, 100, 0, 0, 0, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1})
-    // the primal route (docs/decisions/027) off, the way before it: 10 x 400 graduated and
-    // identical, graduated 100 / 200; and its threshold (primal_min_rows) 100 / 200 / 800
-    ->Args({400, 1, 1, 100, 0, 1, 0, 0})->Args({400, 2, 1, 100, 0, 1, 0, 0})
-    ->Args({100, 1, 1, 100, 0, 1, 0, 0})->Args({200, 1, 1, 100, 0, 1, 0, 0})
+    // the primal route (docs/decisions/027; off by default) from 401 held rows: 10 x 400
+    // graduated and identical, graduated 100 / 200; and its threshold 100 / 200 / 800
+    ->Args({400, 1, 1, 100, 0, 1, 0, 401})->Args({400, 2, 1, 100, 0, 1, 0, 401})
+    ->Args({100, 1, 1, 100, 0, 1, 0, 401})->Args({200, 1, 1, 100, 0, 1, 0, 401})
     ->Args({400, 1, 1, 30, 0, 1, 0, 100})->Args({400, 1, 1, 30, 0, 1, 0, 200})->Args({400, 1, 1, 30, 0, 1, 0, 800})
     // the Schur way's limit (SparsePathTuning::schur_max_rows) with the incremental solve
     ->Args({400, 1, 1, 30, 0, 1, 0, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1})
@@ -503,93 +500,6 @@ BENCHMARK(ElasticRuns)
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
     ->Args({100, 1, 1, 300, 1, 1, 0, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1})
     ->Args({50, 1, 0, 300, 1, 1, 0, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1})
-    ->Unit(benchmark::kMillisecond)->Iterations(1);
-
-/// The primal route's factor (lib/contact/sparse/primal_solver.cpp, docs/decisions/027) on the
-/// graduated or identical 10-leaf x 400 elastic stack's contact problem after 5 closed-form
-/// steps: every pair closed and stuck (the broadest held set), then sets that differ by `rank`
-/// layer rows from the factor's (rows leaving and returning), by cholmod_updown and, for the
-/// same sets, by a numeric refactorisation on the same ordering. args: stack (1 graduated, 2
-/// identical), ordering (0 AMD, 1 METIS, 2 CHOLMOD's nested dissection), rank. Counters (CPU
-/// ms): the analysis (ordering and symbolic factorisation, once per run), one set (its factor
-/// and one solve) by updown, the same by refactorisation.
-void PrimalFactor(benchmark::State& state) {
-    namespace sp = detail::sparse;
-    const int stack = static_cast<int>(state.range(0));
-    ModelSpec spec = stack == 1 ? graduated_stack(400, 10) : paper_stack(PaperCase::friction, 400, 10);
-    for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
-    const System sys(Model::build(spec));
-    SimulationOptions so;
-    so.contact_path = ContactPath::sparse;
-    ClosedFormStepper st(sys, so);
-    for (int i = 0; i < 5; ++i) st.advance();
-    SparseContactProblem pr = st.last_sparse_problem();
-    const Eigen::VectorXd b0 = pr.b;
-    sp::layer_structure(st.last_sparse_problem(), pr);
-    pr.b.head(b0.size()) = b0;
-    sp::ModeSolverTuning tuning{0, 0, true, 1};
-    tuning.primal_ordering = state.range(1) == 0   ? sp::PrimalOrdering::amd
-                             : state.range(1) == 1 ? sp::PrimalOrdering::metis
-                                                   : sp::PrimalOrdering::nesdis;
-    const int rank = static_cast<int>(state.range(2));
-    auto cpu_ms = [] { return 1e3 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; };
-    double analyse = 0, updown = 0, refactor = 0;
-    int sets = 0;
-    for (auto _ : state) {
-        sp::ModeSolver ms(tuning);
-        double t0 = cpu_ms();
-        ms.reset(pr.K, pr.G);
-        analyse = cpu_ms() - t0;
-        ContactProblem laws;
-        laws.pairs = pr.pairs;
-        laws.q = Eigen::VectorXd::Zero(pr.size());
-        detail::ModeSet modes;
-        const auto np = pr.pairs.size();
-        modes.nmode.assign(np, detail::CLOSED);
-        modes.tmode.assign(np, detail::STICK);
-        for (std::size_t k = 0; k < np; ++k) {
-            if (pr.pairs[k].row_n < 0) modes.nmode[k] = detail::NONE;
-            if (pr.pairs[k].row_t < 0 || pr.pairs[k].kind == PairKind::bonded) modes.tmode[k] = detail::NONE;
-        }
-        detail::ModeLinearization lin;
-        Eigen::VectorXd p, z;
-        std::mt19937 rng(27);
-        std::vector<detail::ModeSet> walk;
-        for (int i = 0; i < 20; ++i) {  // sets differing by `rank` pairs' normal rows (and their tangential ones)
-            detail::ModeSet m = modes;
-            for (int j = 0; j < rank; ++j) {
-                const std::size_t k = std::uniform_int_distribution<std::size_t>(0, np - 1)(rng);
-                if (pr.pairs[k].kind == PairKind::coulomb && pr.pairs[k].row_n >= 0) {
-                    m.nmode[k] = detail::OPEN;
-                    m.make_consistent(laws, static_cast<int>(k));
-                }
-            }
-            walk.push_back(m);
-        }
-        modes.linearize(laws, lin);
-        ms.solve(lin, modes.key(), pr.b, pr.d, p, z);
-        for (int pass = 0; pass < 2; ++pass) {
-            ms.primal()->set_always_refactorise(pass == 1);
-            t0 = cpu_ms();
-            for (const auto& m : walk) {  // away from the base set and back: 2 sets per walk entry
-                m.linearize(laws, lin);
-                ms.solve(lin, m.key(), pr.b, pr.d, p, z);
-                modes.linearize(laws, lin);
-                ms.solve(lin, modes.key(), pr.b, pr.d, p, z);
-            }
-            (pass == 0 ? updown : refactor) = cpu_ms() - t0;
-        }
-        sets = 2 * static_cast<int>(walk.size());
-    }
-    state.counters["analyse_ms"] = analyse;
-    state.counters["set_by_updown_ms"] = updown / sets;
-    state.counters["set_by_refactor_ms"] = refactor / sets;
-    state.counters["rows"] = static_cast<double>(pr.size());
-}
-BENCHMARK(PrimalFactor)
-    ->ArgNames({"stack", "ordering", "rank"})
-    ->Args({1, 0, 10})->Args({1, 1, 10})->Args({1, 2, 10})->Args({2, 0, 10})->Args({2, 1, 10})->Args({2, 2, 10})
-    ->Args({1, 0, 1})->Args({1, 0, 40})->Args({1, 0, 100})->Args({1, 0, 200})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
