@@ -402,7 +402,9 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// 10 leaves, 3 graduated 10 leaves bonded, 4 identical 10 leaves bonded), elastic (0/1),
 /// simulated ms, contact path (0 automatic: sparse from 1000 rows; 1 sparse), inc (1 the
 /// incremental solve, the default; 0 the way before it: Switches::incremental), schur (> 0:
-/// SparsePathTuning::schur_max_rows; 0 its default). Counters: wall
+/// SparsePathTuning::schur_max_rows; 0 its default), primal (SparsePathTuning::primal_min_rows:
+/// -1 its default (0: off), 0 off: the large held sets on the sparse LU; > 0 the primal
+/// route from that many held rows, docs/decisions/027). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -435,6 +437,7 @@ void ElasticRuns(benchmark::State& state) {
         so.stop_on_nonconvergence = false;
         if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
         if (state.range(6) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(6));
+        if (state.range(7) >= 0) so.sparse_tuning.primal_min_rows = static_cast<int>(state.range(7));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = mode_solves = 0.0;
@@ -473,25 +476,30 @@ void ElasticRuns(benchmark::State& state) {
     state.counters["by_tresca"] = static_cast<double>(by_tresca);
 }
 BENCHMARK(ElasticRuns)
-    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur"})
+    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal"})
     // the reference: the paper example, rigid and elastic, 1 s
-    ->Args({20, 0, 0, 1000, 0, 1, 0})->Args({20, 0, 1, 1000, 0, 1, 0})
+    ->Args({20, 0, 0, 1000, 0, 1, 0, -1})->Args({20, 0, 1, 1000, 0, 1, 0, -1})
     // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf, 1 s
     // (the target's measure: the first 50 ms, from rest at 2 m/s, are not typical of the second)
-    ->Args({100, 1, 1, 1000, 0, 1, 0})->Args({200, 1, 1, 1000, 0, 1, 0})->Args({400, 1, 1, 1000, 0, 1, 0})
-    ->Args({100, 2, 1, 1000, 0, 1, 0})->Args({200, 2, 1, 1000, 0, 1, 0})->Args({400, 2, 1, 1000, 0, 1, 0})
+    ->Args({100, 1, 1, 1000, 0, 1, 0, -1})->Args({200, 1, 1, 1000, 0, 1, 0, -1})->Args({400, 1, 1, 1000, 0, 1, 0, -1})
+    ->Args({100, 2, 1, 1000, 0, 1, 0, -1})->Args({200, 2, 1, 1000, 0, 1, 0, -1})->Args({400, 2, 1, 1000, 0, 1, 0, -1})
     // issue 27's targets: 100 ms, graduated / identical 10 x 400 elastic against the same mesh
     // bonded, the incremental solve and the way before; graduated 50 / 100 / 200 / 400
-    ->Args({400, 1, 1, 100, 0, 1, 0})->Args({400, 1, 1, 100, 0, 0, 0})->Args({400, 3, 0, 100, 0, 1, 0})
-    ->Args({400, 2, 1, 100, 0, 1, 0})->Args({400, 2, 1, 100, 0, 0, 0})->Args({400, 4, 0, 100, 0, 1, 0})
-    ->Args({50, 1, 1, 100, 0, 1, 0})->Args({100, 1, 1, 100, 0, 1, 0})->Args({200, 1, 1, 100, 0, 1, 0})
-    ->Args({50, 1, 1, 100, 0, 0, 0})->Args({100, 1, 1, 100, 0, 0, 0})->Args({200, 1, 1, 100, 0, 0, 0})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1})->Args({400, 1, 1, 100, 0, 0, 0, -1})->Args({400, 3, 0, 100, 0, 1, 0, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1})
+    ->Args({50, 1, 1, 100, 0, 1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1})
+    ->Args({50, 1, 1, 100, 0, 0, 0, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1})
+    // the primal route (docs/decisions/027; off by default) from 401 held rows: 10 x 400
+    // graduated and identical, graduated 100 / 200; and its threshold 100 / 200 / 800
+    ->Args({400, 1, 1, 100, 0, 1, 0, 401})->Args({400, 2, 1, 100, 0, 1, 0, 401})
+    ->Args({100, 1, 1, 100, 0, 1, 0, 401})->Args({200, 1, 1, 100, 0, 1, 0, 401})
+    ->Args({400, 1, 1, 30, 0, 1, 0, 100})->Args({400, 1, 1, 30, 0, 1, 0, 200})->Args({400, 1, 1, 30, 0, 1, 0, 800})
     // the Schur way's limit (SparsePathTuning::schur_max_rows) with the incremental solve
-    ->Args({400, 1, 1, 30, 0, 1, 0})->Args({400, 1, 1, 30, 0, 1, 1200})->Args({400, 1, 1, 30, 0, 1, 2500})
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
-    ->Args({100, 1, 1, 300, 1, 1, 0})->Args({100, 2, 1, 300, 1, 1, 0})
-    ->Args({50, 1, 0, 300, 1, 1, 0})->Args({50, 2, 0, 300, 1, 1, 0})->Args({50, 1, 1, 300, 1, 1, 0})->Args({50, 2, 1, 300, 1, 1, 0})
+    ->Args({100, 1, 1, 300, 1, 1, 0, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1})
+    ->Args({50, 1, 0, 300, 1, 1, 0, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -42,7 +42,13 @@ function(stackbeam_pc_file name library requires libs_private description)
   install(FILES ${CMAKE_CURRENT_BINARY_DIR}/${name}.pc DESTINATION ${_pc_dir} COMPONENT library)
 endfunction()
 
-stackbeam_pc_file(stackbeam-contact stackbeam_contact "eigen3 >= 3.3" ""
+# CHOLMOD (when the build uses it): a static link needs it (pkg-config --static)
+set(_pc_contact_private "")
+if(CHOLMOD_FOUND)
+  get_filename_component(_pc_cholmod_dir "${CHOLMOD_LIBRARY}" DIRECTORY)
+  set(_pc_contact_private "-L${_pc_cholmod_dir} -lcholmod")
+endif()
+stackbeam_pc_file(stackbeam-contact stackbeam_contact "eigen3 >= 3.3" "${_pc_contact_private}"
   "stackbeam's model, finite elements and contact solvers (no time integration, no SUNDIALS)")
 stackbeam_pc_file(stackbeam stackbeam "stackbeam-contact = ${PROJECT_VERSION}" "${_pc_sundials_libs}"
   "${PROJECT_DESCRIPTION}")

@@ -2,7 +2,7 @@
 # packages the project needs, if missing, and configures and builds it in build/.
 
 # The packages every build needs (pkgconf: the test of the installed stackbeam.pc).
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen3-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)

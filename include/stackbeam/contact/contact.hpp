@@ -202,6 +202,13 @@ struct SparseContactProblem {
 struct SparsePathTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
     int max_border_rows = 150;  ///< >= 0 (0: never update, always refactorise)
+    /// >= 0: held sets of at least this many rows, some of them elastic-interface (layer) rows
+    /// and at most 200 of them rigid, take the primal route when the library was built with
+    /// CHOLMOD (0: never, the default: measured no faster on the 10 x 400 friction runs, where
+    /// the slip coupling needs many Krylov iterations): the leaves' stiffness plus the held
+    /// layer springs, factorised by CHOLMOD once per run and updated by rank-k updates as rows
+    /// enter and leave the set (docs/contact-solvers.md, "Large held sets")
+    int primal_min_rows = 0;
     /// >= 0: the Newton method is tried on problems of at least this many contact rows (smaller
     /// ones, e.g. the paper example's 76, settle quickly by the passes and the Tresca fixed
     /// point, and keep exactly the answers they had: their near-degenerate pairs may settle in

@@ -26,6 +26,12 @@
 
 namespace stackbeam::detail::sparse {
 
+#ifndef STACKBEAM_HAVE_CHOLMOD
+// a build without CHOLMOD: no primal route (held sets above the Schur way's limit take the sparse LU)
+bool primal_route_built() { return false; }
+std::shared_ptr<PrimalSolver> make_primal_solver(PrimalOrdering) { return nullptr; }
+#endif
+
 namespace {
 // cached columns K^-1 g_i^T: at most this many doubles (80 MB)
 constexpr double kColumnCacheDoubles = 1e7;
@@ -35,6 +41,9 @@ constexpr double kColumnCacheDoubles = 1e7;
 // k base solves and a k x k LU, against the LU's ms^3 / 3; docs/decisions/020)
 constexpr int kMinUpdateRows = 24;
 constexpr int kUpdateRankFraction = 4;
+// the primal route takes a held set with at most this many held rigid rows (each one a
+// column of its Schur complement, solved with the factor at every new set)
+constexpr int kPrimalMaxRigidRows = 200;
 
 /// The slip couplings of lin's held rows as columns of the Schur complement: ct[c] the slip
 /// row coupled to held row S[c] (or -1), cc[c] its coefficient. False if a held row carries
@@ -117,9 +126,17 @@ void ModeSolver::reset(const SpMat& K, const SpMat& G) {
     base_schur = false;
     wb_active = false;
     l_nonzeros = static_cast<double>(st_.k_llt.matrixL().nestedExpression().nonZeros());
+    lu_primal = false;
+    primal_.reset();
+    if (tuning_.primal_min_rows > 0 && primal_route_built()) {
+        primal_ = make_primal_solver(tuning_.primal_ordering);
+        primal_->reset(st_);
+        if (primal_->layer_rows() == 0) primal_.reset();
+    }
 }
 
 void ModeSolver::accept() {
+    if (lu_primal && !lu_key_.empty()) primal_->refresh();
     if (!lu_schur || !wb_active || lu_key_.empty() || border_active) return;
     dlu.compute(Mschur);
     wb_active = false;
@@ -157,10 +174,23 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
         unit_dof = -1;
     } else if (key != lu_key_) {
         border_active = false;
-        lu_schur = ms <= tuning_.schur_max_rows;
         wb_active = false;
         factorised = 1;
-        if (lu_schur) {
+        lu_primal = false;
+        if (primal_ && ms >= tuning_.primal_min_rows) {
+            // the primal route: at least one held layer row, and few enough held rigid rows
+            // for their Schur complement (kPrimalMaxRigidRows solves per set)
+            int layer = 0;
+            for (int r : S) layer += primal_->is_layer(r) ? 1 : 0;
+            lu_primal = layer > 0 && ms - layer <= kPrimalMaxRigidRows;
+        }
+        lu_schur = !lu_primal && ms <= tuning_.schur_max_rows;
+        if (lu_primal) {
+            const long before = primal_->stats().factorisations;
+            lu_ok = primal_->factor(lin, pos);
+            factorised = primal_->stats().factorisations > before ? 1 : 0;
+            if (factorised == 0) ++updates_;
+        } else if (lu_schur) {
             factorised = factor_schur_update(lin);
             if (factorised < 0) {
                 factor_schur(lin);
@@ -169,33 +199,7 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
                 ++updates_;
             }
         } else {
-            row_scale.resize(ms);
-            for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / st_.row_h[S[i]];
-            // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
-            std::vector<Eigen::Triplet<double>> t;
-            t.reserve(static_cast<std::size_t>(st_.K.nonZeros() + 4 * st_.G.nonZeros()));
-            st_.append_scaled_K(t);
-            for (int i = 0; i < ms; ++i)
-                for (SpMat::InnerIterator it(st_.Gt_scaled, S[i]); it; ++it) {
-                    t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
-                    t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
-                }
-            for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
-                const int col = pos[lin.coupled[a].second];
-                if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
-                for (SpMat::InnerIterator it(st_.Gt_scaled, lin.coupled[a].first); it; ++it)
-                    t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
-            }
-            A.resize(n + ms, n + ms);
-            A.setFromTriplets(t.begin(), t.end());
-            A.makeCompressed();
-            lu.compute(A);
-            lu_ok = lu.info() == Eigen::Success;
-            base_valid = lu_ok && lin.coupled.empty();
-            base_S = S;
-            base_pos = pos;
-            for (auto& c : bcol) c.resize(0);
-            bcol_count = 0;
+            factor_lu(lin);
         }
         lu_key_ = key;
         key_uses = 0;
@@ -213,17 +217,7 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
     if (++key_uses == 1) {
         // first use of a factorisation (most active-set passes use it once): one solve
         // with the whole load; the affine caches are made if it is used again
-        const Eigen::VectorXd f = b + st_.G.transpose() * lin.e;
-        if (lu_schur) {
-            schur_solve(lin, st_.k_llt.solve(f), dS, pS, z);
-        } else {
-            rhs.resize(n + ms);
-            rhs.head(n) = st_.dz.cwiseProduct(f);
-            rhs.tail(ms) = row_scale.cwiseProduct(dS);
-            x = refined_solve(rhs);
-            z = st_.dz.cwiseProduct(x.head(n));
-            pS = row_scale.cwiseProduct(x.tail(ms));
-        }
+        direct_solve(lin, b + st_.G.transpose() * lin.e, dS, pS, z);
         p = lin.e;
         for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
         for (std::size_t a = 0; a < lin.coupled.size(); ++a)
@@ -231,16 +225,7 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
         return factorised;
     }
     if (!const_ok || const_e != lin.e || const_dS != dS) {
-        if (lu_schur) {
-            schur_solve(lin, st_.k_llt.solve(st_.G.transpose() * lin.e), dS, pc, zc);
-        } else {  // right-hand side [Dz G^T e; R d_S]
-            rhs.resize(n + ms);
-            rhs.head(n) = st_.dz.cwiseProduct(st_.G.transpose() * lin.e);
-            rhs.tail(ms) = row_scale.cwiseProduct(dS);
-            x = refined_solve(rhs);
-            zc = st_.dz.cwiseProduct(x.head(n));
-            pc = row_scale.cwiseProduct(x.tail(ms));
-        }
+        direct_solve(lin, st_.G.transpose() * lin.e, dS, pc, zc);
         const_e = lin.e;
         const_dS = dS;
         const_ok = true;
@@ -274,6 +259,64 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
     for (std::size_t a = 0; a < lin.coupled.size(); ++a)
         p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
     return factorised;
+}
+
+/// The scaled saddle-point system of lin's held set, factorised by the sparse LU.
+void ModeSolver::factor_lu(const ModeLinearization& lin) {
+    const int n = static_cast<int>(st_.K.rows());
+    const auto& S = lin.S;
+    const int ms = static_cast<int>(S.size());
+    row_scale.resize(ms);
+    for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / st_.row_h[S[i]];
+    // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(st_.K.nonZeros() + 4 * st_.G.nonZeros()));
+    st_.append_scaled_K(t);
+    for (int i = 0; i < ms; ++i)
+        for (SpMat::InnerIterator it(st_.Gt_scaled, S[i]); it; ++it) {
+            t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+            t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+        }
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+        const int col = pos[lin.coupled[a].second];
+        if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+        for (SpMat::InnerIterator it(st_.Gt_scaled, lin.coupled[a].first); it; ++it)
+            t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+    }
+    A.resize(n + ms, n + ms);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    lu.compute(A);
+    lu_ok = lu.info() == Eigen::Success;
+    base_valid = lu_ok && lin.coupled.empty();
+    base_S = S;
+    base_pos = pos;
+    for (auto& c : bcol) c.resize(0);
+    bcol_count = 0;
+}
+
+/// (p_S, z) of lin's held set for the load f = b + G^T e and the held rows' offsets dS with
+/// the current factorisation (Schur, primal or sparse LU). A primal solve that does not
+/// converge gives the set to the sparse LU.
+void ModeSolver::direct_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
+                              Eigen::VectorXd& pS, Eigen::VectorXd& zf) {
+    if (lu_schur) {
+        schur_solve(lin, st_.k_llt.solve(f), dS, pS, zf);
+        return;
+    }
+    if (lu_primal) {
+        if (primal_->solve(lin, pos, f, dS, pS, zf)) return;
+        lu_primal = false;
+        factor_lu(lin);
+        if (!lu_ok) throw SingularModes{};
+    }
+    const int n = static_cast<int>(st_.K.rows()), ms = static_cast<int>(lin.S.size());
+    rhs.resize(n + ms);
+    rhs.head(n) = st_.dz.cwiseProduct(f);
+    rhs.tail(ms) = row_scale.cwiseProduct(dS);
+    x = refined_solve(rhs);
+    zf = st_.dz.cwiseProduct(x.head(n));
+    pS = row_scale.cwiseProduct(x.tail(ms));
 }
 
 /// Low-rank updates of the sparse saddle-point LU (the "base", held set S0, no slip
@@ -400,16 +443,7 @@ void ModeSolver::border_solve(const ModeLinearization& lin, const Eigen::VectorX
 /// (p_S, z) for load `f` alone (e = 0, d_S = 0) with the current factorisation.
 void ModeSolver::load_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS,
                 Eigen::VectorXd& zf) {
-    const int n = static_cast<int>(st_.K.rows()), ms = static_cast<int>(lin.S.size());
-    if (lu_schur) {
-        schur_solve(lin, st_.k_llt.solve(f), Eigen::VectorXd::Zero(ms), pS, zf);
-    } else {
-        rhs.setZero(n + ms);
-        rhs.head(n) = st_.dz.cwiseProduct(f);
-        x = refined_solve(rhs);
-        zf = st_.dz.cwiseProduct(x.head(n));
-        pS = row_scale.cwiseProduct(x.tail(ms));
-    }
+    direct_solve(lin, f, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(lin.S.size())), pS, zf);
 }
 
 /// Column K^-1 g_i^T of contact row i [m/N per unit force], cached (solved in blocks

@@ -25,10 +25,12 @@
 // the back-solves of that map are cached.
 #include <Eigen/Dense>
 #include <Eigen/SparseLU>
+#include <memory>
 #include <vector>
 
 #include "contact/active_set.hpp"
 #include "contact/sparse/common.hpp"
+#include "contact/sparse/primal_solver.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -67,6 +69,11 @@ struct ModeSolverTuning {
     /// the Schur way's incremental build and low-rank update of the dense LU (false: every
     /// new held set's Schur complement computed and factorised from scratch, as before)
     bool schur_updates = true;
+    /// > 0: held sets of at least this many rows, some of them layer rows, take the primal
+    /// route (primal_solver.hpp: CHOLMOD, rank-k updates) when this build has CHOLMOD;
+    /// 0: never (SparsePathTuning::primal_min_rows; docs/decisions/027)
+    int primal_min_rows = 0;
+    PrimalOrdering primal_ordering = PrimalOrdering::amd;  ///< its fill-reducing ordering
 };
 
 class ModeSolver {
@@ -99,6 +106,10 @@ public:
     /// Solves by a bordered update since the last reset_updates().
     int updates() const { return updates_; }
     void reset_updates() { updates_ = 0; }
+    /// The primal route's solver (null when it is off or not built; tests, benchmark).
+    PrimalSolver* primal() { return primal_.get(); }
+    /// Whether the current factorisation is the primal route's.
+    bool on_primal_route() const { return lu_primal; }
 
 private:
     bool try_border(const ModeLinearization& lin);
@@ -113,6 +124,9 @@ private:
     void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
+    void factor_lu(const ModeLinearization& lin);
+    void direct_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
+                      Eigen::VectorXd& pS, Eigen::VectorXd& zf);
 
     ModeSolverTuning tuning_;
     SparseStiffness st_;
@@ -163,6 +177,10 @@ private:
     std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
     std::size_t bcol_count = 0;          // non-empty entries of bcol
     int key_uses = 0;                    // solves with the current factorisation
+    // the primal route (primal_solver.hpp), shared_ptr: PrimalSolver is defined only in
+    // builds with CHOLMOD
+    std::shared_ptr<PrimalSolver> primal_;
+    bool lu_primal = false;
 };
 
 }  // namespace stackbeam::detail::sparse

@@ -22,6 +22,12 @@ struct Step {
     const Eigen::VectorXd& d;  ///< offsets [m], one entry per contact row
 };
 
+/// The elastic layer of `pr` (SparseContactProblem::layer_compliance) as extra degrees of
+/// freedom (docs/decisions/013): layered.K = diag(K, 1/c_L) over the layer rows, layered.G =
+/// [G  E] with E(r, n + j) = 1 for the j-th layer row r, layered.b = 0 (n + layer rows
+/// entries); the rest of `layered` is left as it was. False (nothing set) if no row has a layer.
+bool layer_structure(const SparseContactProblem& pr, SparseContactProblem& layered);
+
 struct SparsePath {
     SolverOptions options;   ///< tolerance_m, max_active_set_iterations, tresca_anderson_depth
     Switches switches;       ///< the test-only switches (switches.hpp)

@@ -176,6 +176,42 @@ bool same_laws(const std::vector<ContactPair>& a, const std::vector<ContactPair>
 }
 }  // namespace
 
+namespace detail::sparse {
+
+/// Builds `layered` from `pr`: K' = diag(K, 1/c_L) over the layer rows, G' = [G  E] with
+/// E(r, n + j) = 1 for the j-th layer row r, b' = [b; 0]. Returns false if no row has a layer.
+bool layer_structure(const SparseContactProblem& pr, SparseContactProblem& layered) {
+    const int n = static_cast<int>(pr.K.rows());
+    std::vector<int> rows;
+    for (int r = 0; r < pr.layer_compliance.size(); ++r)
+        if (pr.layer_compliance[r] > 0.0) rows.push_back(r);
+    if (rows.empty()) return false;
+    const int ne = static_cast<int>(rows.size());
+    std::vector<Eigen::Triplet<double>> kt, gt;
+    kt.reserve(static_cast<std::size_t>(pr.K.nonZeros()) + rows.size());
+    for (int col = 0; col < pr.K.outerSize(); ++col)
+        for (SpMat::InnerIterator it(pr.K, col); it; ++it)
+            kt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+    for (int col = 0; col < pr.G.outerSize(); ++col)
+        for (SpMat::InnerIterator it(pr.G, col); it; ++it)
+            gt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+    for (int j = 0; j < ne; ++j) {
+        kt.emplace_back(n + j, n + j, 1.0 / pr.layer_compliance[rows[j]]);
+        gt.emplace_back(rows[j], n + j, 1.0);
+    }
+    layered.K.resize(n + ne, n + ne);
+    layered.K.setFromTriplets(kt.begin(), kt.end());
+    layered.K.makeCompressed();
+    layered.G.resize(pr.G.rows(), n + ne);
+    layered.G.setFromTriplets(gt.begin(), gt.end());
+    layered.G.makeCompressed();
+    layered.b = Eigen::VectorXd::Zero(n + ne);
+    layered.layer_compliance.resize(0);
+    return true;
+}
+
+}  // namespace detail::sparse
+
 struct SparseContactSolver::Impl {
     detail::sparse::SparsePath path;
     int newton_min_rows = 0;
@@ -186,7 +222,8 @@ struct SparseContactSolver::Impl {
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
         : path(options,
                detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows,
-                                                detail::sparse::current_switches().incremental},
+                                                detail::sparse::current_switches().incremental,
+                                                tuning.primal_min_rows},
                detail::sparse::current_switches()),
           newton_min_rows(tuning.newton_min_rows) {}
 
@@ -195,37 +232,7 @@ struct SparseContactSolver::Impl {
     SparseContactProblem layered;
     Eigen::VectorXd z_layered;
 
-    /// Builds `layered` from `pr`: K' = diag(K, 1/c_L) over the layer rows, G' = [G  E] with
-    /// E(r, n + j) = 1 for the j-th layer row r, b' = [b; 0]. Returns false if no row has a layer.
-    bool layer_structure(const SparseContactProblem& pr) {
-        const int n = static_cast<int>(pr.K.rows());
-        std::vector<int> rows;
-        for (int r = 0; r < pr.layer_compliance.size(); ++r)
-            if (pr.layer_compliance[r] > 0.0) rows.push_back(r);
-        if (rows.empty()) return false;
-        const int ne = static_cast<int>(rows.size());
-        std::vector<Eigen::Triplet<double>> kt, gt;
-        kt.reserve(static_cast<std::size_t>(pr.K.nonZeros()) + rows.size());
-        for (int col = 0; col < pr.K.outerSize(); ++col)
-            for (detail::sparse::SpMat::InnerIterator it(pr.K, col); it; ++it)
-                kt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
-        for (int col = 0; col < pr.G.outerSize(); ++col)
-            for (detail::sparse::SpMat::InnerIterator it(pr.G, col); it; ++it)
-                gt.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
-        for (int j = 0; j < ne; ++j) {
-            kt.emplace_back(n + j, n + j, 1.0 / pr.layer_compliance[rows[j]]);
-            gt.emplace_back(rows[j], n + j, 1.0);
-        }
-        layered.K.resize(n + ne, n + ne);
-        layered.K.setFromTriplets(kt.begin(), kt.end());
-        layered.K.makeCompressed();
-        layered.G.resize(pr.G.rows(), n + ne);
-        layered.G.setFromTriplets(gt.begin(), gt.end());
-        layered.G.makeCompressed();
-        layered.b = Eigen::VectorXd::Zero(n + ne);
-        layered.layer_compliance.resize(0);
-        return true;
-    }
+    bool layer_structure(const SparseContactProblem& pr) { return detail::sparse::layer_structure(pr, layered); }
 
     void reset_structure(const SparseContactProblem& pr) {
         path.reset(pr);
@@ -298,6 +305,8 @@ SparseContactSolver::SparseContactSolver(const SolverOptions& options, const Spa
         throw InputError("tuning.newton_min_rows", "value " + std::to_string(tuning.newton_min_rows) + " must be >= 0");
     if (tuning.max_border_rows < 0)
         throw InputError("tuning.max_border_rows", "value " + std::to_string(tuning.max_border_rows) + " must be >= 0");
+    if (tuning.primal_min_rows < 0)
+        throw InputError("tuning.primal_min_rows", "value " + std::to_string(tuning.primal_min_rows) + " must be >= 0");
     if (options.kind != SolverKind::exact)
         throw InputError("solver.kind", std::string("value '") + to_string(options.kind) +
                                             "' is not available on the sparse contact path: it has the exact "
