@@ -20,7 +20,7 @@ source scripts/common.sh
 
 seconds=${1:-20}
 shift || true
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" clang-14 libclang-rt-14-dev
+install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_SANITIZER_PACKAGES[@]}"
 start=$(date +%s)
 # -O1 -g1: as the sanitizer build (common.sh), a third of the compile time of -O2 -g
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++-14 \

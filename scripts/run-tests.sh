@@ -13,7 +13,11 @@ export DEBIAN_FRONTEND=noninteractive
 source scripts/common.sh
 
 # gnuplot: the CLI test of --plot; MPI: the sweep's; Python: the module's tests
-install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" "${STACKBEAM_PYTHON_PACKAGES[@]}" gnuplot-nox
+pkgs=("${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_MPI_PACKAGES[@]}" "${STACKBEAM_PYTHON_PACKAGES[@]}" gnuplot-nox)
+if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ] || [ "${STACKBEAM_FUZZ:-1}" != 0 ]; then
+  pkgs+=("${STACKBEAM_SANITIZER_PACKAGES[@]}")
+fi
+install_packages "${pkgs[@]}"
 build
 # --timeout: a test that hangs (a sanitizer's abort_on_error was seen to hang a binary for
 # over 16 min instead of failing) fails after 15 min instead of stalling the run.
