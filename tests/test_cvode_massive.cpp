@@ -240,7 +240,9 @@ BOOST_AUTO_TEST_CASE(newmark_and_cvode_agree_under_base_excitation, *boost::unit
     BOOST_TEST(gdev < 4e-8);
 }
 
-BOOST_AUTO_TEST_CASE(applied_force_on_the_massive_stack) {
+// Release only (label slow: the longest case of this file under the sanitizers); the sanitizer
+// build still runs the massive stepper's other quick cases (the energy balance with friction and damping, Rayleigh damping).
+BOOST_AUTO_TEST_CASE(applied_force_on_the_massive_stack, *boost::unit_test::label("slow")) {
     // A step force of 2 kN on R (whole spring) with the initial conditions, 5 ms. As the leaves'
     // density falls the run tends to the massless cvode run under the same force (measured 7.4x
     // per decade: 8.0e-5, 1.1e-5 m; asked 5x, as without the force); the external work, a state

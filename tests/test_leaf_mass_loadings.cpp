@@ -167,7 +167,9 @@ BOOST_AUTO_TEST_CASE(applied_force_with_leaf_mass) {
     check_case("applied force", s, load, 0.0, 0.05, w_of, w_reference(ref, L.w), 0.5 * s.tied_stiffness_n_per_m() * amp * amp);
 }
 
-BOOST_AUTO_TEST_CASE(base_excitation_with_leaf_mass) {
+// Release only (label slow: the longest case of this file under the sanitizers); the sanitizer
+// build still runs the other loadings with leaf mass (applied force, the rig, free response) and base excitation on the modal stepper (test_cvode_modal_loadings).
+BOOST_AUTO_TEST_CASE(base_excitation_with_leaf_mass, *boost::unit_test::label("slow")) {
     // The supports move by y_b = A cos(Omega t) (A = 1 mm, 3 Hz; y_b'(0) = 0, so the stack starts
     // at rest relative to them): in their frame every mass feels -y_b'' times itself,
     // q = A Omega^2 cos(Omega t) l. Well below R's mode, R moves with the base (w + y_b ~ y_b).
