@@ -30,6 +30,7 @@
 
 #include "contact/active_set.hpp"
 #include "contact/sparse/common.hpp"
+#include "contact/sparse/fixed_saddle.hpp"
 #include "contact/sparse/primal_solver.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -74,14 +75,20 @@ struct ModeSolverTuning {
     /// 0: never (SparsePathTuning::primal_min_rows; docs/decisions/027)
     int primal_min_rows = 0;
     PrimalOrdering primal_ordering = PrimalOrdering::amd;  ///< its fill-reducing ordering
+    /// the sparse LU of held sets above schur_max_rows: on one pattern for every set, ordered
+    /// once per (K, G) (fixed_saddle.hpp; docs/decisions/031), or `off`: the variable system
+    /// of each set ordered and factorised from scratch (the way before)
+    FixedPatternLu fixed_pattern = FixedPatternLu::off;
 };
 
 class ModeSolver {
 public:
     explicit ModeSolver(const ModeSolverTuning& tuning = {}) : tuning_(tuning) {}
 
-    /// A new (K, G): factorises K, computes W's diagonal and drops every cache.
-    void reset(const SpMat& K, const SpMat& G);
+    /// A new (K, G): factorises K, computes W's diagonal and drops every cache. `couplings`:
+    /// the (tangential row, normal row) of the pairs whose slip may couple them (the fixed
+    /// pattern's; a coupling not listed extends the pattern when it first occurs).
+    void reset(const SpMat& K, const SpMat& G, const std::vector<std::pair<int, int>>& couplings = {});
     const SparseStiffness& stiffness() const { return st_; }
 
     /// Solves the linear problem of `lin` (held rows S with s = 0, fixed forces e, slip
@@ -110,6 +117,8 @@ public:
     PrimalSolver* primal() { return primal_.get(); }
     /// Whether the current factorisation is the primal route's.
     bool on_primal_route() const { return lu_primal; }
+    /// The fixed-pattern LU (null when ModeSolverTuning::fixed_pattern is off; tests, benchmark).
+    const FixedSaddle* fixed() const { return fixed_.get(); }
 
 private:
     bool try_border(const ModeLinearization& lin);
@@ -124,6 +133,7 @@ private:
     void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
+    Eigen::VectorXd apply_A(const Eigen::VectorXd& x) const;
     void factor_lu(const ModeLinearization& lin);
     void direct_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
                       Eigen::VectorXd& pS, Eigen::VectorXd& zf);
@@ -181,6 +191,8 @@ private:
     // builds with CHOLMOD
     std::shared_ptr<PrimalSolver> primal_;
     bool lu_primal = false;
+    // the sparse LU on the fixed pattern (replaces lu and A when tuning_.fixed_pattern is on)
+    std::unique_ptr<FixedSaddle> fixed_;
 };
 
 }  // namespace stackbeam::detail::sparse

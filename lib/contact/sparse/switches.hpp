@@ -41,6 +41,11 @@ struct Switches {
     /// breakpoint line search. false: every held set's Schur complement from scratch and the
     /// 49-point line search, the way before (kept for comparison in the benchmark and tests).
     bool incremental = true;
+    /// The sparse LU of the mode solver's held sets above the Schur way's limit and of the
+    /// smoothing Newton method's Jacobian: 0 the way before (a variable system per held set,
+    /// ordered from scratch; Eigen's SparseLU), 1 Eigen's SparseLU on the fixed pattern
+    /// (ordered once per (K, G)), 2 KLU on it (builds with KLU; else as 1): docs/decisions/031.
+    int fixed_pattern = 0;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
