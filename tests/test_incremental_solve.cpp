@@ -406,7 +406,8 @@ std::vector<std::pair<int, int>> couplings_of(const SparseContactProblem& pr) {
 /// (so that the bordered updates of the LU run). Returns the largest difference against its
 /// bound; counts.largest the largest relative difference.
 double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu, int border, bool no_slip,
-                          bool pass_couplings, int sets, Counts& counts, int& analyses, int& updates) {
+                          bool pass_couplings, int sets, Counts& counts, int& analyses, int& updates,
+                          long* reused = nullptr) {
     sp::ModeSolverTuning tf{0, border, true, 0};
     tf.fixed_pattern = lu;
     sp::ModeSolver fixed(tf), ref(sp::ModeSolverTuning{0, 0, true, 0}), schur(sp::ModeSolverTuning{100000, 0, false});
@@ -437,6 +438,9 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
         updates += fixed.updates();
     }
     analyses = fixed.fixed()->analyses();
+    if (reused) *reused = fixed.fixed()->lu().reused;
+    BOOST_TEST_MESSAGE("  LU: " << fixed.fixed()->lu().pivoted << " with pivoting, " << fixed.fixed()->lu().reused
+                                << " on the previous pivot sequence");
     return worst;
 }
 
@@ -452,7 +456,9 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
         for (const auto lu : lus) {
             Counts counts;
             int analyses = 0, updates = 0;
-            const double worst = fixed_pattern_walk(*pr, lu, 0, false, true, 300, counts, analyses, updates);
+            long reused = 0;
+            const double worst =
+                fixed_pattern_walk(*pr, lu, 0, false, true, 300, counts, analyses, updates, &reused);
             BOOST_TEST_MESSAGE("fixed pattern (" << (lu == sp::FixedPatternLu::klu ? "KLU" : "Eigen") << ", "
                                                  << pr->G.rows() << " rows): solves " << counts.solves
                                                  << ", with slip coupling " << counts.slip_coupled
@@ -461,6 +467,11 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
             BOOST_TEST(counts.solves > 280);
             BOOST_TEST(counts.slip_coupled > 280);
             BOOST_TEST(analyses == 1);  // the ordering once for the whole walk
+            // KLU on the elastic stack (the layer rows' own DOFs: the pivots barely depend on
+            // the held set): most sets on the previous pivot sequence (klu_refactor; measured
+            // 233 of 249). On the rigid stack most random sets need pivoting afresh (measured
+            // 19 of 249 reused): the answers are checked either way.
+            if (lu == sp::FixedPatternLu::klu && pr == &elastic_problem()) BOOST_TEST(reused > 150);
             BOOST_TEST(worst < 1.0);
         }
 }

@@ -32,7 +32,8 @@ struct SparseStiffness;
 enum class FixedPatternLu {
     off,    ///< the variable system of each held set, ordered and factorised from scratch (before)
     eigen,  ///< Eigen::SparseLU: COLAMD and the symbolic analysis once, factorize() per set
-    klu,    ///< SuiteSparse's KLU (AMD ordering once, klu_factor per set; builds with KLU only)
+    klu,    ///< SuiteSparse's KLU (AMD ordering once; per set klu_refactor on the last pivot sequence
+            ///< where its pivots stay good, else klu_factor; builds with KLU only)
 };
 
 /// Whether this build has SuiteSparse's KLU (STACKBEAM_HAVE_KLU).
@@ -49,6 +50,8 @@ public:
     virtual bool factorize(const SpMat& A) = 0;
     /// x = A^-1 x with the last factorisation.
     virtual void solve_in_place(Eigen::VectorXd& x) = 0;
+    long pivoted = 0;  ///< numeric factorisations with pivoting
+    long reused = 0;   ///< refactorisations on the previous pivot sequence (KLU)
 };
 
 /// A PatternLu on `lu` (not off; klu only when klu_built(), else Eigen's).
@@ -72,6 +75,8 @@ public:
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
     /// Orderings and symbolic analyses made since reset() (tests, benchmark).
     int analyses() const { return analyses_; }
+    /// The LU's counts of factorisations (tests, benchmark).
+    const PatternLu& lu() const { return *lu_; }
 
 private:
     std::unique_ptr<PatternLu> lu_;

@@ -267,7 +267,7 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
 }
 
 /// The scaled saddle-point system of lin's held set, factorised by the sparse LU: its own
-/// system ordered from scratch, or the fixed-pattern one (fixed_saddle.hpp) ordered once./
+/// system ordered from scratch, or the fixed-pattern one (fixed_saddle.hpp) ordered once.
 void ModeSolver::factor_lu(const ModeLinearization& lin) {
     const int n = static_cast<int>(st_.K.rows());
     const auto& S = lin.S;

@@ -31,9 +31,9 @@ bool layer_structure(const SparseContactProblem& pr, SparseContactProblem& layer
 
 /// `tuning` with the switches' choice of the fixed-pattern LU.
 inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& sw) {
-    tuning.fixed_pattern = sw.fixed_pattern == 0   ? FixedPatternLu::off
-                           : sw.fixed_pattern == 1 ? FixedPatternLu::eigen
-                                                   : FixedPatternLu::klu;
+    tuning.fixed_pattern = sw.fixed_pattern == 1                 ? FixedPatternLu::eigen
+                           : sw.fixed_pattern == 2 && klu_built() ? FixedPatternLu::klu
+                                                                  : FixedPatternLu::off;
     return tuning;
 }
 
