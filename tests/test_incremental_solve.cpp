@@ -410,6 +410,7 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
                           long* reused = nullptr) {
     sp::ModeSolverTuning tf{0, border, true, 0};
     tf.fixed_pattern = lu;
+    tf.fixed_max_rigid_rows = 100000;  // the rigid stack's sets too
     sp::ModeSolver fixed(tf), ref(sp::ModeSolverTuning{0, 0, true, 0}), schur(sp::ModeSolverTuning{100000, 0, false});
     fixed.reset(pr.K, pr.G, pass_couplings ? couplings_of(pr) : std::vector<std::pair<int, int>>{});
     ref.reset(pr.K, pr.G);

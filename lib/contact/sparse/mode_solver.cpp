@@ -63,6 +63,27 @@ bool column_couplings(const ModeLinearization& lin, const std::vector<int>& pos,
 }
 }  // namespace
 
+std::vector<int> layer_dofs(const SpMat& K, const SpMat& G) {
+    std::vector<int> dof(static_cast<std::size_t>(G.rows()), -1);
+    for (int j = 0; j < static_cast<int>(K.cols()); ++j) {
+        bool diag_only = true;
+        double kjj = 0.0;
+        for (SpMat::InnerIterator it(K, j); it; ++it) {
+            if (it.row() != j && it.value() != 0.0) diag_only = false;
+            if (it.row() == j) kjj = it.value();
+        }
+        int row = -1, count = 0;
+        for (SpMat::InnerIterator it(G, j); it; ++it)
+            if (it.value() != 0.0) {
+                row = static_cast<int>(it.row());
+                ++count;
+            }
+        if (diag_only && kjj > 0.0 && count == 1 && dof[static_cast<std::size_t>(row)] < 0)
+            dof[static_cast<std::size_t>(row)] = j;
+    }
+    return dof;
+}
+
 void SparseStiffness::build(const SpMat& K_, const SpMat& G_) {
     K = K_;
     G = G_;
@@ -131,6 +152,9 @@ void ModeSolver::reset(const SpMat& K, const SpMat& G, const std::vector<std::pa
     if (tuning_.fixed_pattern != FixedPatternLu::off) {
         fixed_ = std::make_unique<FixedSaddle>(tuning_.fixed_pattern);
         fixed_->reset(st_, couplings);
+        const std::vector<int> dof = layer_dofs(st_.K, st_.G);
+        layer_row_.assign(m, 0);
+        for (std::size_t r = 0; r < m; ++r) layer_row_[r] = dof[r] >= 0 ? 1 : 0;
     }
     primal_.reset();
     if (tuning_.primal_min_rows > 0 && primal_route_built()) {
@@ -274,7 +298,11 @@ void ModeSolver::factor_lu(const ModeLinearization& lin) {
     const int ms = static_cast<int>(S.size());
     row_scale.resize(ms);
     for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / st_.row_h[S[i]];
-    if (fixed_) {
+    int rigid = 0;
+    if (fixed_)
+        for (int r : S) rigid += layer_row_[static_cast<std::size_t>(r)] ? 0 : 1;
+    lu_fixed = fixed_ && rigid <= tuning_.fixed_max_rigid_rows;
+    if (lu_fixed) {
         lu_ok = fixed_->factor(lin, pos, row_scale);
     } else {
         // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
@@ -730,12 +758,12 @@ void ModeSolver::schur_solve(const ModeLinearization& lin, const Eigen::VectorXd
 }
 
 Eigen::VectorXd ModeSolver::apply_A(const Eigen::VectorXd& x) const {
-    if (fixed_) return fixed_->multiply(x);
+    if (lu_fixed) return fixed_->multiply(x);
     return A * x;
 }
 
 Eigen::VectorXd ModeSolver::refined_solve(const Eigen::VectorXd& r) {
-    if (fixed_) return fixed_->solve(r);
+    if (lu_fixed) return fixed_->solve(r);
     Eigen::VectorXd y = lu.solve(r);
     const Eigen::VectorXd res = r - A * y;
     y += lu.solve(res);

@@ -63,6 +63,10 @@ struct SparseStiffness {
     double row_dot(int r, const Eigen::VectorXd& v) const;
 };
 
+/// Per contact row: its elastic-interface layer DOF (decision 013: a column of K with its
+/// positive diagonal only and one nonzero of G, in this row, the first such column), or -1.
+std::vector<int> layer_dofs(const SpMat& K, const SpMat& G);
+
 /// The ways of ModeSolver (SparsePathTuning's fields of the same names).
 struct ModeSolverTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
@@ -79,6 +83,10 @@ struct ModeSolverTuning {
     /// once per (K, G) (fixed_saddle.hpp; docs/decisions/031), or `off`: the variable system
     /// of each set ordered and factorised from scratch (the way before)
     FixedPatternLu fixed_pattern = FixedPatternLu::off;
+    /// the fixed pattern only for held sets with at most this many rigid (not layer) rows:
+    /// each forces an off-diagonal pivot that the pattern's ordering (made for diagonal
+    /// pivots) does not foresee (measured: bonded 10 x 400, every row rigid and held, 20x slower)
+    int fixed_max_rigid_rows = 200;
 };
 
 class ModeSolver {
@@ -193,6 +201,8 @@ private:
     bool lu_primal = false;
     // the sparse LU on the fixed pattern (replaces lu and A when tuning_.fixed_pattern is on)
     std::unique_ptr<FixedSaddle> fixed_;
+    std::vector<char> layer_row_;        // per contact row: a layer row (layer_dofs)
+    bool lu_fixed = false;               // the current sparse LU is fixed_'s
 };
 
 }  // namespace stackbeam::detail::sparse

@@ -23,7 +23,13 @@ void SparsePath::reset(const SparseContactProblem& pr) {
     solver.reset(pr.K, pr.G, couplings);
     ipm_analysed = false;
     js_analysed = false;
-    js_lu = make_pattern_lu(switches.fixed_pattern == 2 ? FixedPatternLu::klu : FixedPatternLu::eigen);
+    // KLU for the smoothing Newton method's Jacobian with few rigid rows (as the mode solver's
+    // fixed_max_rigid_rows: a rigid row near its held mode has a zero diagonal there)
+    const std::vector<int> layer = layer_dofs(pr.K, pr.G);
+    const auto rigid = std::count(layer.begin(), layer.end(), -1);
+    js_lu = make_pattern_lu(switches.fixed_pattern == 2 && rigid <= ModeSolverTuning{}.fixed_max_rigid_rows
+                                ? FixedPatternLu::klu
+                                : FixedPatternLu::eigen);
     const int m = pr.size();
     laws.W.resize(0, 0);
     laws.q = Eigen::VectorXd::Zero(m);
