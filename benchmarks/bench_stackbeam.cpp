@@ -404,7 +404,9 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// incremental solve, the default; 0 the way before it: Switches::incremental), schur (> 0:
 /// SparsePathTuning::schur_max_rows; 0 its default), primal (SparsePathTuning::primal_min_rows:
 /// -1 its default (0: off), 0 off: the large held sets on the sparse LU; > 0 the primal
-/// route from that many held rows, docs/decisions/027). Counters: wall
+/// route from that many held rows, docs/decisions/027), fixed (Switches::fixed_pattern: -1 its
+/// default; 0 the variable saddle-point LU per held set, 1 Eigen's SparseLU on the fixed
+/// pattern, 2 KLU on it, docs/decisions/031). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -423,6 +425,7 @@ void ElasticRuns(benchmark::State& state) {
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
     detail::sparse::Switches sw;
     sw.incremental = state.range(5) != 0;
+    if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
     const detail::sparse::ScopedSwitches scoped(sw);
     double total = 0.0, cpu = 0.0, factorizations = 0.0, newton = 0.0, mode_solves = 0.0;
     long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_tresca = 0;
@@ -476,30 +479,37 @@ void ElasticRuns(benchmark::State& state) {
     state.counters["by_tresca"] = static_cast<double>(by_tresca);
 }
 BENCHMARK(ElasticRuns)
-    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal"})
+    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal", "fixed"})
     // the reference: the paper example, rigid and elastic, 1 s
-    ->Args({20, 0, 0, 1000, 0, 1, 0, -1})->Args({20, 0, 1, 1000, 0, 1, 0, -1})
+    ->Args({20, 0, 0, 1000, 0, 1, 0, -1, -1})->Args({20, 0, 1, 1000, 0, 1, 0, -1, -1})
     // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf, 1 s
     // (the target's measure: the first 50 ms, from rest at 2 m/s, are not typical of the second)
-    ->Args({100, 1, 1, 1000, 0, 1, 0, -1})->Args({200, 1, 1, 1000, 0, 1, 0, -1})->Args({400, 1, 1, 1000, 0, 1, 0, -1})
-    ->Args({100, 2, 1, 1000, 0, 1, 0, -1})->Args({200, 2, 1, 1000, 0, 1, 0, -1})->Args({400, 2, 1, 1000, 0, 1, 0, -1})
+    ->Args({100, 1, 1, 1000, 0, 1, 0, -1, -1})->Args({200, 1, 1, 1000, 0, 1, 0, -1, -1})->Args({400, 1, 1, 1000, 0, 1, 0, -1, -1})
+    ->Args({100, 2, 1, 1000, 0, 1, 0, -1, -1})->Args({200, 2, 1, 1000, 0, 1, 0, -1, -1})->Args({400, 2, 1, 1000, 0, 1, 0, -1, -1})
     // issue 27's targets: 100 ms, graduated / identical 10 x 400 elastic against the same mesh
     // bonded, the incremental solve and the way before; graduated 50 / 100 / 200 / 400
-    ->Args({400, 1, 1, 100, 0, 1, 0, -1})->Args({400, 1, 1, 100, 0, 0, 0, -1})->Args({400, 3, 0, 100, 0, 1, 0, -1})
-    ->Args({400, 2, 1, 100, 0, 1, 0, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1})
-    ->Args({50, 1, 1, 100, 0, 1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1})
-    ->Args({50, 1, 1, 100, 0, 0, 0, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1})->Args({400, 1, 1, 100, 0, 0, 0, -1, -1})->Args({400, 3, 0, 100, 0, 1, 0, -1, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1, -1})
+    ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, -1})
+    ->Args({50, 1, 1, 100, 0, 0, 0, -1, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1, -1})
     // the primal route (docs/decisions/027; off by default) from 401 held rows: 10 x 400
     // graduated and identical, graduated 100 / 200; and its threshold 100 / 200 / 800
-    ->Args({400, 1, 1, 100, 0, 1, 0, 401})->Args({400, 2, 1, 100, 0, 1, 0, 401})
-    ->Args({100, 1, 1, 100, 0, 1, 0, 401})->Args({200, 1, 1, 100, 0, 1, 0, 401})
-    ->Args({400, 1, 1, 30, 0, 1, 0, 100})->Args({400, 1, 1, 30, 0, 1, 0, 200})->Args({400, 1, 1, 30, 0, 1, 0, 800})
+    ->Args({400, 1, 1, 100, 0, 1, 0, 401, -1})->Args({400, 2, 1, 100, 0, 1, 0, 401, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, 401, -1})->Args({200, 1, 1, 100, 0, 1, 0, 401, -1})
+    ->Args({400, 1, 1, 30, 0, 1, 0, 100, -1})->Args({400, 1, 1, 30, 0, 1, 0, 200, -1})->Args({400, 1, 1, 30, 0, 1, 0, 800, -1})
     // the Schur way's limit (SparsePathTuning::schur_max_rows) with the incremental solve
-    ->Args({400, 1, 1, 30, 0, 1, 0, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1})
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1, -1})
+    // the fixed-pattern LU (docs/decisions/031): off / Eigen / KLU, graduated and identical
+    // 10 x 400, 30 ms (quick) and 100 ms (the targets' measure), graduated 100 / 200
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, 0})->Args({400, 1, 1, 30, 0, 1, 0, -1, 1})->Args({400, 1, 1, 30, 0, 1, 0, -1, 2})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, 0})->Args({400, 1, 1, 100, 0, 1, 0, -1, 1})->Args({400, 1, 1, 100, 0, 1, 0, -1, 2})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, 0})->Args({400, 2, 1, 100, 0, 1, 0, -1, 1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 2})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, 0})->Args({100, 1, 1, 100, 0, 1, 0, -1, 2})
+    ->Args({200, 1, 1, 100, 0, 1, 0, -1, 0})->Args({200, 1, 1, 100, 0, 1, 0, -1, 2})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
-    ->Args({100, 1, 1, 300, 1, 1, 0, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1})
-    ->Args({50, 1, 0, 300, 1, 1, 0, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1})
+    ->Args({100, 1, 1, 300, 1, 1, 0, -1, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1, -1})
+    ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -63,6 +63,27 @@ bool column_couplings(const ModeLinearization& lin, const std::vector<int>& pos,
 }
 }  // namespace
 
+std::vector<int> layer_dofs(const SpMat& K, const SpMat& G) {
+    std::vector<int> dof(static_cast<std::size_t>(G.rows()), -1);
+    for (int j = 0; j < static_cast<int>(K.cols()); ++j) {
+        bool diag_only = true;
+        double kjj = 0.0;
+        for (SpMat::InnerIterator it(K, j); it; ++it) {
+            if (it.row() != j && it.value() != 0.0) diag_only = false;
+            if (it.row() == j) kjj = it.value();
+        }
+        int row = -1, count = 0;
+        for (SpMat::InnerIterator it(G, j); it; ++it)
+            if (it.value() != 0.0) {
+                row = static_cast<int>(it.row());
+                ++count;
+            }
+        if (diag_only && kjj > 0.0 && count == 1 && dof[static_cast<std::size_t>(row)] < 0)
+            dof[static_cast<std::size_t>(row)] = j;
+    }
+    return dof;
+}
+
 void SparseStiffness::build(const SpMat& K_, const SpMat& G_) {
     K = K_;
     G = G_;
@@ -110,7 +131,7 @@ double SparseStiffness::row_dot(int r, const Eigen::VectorXd& v) const {
     return sum;
 }
 
-void ModeSolver::reset(const SpMat& K, const SpMat& G) {
+void ModeSolver::reset(const SpMat& K, const SpMat& G, const std::vector<std::pair<int, int>>& couplings) {
     st_.build(K, G);
     const auto m = static_cast<std::size_t>(st_.rows());
     lu_key_.clear();
@@ -127,6 +148,14 @@ void ModeSolver::reset(const SpMat& K, const SpMat& G) {
     wb_active = false;
     l_nonzeros = static_cast<double>(st_.k_llt.matrixL().nestedExpression().nonZeros());
     lu_primal = false;
+    fixed_.reset();
+    if (tuning_.fixed_pattern != FixedPatternLu::off) {
+        fixed_ = std::make_unique<FixedSaddle>(tuning_.fixed_pattern);
+        fixed_->reset(st_, couplings);
+        const std::vector<int> dof = layer_dofs(st_.K, st_.G);
+        layer_row_.assign(m, 0);
+        for (std::size_t r = 0; r < m; ++r) layer_row_[r] = dof[r] >= 0 ? 1 : 0;
+    }
     primal_.reset();
     if (tuning_.primal_min_rows > 0 && primal_route_built()) {
         primal_ = make_primal_solver(tuning_.primal_ordering);
@@ -261,33 +290,42 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
     return factorised;
 }
 
-/// The scaled saddle-point system of lin's held set, factorised by the sparse LU.
+/// The scaled saddle-point system of lin's held set, factorised by the sparse LU: its own
+/// system ordered from scratch, or the fixed-pattern one (fixed_saddle.hpp) ordered once.
 void ModeSolver::factor_lu(const ModeLinearization& lin) {
     const int n = static_cast<int>(st_.K.rows());
     const auto& S = lin.S;
     const int ms = static_cast<int>(S.size());
     row_scale.resize(ms);
     for (int i = 0; i < ms; ++i) row_scale[i] = 1.0 / st_.row_h[S[i]];
-    // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(st_.K.nonZeros() + 4 * st_.G.nonZeros()));
-    st_.append_scaled_K(t);
-    for (int i = 0; i < ms; ++i)
-        for (SpMat::InnerIterator it(st_.Gt_scaled, S[i]); it; ++it) {
-            t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
-            t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+    int rigid = 0;
+    if (fixed_)
+        for (int r : S) rigid += layer_row_[static_cast<std::size_t>(r)] ? 0 : 1;
+    lu_fixed = fixed_ && rigid <= tuning_.fixed_max_rigid_rows;
+    if (lu_fixed) {
+        lu_ok = fixed_->factor(lin, pos, row_scale);
+    } else {
+        // [Dz K Dz, -Dz (G_S^T + G_slip^T D) R; R G_S Dz, 0]
+        std::vector<Eigen::Triplet<double>> t;
+        t.reserve(static_cast<std::size_t>(st_.K.nonZeros() + 4 * st_.G.nonZeros()));
+        st_.append_scaled_K(t);
+        for (int i = 0; i < ms; ++i)
+            for (SpMat::InnerIterator it(st_.Gt_scaled, S[i]); it; ++it) {
+                t.emplace_back(it.row(), n + i, -it.value() * row_scale[i]);
+                t.emplace_back(n + i, it.row(), it.value() * row_scale[i]);
+            }
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
+            const int col = pos[lin.coupled[a].second];
+            if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
+            for (SpMat::InnerIterator it(st_.Gt_scaled, lin.coupled[a].first); it; ++it)
+                t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
         }
-    for (std::size_t a = 0; a < lin.coupled.size(); ++a) {
-        const int col = pos[lin.coupled[a].second];
-        if (col < 0) continue;  // the normal row is not held: its force is fixed (e)
-        for (SpMat::InnerIterator it(st_.Gt_scaled, lin.coupled[a].first); it; ++it)
-            t.emplace_back(it.row(), n + col, -lin.coef[a] * it.value() * row_scale[col]);
+        A.resize(n + ms, n + ms);
+        A.setFromTriplets(t.begin(), t.end());
+        A.makeCompressed();
+        lu.compute(A);
+        lu_ok = lu.info() == Eigen::Success;
     }
-    A.resize(n + ms, n + ms);
-    A.setFromTriplets(t.begin(), t.end());
-    A.makeCompressed();
-    lu.compute(A);
-    lu_ok = lu.info() == Eigen::Success;
     base_valid = lu_ok && lin.coupled.empty();
     base_S = S;
     base_pos = pos;
@@ -419,7 +457,7 @@ void ModeSolver::border_solve(const ModeLinearization& lin, const Eigen::VectorX
     Eigen::VectorXd xx, yy, dx, dy;
     solve_bordered(f, g, xx, yy);
     {  // one step of iterative refinement on the bordered system
-        Eigen::VectorXd rf = f - A * xx;
+        Eigen::VectorXd rf = f - apply_A(xx);
         Eigen::VectorXd uy = Eigen::VectorXd::Zero(n + ms0);
         add_U(yy, uy);
         rf -= uy;
@@ -719,7 +757,13 @@ void ModeSolver::schur_solve(const ModeLinearization& lin, const Eigen::VectorXd
     }
 }
 
+Eigen::VectorXd ModeSolver::apply_A(const Eigen::VectorXd& x) const {
+    if (lu_fixed) return fixed_->multiply(x);
+    return A * x;
+}
+
 Eigen::VectorXd ModeSolver::refined_solve(const Eigen::VectorXd& r) {
+    if (lu_fixed) return fixed_->solve(r);
     Eigen::VectorXd y = lu.solve(r);
     const Eigen::VectorXd res = r - A * y;
     y += lu.solve(res);

@@ -30,6 +30,7 @@
 
 #include "contact/active_set.hpp"
 #include "contact/sparse/common.hpp"
+#include "contact/sparse/fixed_saddle.hpp"
 #include "contact/sparse/primal_solver.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -62,6 +63,10 @@ struct SparseStiffness {
     double row_dot(int r, const Eigen::VectorXd& v) const;
 };
 
+/// Per contact row: its elastic-interface layer DOF (decision 013: a column of K with its
+/// positive diagonal only and one nonzero of G, in this row, the first such column), or -1.
+std::vector<int> layer_dofs(const SpMat& K, const SpMat& G);
+
 /// The ways of ModeSolver (SparsePathTuning's fields of the same names).
 struct ModeSolverTuning {
     int schur_max_rows = 400;   ///< >= 0 (0: always the sparse LU)
@@ -74,14 +79,24 @@ struct ModeSolverTuning {
     /// 0: never (SparsePathTuning::primal_min_rows; docs/decisions/027)
     int primal_min_rows = 0;
     PrimalOrdering primal_ordering = PrimalOrdering::amd;  ///< its fill-reducing ordering
+    /// the sparse LU of held sets above schur_max_rows: on one pattern for every set, ordered
+    /// once per (K, G) (fixed_saddle.hpp; docs/decisions/031), or `off`: the variable system
+    /// of each set ordered and factorised from scratch (the way before)
+    FixedPatternLu fixed_pattern = FixedPatternLu::off;
+    /// the fixed pattern only for held sets with at most this many rigid (not layer) rows:
+    /// each forces an off-diagonal pivot that the pattern's ordering (made for diagonal
+    /// pivots) does not foresee (measured: bonded 10 x 400, every row rigid and held, 20x slower)
+    int fixed_max_rigid_rows = 200;
 };
 
 class ModeSolver {
 public:
     explicit ModeSolver(const ModeSolverTuning& tuning = {}) : tuning_(tuning) {}
 
-    /// A new (K, G): factorises K, computes W's diagonal and drops every cache.
-    void reset(const SpMat& K, const SpMat& G);
+    /// A new (K, G): factorises K, computes W's diagonal and drops every cache. `couplings`:
+    /// the (tangential row, normal row) of the pairs whose slip may couple them (the fixed
+    /// pattern's; a coupling not listed extends the pattern when it first occurs).
+    void reset(const SpMat& K, const SpMat& G, const std::vector<std::pair<int, int>>& couplings = {});
     const SparseStiffness& stiffness() const { return st_; }
 
     /// Solves the linear problem of `lin` (held rows S with s = 0, fixed forces e, slip
@@ -110,6 +125,8 @@ public:
     PrimalSolver* primal() { return primal_.get(); }
     /// Whether the current factorisation is the primal route's.
     bool on_primal_route() const { return lu_primal; }
+    /// The fixed-pattern LU (null when ModeSolverTuning::fixed_pattern is off; tests, benchmark).
+    const FixedSaddle* fixed() const { return fixed_.get(); }
 
 private:
     bool try_border(const ModeLinearization& lin);
@@ -124,6 +141,7 @@ private:
     void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
+    Eigen::VectorXd apply_A(const Eigen::VectorXd& x) const;
     void factor_lu(const ModeLinearization& lin);
     void direct_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
                       Eigen::VectorXd& pS, Eigen::VectorXd& zf);
@@ -181,6 +199,10 @@ private:
     // builds with CHOLMOD
     std::shared_ptr<PrimalSolver> primal_;
     bool lu_primal = false;
+    // the sparse LU on the fixed pattern (replaces lu and A when tuning_.fixed_pattern is on)
+    std::unique_ptr<FixedSaddle> fixed_;
+    std::vector<char> layer_row_;        // per contact row: a layer row (layer_dofs)
+    bool lu_fixed = false;               // the current sparse LU is fixed_'s
 };
 
 }  // namespace stackbeam::detail::sparse

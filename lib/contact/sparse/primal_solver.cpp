@@ -129,42 +129,30 @@ void CholmodPrimal::reset(const SparseStiffness& st) {
     const SpMat& G = st.G;
     n = static_cast<int>(K.rows());
     m = static_cast<int>(G.rows());
-    // layer DOFs: a column of K' with its diagonal only, and one entry of G', in a row without
-    // another layer DOF
-    layer_dof.assign(static_cast<std::size_t>(m), -1);
+    // layer DOFs (layer_dofs, mode_solver.hpp)
     layer_e.assign(static_cast<std::size_t>(m), 0.0);
     layer_k.assign(static_cast<std::size_t>(m), 0.0);
     layer_c.assign(static_cast<std::size_t>(m), 0.0);
     zidx.assign(static_cast<std::size_t>(n), -1);
     zdof.clear();
     nlayer = 0;
-    for (int j = 0; j < n; ++j) {
-        bool diag_only = true;
-        double kjj = 0.0;
-        for (SpMat::InnerIterator it(K, j); it; ++it) {
-            if (it.row() != j && it.value() != 0.0) diag_only = false;
-            if (it.row() == j) kjj = it.value();
-        }
-        int row = -1, count = 0;
-        double e = 0.0;
-        for (SpMat::InnerIterator it(G, j); it; ++it)
-            if (it.value() != 0.0) {
-                row = static_cast<int>(it.row());
-                e = it.value();
-                ++count;
-            }
-        if (diag_only && kjj > 0.0 && count == 1 && layer_dof[static_cast<std::size_t>(row)] < 0) {
-            const auto r = static_cast<std::size_t>(row);
-            layer_dof[r] = j;
-            layer_e[r] = e;
-            layer_k[r] = kjj;
-            layer_c[r] = e * e / kjj;
-            ++nlayer;
-        } else {
+    layer_dof = layer_dofs(K, G);
+    std::vector<char> on_layer(static_cast<std::size_t>(n), 0);
+    for (int r = 0; r < m; ++r) {
+        const int j = layer_dof[static_cast<std::size_t>(r)];
+        if (j < 0) continue;
+        const auto ru = static_cast<std::size_t>(r);
+        layer_e[ru] = G.coeff(r, j);
+        layer_k[ru] = K.coeff(j, j);
+        layer_c[ru] = layer_e[ru] * layer_e[ru] / layer_k[ru];
+        on_layer[static_cast<std::size_t>(j)] = 1;
+        ++nlayer;
+    }
+    for (int j = 0; j < n; ++j)
+        if (!on_layer[static_cast<std::size_t>(j)]) {
             zidx[static_cast<std::size_t>(j)] = static_cast<int>(zdof.size());
             zdof.push_back(j);
         }
-    }
     nz = static_cast<int>(zdof.size());
     in_factor.assign(static_cast<std::size_t>(m), 0);
     if (nlayer == 0) return;

@@ -112,15 +112,17 @@ bool smoothing_direction(SparsePath& path, const std::vector<SmoothRow>& J, cons
     path.Js.setFromTriplets(t.begin(), t.end());
     path.Js.makeCompressed();
     if (!path.js_analysed) {
-        path.js_lu.analyzePattern(path.Js);
+        path.js_lu->analyze(path.Js);
         path.js_analysed = true;
     }
-    path.js_lu.factorize(path.Js);
-    if (path.js_lu.info() != Eigen::Success) return false;
+    if (!path.js_lu->factorize(path.Js)) return false;
     Eigen::VectorXd rhs_s = Eigen::VectorXd::Zero(n + m);
     for (int i = 0; i < m; ++i) rhs_s[n + i] = -F[i] / st.row_h[i];
-    Eigen::VectorXd y = path.js_lu.solve(rhs_s);
-    y += path.js_lu.solve(rhs_s - path.Js * y);  // one step of iterative refinement
+    Eigen::VectorXd y = rhs_s;
+    path.js_lu->solve_in_place(y);
+    Eigen::VectorXd res = rhs_s - path.Js * y;  // one step of iterative refinement
+    path.js_lu->solve_in_place(res);
+    y += res;
     if (!y.allFinite()) return false;
     dzv = st.dz.cwiseProduct(y.head(n));
     dp = y.tail(m).cwiseQuotient(st.row_h);

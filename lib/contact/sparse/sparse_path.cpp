@@ -15,9 +15,21 @@ constexpr int kBudget = 3;  // passes without fewer violations before Murty's ru
 
 void SparsePath::reset(const SparseContactProblem& pr) {
     pr.validate();
-    solver.reset(pr.K, pr.G);
+    // the slip couplings the pairs can make (a friction pair's tangential row on its normal
+    // row's force: ModeSet::linearize), for the fixed-pattern LU's pattern
+    std::vector<std::pair<int, int>> couplings;
+    for (const auto& c : pr.pairs)
+        if (c.row_t >= 0 && c.row_n >= 0 && c.kind != PairKind::bonded) couplings.emplace_back(c.row_t, c.row_n);
+    solver.reset(pr.K, pr.G, couplings);
     ipm_analysed = false;
     js_analysed = false;
+    // KLU for the smoothing Newton method's Jacobian with few rigid rows (as the mode solver's
+    // fixed_max_rigid_rows: a rigid row near its held mode has a zero diagonal there)
+    const std::vector<int> layer = layer_dofs(pr.K, pr.G);
+    const auto rigid = std::count(layer.begin(), layer.end(), -1);
+    js_lu = make_pattern_lu(switches.fixed_pattern == 2 && rigid <= ModeSolverTuning{}.fixed_max_rigid_rows
+                                ? FixedPatternLu::klu
+                                : FixedPatternLu::eigen);
     const int m = pr.size();
     laws.W.resize(0, 0);
     laws.q = Eigen::VectorXd::Zero(m);

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <memory>
 #include <vector>
 
 #include "contact/active_set.hpp"
@@ -28,6 +29,14 @@ struct Step {
 /// entries); the rest of `layered` is left as it was. False (nothing set) if no row has a layer.
 bool layer_structure(const SparseContactProblem& pr, SparseContactProblem& layered);
 
+/// `tuning` with the switches' choice of the fixed-pattern LU.
+inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& sw) {
+    tuning.fixed_pattern = sw.fixed_pattern == 1                 ? FixedPatternLu::eigen
+                           : sw.fixed_pattern == 2 && klu_built() ? FixedPatternLu::klu
+                                                                  : FixedPatternLu::off;
+    return tuning;
+}
+
 struct SparsePath {
     SolverOptions options;   ///< tolerance_m, max_active_set_iterations, tresca_anderson_depth
     Switches switches;       ///< the test-only switches (switches.hpp)
@@ -42,11 +51,11 @@ struct SparsePath {
     bool ipm_analysed = false;
     Eigen::Index ipm_nnz = 0;
     SpMat Js;
-    Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> js_lu;
+    std::unique_ptr<PatternLu> js_lu;  ///< Eigen's SparseLU, or KLU with Switches::fixed_pattern 2
     bool js_analysed = false;
 
     SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
-        : options(o), switches(sw), solver(tuning) {}
+        : options(o), switches(sw), solver(with_switches(tuning, sw)) {}
 
     /// A new structure (K, G, pairs): validates `pr` (InputError), refactorises, forgets the modes.
     void reset(const SparseContactProblem& pr);

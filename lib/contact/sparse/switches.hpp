@@ -41,6 +41,13 @@ struct Switches {
     /// breakpoint line search. false: every held set's Schur complement from scratch and the
     /// 49-point line search, the way before (kept for comparison in the benchmark and tests).
     bool incremental = true;
+    /// The sparse LU of the mode solver's held sets above the Schur way's limit and of the
+    /// smoothing Newton method's Jacobian (docs/decisions/031): 2 (default) KLU on the fixed
+    /// pattern, ordered once per (K, G), refactorised on the last pivot sequence where it
+    /// fits (builds with KLU; without it as 0); 1 Eigen's SparseLU on the fixed pattern
+    /// (measured slower than 0); 0 the way before: each held set's own saddle-point system
+    /// ordered and factorised from scratch, and Eigen's SparseLU for the smoothing method.
+    int fixed_pattern = 2;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,

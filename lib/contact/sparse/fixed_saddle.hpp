@@ -1,0 +1,100 @@
+#pragma once
+// Internal: the saddle-point system of a set of modes on one pattern for every set
+// (fixed_saddle.cpp; docs/decisions/031-fixed-pattern-refactorisation.md).
+//
+// The mode solver's sparse LU factorised, per held set S, the scaled system
+//     [ Dz K Dz                  -Dz (G_S^T + G_slip^T D) R ] [y  ]   [Dz f  ]
+//     [ R G_S Dz                  0                         ] [pi ] = [R d_S ]
+// whose size and pattern change with S, so its ordering (COLAMD) and symbolic analysis were
+// redone at every set. Here the system has one row and one column per contact row, held or
+// not: a row i outside S is the trivial equation pi_i = 0 (its entries of G stored as
+// explicit zeros, its diagonal 1), a held row's diagonal an explicit zero, and every slip
+// coupling the problem can have (each friction pair's tangential row on its normal row's
+// column) has its entries in the pattern, zero when not slipping. The pattern then depends on
+// (K, G) and the pairs only: the fill-reducing ordering and the symbolic analysis are made
+// once, and each held set costs one numeric factorisation with partial pivoting (so a row
+// whose value changed from 1 to 0 between sets is pivoted as it must be). The solution is
+// the same as the variable system's: the rows outside S only add pi_i = 0, which the load
+// f = b + G^T e already accounts for.
+#include <Eigen/Dense>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "contact/active_set.hpp"
+#include "contact/sparse/common.hpp"
+
+namespace stackbeam::detail::sparse {
+
+struct SparseStiffness;
+
+/// The sparse LU used on the fixed pattern (ModeSolverTuning::fixed_pattern).
+enum class FixedPatternLu {
+    off,    ///< the variable system of each held set, ordered and factorised from scratch (before)
+    eigen,  ///< Eigen::SparseLU: COLAMD and the symbolic analysis once, factorize() per set
+    klu,    ///< SuiteSparse's KLU (AMD ordering once; per set klu_refactor on the last pivot sequence
+            ///< where its pivots stay good, else klu_factor; builds with KLU only)
+};
+
+/// Whether this build has SuiteSparse's KLU (STACKBEAM_HAVE_KLU).
+bool klu_built();
+
+/// A sparse LU with partial pivoting whose ordering and symbolic analysis are made once for
+/// a pattern and reused by every numeric factorisation of a matrix of that pattern.
+class PatternLu {
+public:
+    virtual ~PatternLu() = default;
+    /// The ordering and symbolic analysis of A's pattern.
+    virtual void analyze(const SpMat& A) = 0;
+    /// The numeric factorisation of A (A's pattern is the analysed one); false if singular.
+    virtual bool factorize(const SpMat& A) = 0;
+    /// x = A^-1 x with the last factorisation.
+    virtual void solve_in_place(Eigen::VectorXd& x) = 0;
+    long pivoted = 0;  ///< numeric factorisations with pivoting
+    long reused = 0;   ///< refactorisations on the previous pivot sequence (KLU)
+};
+
+/// A PatternLu on `lu` (not off; klu only when klu_built(), else Eigen's).
+std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu);
+
+/// The numeric factorisations of the fixed-pattern system of one (K, G, pairs).
+class FixedSaddle {
+public:
+    explicit FixedSaddle(FixedPatternLu lu) : lu_(make_pattern_lu(lu)) {}
+    /// A new structure: the pattern of K, of every contact row and of the couplings
+    /// (tangential row, normal row) of `couplings`; the ordering is made at the first factor().
+    void reset(const SparseStiffness& st, const std::vector<std::pair<int, int>>& couplings);
+    /// Factorises the system of lin's held set (pos: row -> index in lin.S or -1; row_scale:
+    /// the held rows' scaling). A coupling outside the pattern extends it (a new analysis).
+    /// False if the matrix is singular.
+    bool factor(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& row_scale);
+    /// x = A_S^-1 r for the variable system's layout (n DOFs, then the held rows in lin.S's
+    /// order), with one step of iterative refinement against the fixed-pattern matrix.
+    Eigen::VectorXd solve(const Eigen::VectorXd& r);
+    /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
+    Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
+    /// Orderings and symbolic analyses made since reset() (tests, benchmark).
+    int analyses() const { return analyses_; }
+    /// The LU's counts of factorisations (tests, benchmark).
+    const PatternLu& lu() const { return *lu_; }
+
+private:
+    std::unique_ptr<PatternLu> lu_;
+    void build_pattern();
+    Eigen::VectorXd scatter(const Eigen::VectorXd& x) const;
+    Eigen::VectorXd gather(const Eigen::VectorXd& full) const;
+    const SparseStiffness* st_ = nullptr;
+    std::vector<std::pair<int, int>> couplings_;  // (tangential row, normal row) in the pattern
+    std::vector<int> coupling_of_t_;              // tangential row -> its index in couplings_, or -1
+    SpMat A_;                                     // the pattern and the current values
+    std::vector<int> k_slot_;                     // per nonzero of K: its slot in A_
+    std::vector<double> k_scaled_;                //   and its value in Dz K Dz
+    std::vector<int> gcol_slot_, grow_slot_;      // per nonzero of Gt_scaled: slots (dof, n + i), (n + i, dof)
+    std::vector<int> diag_slot_;                  // per contact row: the slot (n + i, n + i)
+    std::vector<std::vector<int>> cpl_slot_;      // per coupling: slots (dof, n + normal) for g_t's nonzeros
+    bool analysed_ = false;
+    int analyses_ = 0;
+    std::vector<int> held_;                       // the held rows of the current factorisation
+};
+
+}  // namespace stackbeam::detail::sparse
