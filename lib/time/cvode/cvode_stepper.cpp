@@ -11,6 +11,7 @@
 
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/cvode_massless.hpp"
 #include "time/cvode/event_driver.hpp"
 #include "time/initial_state.hpp"
 #include "time/record.hpp"
@@ -231,10 +232,13 @@ struct CvodeStepper::Impl final : detail::EventDriver {
 };
 
 CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options)
-    : CvodeStepper(system, detail::initial_state("cvode-massless", system, options)) {}
+    : impl_(std::make_unique<Impl>(system, detail::initial_state("cvode-massless", system, options))) {}
 
-CvodeStepper::CvodeStepper(const System& system, const detail::InitialState& start)
-    : impl_(std::make_unique<Impl>(system, start)) {}
+CvodeStepper::CvodeStepper(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+std::unique_ptr<Stepper> CvodeStepperAccess::build(const System& system, const detail::InitialState& start) {
+    return std::unique_ptr<Stepper>(new CvodeStepper(std::make_unique<CvodeStepper::Impl>(system, start)));
+}
 
 CvodeStepper::~CvodeStepper() = default;
 
