@@ -118,7 +118,10 @@ void install_stop_handlers(void (*handler)(int)) {
 
 RunResult run(const RunRequest& request, const System& system) {
     const auto t0 = std::chrono::steady_clock::now();
-    const SimulationOptions& options = request.options;
+    // SIGINT / SIGTERM reach the library's stop check too, so a long step between two outputs
+    // (mode cvode: the event driver polls it inside its step loop) stops promptly
+    SimulationOptions options = request.options;
+    options.stop_requested = [] { return g_stop_signal != 0; };
     PartialFile csv(request.out, "--out");
     PartialFile pairs_csv(request.pairs, "--pairs");
     PartialFile nodes_csv(request.nodes, "--nodes");
@@ -171,10 +174,9 @@ RunResult run(const RunRequest& request, const System& system) {
         result.stats.add(r);
         progress.update(r.t_s);
     };
-    try {
-        result.records = simulate(system, options, on_step, &result.report, on_pairs, on_nodes);
-        progress.finish();
-    } catch (const Interrupted&) {
+    // A stop (the signal seen between records, or by the library's stop check within a step): the
+    // whole records so far are kept in the partial files.
+    auto stopped = [&]() -> RunResult {
         progress.finish();
         result.signal = g_stop_signal;
         csv.close();
@@ -187,6 +189,14 @@ RunResult run(const RunRequest& request, const System& system) {
         std::cerr << "stackbeam: interrupted by signal " << result.signal << " at t = " << result.stats.last.t_s
                   << " s; the rows up to it are in " << csv.partial() << "\n";
         return result;
+    };
+    try {
+        result.records = simulate(system, options, on_step, &result.report, on_pairs, on_nodes);
+        progress.finish();
+    } catch (const Interrupted&) {
+        return stopped();
+    } catch (const RunStopped&) {  // the library's stop check saw the signal within a step
+        return stopped();
     } catch (const InputError&) {
         // bad input found when the run starts (e.g. an option the mode cannot use): no rows to keep
         progress.finish();

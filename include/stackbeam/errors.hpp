@@ -45,6 +45,20 @@ private:
     double residual_;
 };
 
+/// A run stopped because its caller asked for it (SimulationOptions::stop_requested returned
+/// true, e.g. on SIGINT in the command line): not a failure. Carries where the run stood.
+class RunStopped : public std::runtime_error {
+public:
+    RunStopped(const std::string& message, long step, double time_s)
+        : std::runtime_error(message), step_(step), time_s_(time_s) {}
+    long step() const noexcept { return step_; }        ///< the integrator's steps so far
+    double time_s() const noexcept { return time_s_; }  ///< the last accepted time [s]
+
+private:
+    long step_;
+    double time_s_;
+};
+
 /// Formats "value" for messages with full precision.
 std::string format_value(double value);
 

@@ -318,7 +318,7 @@ const Eigen::MatrixXd& System::compliance_held() const {
     return C_held_->C;
 }
 
-bool detail::compliance_held_built(const System& system) noexcept {
+bool SystemAccess::compliance_held_built(const System& system) noexcept {
     return system.C_held_->built;
 }
 

@@ -146,6 +146,10 @@ std::vector<StepRecord> simulate(const System& system, const SimulationOptions& 
     std::vector<StepRecord> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
     for (long i = 0; i <= n; ++i) {
+        // the caller's stop check between outputs (mode cvode also polls it inside a step: event_driver.hpp)
+        if (i > 0 && options.stop_requested && options.stop_requested())
+            throw RunStopped("stopped on request at t = " + format_value(out.back().t_s) + " s (the last output)",
+                             stepper->report().steps, out.back().t_s);
         out.push_back(i == 0 ? stepper->current() : stepper->advance());
         if (on_step) on_step(out.back());
         if (on_pairs) on_pairs(out.back().t_s, stepper->pairs());

@@ -11,6 +11,7 @@
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/newmark_stepper.hpp"
 #include "time/cvode/cvode_held.hpp"
+#include "time/cvode/cvode_massless.hpp"
 #include "time/cvode/cvode_massive.hpp"
 #include "time/cvode/cvode_modal.hpp"
 #include "time/initial_state.hpp"
@@ -64,7 +65,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.friction = c.rigid_rows = c.elastic_layer = c.cvode_stats = true;
     c.start = StartKind::massless_stack;
     c.exact_start = true;
-    c.build = &build<CvodeStepper>;
+    c.build = &CvodeStepperAccess::build;
     rows.push_back(c);
 
     c = StepperCapabilities{};

@@ -33,10 +33,6 @@ struct LeafNodes {
     std::vector<double> theta_rad;  ///< rotation of the cross-section, dv/dx [rad], counter-clockwise
 };
 
-namespace detail {
-bool compliance_held_built(const System& system) noexcept;  // internal (lib/fe/system_internal.hpp)
-}
-
 class System {
 public:
     /// Assembles and condenses. Throws InputError when the stack is not
@@ -121,7 +117,7 @@ public:
     std::vector<LeafNodes> leaf_nodes(const Eigen::VectorXd& z) const;
 
 private:
-    friend bool detail::compliance_held_built(const System& system) noexcept;
+    friend struct SystemAccess;  // internal: lib/fe/system_internal.hpp
     Model model_;
     std::vector<ContactPair> pairs_;
     std::vector<int> pair_candidate_;

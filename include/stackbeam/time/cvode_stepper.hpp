@@ -58,9 +58,6 @@
 #include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
-namespace detail {
-struct InitialState;  // internal: the shared set-up stage (lib/time/initial_state.hpp)
-}
 
 /// The CVODE integration (mode "cvode"). Outputs come on the grid t = i * dt_s
 /// (SimulationOptions::dt_s is the output interval here, not a step).
@@ -69,8 +66,6 @@ public:
     /// Throws InputError for bad options (e.g. rtol <= 0), SolverError if the initial
     /// contact state cannot be resolved.
     CvodeStepper(const System& system, const SimulationOptions& options);
-    /// From the shared set-up stage's state (make_stepper).
-    CvodeStepper(const System& system, const detail::InitialState& start);
     ~CvodeStepper() override;
 
     /// Integrates to the next output time and returns its record. Throws SolverError
@@ -99,6 +94,8 @@ public:
 
 private:
     struct Impl;
+    friend struct CvodeStepperAccess;  // internal: make_stepper builds it from the set-up stage
+    explicit CvodeStepper(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
 

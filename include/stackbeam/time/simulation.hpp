@@ -143,6 +143,13 @@ struct SimulationOptions {
     /// start (0: perfectly inelastic, the default; 1: elastic); every other held component
     /// ends with relative velocity 0. Docs: docs/time-integration.md.
     double restitution = 0.0;
+    /// The caller's stop check, polled while a run integrates (mode cvode: every 64 internal
+    /// steps inside the event driver, so a stalled run can be interrupted between outputs;
+    /// every mode: before each output step in simulate()). When it returns true the run ends
+    /// with RunStopped (errors.hpp) at the time reached; the records so far stay delivered.
+    /// Empty (the default): never stops. It must be cheap and safe to call from the run's thread
+    /// (e.g. reading a std::sig_atomic_t set by a signal handler).
+    std::function<bool()> stop_requested;
     /// Structural damping of the leaves (mode newmark with massive leaves, mode cvode with the massive stack).
     StructuralDamping damping;
     /// Throws InputError when a value is out of range; its field() is the member's path

@@ -81,11 +81,11 @@ using RowSpMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 }  // namespace
 
 struct CvodeMassiveStepper::Impl final : EventDriver {
-    Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (massive leaves)") {}
+    Impl(const System& system, const InitialState& start);
 
     SpMat K, M, Gt;
     SpMat C;                  // structural damping alpha M + beta K [N s/m] (empty: none)
-    bool damped() const { return opt.damping.active(); }
+    bool damped() const { return options().damping.active(); }
     RowSpMat Grow;            // G, row-major [-]
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
@@ -102,47 +102,25 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> nlu;
     double gamma_lu = -1.0;
 
-    /// The witness scales (as the modal stepper): R's amplitude on the tied stack and its
-    /// frequency, with the loading's scales: the applied force's largest value [N, whole spring],
-    /// the weight of everything [N, whole spring], the base's or the rig's largest displacement [m].
-    void set_scales() {
-        const auto& body = sys.model().spec().rigid_body;
-        const Loading& L = opt.loading;
-        omega_t = std::sqrt(sys.tied_stiffness_n_per_m() / body.mass_kg);
-        auto largest = [](const TimeFunction& F) {
-            double v = std::abs(F.mean) + F.amplitude;
-            for (double x : F.values) v = std::max(v, std::abs(x));
-            return v;
-        };
-        const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
-                                   f * L.gravity_m_per_s2 * load->inertia_kg().sum();
-        const double motion_scale = L.kind == LoadingKind::base_excitation || rig ? largest(L.displacement_m) : 0.0;
-        L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / omega_t +
-                force_scale / sys.tied_stiffness_n_per_m() + motion_scale;
-        if (!(L_ref > 0.0)) L_ref = 1e-3;
-        V_ref = omega_t * L_ref;
-        double preload = 0.0;
-        for (const auto& cp : sys.pairs()) preload = std::max(preload, cp.preload_n);
-        F_ref = std::max(preload, sys.tied_stiffness_n_per_m() / f * L_ref);
-    }
-    double omega_t = 1.0;  // R's frequency on the tied stack [rad/s]
-
     /// CVODE's tolerances: displacements and rotations to atol_m, velocities to omega_t atol_m,
-    /// the dissipated energy to rtol of the initial energy (z0, v0: the initial state).
-    void set_tolerances(const Eigen::VectorXd& z0, const Eigen::VectorXd& v0) {
-        auto A = cvode->atol();
-        A.head(ndof).setConstant(opt.cvode.atol_m);
-        A.segment(ndof, ndof).setConstant(omega_t * opt.cvode.atol_m);
+    /// the dissipated, damping and external energies to rtol of the initial energy (y0: z0, v0).
+    void tolerances(const State& y0, Eigen::Ref<Vec> A) const override {
+        const int nd = ndof();
+        const auto z0 = y0.head(nd);
+        const auto v0 = y0.segment(nd, nd);
+        const double omega_t = scales().omega_rad_per_s, L_ref = scales().L_ref_m;
+        A.head(nd).setConstant(options().cvode.atol_m);
+        A.segment(nd, nd).setConstant(omega_t * options().cvode.atol_m);
         const double e_meshed = 0.5 * v0.dot(M * v0) + 0.5 * z0.dot(K * z0) +
-                                0.5 * sys.tied_stiffness_n_per_m() / f * L_ref * L_ref;
-        A[2 * ndof] = A[2 * ndof + 1] = A[2 * ndof + 2] = std::max(1e-300, opt.cvode.rtol * e_meshed);
+                                0.5 * system().tied_stiffness_n_per_m() / spring_factor() * L_ref * L_ref;
+        A[2 * nd] = A[2 * nd + 1] = A[2 * nd + 2] = std::max(1e-300, options().cvode.rtol * e_meshed);
     }
 
     // ---- modes ------------------------------------------------------------------
 
-    void build_mode() override {
-        ModeLinearization lin;
-        modes.linearize(chk_problem, lin);
+    void build_mode(const ModeLinearization& lin) override {
+        const int n = rows();
+        const Eigen::VectorXd& d = anchors();
         std::vector<int> pos(static_cast<std::size_t>(n), -1);
         for (std::size_t i = 0; i < lin.S.size(); ++i) pos[static_cast<std::size_t>(lin.S[i])] = static_cast<int>(i);
         std::vector<Eigen::Triplet<double>> tp;
@@ -150,8 +128,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         // held rows: c_i p_i + G_i z - d_i = 0 (W = C_L is diagonal: no coupling to other rows)
         for (int row : lin.S) {
             const double c = cL[row];
-            if (!(c > 0.0))
-                throw SolverError(who + ": contact row " + std::to_string(row) + " has no elastic layer", stats.steps, t, 0.0);
+            if (!(c > 0.0)) throw failure("contact row " + std::to_string(row) + " has no elastic layer");
             for (RowSpMat::InnerIterator it(Grow, row); it; ++it) tp.emplace_back(row, it.col(), -it.value() / c);
             p0[row] = d[row] / c;
         }
@@ -163,7 +140,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
             for (RowSpMat::InnerIterator it(Grow, rn); it; ++it) tp.emplace_back(rt, it.col(), -coef * it.value() / c);
             p0[rt] = lin.e[rt] + coef * p0[rn];
         }
-        P.resize(n, ndof);
+        P.resize(n, ndof());
         P.setFromTriplets(tp.begin(), tp.end());
         const RowSpMat CP = cL.asDiagonal() * P;
         Hs = Grow + CP;
@@ -172,9 +149,9 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         Keff.makeCompressed();
         b0 = Gt * p0;
         slip_rows.clear();
-        for (int kk = 0; kk < np; ++kk) {
+        for (int kk = 0; kk < num_pairs(); ++kk) {
             const int rt = pairs()[kk].row_t;
-            if (rt >= 0 && (tmode[kk] == SLIP_POS || tmode[kk] == SLIP_NEG)) slip_rows.push_back(rt);
+            if (rt >= 0 && (modes().tmode[kk] == SLIP_POS || modes().tmode[kk] == SLIP_NEG)) slip_rows.push_back(rt);
         }
         // the Newton matrix's pattern (M + K_eff: the same for every gamma)
         SpMat A = M + Keff;
@@ -182,15 +159,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         prescribe_w_row(A);
         nlu.analyzePattern(A);
         gamma_lu = -1.0;
-        ++stats.mode_factorizations;
-        ++facts_since;
     }
 
     /// The rig: R's row of the Newton matrix becomes e_w^T (x_vw = r_vw: w'' does not depend on
     /// the state). Compresses A.
     void prescribe_w_row(SpMat& A) const {
         if (rig) {
-            const int w = w_dof;
+            const int w = w_dof();
             A.prune([w](const Eigen::Index& row, const Eigen::Index&, const double&) { return row != w; });
             A.coeffRef(w, w) = 1.0;
         }
@@ -198,12 +173,12 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
 
     Vec forces_z(const Eigen::Ref<const Eigen::VectorXd>& z) const { return P * z + p0; }
-    Vec forces(const State& y) const override { return forces_z(y.head(ndof)); }
-    Vec relative(const State& y) const override { return Hs * y.head(ndof) + hs; }
+    Vec forces(const State& y) const override { return forces_z(y.head(ndof())); }
+    Vec relative(const State& y) const override { return Hs * y.head(ndof()) + hs; }
     Vec relative_at_event(const State& y, const Vec& p_cur) const override {
-        return Grow * y.head(ndof) + cL.cwiseProduct(p_cur);
+        return Grow * y.head(ndof()) + cL.cwiseProduct(p_cur);
     }
-    Vec motion(const State& y) const override { return Grow * y.head(ndof); }
+    Vec motion(const State& y) const override { return Grow * y.head(ndof()); }
 
     /// z'' = M^-1 (G^T p0 + q(t) - K_eff z - C z' + lambda e_w) [m/s^2, rad/s^2] of the current
     /// modes; lambda [N, meshed part] the rig's reaction (0 without a rig), returned in `rig_n`.
@@ -214,7 +189,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         if (damped()) r -= C * v;
         Eigen::VectorXd a = mass.solve(r);
         if (rig) {
-            const double lambda = prescribe_w_acceleration(a, u_w, opt.loading.displacement_m.second_derivative(t_s));
+            const double lambda = prescribe_w_acceleration(a, u_w, options().loading.displacement_m.second_derivative(t_s));
             if (rig_n) *rig_n = lambda;
         } else if (rig_n) {
             *rig_n = 0.0;
@@ -224,13 +199,14 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     /// The external power [W, meshed part] at (t, v) with acceleration-side rig force lambda.
     double external_power(double t_s, const Eigen::Ref<const Eigen::VectorXd>& v, double lambda) const {
-        if (rig) return lambda * v[w_dof];
+        if (rig) return lambda * v[w_dof()];
         return load->none() ? 0.0 : load->at(t_s).dot(v);
     }
 
     void witnesses(const State& y, double* g) const override {
-        const auto z = y.head(ndof);
-        const auto v = y.segment(ndof, ndof);
+        const auto z = y.head(ndof());
+        const auto v = y.segment(ndof(), ndof());
+        const Eigen::VectorXd& d = anchors();
         witnesses_from(
             forces_z(z), [&](int row) { return Hs.row(row).dot(z) + hs[row] - d[row]; },
             [&](int row) { return Hs.row(row).dot(v); }, g);
@@ -239,16 +215,17 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     /// The look-ahead: the contact points move by ~kLookahead L_ref and the forces by
     /// ~kLookahead F_ref (as the modal stepper), on the second-order Taylor expansion.
     Vec look_ahead(double te, const State& y, const Vec&) const override {
+        const int ndof = this->ndof();
         const auto z = y.head(ndof);
         const auto v = y.segment(ndof, ndof);
         const Eigen::VectorXd a = acceleration(te, z, v);
-        const double target = kLookahead * L_ref;
+        const double target = kLookahead * scales().L_ref_m;
         const double vmax = (Grow * v).lpNorm<Eigen::Infinity>(), amax = (Grow * a).lpNorm<Eigen::Infinity>();
         double delta = std::numeric_limits<double>::infinity();
         if (vmax > 0.0) delta = std::min(delta, target / vmax);
         if (amax > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / amax));
         const double prate = (P * v).lpNorm<Eigen::Infinity>();
-        if (prate > 0.0) delta = std::min(delta, kLookahead * F_ref / prate);
+        if (prate > 0.0) delta = std::min(delta, kLookahead * scales().F_ref_n / prate);
         if (!std::isfinite(delta)) delta = 0.0;
         // The third-order term: z^(3) = M^-1 (q'(t) - K_eff z' - C z'') of the current modes (the
         // rig's w^(3) taken as 0). It decides where the lower orders vanish at the contact points: a
@@ -273,20 +250,20 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
 
     void body_motion(const State& y, const Vec&, double& w, double& wd) const override {
-        w = y[w_dof];
-        wd = y[ndof + w_dof];
+        w = y[w_dof()];
+        wd = y[ndof() + w_dof()];
     }
 
     /// A slipping pair slips against its slider rate (EventDriver::signs_follow_slip_rates).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {
-        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(ndof, ndof)); });
+        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(ndof(), ndof())); });
     }
 
     /// A force jump at an event (a slip that reverses) releases the layer's energy
     /// p^T C_L p / 2 of the jump: friction work, booked as dissipated (z and z' are continuous).
     void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) override {
-        book_force_jump(cause, 0.5 * f * (p_cur.dot(cL.cwiseProduct(p_cur)) - p_new.dot(cL.cwiseProduct(p_new))), p_cur,
+        book_force_jump(cause, 0.5 * spring_factor() * (p_cur.dot(cL.cwiseProduct(p_cur)) - p_new.dot(cL.cwiseProduct(p_new))), p_cur,
                         p_new);
     }
 
@@ -295,75 +272,61 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
 
     // ---- CVODE ------------------------------------------------------------------
 
-    static Impl* self(void* user) { return static_cast<Impl*>(static_cast<EventDriver*>(user)); }
-
     /// y = [z, z', D, D_c, W]: z' = v, v' = M^-1 (G^T p0 + q(t) - K_eff z - C v + lambda e_w), D' =
     /// friction power -sum_slip p_t ds_t/dt >= 0, D_c' = damping power v^T C v >= 0, W' = the
     /// loading's power q^T v (rig: lambda w') [W, meshed part].
-    static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {
-        const Impl* s = self(user);
-        const int n_ = s->ndof;
-        const double* Y = N_VGetArrayPointer(yv);
-        double* D = N_VGetArrayPointer(ydot);
+    void derivatives(double t, const double* Y, double* D) const override {
+        const int n_ = ndof();
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
         double lambda = 0.0;
-        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = s->acceleration(t, z, v, &lambda);
-        s->rig_lambda_rhs = lambda;
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = acceleration(t, z, v, &lambda);
+        rig_lambda_rhs = lambda;
         double pw = 0.0;
-        for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(v);
+        for (int rt : slip_rows) pw -= (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(v);
         D[2 * n_] = pw;
-        D[2 * n_ + 1] = s->damped() ? v.dot(s->C * v) : 0.0;
-        D[2 * n_ + 2] = s->external_power(t, v, lambda);
-        return 0;
+        D[2 * n_ + 1] = damped() ? v.dot(C * v) : 0.0;
+        D[2 * n_ + 2] = external_power(t, v, lambda);
     }
 
     /// Factorises M + gamma C + gamma^2 K_eff (the Newton matrix after block elimination).
-    static int psetup(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
-                      void* user) {
-        Impl* s = self(user);
-        *jcur = SUNTRUE;
-        if (gamma == s->gamma_lu) return 0;
-        SpMat A = s->M + (gamma * gamma) * s->Keff;
-        if (s->damped()) A += gamma * s->C;
-        s->prescribe_w_row(A);
-        s->nlu.factorize(A);
-        if (s->nlu.info() != Eigen::Success) {
-            s->gamma_lu = -1.0;
+    int newton_setup(double gamma) override {
+        if (gamma == gamma_lu) return 0;
+        SpMat A = M + (gamma * gamma) * Keff;
+        if (damped()) A += gamma * C;
+        prescribe_w_row(A);
+        nlu.factorize(A);
+        if (nlu.info() != Eigen::Success) {
+            gamma_lu = -1.0;
             return 1;  // recoverable: CVODE retries with a smaller step
         }
-        s->gamma_lu = gamma;
+        gamma_lu = gamma;
         return 0;
     }
 
-    /// Solves (I - gamma J) x = r: the (z, v) block by elimination on the LU of psetup, the
+    /// Solves (I - gamma J) x = r: the (z, v) block by elimination on the LU of newton_setup, the
     /// friction-power row by its linearisation at y.
-    static int psolve(sunrealtype t, N_Vector yv, N_Vector, N_Vector rv, N_Vector xv, sunrealtype gamma, sunrealtype,
-                      int, void* user) {
-        const Impl* s = self(user);
-        if (s->gamma_lu < 0.0) return 1;
-        const int n_ = s->ndof;
-        const double* Y = N_VGetArrayPointer(yv);
-        const double* R = N_VGetArrayPointer(rv);
-        double* X = N_VGetArrayPointer(xv);
+    int newton_solve(double t, const double* Y, const double* R, double* X, double gamma) const override {
+        if (gamma_lu < 0.0) return 1;
+        const int n_ = ndof();
         const Eigen::Map<const Eigen::VectorXd> rz(R, n_), rvel(R + n_, n_);
-        Eigen::VectorXd rhs_v = s->M * rvel - gamma * (s->Keff * rz);  // (M + g C + g^2 Keff) x_v
-        if (s->rig) rhs_v[s->w_dof] = rvel[s->w_dof];                    // w'' prescribed: x_vw = r_vw
-        const Eigen::VectorXd xvel = s->nlu.solve(rhs_v);
+        Eigen::VectorXd rhs_v = M * rvel - gamma * (Keff * rz);  // (M + g C + g^2 Keff) x_v
+        if (rig) rhs_v[w_dof()] = rvel[w_dof()];                   // w'' prescribed: x_vw = r_vw
+        const Eigen::VectorXd xvel = nlu.solve(rhs_v);
         const Eigen::VectorXd xz = rz + gamma * xvel;
         Eigen::Map<Eigen::VectorXd>(X, n_) = xz;
         Eigen::Map<Eigen::VectorXd>(X + n_, n_) = xvel;
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         // d(pw) = -sum (P_t dz) (Hs_t v) + (P_t z + p0_t) (Hs_t dv)
         double dpw = 0.0;
-        for (int rt : s->slip_rows)
-            dpw -= s->P.row(rt).dot(xz) * s->Hs.row(rt).dot(v) + (s->P.row(rt).dot(z) + s->p0[rt]) * s->Hs.row(rt).dot(xvel);
+        for (int rt : slip_rows)
+            dpw -= P.row(rt).dot(xz) * Hs.row(rt).dot(v) + (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
-        X[2 * n_ + 1] = R[2 * n_ + 1] + (s->damped() ? gamma * 2.0 * (s->C * v).dot(xvel) : 0.0);  // d(v^T C v)
+        X[2 * n_ + 1] = R[2 * n_ + 1] + (damped() ? gamma * 2.0 * (C * v).dot(xvel) : 0.0);  // d(v^T C v)
         // d(q^T v) = q^T dv (the rig's lambda w': lambda dw' with the lambda of the last right-hand
         // side, lambda's own change left out of this row of the Newton matrix, which nothing else
         // depends on)
-        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * s->external_power(t, xvel, s->rig_lambda_rhs);
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * external_power(t, xvel, rig_lambda_rhs);
         return 0;
     }
 
@@ -372,9 +335,11 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R), strain
     /// z^T K z / 2 + p^T C_L p / 2 (leaves and layer), whole spring.
     /// z is the state's first part.
-    Vec displacements(const State& Y, const Vec&) const override { return Y.head(ndof); }
+    Vec displacements(const State& Y, const Vec&) const override { return Y.head(ndof()); }
 
     StepRecord make_record(double tau, const State& Y, Vec& p, Vec& rel) const override {
+        const int ndof = this->ndof(), w_dof = this->w_dof();
+        const double f = spring_factor(), m_body = body_mass_kg();
         const auto z = Y.head(ndof);
         const auto v = Y.segment(ndof, ndof);
         p = forces_z(z);
@@ -383,13 +348,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
         const Eigen::VectorXd a = acceleration(tau, z, v, &lambda);
         const double strain = 0.5 * f * (z.dot(K * z) + p.dot(cL.cwiseProduct(p)));
         LoadState ls;  // the loading's force on R, whole spring, and the external work
-        const Loading& L = opt.loading;
+        const Loading& L = options().loading;
         ls.external_force_n = rig ? f * lambda - m_body * a[w_dof] : L.external_force_n(tau, m_body);
         ls.external_work_j = f * Y[2 * ndof + 2];
         ls.base_displacement_m = L.base_displacement_m(tau);
         StepRecord rec;
-        fill_state(sys, chk_problem, p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation, e0, ls,
-                   rec);
+        fill_state(system(), laws(), p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation_j(),
+                   initial_energy_j(), ls, rec);
         finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_body * a[w_dof], f * Y[2 * ndof + 1]);
         // R's balance m w'' = F - spring force; the rig: the load cell between R and the spring reads
         // the force on the spring, lambda - m w'' (the leaves' inertia included)
@@ -398,58 +363,41 @@ struct CvodeMassiveStepper::Impl final : EventDriver {
     }
 };
 
-CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const InitialState& start)
-    : EventStepper(std::make_unique<Impl>(system, start.options)) {
-    Impl& s = static_cast<Impl&>(*driver_);
-    s.K = system.stiffness_reduced();
-    s.M = system.mass_reduced();
-    const SpMat& G = system.contact_rows();
-    s.Grow = G;
-    s.Gt = G.transpose();
-    s.cL = system.layer_compliance_m_per_n();
-    if (s.damped()) {
-        s.C = s.opt.damping.rayleigh_alpha_per_s * s.M + s.opt.damping.rayleigh_beta_s * s.K;
-        s.C.makeCompressed();
+CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
+    : EventDriver(system, start.options, "cvode mode (massive leaves)"),
+      K(system.stiffness_reduced()),
+      M(system.mass_reduced()),
+      Gt(system.contact_rows().transpose()),
+      Grow(system.contact_rows()),
+      cL(system.layer_compliance_m_per_n()),
+      load(std::make_unique<ReducedLoad>(system, start.options.loading)),
+      rig(start.rig) {
+    if (damped()) {
+        C = options().damping.rayleigh_alpha_per_s * M + options().damping.rayleigh_beta_s * K;
+        C.makeCompressed();
     }
-    s.mass.compute(s.M);
-    if (s.mass.info() != Eigen::Success || !(s.mass.vectorD().minCoeff() > 0.0))
-        throw SolverError(s.who + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
-    s.load = std::make_unique<ReducedLoad>(system, s.opt.loading);
-    s.rig = start.rig;
-    if (s.rig) {
-        Eigen::VectorXd ew = Eigen::VectorXd::Zero(s.ndof);
-        ew[s.w_dof] = 1.0;
-        s.u_w = s.mass.solve(ew);
-    }
-    s.set_scales();
-    // the instantaneous compliance: only the layer (z is held by the leaves' inertia)
-    const Eigen::MatrixXd W = s.cL.asDiagonal();
-    s.init_problems(W, 1e-9 * s.F_ref * s.cL.maxCoeff());
-    s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
-    s.init_slots();
-
+    mass.compute(M);
+    if (mass.info() != Eigen::Success || !(mass.vectorD().minCoeff() > 0.0))
+        throw SolverError(who() + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
+    if (rig) u_w = mass.solve(Eigen::VectorXd::Unit(ndof(), w_dof()));
+    EventStart es;
+    es.nstate = 2 * ndof() + 3;
     // the initial state (as mode newmark, initial_state.hpp): the assembly and the static
     // equilibrium under the weight of everything, the leaves in the static shape with R held at
     // w(0) (the rig: w_p(0)), moving with R in the tied shape per unit w times w'(0)
-    s.d = start.d;
-    s.nstate = 2 * s.ndof + 3;
-    s.init_grid();
-    s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
-    auto Y = s.cvode->y();
-    Y.head(s.ndof) = start.z;
-    Y.segment(s.ndof, s.ndof) = start.v0;
-    Y[2 * s.ndof] = Y[2 * s.ndof + 1] = Y[2 * s.ndof + 2] = 0.0;
-
-    // initial modes: the contact problem at z(0) (per pair, W = C_L), then decided a look-ahead on
-    Eigen::VectorXd p_init = start.p;
-    s.solve_initial_forces(G * start.z, p_init);
-    modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
-    s.build_mode();
-    s.decide_modes(0.0, Y, p_init, "start");
-    s.set_tolerances(start.z, start.v0);
-    s.start_record(Y);
-    const EventDriver::StiffIntegrator stiff{2, &Impl::psetup, &Impl::psolve};
-    s.start_cvode(&Impl::rhs, &stiff);
+    es.y0 = Eigen::VectorXd::Zero(es.nstate);
+    es.y0.head(ndof()) = start.z;
+    es.y0.segment(ndof(), ndof()) = start.v0;
+    es.scales = event_scales(system, leaf_mass_scale_inputs(system, options().loading));
+    // the instantaneous compliance: only the layer (z is held by the leaves' inertia)
+    es.compliance = cL.asDiagonal();
+    es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * cL.maxCoeff();
+    es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
+    es.stiff_max_order = 2;  // BDF order <= 2, Newton on newton_setup / newton_solve (file comment)
+    this->start(start, es);
 }
+
+CvodeMassiveStepper::CvodeMassiveStepper(const System& system, const InitialState& start)
+    : EventStepper(std::make_unique<Impl>(system, start)) {}
 
 }  // namespace stackbeam::detail

@@ -50,7 +50,7 @@
 namespace stackbeam::detail {
 
 struct CvodeModalStepper::Impl final : EventDriver {
-    Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode (leaf inertia)") {}
+    Impl(const System& system, const InitialState& start);
 
     int r = 0;                // retained modes
     Eigen::MatrixXd Phi;      // retained modes, n x r (mass-normalised)
@@ -71,13 +71,25 @@ struct CvodeModalStepper::Impl final : EventDriver {
     double qz0 = 0.0;  // q^T z at t = 0 [J, meshed part]
     ModalLoad::Values u_of(const State& y) const { return i_clock < 0 ? ModalLoad::Values{} : load->at(y[i_clock]); }
 
+    /// The retained modes (Phi, om) of the unconnected stack (K, M) up to the cut-off [rad/s]
+    /// (CvodeOptions::modal_cutoff_rad_per_s; 0: 10 times the stack's first frequency); returns the cut.
+    double retain_modes(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M);
+    /// The residual compliance W = G R G^T + C_L on the contact rows, R = K^-1 - Phi Omega^-2
+    /// Phi^T, and R's rows (phiw, rw); KiGt = K^-1 G^T.
+    void residual_compliance(const Eigen::MatrixXd& Gd, const Eigen::MatrixXd& KiGt);
+    /// The initial state: the shared stage's z0, v0 projected on the retained modes, q = Omega^-2
+    /// Phi^T K z (= Phi^T M z for exact eigenvectors; this one makes Phi q + R K z = z exactly
+    /// whatever the eigen-solve's residual, so a static state stays static), q' = Phi^T M z'.
+    Eigen::VectorXd initial_state_vector(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                                         const InitialState& start, int nstate) const;
+
     // ---- modes ------------------------------------------------------------------
 
     /// p(q) = P q + p0 of the current modes: the held rows S solve
     /// (W T)_S p_S = d_S - (G Phi q)_S - (W e)_S, p = T p_S + e (active_set.hpp).
-    void build_mode() override {
-        ModeLinearization lin;
-        modes.linearize(chk_problem, lin);
+    void build_mode(const ModeLinearization& lin) override {
+        const int n = rows();
+        const Eigen::VectorXd& d = anchors();
         const std::vector<int>& S = lin.S;
         const int ms = static_cast<int>(S.size());
         std::vector<int> pos(n, -1);
@@ -106,9 +118,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
             x0 = lu.solve(b0);
             Xu = lu.solve(Bu);
             if (!X1.allFinite() || !x0.allFinite() || !Xu.allFinite())
-                throw SolverError("cvode mode (leaf inertia): the contact conditions of the current modes are singular "
-                                  "at t = " + format_value(t) + " s",
-                                  stats.steps, t, 0.0);
+                throw failure("the contact conditions of the current modes are singular");
         }
         P = Eigen::MatrixXd::Zero(n, r);
         Pu = Eigen::MatrixXd::Zero(n, 2);
@@ -126,19 +136,17 @@ struct CvodeModalStepper::Impl final : EventDriver {
         a0 = GPhi.transpose() * p0;
         Au = GPhi.transpose() * Pu + load->Fq;
         slip_rows.clear();
-        for (int kk = 0; kk < np; ++kk) {
+        for (int kk = 0; kk < num_pairs(); ++kk) {
             const int rt = pairs()[kk].row_t;
-            if (rt >= 0 && (tmode[kk] == SLIP_POS || tmode[kk] == SLIP_NEG)) slip_rows.push_back(rt);
+            if (rt >= 0 && (modes().tmode[kk] == SLIP_POS || modes().tmode[kk] == SLIP_NEG)) slip_rows.push_back(rt);
         }
-        ++stats.mode_factorizations;
-        ++facts_since;
     }
 
     Eigen::VectorXd forces_q(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Vector2d& u) const {
         return P * q + p0 + Pu * u;
     }
     Vec forces(const State& y) const override { return forces_q(y.head(r), u_of(y).u); }
-    Vec relative(const State& y) const override { return Hs * y.head(r) + bs + d + Hsu * u_of(y).u; }
+    Vec relative(const State& y) const override { return Hs * y.head(r) + bs + anchors() + Hsu * u_of(y).u; }
     Vec relative_at_event(const State& y, const Vec& p_cur) const override { return W * p_cur + motion(y); }
     Vec motion(const State& y) const override { return GPhi * y.head(r) + load->Hq * u_of(y).u; }
     void witnesses(const State& y, double* g) const override {
@@ -162,7 +170,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
         const auto qd = y.segment(r, r);
         const ModalLoad::Values u = u_of(y);
         const Eigen::VectorXd qdd = P.size() > 0 ? modal_acceleration(q, u.u) : Eigen::VectorXd::Zero(r);
-        const double target = kLookahead * L_ref;
+        const double target = kLookahead * scales().L_ref_m;
         const double vmax = (GPhi * qd + load->Hq * u.ud).lpNorm<Eigen::Infinity>();
         const double amax = (GPhi * qdd + load->Hq * u.udd).lpNorm<Eigen::Infinity>();
         double delta = std::numeric_limits<double>::infinity();
@@ -170,7 +178,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
         if (amax > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / amax));
         if (P.size() > 0) {
             const double prate = (P * qd + Pu * u.ud).lpNorm<Eigen::Infinity>();
-            if (prate > 0.0) delta = std::min(delta, kLookahead * F_ref / prate);
+            if (prate > 0.0) delta = std::min(delta, kLookahead * scales().F_ref_n / prate);
         }
         if (!std::isfinite(delta)) delta = 0.0;
         Vec yl = y;
@@ -200,34 +208,55 @@ struct CvodeModalStepper::Impl final : EventDriver {
     /// strain energy p^T W p / 2 drops, and that is friction work done in the jump (the
     /// kinetic energy, q', is continuous). Booked as dissipated.
     void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) override {
-        book_force_jump(cause, 0.5 * f * (p_cur.dot(W * p_cur) - p_new.dot(W * p_new)), p_cur, p_new);
+        book_force_jump(cause, 0.5 * spring_factor() * (p_cur.dot(W * p_cur) - p_new.dot(W * p_new)), p_cur, p_new);
     }
 
     // ---- CVODE ------------------------------------------------------------------
 
-    static int rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
-        const auto* s = static_cast<const Impl*>(static_cast<const EventDriver*>(user));
-        const int r = s->r;
-        const double* Y = N_VGetArrayPointer(yv);
-        double* D = N_VGetArrayPointer(ydot);
+    /// y = [q, q', D (, X, t)] (file comment): q'' of the current modes, D' the friction power
+    /// -sum_slip p_t ds_t/dt >= 0, X' = q'(t)^T z (modal_load.hpp), t' = 1.
+    void derivatives(double, const double* Y, double* D) const override {
         const Eigen::Map<const Eigen::VectorXd> q(Y, r), qd(Y + r, r);
         Eigen::Map<Eigen::VectorXd>(D, r) = qd;
-        if (s->i_clock < 0) {  // initial conditions only: y = [q, q', D]
-            Eigen::Map<Eigen::VectorXd>(D + r, r) = s->A1 * q + s->a0;
-            double pw = 0.0;  // friction power -sum_slip p_t ds_t/dt >= 0
-            for (int rt : s->slip_rows) pw -= (s->P.row(rt).dot(q) + s->p0[rt]) * s->Hs.row(rt).dot(qd);
+        if (i_clock < 0) {  // initial conditions only: y = [q, q', D]
+            Eigen::Map<Eigen::VectorXd>(D + r, r) = A1 * q + a0;
+            double pw = 0.0;
+            for (int rt : slip_rows) pw -= (P.row(rt).dot(q) + p0[rt]) * Hs.row(rt).dot(qd);
             D[2 * r] = pw;
-            return 0;
+            return;
         }
-        const ModalLoad::Values u = s->load->at(Y[s->i_clock]);
-        Eigen::Map<Eigen::VectorXd>(D + r, r) = s->modal_acceleration(q, u.u);
-        const Eigen::VectorXd p = s->forces_q(q, u.u);
+        const ModalLoad::Values u = load->at(Y[i_clock]);
+        Eigen::Map<Eigen::VectorXd>(D + r, r) = modal_acceleration(q, u.u);
+        const Eigen::VectorXd p = forces_q(q, u.u);
         double pw = 0.0;
-        for (int rt : s->slip_rows) pw -= p[rt] * (s->Hs.row(rt).dot(qd) + s->Hsu.row(rt).dot(u.ud));
+        for (int rt : slip_rows) pw -= p[rt] * (Hs.row(rt).dot(qd) + Hsu.row(rt).dot(u.ud));
         D[2 * r] = pw;
-        D[s->i_work] = s->load->q_dot_z(q, p, u.u, u.ud);  // X' = q'(t)^T z (modal_load.hpp)
-        D[s->i_clock] = 1.0;
-        return 0;
+        D[i_work] = load->q_dot_z(q, p, u.u, u.ud);
+        D[i_clock] = 1.0;
+    }
+
+    /// q^T z at t = 0 (the loading's work, make_record) from the decided modes' forces.
+    void started(const State& Y) override {
+        const ModalLoad::Values u0 = u_of(Y);
+        qz0 = load->q_dot_z(Y.head(r), forces(Y), u0.u, u0.u);
+    }
+
+    /// The modal coordinates carry energy (q' in sqrt(J), mass-normalised): the same absolute
+    /// tolerance on every coordinate, from the user's atol on w as an amplitude of the body's mode
+    /// (sqrt(m) omega atol) and rtol of the motion's energy.
+    void tolerances(const State& Y, Eigen::Ref<Vec> A) const override {
+        const double e_meshed = 0.5 * Y.segment(r, r).squaredNorm() + 0.5 * Y.head(r).dot(om.cwiseProduct(om).cwiseProduct(Y.head(r)));
+        const double a_e = std::max(std::sqrt(system().mass_kg()) * scales().omega_rad_per_s * options().cvode.atol_m,
+                                    options().cvode.rtol * std::sqrt(2.0 * e_meshed));
+        for (int i = 0; i < r; ++i) {
+            A[i] = a_e / om[i];  // q_i: energy-norm amplitude omega_i q_i
+            A[r + i] = a_e;      // q_i'
+        }
+        A[2 * r] = a_e * a_e;    // D [J, meshed part]
+        if (i_clock >= 0) {
+            A[i_work] = a_e * a_e;                                     // X [J, meshed part]
+            A[i_clock] = 1e-12 * std::max(1.0, options().t_end_s);     // t [s]: t' = 1 is integrated exactly
+        }
     }
 
     // ---- records ----------------------------------------------------------------
@@ -238,8 +267,8 @@ struct CvodeModalStepper::Impl final : EventDriver {
     /// is made on the first call (only a run that asks for the nodes pays for it).
     Vec displacements(const State& Y, const Vec& p) const override {
         if (!stiffness_factor)
-            stiffness_factor = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(sys.stiffness_reduced());
-        const Vec gtp = sys.contact_rows().transpose() * p;  // G^T p [N, N m]
+            stiffness_factor = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(system().stiffness_reduced());
+        const Vec gtp = system().contact_rows().transpose() * p;  // G^T p [N, N m]
         const Vec phi_gtp = Phi.transpose() * gtp;
         Vec z = Phi * Vec(Y.head(r) - phi_gtp.cwiseQuotient(om.cwiseProduct(om))) + stiffness_factor->solve(gtp);
         if (i_clock >= 0) z += load->RB * u_of(Y).u;
@@ -262,31 +291,26 @@ struct CvodeModalStepper::Impl final : EventDriver {
         const double w = phiw.dot(q) + rw.dot(p) + load->wq.dot(u.u);
         const double wd = phiw.dot(qd) + rw.dot(P * qd + Pu * u.ud) + load->wq.dot(u.ud);
         const double wdd = phiw.dot(qdd) + rw.dot(P * qdd + Pu * u.udd) + load->wq.dot(u.udd);
+        const double f = spring_factor();
         const double strain = 0.5 * f *
                               (q.dot(om.cwiseProduct(om).cwiseProduct(q)) + p.dot(W * p) +
                                2.0 * p.dot(load->Hq * u.u) + u.u.dot(load->Rqq * u.u));
         LoadState ls;  // the loading's force on R and its work, whole spring
         if (i_clock >= 0) {
-            const Loading& L = opt.loading;
-            ls.external_force_n = L.external_force_n(tau, m_body);
+            const Loading& L = options().loading;
+            ls.external_force_n = L.external_force_n(tau, body_mass_kg());
             ls.external_work_j = f * (load->q_dot_z(q, p, u.u, u.u) - qz0 - Y[i_work]);
             ls.base_displacement_m = L.base_displacement_m(tau);
         }
         StepRecord rec;
-        fill_state(sys, chk_problem, p, w, wd, strain, f * Y[2 * r] + jump_dissipation, e0, ls, rec);
-        finish_inertia_record(rec, 0.5 * f * qd.squaredNorm(), m_body * wdd);
+        fill_state(system(), laws(), p, w, wd, strain, f * Y[2 * r] + jump_dissipation_j(), initial_energy_j(), ls, rec);
+        finish_inertia_record(rec, 0.5 * f * qd.squaredNorm(), body_mass_kg() * wdd);
         return rec;
     }
 
 };
 
-CvodeModalStepper::CvodeModalStepper(const System& system, const InitialState& start)
-    : EventStepper(std::make_unique<Impl>(system, start.options)) {
-    Impl& s = static_cast<Impl&>(*driver_);
-    const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
-    const Eigen::SparseMatrix<double> M = system.mass_reduced();
-    const Eigen::SparseMatrix<double>& G = system.contact_rows();
-
+double CvodeModalStepper::Impl::retain_modes(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M) {
     // modes of the unconnected stack (K, M), dense: n is a few hundred on the example
     const Eigen::MatrixXd Kd(K), Md(M);
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kd, Md);
@@ -296,100 +320,69 @@ CvodeModalStepper::CvodeModalStepper(const System& system, const InitialState& s
     const Eigen::VectorXd omega = eig.eigenvalues().cwiseSqrt();
     // default cut: 10 times the stack's first frequency (the body's mode with the leaves'
     // mass in it); the leaf bending modes above respond quasi-statically
-    const double cut = s.opt.cvode.modal_cutoff_rad_per_s > 0.0 ? s.opt.cvode.modal_cutoff_rad_per_s : 10.0 * omega[0];
-    s.r = 0;
-    while (s.r < s.ndof && omega[s.r] <= cut) ++s.r;
-    if (s.r == 0)
+    const double cut = options().cvode.modal_cutoff_rad_per_s > 0.0 ? options().cvode.modal_cutoff_rad_per_s : 10.0 * omega[0];
+    r = 0;
+    while (r < ndof() && omega[r] <= cut) ++r;
+    if (r == 0)
         throw InputError("modal_cutoff", "value " + format_value(cut) + " rad/s is below the stack's first frequency " +
                                              format_value(omega[0]) + " rad/s: no mode would carry the motion");
-    s.Phi = eig.eigenvectors().leftCols(s.r);
-    s.om = omega.head(s.r);
-    s.nstate = 2 * s.r + 1;
-    s.stats.retained_modes = s.r;
-    s.stats.modal_cutoff_rad_per_s = cut;
-
-    // residual flexibility R = K^-1 - Phi Omega^-2 Phi^T, on the contact rows
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> kf(K);
-    const Eigen::MatrixXd Gd(G);
-    const Eigen::MatrixXd KiGt = kf.solve(Eigen::MatrixXd(Gd.transpose()));  // n x m
-    s.GPhi = Gd * s.Phi;
-    const Eigen::MatrixXd GPhiS = s.GPhi * s.om.cwiseInverse().asDiagonal();
-    s.W = Gd * KiGt - GPhiS * GPhiS.transpose();
-    s.W = 0.5 * (s.W + s.W.transpose()).eval();
-    s.W.diagonal() += system.layer_compliance_m_per_n();  // the elastic layer, massless (system.hpp)
-    s.phiw = s.Phi.row(s.w_dof).transpose();
-    s.rw = KiGt.row(s.w_dof).transpose() - s.GPhi * s.om.cwiseProduct(s.om).cwiseInverse().cwiseProduct(s.phiw);
-    s.load = std::make_unique<ModalLoad>(system, s.opt.loading, s.Phi, s.om, kf);
-    if (!s.load->none()) {  // the loading's work X and the clock t (file comment)
-        s.i_work = 2 * s.r + 1;
-        s.i_clock = 2 * s.r + 2;
-        s.nstate = 2 * s.r + 3;
-    }
-
-    // scales: R's amplitude on the tied stack and the loading's, its frequency
-    const EventScales sc = loaded_event_scales(system, s.opt.loading, system.vertical_inertia_kg());
-    const double omega_t = sc.omega_t;
-    s.L_ref = sc.L_ref;
-    s.V_ref = sc.V_ref;
-    s.F_ref = sc.F_ref;
-
-    // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual
-    // compliance (its entries are far smaller than C''s: most of the leaves'
-    // flexibility is in the retained modes)
-    s.init_problems(s.W, 1e-9 * s.F_ref * s.W.diagonal().maxCoeff());
-    // the gap witnesses' margin: kMotionMargin, or ten times the decisions' displacement
-    // resolution if that is coarser (a gap the contact iteration cannot see closing must
-    // not count as closed)
-    s.gap_margin = std::max(kMotionMargin, 10.0 * s.ev_tolerance / s.L_ref);
-    s.init_slots();  // as the massless mode
-
-    // initial state: the assembly and gravity's static state, R held at w(0), the leaves moving
-    // with R in the tied shape (modal_load.hpp; z = 0 on the paper example), projected on the
-    // retained modes: q = Omega^-2 Phi^T K z (= Phi^T M z for exact eigenvectors; this one makes
-    // Phi q + R K z = z exactly whatever the eigen-solve's residual, so a static state stays
-    // static), q' = Phi^T M z' (mass-normalised)
-    const Eigen::VectorXd& z0 = start.z;  // the shared stage (initial_state.hpp: whole_stack_static)
-    const Eigen::VectorXd& v0 = start.v0;
-    Eigen::VectorXd p_init = start.p;
-    s.d = start.d;
-    s.init_grid();
-    s.cvode = std::make_unique<CvodeSession>(s.who, s.nstate);
-    auto Y = s.cvode->y();
-    Y.setZero();
-    Y.head(s.r) = (s.Phi.transpose() * (K * z0)).cwiseQuotient(s.om.cwiseProduct(s.om));
-    Y.segment(s.r, s.r) = s.Phi.transpose() * (M * v0);
-
-    // initial modes: from the contact problem at q(0), then decided a look-ahead on
-    s.solve_initial_forces(s.motion(Y), p_init);
-    modes_from_solution(s.chk_problem, p_init, 1e-12 * s.F_ref, s.nmode, s.tmode);
-    s.build_mode();
-    s.decide_modes(0.0, Y, p_init, "start");
-    const ModalLoad::Values u0 = s.u_of(Y);
-    s.qz0 = s.load->q_dot_z(Y.head(s.r), s.forces(Y), u0.u, u0.u);
-
-    // tolerances: the modal coordinates carry energy (q' in sqrt(J)/..., mass-normalised):
-    // the same absolute tolerance on every coordinate, from the user's atol on w as an
-    // amplitude of the body's mode (sqrt(m) omega atol) and rtol of the motion's energy
-    {
-        const double e_meshed = 0.5 * Y.segment(s.r, s.r).squaredNorm() +
-                                0.5 * Y.head(s.r).dot(s.om.cwiseProduct(s.om).cwiseProduct(Y.head(s.r)));
-        const double a_e = std::max(std::sqrt(system.mass_kg()) * omega_t * s.opt.cvode.atol_m,
-                                    s.opt.cvode.rtol * std::sqrt(2.0 * e_meshed));
-        auto A = s.cvode->atol();
-        for (int i = 0; i < s.r; ++i) {
-            A[i] = a_e / s.om[i];  // q_i: energy-norm amplitude omega_i q_i
-            A[s.r + i] = a_e;      // q_i'
-        }
-        A[2 * s.r] = a_e * a_e;    // D [J, meshed part]
-        if (s.i_clock >= 0) {
-            A[s.i_work] = a_e * a_e;                                   // X [J, meshed part]
-            A[s.i_clock] = 1e-12 * std::max(1.0, s.opt.t_end_s);       // t [s]: t' = 1 is integrated exactly
-        }
-    }
-    s.start_record(Y);
-    s.start_cvode(&Impl::rhs);
+    Phi = eig.eigenvectors().leftCols(r);
+    om = omega.head(r);
+    return cut;
 }
 
+void CvodeModalStepper::Impl::residual_compliance(const Eigen::MatrixXd& Gd, const Eigen::MatrixXd& KiGt) {
+    GPhi = Gd * Phi;
+    const Eigen::MatrixXd GPhiS = GPhi * om.cwiseInverse().asDiagonal();
+    W = Gd * KiGt - GPhiS * GPhiS.transpose();
+    W = 0.5 * (W + W.transpose()).eval();
+    W.diagonal() += system().layer_compliance_m_per_n();  // the elastic layer, massless (system.hpp)
+    phiw = Phi.row(w_dof()).transpose();
+    rw = KiGt.row(w_dof()).transpose() - GPhi * om.cwiseProduct(om).cwiseInverse().cwiseProduct(phiw);
+}
 
+Eigen::VectorXd CvodeModalStepper::Impl::initial_state_vector(const Eigen::SparseMatrix<double>& K,
+                                                              const Eigen::SparseMatrix<double>& M,
+                                                              const InitialState& start, int nstate) const {
+    Eigen::VectorXd Y = Eigen::VectorXd::Zero(nstate);
+    Y.head(r) = (Phi.transpose() * (K * start.z)).cwiseQuotient(om.cwiseProduct(om));
+    Y.segment(r, r) = Phi.transpose() * (M * start.v0);
+    return Y;
+}
+
+CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
+    : EventDriver(system, start.options, "cvode mode (leaf inertia)") {
+    const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
+    const Eigen::SparseMatrix<double> M = system.mass_reduced();
+    EventStart es;
+    es.modal_cutoff_rad_per_s = retain_modes(K, M);
+    es.retained_modes = r;
+    // residual flexibility R = K^-1 - Phi Omega^-2 Phi^T, on the contact rows
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> kf(K);
+    const Eigen::MatrixXd Gd(system.contact_rows());
+    residual_compliance(Gd, kf.solve(Eigen::MatrixXd(Gd.transpose())));
+    load = std::make_unique<ModalLoad>(system, options().loading, Phi, om, kf);
+    es.nstate = 2 * r + 1;
+    if (!load->none()) {  // the loading's work X and the clock t (file comment)
+        i_work = 2 * r + 1;
+        i_clock = 2 * r + 2;
+        es.nstate = 2 * r + 3;
+    }
+    // the initial state: the assembly and gravity's static state, R held at w(0), the leaves moving
+    // with R in the tied shape (the shared stage, initial_state.hpp: whole_stack_static)
+    es.y0 = initial_state_vector(K, M, start, es.nstate);
+    es.scales = event_scales(system, leaf_mass_scale_inputs(system, options().loading));
+    es.compliance = W;
+    // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual compliance (its
+    // entries are far smaller than C''s: most of the leaves' flexibility is in the retained modes)
+    es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * W.diagonal().maxCoeff();
+    // the gap witnesses' margin: kMotionMargin, or ten times the decisions' displacement
+    // resolution if that is coarser (a gap the contact iteration cannot see closing must not count as closed)
+    es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
+    this->start(start, es);
+}
+
+CvodeModalStepper::CvodeModalStepper(const System& system, const InitialState& start)
+    : EventStepper(std::make_unique<Impl>(system, start)) {}
 
 }  // namespace stackbeam::detail

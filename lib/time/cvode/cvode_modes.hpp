@@ -33,6 +33,10 @@ constexpr double kLookahead = 1e-7;
 constexpr int kMaxEventsAtOneTime = 200;
 /// Passes of EventDriver::decide_modes that make the decided modes hold at the event's state.
 constexpr int kSettlePasses = 4;
+/// The event driver polls the caller's stop check (SimulationOptions::stop_requested) once
+/// every this many CVODE steps (a step costs microseconds, so a stop is seen within a
+/// millisecond or so while the check itself stays off the profile).
+constexpr long kStopCheckSteps = 64;
 
 /// The options of the event solver that decides the modes at an event: the exact solver
 /// at `tolerance_m` (each stepper's own, from its scales), with the user's active-set

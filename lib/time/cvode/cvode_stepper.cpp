@@ -11,23 +11,20 @@
 
 #include "contact/active_set.hpp"
 #include "time/cvode/cvode_modes.hpp"
+#include "time/cvode/cvode_massless.hpp"
 #include "time/cvode/event_driver.hpp"
-#include "time/record.hpp"
 #include "time/initial_state.hpp"
+#include "time/record.hpp"
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam {
 namespace {
 
 // Pair modes: those of the active-set solvers (active_set.hpp).
-using detail::CLOSED;
-using detail::FREE;
 using detail::SLIP_NEG;
 using detail::SLIP_POS;
 using detail::STICK;
-using detail::kForceMargin;
 using detail::kLookahead;
-using detail::kMotionMargin;
 
 }  // namespace
 
@@ -39,15 +36,10 @@ bool ContactEvent::is_stick_slip() const {
 struct CvodeStepper::Impl final : detail::EventDriver {
     const Eigen::MatrixXd& C;  // C' [m/N]
     Eigen::VectorXd c;         // coupling [-]
-    double k = 0, m = 0;
+    double k = 0, m = 0;       // R's spring [N/m] and mass [kg] of the meshed part
     Loading load;              // the loading (loading.hpp), prepared
-    double m_whole = 0;        // R's whole mass [kg]
     /// External force on R of the meshed part at t [N] (loading.hpp: F/f - m g - m y_b'').
-    double fe(double t_s) const { return load.external_force_n(t_s, m_whole) / f; }
-    // ODE size nstate: [w, w', D], plus the external work W_e when a loading exerts a force
-    // (under the paper's initial conditions it is identically zero and left out, so
-    // that CVODE's error norm, an RMS over the states, is the same as without it).
-    double omega_ref = 1;
+    double fe(double t_s) const { return load.external_force_n(t_s, body_mass_kg()) / spring_factor(); }
 
     // the current mode set: p(w) = P w + r, s(w) = hs w + bs, m w'' = a1 w + a0,
     // D' = -w' (diss_a w + diss_b)
@@ -55,7 +47,49 @@ struct CvodeStepper::Impl final : detail::EventDriver {
     double a1 = 0, a0 = 0, diss_a = 0, diss_b = 0;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;
 
-    Impl(const System& s, const SimulationOptions& o) : EventDriver(s, o, "cvode mode"), C(s.compliance_held()) {}
+    /// Builds R's operators (c, k, m, the loading) and starts the driver from the set-up stage.
+    Impl(const System& s, const detail::InitialState& start)
+        : EventDriver(s, start.options, "cvode mode"),
+          C(s.compliance_held()),
+          c(s.coupling()),
+          k(s.stiffness_n_per_m()),
+          m(s.mass_kg()),
+          load(start.options.loading) {
+        detail::EventStart es;
+        // ODE size: [w, w', D], plus the external work W_e when a loading exerts a force (under
+        // the paper's initial conditions it is identically zero and left out, so that CVODE's
+        // error norm, an RMS over the states, is the same as without it).
+        es.nstate = load.is_free() ? 3 : 4;
+        es.y0 = Eigen::VectorXd::Zero(es.nstate);
+        es.y0[0] = start.w0_m;
+        es.y0[1] = start.wd0_m_per_s;
+        es.scales = detail::event_scales(s, scale_inputs(start));
+        es.compliance = C;
+        // ||v|| of an exact active-set answer is LU round-off, ~cond(C') 1e-16 L_ref ~ 1e-11 L_ref;
+        // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
+        es.event_tolerance_m = 1e-10 * es.scales.L_ref_m;
+        es.resolve_initial_forces = false;  // the stage solved the forces with R held at w(0) (exact)
+        this->start(start, es);
+    }
+
+    /// The witness scales' inputs (event_driver.hpp): R's amplitude on the softest stack (no
+    /// contact force) with the largest external force over the run (sampled, table points
+    /// included; gravity: the static deflection), the stiffest frequency (everything tied).
+    detail::ScaleInputs scale_inputs(const detail::InitialState& start) const {
+        double fe_max = 0.0;
+        const double t_end = options().t_end_s;
+        for (int i = 0; i <= 4000; ++i) fe_max = std::max(fe_max, std::abs(fe(t_end * i / 4000.0)));
+        for (double tp : load.force_n.times_s) fe_max = std::max(fe_max, std::abs(fe(tp)));
+        const double k_tied = system().num_components() > 0 ? system().tied_stiffness_n_per_m() / spring_factor() : k;
+        detail::ScaleInputs in;
+        in.stiffness_n_per_m = std::max(k_tied, k);
+        in.omega_rad_per_s = std::sqrt(std::max(k_tied, k) / m);
+        in.omega_amplitude_rad_per_s = std::sqrt(k / m);
+        in.w0_m = system().model().spec().rigid_body.initial_displacement_m;
+        in.wd0_m_per_s = start.wd0_m_per_s;
+        in.deflection_m = fe_max / k;
+        return in;
+    }
 
     // ---- modes -------------------------------------------------------------------
 
@@ -66,9 +100,9 @@ struct CvodeStepper::Impl final : detail::EventDriver {
     /// pair's normal force (coulomb: -p_n; clamp: F_c - p_n). So p = T p_S + e and
     ///     (C'_S: T) p_S = d_S - c_S w - C'_S: e,
     /// an |S| x |S| LU (|S| is small when most pairs are open or slipping).
-    void build_mode() override {
-        detail::ModeLinearization lin;
-        modes.linearize(chk_problem, lin);
+    void build_mode(const detail::ModeLinearization& lin) override {
+        const int n = rows();
+        const Eigen::VectorXd& d = anchors();
         const std::vector<int>& S = lin.S;
         std::vector<int> pos(n, -1);
         const int ms = static_cast<int>(S.size());
@@ -95,10 +129,7 @@ struct CvodeStepper::Impl final : detail::EventDriver {
             lu.compute(A);
             x1 = lu.solve(b1);
             x0 = lu.solve(b0);
-            if (!x1.allFinite() || !x0.allFinite())
-                throw SolverError("cvode mode: the contact conditions of the current modes are singular at t = " +
-                                      format_value(t) + " s",
-                                  stats.steps, t, 0.0);
+            if (!x1.allFinite() || !x0.allFinite()) throw failure("the contact conditions of the current modes are singular");
         }
         P = Eigen::VectorXd::Zero(n);
         r = e;
@@ -111,69 +142,35 @@ struct CvodeStepper::Impl final : detail::EventDriver {
         a1 = c.dot(P) - k;
         a0 = c.dot(r);
         diss_a = diss_b = 0.0;
-        for (int kk = 0; kk < np; ++kk) {
+        for (int kk = 0; kk < num_pairs(); ++kk) {
             const int rt = pairs()[kk].row_t;
-            if (rt >= 0 && (tmode[kk] == SLIP_POS || tmode[kk] == SLIP_NEG)) {
+            if (rt >= 0 && (modes().tmode[kk] == SLIP_POS || modes().tmode[kk] == SLIP_NEG)) {
                 diss_a += P[rt] * hs[rt];
                 diss_b += r[rt] * hs[rt];
             }
         }
-        ++stats.mode_factorizations;
-        ++facts_since;
     }
 
     Eigen::VectorXd forces(double w) const { return P * w + r; }
     Vec forces(const State& y) const override { return forces(y[0]); }
-    Vec relative(const State& y) const override { return hs * y[0] + bs + d; }
+    Vec relative(const State& y) const override { return hs * y[0] + bs + anchors(); }
     Vec relative_at_event(const State& y, const Vec& p_cur) const override {
         // in a built mode affine in w (O(n)), else (t = 0) from the forces
-        return P.size() == n ? relative(y) : Vec(C * p_cur + c * y[0]);
+        return P.size() == rows() ? relative(y) : Vec(C * p_cur + c * y[0]);
     }
     Vec motion(const State& y) const override { return c * y[0]; }
-    void witnesses(const State& y, double* g) const override { witnesses(y[0], y[1], g); }
-
-    /// Witness functions at (w, w'): positive while the modes hold.
-    void witnesses(double w, double wd, double* g) const {
-        for (std::size_t i = 0; i < slots.size(); ++i) {
-            const int kk = slots[i].pair;
-            const auto& cp = pairs()[kk];
-            const auto pn = [&] { return cp.row_n >= 0 ? P[cp.row_n] * w + r[cp.row_n] : 0.0; };
-            double v = 1.0;
-            double margin = kForceMargin;
-            if (slots[i].normal) {
-                if (cp.kind == PairKind::coulomb) {
-                    if (nmode[kk] == CLOSED) {
-                        v = -pn() / F_ref;
-                    } else {
-                        v = -(hs[cp.row_n] * w + bs[cp.row_n]) / L_ref;
-                        margin = kMotionMargin;
-                    }
-                } else {  // clamp: engaged while p_n < F_c
-                    v = tmode[kk] == FREE ? (pn() - cp.preload_n) / F_ref : (cp.preload_n - pn()) / F_ref;
-                }
-            } else {
-                const int rt = cp.row_t;
-                const double pt = P[rt] * w + r[rt];
-                switch (tmode[kk]) {
-                    case STICK: {
-                        const double tau_n = cp.kind == PairKind::clamp ? std::max(0.0, cp.preload_n - pn()) : -pn();
-                        v = (cp.friction_coefficient * tau_n - std::abs(pt)) / F_ref;
-                        break;
-                    }
-                    case SLIP_POS: v = -hs[rt] * wd / V_ref; margin = kMotionMargin; break;
-                    case SLIP_NEG: v = hs[rt] * wd / V_ref; margin = kMotionMargin; break;
-                    default: v = 1.0; break;
-                }
-            }
-            g[i] = v + margin;
-        }
+    /// The witnesses of cvode_stepper.hpp at (w, w'): s = hs w + bs, ds_t/dt = hs_t w'.
+    void witnesses(const State& y, double* g) const override {
+        const double w = y[0], wd = y[1];
+        witnesses_from(
+            forces(w), [&](int row) { return hs[row] * w + bs[row]; }, [&](int row) { return hs[row] * wd; }, g);
     }
 
     /// R a short look-ahead on (cvode_stepper.hpp): |dw| = kLookahead L_ref along w' and w''.
     Vec look_ahead(double te, const State& y, const Vec& p_cur) const override {
         const double w = y[0], wd = y[1];
         const double wdd = (c.dot(p_cur) - k * w + fe(te)) / m;
-        const double target = kLookahead * L_ref;
+        const double target = kLookahead * scales().L_ref_m;
         double delta = std::numeric_limits<double>::infinity();
         if (wd != 0.0) delta = std::min(delta, target / std::abs(wd));
         if (wdd != 0.0) delta = std::min(delta, std::sqrt(2.0 * target / std::abs(wdd)));
@@ -191,113 +188,74 @@ struct CvodeStepper::Impl final : detail::EventDriver {
 
     /// The massless leaves in equilibrium with the forces p and R at w = y[0] (the leaves carry no
     /// load of their own: gravity acts on R only).
-    Vec displacements(const State& y, const Vec& p) const override { return sys.reduced_displacements(p, y[0]); }
+    Vec displacements(const State& y, const Vec& p) const override { return system().reduced_displacements(p, y[0]); }
 
-    void after_event(const std::string&, const Vec& p_cur, const Vec& p_new) override {
-        if (n > 0) stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
-    }
+    /// The massless layer stores no energy of its own: a force jump is only noted.
+    void after_event(const std::string&, const Vec& p_cur, const Vec& p_new) override { note_force_jump(p_cur, p_new); }
 
     // ---- CVODE -------------------------------------------------------------------
 
-    static int rhs(sunrealtype tt, N_Vector yv, N_Vector ydot, void* user) {
-        const auto* self = static_cast<const Impl*>(static_cast<const detail::EventDriver*>(user));
-        const double* yy = N_VGetArrayPointer(yv);
-        double* dy = N_VGetArrayPointer(ydot);
-        const double fe = self->fe(tt);
+    /// y = [w, w', D (, W_e)]: m w'' = a1 w + a0 + F_e(t), D' = -w' (diss_a w + diss_b), W_e' = F_e w'.
+    void derivatives(double tt, const double* yy, double* dy) const override {
+        const double fe_t = fe(tt);
         dy[0] = yy[1];
-        dy[1] = (self->a1 * yy[0] + self->a0 + fe) / self->m;
-        dy[2] = -yy[1] * (self->diss_a * yy[0] + self->diss_b);
-        if (self->nstate > 3) dy[3] = fe * yy[1];  // power of the external force (meshed part)
-        return 0;
+        dy[1] = (a1 * yy[0] + a0 + fe_t) / m;
+        dy[2] = -yy[1] * (diss_a * yy[0] + diss_b);
+        if (nstate() > 3) dy[3] = fe_t * yy[1];  // power of the external force (meshed part)
+    }
+
+    void tolerances(const State&, Eigen::Ref<Vec> at) const override {
+        const double atol = options().cvode.atol_m;
+        at[0] = atol;                                  // w [m]
+        at[1] = atol * scales().omega_rad_per_s;       // w' [m/s]
+        at[2] = atol * scales().F_ref_n;               // D [J]
+        if (nstate() > 3) at[3] = atol * scales().F_ref_n;  // external work [J]
     }
 
     // ---- records -----------------------------------------------------------------
 
     StepRecord make_record(double tau, const State& y, Vec& p, Vec&) const override {
-        const double w = y[0], wd = y[1], D = y[2], We = nstate > 3 ? y[3] : 0.0;
+        const int n = rows();
+        const double f = spring_factor();
+        const double w = y[0], wd = y[1], D = y[2], We = nstate() > 3 ? y[3] : 0.0;
         p = n > 0 ? forces(w) : Vec();
         // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
-        const double strain = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + d - c * w) : 0.0) + k * w * w);
+        const double strain = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + anchors() - c * w) : 0.0) + k * w * w);
         StepRecord rec;
         detail::LoadState ls;
         ls.external_force_n = f * fe(tau);
         ls.external_work_j = f * We;
         ls.base_displacement_m = load.base_displacement_m(tau);
-        detail::fill_state(sys, chk_problem, p, w, wd, strain, f * D, e0, ls, rec);
+        detail::fill_state(system(), laws(), p, w, wd, strain, f * D, initial_energy_j(), ls, rec);
         return rec;
     }
-
 };
 
 CvodeStepper::CvodeStepper(const System& system, const SimulationOptions& options)
-    : CvodeStepper(system, detail::initial_state("cvode-massless", system, options)) {}
+    : impl_(std::make_unique<Impl>(system, detail::initial_state("cvode-massless", system, options))) {}
 
-CvodeStepper::CvodeStepper(const System& system, const detail::InitialState& start)
-    : impl_(std::make_unique<Impl>(system, start.options)) {
-    Impl& s = *impl_;
-    s.c = system.coupling();
-    s.k = system.stiffness_n_per_m();
-    s.m = system.mass_kg();
-    s.load = start.options.loading;
-    s.m_whole = system.model().spec().rigid_body.mass_kg;
-    s.nstate = s.load.is_free() ? 3 : 4;
-    // The largest external force over the run (sampled; table points included) sets a
-    // displacement scale F_e/k for the witnesses (gravity: the static deflection).
-    double fe_max = 0.0;
-    for (int i = 0; i <= 4000; ++i) fe_max = std::max(fe_max, std::abs(s.fe(s.opt.t_end_s * i / 4000.0)));
-    for (double tp : s.load.force_n.times_s) fe_max = std::max(fe_max, std::abs(s.fe(tp)));
+CvodeStepper::CvodeStepper(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
-    // Scales of the run: the amplitude of R on the softest stack (no contact force),
-    // the stiffest frequency (everything tied), the largest clamp preload.
-    const double k_tied = system.num_components() > 0 ? system.tied_stiffness_n_per_m() / s.f : s.k;
-    const double omega_free = std::sqrt(s.k / s.m);
-    s.omega_ref = std::sqrt(std::max(k_tied, s.k) / s.m);
-    s.L_ref = std::abs(system.model().spec().rigid_body.initial_displacement_m) +
-              std::abs(start.wd0_m_per_s) / omega_free + fe_max / s.k;
-    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;  // at rest: nothing moves; any scale will do
-    double preload = 0.0;
-    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
-    s.F_ref = std::max(preload, std::max(k_tied, s.k) * s.L_ref);
-    s.V_ref = s.omega_ref * s.L_ref;
-
-    s.init_grid();  // as the closed-form mode's steps
-    s.init_slots();
-    // ||v|| of an exact active-set answer is LU round-off, ~cond(C') 1e-16 L_ref ~ 1e-11 L_ref;
-    // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
-    s.init_problems(system.compliance_held(), 1e-10 * s.L_ref);
-
-    // The initial state (gravity's static step, R held at w(0): initial_state.hpp), then the modes.
-    s.d = start.d;
-    detail::modes_from_solution(s.chk_problem, start.p, 1e-12 * s.F_ref, s.nmode, s.tmode);
-    s.cvode = std::make_unique<detail::CvodeSession>(s.who, s.nstate);
-    auto y0 = s.cvode->y();
-    y0[0] = start.w0_m;
-    y0[1] = start.wd0_m_per_s;
-    s.decide_modes(0.0, y0, start.p, "start");
-    auto at = s.cvode->atol();
-    at[0] = s.opt.cvode.atol_m;                 // w [m]
-    at[1] = s.opt.cvode.atol_m * s.omega_ref;   // w' [m/s]
-    at[2] = s.opt.cvode.atol_m * s.F_ref;       // D [J]
-    if (s.nstate > 3) at[3] = s.opt.cvode.atol_m * s.F_ref;  // external work [J]
-    s.start_cvode(&Impl::rhs);
-    s.start_record(s.cvode->y());
+std::unique_ptr<Stepper> CvodeStepperAccess::build(const System& system, const detail::InitialState& start) {
+    return std::unique_ptr<Stepper>(new CvodeStepper(std::make_unique<CvodeStepper::Impl>(system, start)));
 }
 
 CvodeStepper::~CvodeStepper() = default;
 
 const StepRecord& CvodeStepper::advance() { return impl_->advance(); }
 const StepRecord& CvodeStepper::current() const noexcept { return impl_->current(); }
-long CvodeStepper::num_outputs() const noexcept { return impl_->n_out; }
+long CvodeStepper::num_outputs() const noexcept { return impl_->num_outputs(); }
 long CvodeStepper::record_index() const noexcept { return impl_->record_index(); }
 std::vector<PairRecord> CvodeStepper::pairs() const {
     const Impl& s = *impl_;
-    return s.pair_records_at(s.p_out.size() > 0 ? Eigen::VectorXd(s.C * s.p_out + s.c * s.record.w_m) : Eigen::VectorXd());
+    const Eigen::VectorXd& p = s.contact_forces();
+    return s.pair_records_at(p.size() > 0 ? Eigen::VectorXd(s.C * p + s.c * s.current().w_m) : Eigen::VectorXd());
 }
 std::vector<LeafNodes> CvodeStepper::nodes() const { return impl_->nodes_at_output(); }
 RunReport CvodeStepper::report() const { return impl_->report(); }
-const Eigen::VectorXd& CvodeStepper::contact_forces() const noexcept { return impl_->p_out; }
-const std::vector<ContactEvent>& CvodeStepper::events() const noexcept { return impl_->events; }
-const CvodeStats& CvodeStepper::stats() const noexcept { return impl_->stats; }
-const System& CvodeStepper::system() const noexcept { return impl_->sys; }
+const Eigen::VectorXd& CvodeStepper::contact_forces() const noexcept { return impl_->contact_forces(); }
+const std::vector<ContactEvent>& CvodeStepper::events() const noexcept { return impl_->events(); }
+const CvodeStats& CvodeStepper::stats() const noexcept { return impl_->stats(); }
+const System& CvodeStepper::system() const noexcept { return impl_->system(); }
 
 }  // namespace stackbeam

@@ -16,18 +16,54 @@
 
 namespace stackbeam::detail {
 
-EventDriver::EventDriver(const System& system, const SimulationOptions& options, std::string who_)
-    : sys(system),
-      opt(options),
-      who(std::move(who_)),
-      n(system.num_components()),
-      np(static_cast<int>(system.pairs().size())),
-      ndof(system.num_reduced_dofs()),
-      w_dof(system.num_reduced_dofs() - 1),
-      f(system.model().whole_spring_factor()),
-      m_body(system.model().spec().rigid_body.mass_kg),
-      d(system.initial_offsets_m()),
-      root_finding(cvode_testing().root_finding) {}
+double largest_value(const TimeFunction& F) {
+    double v = std::abs(F.mean) + F.amplitude;
+    for (double x : F.values) v = std::max(v, std::abs(x));
+    return v;
+}
+
+EventScales event_scales(const System& system, const ScaleInputs& in) {
+    EventScales s;
+    s.omega_rad_per_s = in.omega_rad_per_s;
+    s.L_ref_m = std::abs(in.w0_m) + std::abs(in.wd0_m_per_s) / in.omega_amplitude_rad_per_s + in.deflection_m +
+                in.motion_max_m;
+    if (!(s.L_ref_m > 0.0)) s.L_ref_m = 1e-3;  // at rest: nothing moves; any scale will do
+    s.V_ref_m_per_s = in.omega_rad_per_s * s.L_ref_m;
+    double preload = 0.0;
+    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
+    s.F_ref_n = std::max(preload, in.stiffness_n_per_m * s.L_ref_m);
+    return s;
+}
+
+ScaleInputs leaf_mass_scale_inputs(const System& system, const Loading& L) {
+    const auto& body = system.model().spec().rigid_body;
+    const double k_t = system.tied_stiffness_n_per_m(), f = system.model().whole_spring_factor();
+    ScaleInputs in;
+    in.omega_rad_per_s = in.omega_amplitude_rad_per_s = std::sqrt(k_t / body.mass_kg);
+    in.stiffness_n_per_m = k_t / f;
+    in.w0_m = body.initial_displacement_m;
+    in.wd0_m_per_s = body.initial_velocity_m_per_s;
+    // [N, whole spring] / [N/m, whole spring]: the applied force's largest value and the weight of everything
+    const double force_scale = (L.kind == LoadingKind::applied_force ? largest_value(L.force_n) : 0.0) +
+                               f * L.gravity_m_per_s2 * system.vertical_inertia_kg().sum();
+    in.deflection_m = force_scale / k_t;
+    in.motion_max_m = L.kind == LoadingKind::base_excitation || L.kind == LoadingKind::prescribed_displacement
+                          ? largest_value(L.displacement_m)
+                          : 0.0;
+    return in;
+}
+
+EventDriver::EventDriver(const System& system, const SimulationOptions& options, std::string who)
+    : sys_(system),
+      opt_(options),
+      who_(std::move(who)),
+      n_(system.num_components()),
+      np_(static_cast<int>(system.pairs().size())),
+      ndof_(system.num_reduced_dofs()),
+      f_(system.model().whole_spring_factor()),
+      m_body_(system.model().spec().rigid_body.mass_kg),
+      d_(system.initial_offsets_m()),
+      root_finding_(cvode_testing().root_finding) {}
 
 EventDriver::~EventDriver() = default;
 
@@ -42,93 +78,144 @@ void EventDriver::finish_inertia_record(StepRecord& rec, double kinetic_j, doubl
     rec.impact_loss_j = 0.0;
     rec.damping_energy_j = damping_energy_j;
     rec.force_on_mass_n = force_on_mass_n;
-    rec.energy_balance_error_j = e0 + rec.external_work_j -
+    rec.energy_balance_error_j = e0_ + rec.external_work_j -
                                  (kinetic_j + rec.strain_energy_j + rec.dissipated_energy_j + rec.damping_energy_j);
 }
 
 void EventDriver::init_grid() {
-    dt = opt.dt_s;
-    n_out = static_cast<long>(std::ceil(opt.t_end_s / dt - 1e-9));
-    t_final = static_cast<double>(n_out) * dt;
+    dt_ = opt_.dt_s;
+    n_out_ = static_cast<long>(std::ceil(opt_.t_end_s / dt_ - 1e-9));
+    t_final_ = static_cast<double>(n_out_) * dt_;
 }
 
 void EventDriver::init_slots() {
-    for (int kk = 0; kk < np; ++kk) {
-        const auto& cp = sys.pairs()[kk];
+    for (int kk = 0; kk < np_; ++kk) {
+        const auto& cp = sys_.pairs()[kk];
         if (cp.kind == PairKind::bonded) continue;
         const bool friction = cp.row_t >= 0 && cp.friction_coefficient > 0.0;
-        if (cp.kind == PairKind::coulomb && cp.row_n >= 0) slots.push_back({kk, true});
-        if (cp.kind == PairKind::clamp && friction && cp.row_n >= 0) slots.push_back({kk, true});
-        if (friction && (cp.kind == PairKind::clamp || cp.row_n >= 0)) slots.push_back({kk, false});
+        if (cp.kind == PairKind::coulomb && cp.row_n >= 0) slots_.push_back({kk, true});
+        if (cp.kind == PairKind::clamp && friction && cp.row_n >= 0) slots_.push_back({kk, true});
+        if (friction && (cp.kind == PairKind::clamp || cp.row_n >= 0)) slots_.push_back({kk, false});
     }
 }
 
 void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance_m) {
-    chk_problem.W = W;
-    chk_problem.pairs = sys.pairs();
-    chk_problem.tau_rule = TauRule::current;
-    chk_problem.tau_previous_n = Vec::Zero(np);
-    chk_problem.q = Vec::Zero(n);  // sized: ModeSet::linearize takes n from it
-    ev_problem = chk_problem;
-    chk_solver = make_solver(opt.solver);
-    ev_tolerance = event_tolerance_m;
-    ev_solver = make_solver(event_solver_options(opt.solver, ev_tolerance));
+    chk_problem_.W = W;
+    chk_problem_.pairs = sys_.pairs();
+    chk_problem_.tau_rule = TauRule::current;
+    chk_problem_.tau_previous_n = Vec::Zero(np_);
+    chk_problem_.q = Vec::Zero(n_);  // sized: ModeSet::linearize takes n from it
+    ev_problem_ = chk_problem_;
+    chk_solver_ = make_solver(opt_.solver);
+    ev_tolerance_ = event_tolerance_m;
+    ev_solver_ = make_solver(event_solver_options(opt_.solver, ev_tolerance_));
 }
 
-void EventDriver::start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff) {
-    cvode->create(stiff ? CV_BDF : CV_ADAMS, rhs, this, opt.cvode.rtol);
-    if (stiff) {
-        cvode->use_embedded_newton(stiff->psetup, stiff->psolve, this);
-        cvode->set_max_order(stiff->max_order);
+void EventDriver::start_cvode(int stiff_max_order) {
+    cvode_->create(stiff_max_order > 0 ? CV_BDF : CV_ADAMS, &EventDriver::rhs_of, this, opt_.cvode.rtol);
+    if (stiff_max_order > 0) {
+        cvode_->use_embedded_newton(&EventDriver::psetup_of, &EventDriver::psolve_of, this);
+        cvode_->set_max_order(stiff_max_order);
     } else {
-        cvode->use_fixed_point();
+        cvode_->use_fixed_point();
     }
-    cvode->set_limits(opt.cvode.max_step_s);
-    cvode->set_stop_time(t_final);
-    if (root_finding && !slots.empty()) cvode->set_roots(static_cast<int>(slots.size()), &EventDriver::roots);
+    cvode_->set_limits(opt_.cvode.max_step_s);
+    cvode_->set_stop_time(t_final_);
+    if (root_finding_ && !slots_.empty()) cvode_->set_roots(static_cast<int>(slots_.size()), &EventDriver::roots_of);
 }
 
-int EventDriver::roots(sunrealtype, N_Vector y, sunrealtype* g, void* user) {
-    const auto* self = static_cast<const EventDriver*>(user);
-    self->witnesses(Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate), g);
+int EventDriver::rhs_of(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
+    static_cast<const EventDriver*>(user)->derivatives(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
     return 0;
+}
+
+int EventDriver::roots_of(sunrealtype, N_Vector y, sunrealtype* g, void* user) {
+    const auto* self = static_cast<const EventDriver*>(user);
+    self->witnesses(Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate_), g);
+    return 0;
+}
+
+int EventDriver::psetup_of(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
+                           void* user) {
+    *jcur = SUNTRUE;
+    return static_cast<EventDriver*>(user)->newton_setup(gamma);
+}
+
+int EventDriver::psolve_of(sunrealtype t, N_Vector y, N_Vector, N_Vector r, N_Vector x, sunrealtype gamma,
+                           sunrealtype, int, void* user) {
+    return static_cast<const EventDriver*>(user)->newton_solve(t, N_VGetArrayPointer(y), N_VGetArrayPointer(r),
+                                                                N_VGetArrayPointer(x), gamma);
+}
+
+int EventDriver::newton_setup(double) { return -1; }
+int EventDriver::newton_solve(double, const double*, const double*, double*, double) const { return -1; }
+void EventDriver::started(const State&) {}
+
+void EventDriver::rebuild() {
+    ModeLinearization lin;
+    modes_.linearize(chk_problem_, lin);
+    build_mode(lin);
+    ++stats_.mode_factorizations;
+    ++facts_since_;
+}
+
+SolverError EventDriver::failure(const std::string& what) const {
+    return SolverError(who_ + ": " + what + " at t = " + format_value(t_) + " s", stats_.steps, t_, 0.0);
+}
+
+void EventDriver::start(const InitialState& stage, const EventStart& s) {
+    nstate_ = s.nstate;
+    scales_ = s.scales;
+    gap_margin_ = s.gap_margin;
+    stats_.retained_modes = s.retained_modes;
+    stats_.modal_cutoff_rad_per_s = s.modal_cutoff_rad_per_s;
+    init_grid();  // as the closed-form mode's steps
+    init_slots();
+    init_problems(s.compliance, s.event_tolerance_m);
+    d_ = stage.d;  // the anchors of the set-up stage (gravity's static step, R held at w(0))
+    cvode_ = std::make_unique<CvodeSession>(who_, nstate_);
+    cvode_->y() = s.y0;
+    const Vec y0 = s.y0;
+    Vec p = stage.p;
+    if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
+        ev_problem_.q = motion(y0) - d_;
+        const SolveResult r0 = ev_solver_->solve(ev_problem_, p);
+        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
+    }
+    modes_from_solution(chk_problem_, p, 1e-12 * scales_.F_ref_n, modes_.nmode, modes_.tmode);
+    if (s.resolve_initial_forces) rebuild();
+    decide_modes(0.0, y0, p, "start");
+    started(y0);
+    tolerances(y0, cvode_->atol());
+    record_ = record_at(0.0, y0, p_out_, rel_out_);
+    y_out_ = y0;
+    e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
+    record_.energy_balance_error_j = 0.0;
+    start_cvode(s.stiff_max_order);
 }
 
 StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) {
     StepRecord rec = make_record(tau, y, p, rel);
     rec.t_s = tau;
-    rec.contact_iterations = static_cast<int>(iters_since);
-    rec.factorizations = static_cast<int>(facts_since);
-    rec.contact_residual_m = last_check_residual;
-    iters_since = facts_since = 0;
+    rec.contact_iterations = static_cast<int>(iters_since_);
+    rec.factorizations = static_cast<int>(facts_since_);
+    rec.contact_residual_m = last_check_residual_;
+    iters_since_ = facts_since_ = 0;
     return rec;
 }
 
-void EventDriver::solve_initial_forces(const Vec& motion0, Vec& p) {
-    ev_problem.q = motion0 - d;
-    const SolveResult r0 = ev_solver->solve(ev_problem, p);
-    if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
-}
-
-void EventDriver::start_record(const Vec& y0) {
-    record = record_at(0.0, y0, p_out, rel_out);
-    y_out = y0;
-    e0 = record.kinetic_energy_j + record.strain_energy_j;
-    record.energy_balance_error_j = 0.0;
-}
-
 std::vector<PairRecord> EventDriver::pair_records_at(const Vec& rel) const {
-    return pair_records(sys, chk_problem, p_out, rel);
+    return detail::pair_records(sys_, chk_problem_, p_out_, rel);
 }
 
 void EventDriver::enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm) {
-    for (int kk = 0; kk < np; ++kk) {
+    for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
-        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == STICK && tmode[kk] != STICK)
-            d[cp.row_t] = rel[cp.row_t];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tm[kk] == STICK && modes_.tmode[kk] != STICK)
+            d_[cp.row_t] = rel[cp.row_t];
     }
-    nmode = nm;
-    tmode = tm;
+    modes_.nmode = nm;
+    modes_.tmode = tm;
 }
 
 void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
@@ -138,24 +225,24 @@ bool EventDriver::settle_after_missed_event() const { return false; }
 
 void EventDriver::in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm,
                                      const std::vector<signed char>& tm, bool build, const std::function<void()>& body) {
-    const Vec d_saved = d;
-    const std::vector<signed char> nm_saved = nmode, tm_saved = tmode;
+    const Vec d_saved = d_;
+    const std::vector<signed char> nm_saved = modes_.nmode, tm_saved = modes_.tmode;
     enter(rel, nm, tm);
-    if (build) build_mode();
+    if (build) rebuild();
     body();
-    d = d_saved;
-    nmode = nm_saved;
-    tmode = tm_saved;
+    d_ = d_saved;
+    modes_.nmode = nm_saved;
+    modes_.tmode = tm_saved;
 }
 
 bool EventDriver::apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
                                          std::vector<signed char>& nm, std::vector<signed char>& tm) const {
     bool any = false;
-    for (std::size_t i = 0; i < slots.size(); ++i) {
+    for (std::size_t i = 0; i < slots_.size(); ++i) {
         if (!take(i)) continue;
-        const int kk = slots[i].pair;
+        const int kk = slots_[i].pair;
         const auto& cp = pairs()[kk];
-        apply_transition(cp, slots[i].normal, cp.row_t >= 0 ? p[cp.row_t] : 0.0, nm[kk], tm[kk]);
+        apply_transition(cp, slots_[i].normal, cp.row_t >= 0 ? p[cp.row_t] : 0.0, nm[kk], tm[kk]);
         any = true;
     }
     return any;
@@ -167,11 +254,11 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
         bool changed = false;
         in_candidate_modes(rel, nm, tm, true, [&] {
             const Vec r = rate();
-            for (int kk = 0; kk < np; ++kk) {
+            for (int kk = 0; kk < np_; ++kk) {
                 const int rt = pairs()[kk].row_t;
                 if (rt < 0) continue;
-                if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * V_ref) { tm[kk] = SLIP_NEG; changed = true; }
-                else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * V_ref) { tm[kk] = SLIP_POS; changed = true; }
+                if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * scales_.V_ref_m_per_s) { tm[kk] = SLIP_NEG; changed = true; }
+                else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * scales_.V_ref_m_per_s) { tm[kk] = SLIP_POS; changed = true; }
             }
         });
         if (!changed) break;
@@ -180,30 +267,30 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
 
 void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>& s_of,
                                  const std::function<double(int)>& rate_of, double* g) const {
-    for (std::size_t i = 0; i < slots.size(); ++i) {
-        const int kk = slots[i].pair;
+    for (std::size_t i = 0; i < slots_.size(); ++i) {
+        const int kk = slots_[i].pair;
         const auto& cp = pairs()[kk];
         double val = 1.0, margin = kForceMargin;
-        if (slots[i].normal) {
+        if (slots_[i].normal) {
             const double pn = p[cp.row_n];
             if (cp.kind == PairKind::coulomb) {
-                if (nmode[kk] == CLOSED) {
-                    val = -pn / F_ref;
+                if (modes_.nmode[kk] == CLOSED) {
+                    val = -pn / scales_.F_ref_n;
                 } else {
-                    val = -s_of(cp.row_n) / L_ref;
-                    margin = gap_margin;
+                    val = -s_of(cp.row_n) / scales_.L_ref_m;
+                    margin = gap_margin_;
                 }
             } else {
-                val = tmode[kk] == FREE ? (pn - cp.preload_n) / F_ref : (cp.preload_n - pn) / F_ref;
+                val = modes_.tmode[kk] == FREE ? (pn - cp.preload_n) / scales_.F_ref_n : (cp.preload_n - pn) / scales_.F_ref_n;
             }
         } else {
             const int rt = cp.row_t;
-            switch (tmode[kk]) {
+            switch (modes_.tmode[kk]) {
                 case STICK:
-                    val = (cp.friction_coefficient * friction_normal_force(chk_problem, kk, p) - std::abs(p[rt])) / F_ref;
+                    val = (cp.friction_coefficient * friction_normal_force(chk_problem_, kk, p) - std::abs(p[rt])) / scales_.F_ref_n;
                     break;
-                case SLIP_POS: val = -rate_of(rt) / V_ref; margin = kMotionMargin; break;
-                case SLIP_NEG: val = rate_of(rt) / V_ref; margin = kMotionMargin; break;
+                case SLIP_POS: val = -rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;
+                case SLIP_NEG: val = rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;
                 default: val = 1.0; break;
             }
         }
@@ -213,57 +300,61 @@ void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>&
 
 void EventDriver::book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new) {
     if (cause == "start") return;
-    jump_dissipation += loss;
-    stats.min_jump_dissipation_j = std::min(stats.min_jump_dissipation_j, loss);
-    stats.max_force_jump_n = std::max(stats.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+    jump_dissipation_ += loss;
+    stats_.min_jump_dissipation_j = std::min(stats_.min_jump_dissipation_j, loss);
+    stats_.max_force_jump_n = std::max(stats_.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
+}
+
+void EventDriver::note_force_jump(const Vec& p_cur, const Vec& p_new) {
+    if (n_ > 0) stats_.max_force_jump_n = std::max(stats_.max_force_jump_n, (p_new - p_cur).lpNorm<Eigen::Infinity>());
 }
 
 void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
                                const std::vector<int>* triggered) {
     const auto t_start = Clock::now();
-    const double contact_before = stats.contact_time_s;
+    const double contact_before = stats_.contact_time_s;
     const Vec rel = relative_at_event(y, p_cur);  // s + d
     // Incremental problem a look-ahead away: stuck pairs keep their anchors, every
     // other pair is anchored where it is (paper, section 5).
     const Vec y_la = look_ahead(te, y, p_cur);
-    Vec d_la = d;
-    for (int kk = 0; kk < np; ++kk) {
+    Vec d_la = d_;
+    for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
-        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
     }
-    ev_problem.q = motion(y_la) - d_la;
+    ev_problem_.q = motion(y_la) - d_la;
 
     std::vector<signed char> nm, tm;
     bool decided = false;
-    if (triggered != nullptr && n > 0) {
-        nm = nmode;
-        tm = tmode;
+    if (triggered != nullptr && n_ > 0) {
+        nm = modes_.nmode;
+        tm = modes_.tmode;
         apply_slot_transitions([&](std::size_t i) { return (*triggered)[i] != 0; }, p_cur, nm, tm);
         // restored either way: the log below compares with the old modes
         in_candidate_modes(rel, nm, tm, true, [&] {
             // the stop test of the contact iteration at the look-ahead, and every witness
             const Vec pl = forces(y_la);
-            const double v = error_vector(ev_problem, pl, Vec(relative(y_la) - d_la)).norm();
-            std::vector<double> g(slots.size());
-            if (!slots.empty()) witnesses(y_la, g.data());
-            decided = v < ev_tolerance && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
+            const double v = error_vector(ev_problem_, pl, Vec(relative(y_la) - d_la)).norm();
+            std::vector<double> g(slots_.size());
+            if (!slots_.empty()) witnesses(y_la, g.data());
+            decided = v < ev_tolerance_ && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
         });
-        ++stats.contact_iterations;
-        ++iters_since;
+        ++stats_.contact_iterations;
+        ++iters_since_;
     }
     // The modes of the exact solution of ev_problem (its q set), slip signs corrected.
     const auto decide_by_solving = [&](const std::string& where) {
         Vec p_sol = p_cur;
         const auto t_solve = Clock::now();
-        const SolveResult res = ev_solver->solve(ev_problem, p_sol);
-        stats.contact_time_s += seconds_since(t_solve);
-        stats.contact_iterations += res.iterations;
-        iters_since += res.iterations;
+        const SolveResult res = ev_solver_->solve(ev_problem_, p_sol);
+        stats_.contact_time_s += seconds_since(t_solve);
+        stats_.contact_iterations += res.iterations;
+        iters_since_ += res.iterations;
         if (!res.converged)
-            throw SolverError(who + ": the contact iteration " + where + " at t = " + format_value(t) + " s (" + cause +
-                                  ") did not converge: " + res.message + mesh_note(sys.model()),
-                              stats.steps, t, res.residual_m);
-        modes_from_solution(chk_problem, p_sol, 1e-12 * F_ref, nm, tm);
+            throw SolverError(who_ + ": the contact iteration " + where + " at t = " + format_value(t_) + " s (" + cause +
+                                  ") did not converge: " + res.message + mesh_note(sys_.model()),
+                              stats_.steps, t_, res.residual_m);
+        modes_from_solution(chk_problem_, p_sol, 1e-12 * scales_.F_ref_n, nm, tm);
         correct_decision(y, rel, nm, tm);
     };
     if (!decided) decide_by_solving("deciding the modes");
@@ -278,8 +369,8 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     // The modal stepper does this only at a missed event (settle_after_missed_event): there the
     // look-ahead's decision can leave a witness negative at y (a force grazing its cone, back
     // inside a look-ahead later), and root-finding, seeing no sign change, would never leave it.
-    if ((settle_at_state() || (settle_after_missed_event() && cause == "check")) && !slots.empty()) {
-        std::vector<double> g(slots.size());
+    if ((settle_at_state() || (settle_after_missed_event() && cause == "check")) && !slots_.empty()) {
+        std::vector<double> g(slots_.size());
         for (int pass = 0; pass < kSettlePasses; ++pass) {
             bool changed = false;
             in_candidate_modes(rel, nm, tm, pass > 0 || !decided, [&] {
@@ -289,7 +380,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
             decided = true;  // the factorisation is of (nm, tm)
             if (!changed) break;
             decided = false;  // (nm, tm) changed after the last factorisation
-            ++stats.settled_transitions;
+            ++stats_.settled_transitions;
         }
         // Not settled in kSettlePasses (a coupled contact layer, the modal stepper's W = G R G^T:
         // one pair's transition moves the others' forces): the modes of the contact problem at y
@@ -303,10 +394,10 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
             });
             decided = true;
             if (!holds) {
-                ev_problem.q = motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
+                ev_problem_.q = motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
                 decide_by_solving("at the state");
                 decided = false;
-                ++stats.settled_transitions;
+                ++stats_.settled_transitions;
             }
         }
     }
@@ -314,37 +405,37 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     // Log the transitions, enter the new modes, refactorise (unless the candidate was).
     double w = 0.0, wd = 0.0;
     body_motion(y, p_cur, w, wd);
-    for (int kk = 0; kk < np; ++kk) {
+    for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
         if (cp.kind == PairKind::bonded) continue;
-        if (nm[kk] == nmode[kk] && tm[kk] == tmode[kk] && cause != "start") continue;
+        if (nm[kk] == modes_.nmode[kk] && tm[kk] == modes_.tmode[kk] && cause != "start") continue;
         ContactEvent e;
-        e.t_s = t;
+        e.t_s = t_;
         e.pair = kk;
-        const PairSpec& spec = sys.pair_spec(kk);
+        const PairSpec& spec = sys_.pair_spec(kk);
         e.interface_index = spec.interface_index;
         e.x_m = spec.x_m;
-        e.from = cause == "start" ? "none" : mode_label(cp, nmode[kk], tmode[kk]);
+        e.from = cause == "start" ? "none" : mode_label(cp, modes_.nmode[kk], modes_.tmode[kk]);
         e.to = mode_label(cp, nm[kk], tm[kk]);
         e.cause = cause;
         e.w_m = w;
         e.w_dot_m_per_s = wd;
-        events.push_back(std::move(e));
+        events_.push_back(std::move(e));
     }
     enter(rel, nm, tm);
-    if (!decided) build_mode();
+    if (!decided) rebuild();
     after_event(cause, p_cur, forces(y));
     reset_check_anchors(y);
-    stats.event_time_s += seconds_since(t_start) - (stats.contact_time_s - contact_before);
+    stats_.event_time_s += seconds_since(t_start) - (stats_.contact_time_s - contact_before);
 }
 
 void EventDriver::reset_check_anchors(const State& y) {
-    d_chk = d;
-    if (n == 0) return;
+    d_chk_ = d_;
+    if (n_ == 0) return;
     const Vec rel = relative(y);
-    for (int kk = 0; kk < np; ++kk) {
+    for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
-        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && tmode[kk] != STICK) d_chk[cp.row_t] = rel[cp.row_t];
+        if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_chk_[cp.row_t] = rel[cp.row_t];
     }
 }
 
@@ -352,74 +443,74 @@ void EventDriver::reset_check_anchors(const State& y) {
 /// problem (anchors d_chk) satisfied by the mode solution to the contact tolerance.
 /// `residual` gets ||v|| (eq. 9).
 bool EventDriver::modes_hold(const State& y, double& residual, bool* witnesses_ok) {
-    std::vector<double> g(slots.size());
-    if (!slots.empty()) witnesses(y, g.data());
+    std::vector<double> g(slots_.size());
+    if (!slots_.empty()) witnesses(y, g.data());
     residual = 0.0;
-    if (n > 0) {
+    if (n_ > 0) {
         const Vec p = forces(y);
-        chk_problem.q = motion(y) - d_chk;
+        chk_problem_.q = motion(y) - d_chk_;
         // s = (s + d) - d_chk, affine in the state: no product with the compliance
-        residual = error_vector(chk_problem, p, Vec(relative(y) - d_chk)).norm();
+        residual = error_vector(chk_problem_, p, Vec(relative(y) - d_chk_)).norm();
     }
     const bool positive = std::all_of(g.begin(), g.end(), [](double v) { return v >= 0.0; });
     if (witnesses_ok) *witnesses_ok = positive;
-    return positive && residual < opt.solver.tolerance_m;
+    return positive && residual < opt_.solver.tolerance_m;
 }
 
 void EventDriver::restart(double te, const Vec& y) {
     const auto t0 = Clock::now();
-    cvode->y() = y;
-    cvode->reinit(te);
-    ++stats.restarts;
-    stats.event_time_s += seconds_since(t0);
+    cvode_->y() = y;
+    cvode_->reinit(te);
+    ++stats_.restarts;
+    stats_.event_time_s += seconds_since(t0);
 }
 
 /// Queues the records of the output times in (t, upto] (the current modes hold there).
 void EventDriver::emit_until(double upto) {
-    long next = out_index + static_cast<long>(pending.size()) + 1;
-    while (next <= n_out && output_time(next) <= upto) {
+    long next = out_index_ + static_cast<long>(pending_.size()) + 1;
+    while (next <= n_out_ && output_time(next) <= upto) {
         const double tau = output_time(next);
-        cvode->dense_output(tau);
+        cvode_->dense_output(tau);
         Output o;
-        o.rec = record_at(tau, cvode->ydky(), o.p, o.rel);
-        o.y = cvode->ydky();
-        pending.push_back(std::move(o));
+        o.rec = record_at(tau, cvode_->ydky(), o.p, o.rel);
+        o.y = cvode_->ydky();
+        pending_.push_back(std::move(o));
         ++next;
     }
 }
 
 void EventDriver::note_event_time(double te) {
-    if (te == last_event_t) {
-        if (++events_at_this_time > kMaxEventsAtOneTime)
-            throw SolverError(who + ": more than " + std::to_string(kMaxEventsAtOneTime) + " events at t = " +
+    if (te == last_event_t_) {
+        if (++events_at_this_time_ > kMaxEventsAtOneTime)
+            throw SolverError(who_ + ": more than " + std::to_string(kMaxEventsAtOneTime) + " events at t = " +
                                   format_value(te) + " s: the contact modes chatter (no consistent mode set found)",
-                              stats.steps, te, 0.0);
+                              stats_.steps, te, 0.0);
     } else {
-        last_event_t = te;
-        events_at_this_time = 0;
+        last_event_t_ = te;
+        events_at_this_time_ = 0;
     }
-    ++stats.events;
+    ++stats_.events;
 }
 
 /// One CVODE step and what follows it; returns false at the end of the run.
 bool EventDriver::step_once() {
-    if (t >= t_final) return false;
-    double tret = t;
+    if (t_ >= t_final_) return false;
+    double tret = t_;
     const auto t_cv = Clock::now();
-    const int flag = cvode->advance(t_final, CV_ONE_STEP, opt.cvode.max_steps, tret);
-    stats.cvode_time_s += seconds_since(t_cv);
-    const CvodeCounters& cc = cvode->counters();
-    stats.steps = cc.steps;
-    stats.rhs_evaluations = cc.rhs_evaluations;
-    stats.root_evaluations = cc.root_evaluations;
-    const Vec y = cvode->y();
+    const int flag = cvode_->advance(t_final_, CV_ONE_STEP, opt_.cvode.max_steps, tret);
+    stats_.cvode_time_s += seconds_since(t_cv);
+    const CvodeCounters& cc = cvode_->counters();
+    stats_.steps = cc.steps;
+    stats_.rhs_evaluations = cc.rhs_evaluations;
+    stats_.root_evaluations = cc.root_evaluations;
+    const Vec y = cvode_->y();
 
     if (flag == CV_ROOT_RETURN) {
         emit_until(tret);  // the old modes hold up to the root
-        t = tret;
+        t_ = tret;
         note_event_time(tret);
-        std::vector<int> found(slots.size(), 0);
-        cvode->root_info(found);
+        std::vector<int> found(slots_.size(), 0);
+        cvode_->root_info(found);
         decide_modes(tret, y, forces(y), "root", &found);
         restart(tret, y);
         return true;
@@ -435,85 +526,97 @@ bool EventDriver::step_once() {
     double residual = 0.0;
     bool witnesses_ok = false;
     bool ok = modes_hold(y, residual, &witnesses_ok);
-    stats.max_check_residual_m = std::max(stats.max_check_residual_m, residual);
-    last_check_residual = residual;
-    if (!ok && witnesses_ok && n > 0) {
+    stats_.max_check_residual_m = std::max(stats_.max_check_residual_m, residual);
+    last_check_residual_ = residual;
+    if (!ok && witnesses_ok && n_ > 0) {
         const Vec pm = forces(y);
         Vec p = pm;
-        const SolveResult res = chk_solver->solve(chk_problem, p);  // q was set by modes_hold
-        stats.contact_iterations += res.iterations;
-        iters_since += res.iterations;
-        last_check_residual = res.residual_m;
+        const SolveResult res = chk_solver_->solve(chk_problem_, p);  // q was set by modes_hold
+        stats_.contact_iterations += res.iterations;
+        iters_since_ += res.iterations;
+        last_check_residual_ = res.residual_m;
         ok = res.converged;
-        for (int kk = 0; kk < np && ok; ++kk)
-            if (pair_state(chk_problem, kk, p) != pair_state(chk_problem, kk, pm)) ok = false;
-        if (ok) stats.max_check_force_difference_n = std::max(stats.max_check_force_difference_n, (p - pm).lpNorm<Eigen::Infinity>());
+        for (int kk = 0; kk < np_ && ok; ++kk)
+            if (pair_state(chk_problem_, kk, p) != pair_state(chk_problem_, kk, pm)) ok = false;
+        if (ok) stats_.max_check_force_difference_n = std::max(stats_.max_check_force_difference_n, (p - pm).lpNorm<Eigen::Infinity>());
     }
-    stats.contact_time_s += seconds_since(t_check);
+    stats_.contact_time_s += seconds_since(t_check);
     if (ok) {
         emit_until(tret);
-        t = tret;
+        t_ = tret;
         reset_check_anchors(y);
-        return tret < t_final;
+        return tret < t_final_;
     }
 
     // A missed event: locate its time by bisection on the dense output of the last step.
-    const double hlast = cvode->last_step();
+    const double hlast = cvode_->last_step();
     double lo = tret - hlast, hi = tret;
     const double tol_t = 1e-13 * std::max(1.0, std::abs(tret)) + 1e-9 * hlast;
     while (hi - lo > tol_t) {
         const double mid = 0.5 * (lo + hi);
-        cvode->dense_output(mid);
+        cvode_->dense_output(mid);
         double res_m = 0.0;
-        if (modes_hold(cvode->ydky(), res_m)) lo = mid;
+        if (modes_hold(cvode_->ydky(), res_m)) lo = mid;
         else hi = mid;
     }
-    cvode->dense_output(hi);
-    const Vec ye = cvode->ydky();
+    cvode_->dense_output(hi);
+    const Vec ye = cvode_->ydky();
     emit_until(hi);
-    t = hi;
-    ++stats.missed_events;
+    t_ = hi;
+    ++stats_.missed_events;
     note_event_time(hi);
     decide_modes(hi, ye, forces(ye), "check");
     restart(hi, ye);
     return true;
 }
 
-const StepRecord& EventDriver::advance() {
-    if (out_index >= n_out) throw InputError("advance", "the run has reached t_end = " + format_value(t_final) + " s");
-    while (pending.empty()) {
-        if (!step_once() && pending.empty())
-            throw SolverError(who + ": reached t = " + format_value(t) + " s without the output at " +
-                                  format_value(output_time(out_index + 1)) + " s",
-                              stats.steps, t, 0.0);
-    }
-    record = std::move(pending.front().rec);
-    p_out = std::move(pending.front().p);
-    rel_out = std::move(pending.front().rel);
-    y_out = std::move(pending.front().y);
-    pending.pop_front();
-    ++out_index;
-    return record;
+/// The caller's stop check (SimulationOptions::stop_requested), polled every
+/// kStopCheckSteps CVODE steps: RunStopped at the last accepted time.
+void EventDriver::check_stop() {
+    if (!opt_.stop_requested || stats_.steps - steps_at_stop_check_ < kStopCheckSteps) return;
+    steps_at_stop_check_ = stats_.steps;
+    if (opt_.stop_requested())
+        throw RunStopped(who_ + ": stopped on request at t = " + format_value(t_) + " s after " +
+                             std::to_string(stats_.steps) + " steps (the last output is at t = " +
+                             format_value(record_.t_s) + " s)",
+                         stats_.steps, t_);
 }
+
+const StepRecord& EventDriver::advance() {
+    if (out_index_ >= n_out_) throw InputError("advance", "the run has reached t_end = " + format_value(t_final_) + " s");
+    while (pending_.empty()) {
+        check_stop();
+        if (!step_once() && pending_.empty())
+            throw SolverError(who_ + ": reached t = " + format_value(t_) + " s without the output at " +
+                                  format_value(output_time(out_index_ + 1)) + " s",
+                              stats_.steps, t_, 0.0);
+    }
+    record_ = std::move(pending_.front().rec);
+    p_out_ = std::move(pending_.front().p);
+    rel_out_ = std::move(pending_.front().rel);
+    y_out_ = std::move(pending_.front().y);
+    pending_.pop_front();
+    ++out_index_;
+    const CvodeCounters& cc = cvode_->counters();  // Newton's (0 with fixed point)
+    stats_.jacobian_evaluations = cc.jacobian_evaluations;
+    stats_.linear_setups = cc.linear_setups;
+    return record_;
+}
+
+RunReport EventDriver::report() const { return event_report(stats_, events_); }
 
 EventStepper::EventStepper(std::unique_ptr<EventDriver> driver) : driver_(std::move(driver)) {}
 EventStepper::~EventStepper() = default;
 
-const StepRecord& EventStepper::advance() {
-    const StepRecord& r = driver_->advance();
-    const CvodeCounters& cc = driver_->cvode->counters();  // Newton's (0 with fixed point)
-    driver_->stats.jacobian_evaluations = cc.jacobian_evaluations;
-    driver_->stats.linear_setups = cc.linear_setups;
-    return r;
-}
+const StepRecord& EventStepper::advance() { return driver_->advance(); }
 const StepRecord& EventStepper::current() const noexcept { return driver_->current(); }
 long EventStepper::record_index() const noexcept { return driver_->record_index(); }
-std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records_at(driver_->rel_out); }
+std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records(); }
 std::vector<LeafNodes> EventStepper::nodes() const { return driver_->nodes_at_output(); }
 RunReport EventStepper::report() const { return driver_->report(); }
-const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats; }
-const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events; }
-const Eigen::VectorXd& EventStepper::contact_forces() const noexcept { return driver_->p_out; }
-const Eigen::VectorXd& EventStepper::relative_positions() const noexcept { return driver_->rel_out; }
+const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats(); }
+const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events(); }
+const Eigen::VectorXd& EventStepper::contact_forces() const noexcept { return driver_->contact_forces(); }
+const Eigen::VectorXd& EventStepper::relative_positions() const noexcept { return driver_->relative_positions(); }
 
 }  // namespace stackbeam::detail

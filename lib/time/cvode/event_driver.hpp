@@ -1,16 +1,21 @@
 #pragma once
 // Internal: the one event driver of the event-driven cvode steppers (cvode_stepper.hpp for
-// the method): CVODE between contact events with root-finding on the witnesses (decreasing
-// crossings), the contact iteration deciding the modes at an event on the look-ahead
-// problem, the per-step check of every accepted step, bisection of a missed event on
-// CVODE's dense output, restarts (CVodeReInit), the event log and the records on the dt
-// grid. Written once; what differs between the steppers is the state and its mode algebra:
+// the method; docs/decisions/029-event-driver-hooks.md): CVODE between contact events with
+// root-finding on the witnesses (decreasing crossings), the contact iteration deciding the
+// modes at an event on the look-ahead problem, the per-step check of every accepted step,
+// bisection of a missed event on CVODE's dense output, restarts (CVodeReInit), the event log,
+// the records on the dt grid and the caller's stop check (SimulationOptions::stop_requested).
+//
+// As Drake's IntegratorBase and its DoStep: the driver owns every piece of run state privately
+// (CVODE's memory, the modes and anchors, the contact problems and solvers, the pending
+// records, the clocks and counters). A stepper derives from it, builds its operators in its
+// constructor, hands the driver one EventStart value (start()) and implements the fixed hooks
+// below, which read the driver's state through const accessors and never write it:
 //  - the massless stepper (cvode_stepper.cpp): y = [w, w', D (, W_e)], the contact
 //    problem driven by R's displacement, s = C'p + c w - d;
-//  - the modal one with leaf inertia (cvode_modal.cpp): y = [q, q', D], driven by the
-//    retained modes, s = W p + G Phi q - d.
-// A stepper derives from EventDriver and implements the hooks below; its Stepper face is an
-// EventStepper (below) that owns the driver.
+//  - the modal one with leaf inertia (cvode_modal.cpp): y = [q, q', D (, X, t)], driven by
+//    the retained modes, s = W p + G Phi q (+ Hq u(t)) - d;
+//  - the massive stack (cvode_massive.cpp): y = [z, z', D, D_c, W], s = G z + C_L p - d.
 #include <Eigen/Dense>
 #include <chrono>
 #include <deque>
@@ -21,133 +26,166 @@
 
 #include "contact/active_set.hpp"
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/stepper.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/sundials.hpp"
+#include "time/initial_state.hpp"
 
 namespace stackbeam::detail {
+
+/// The scales that make every witness of order one (cvode_stepper.hpp: g = -p_n / F_ref,
+/// -s_n / L_ref, -sigma ds_t/dt / V_ref, ...), one formula for every event stepper (event_scales).
+struct EventScales {
+    double L_ref_m = 1e-3;         ///< displacement scale [m]
+    double V_ref_m_per_s = 1.0;    ///< velocity scale omega L_ref [m/s]
+    double F_ref_n = 1.0;          ///< contact force scale [N, meshed part]
+    double omega_rad_per_s = 1.0;  ///< the frequency of V_ref [rad/s]
+};
+
+/// What the one witness-scale formula (event_scales) takes from a stepper.
+struct ScaleInputs {
+    double stiffness_n_per_m = 1.0;           ///< k of F_ref [N/m, meshed part]
+    double omega_rad_per_s = 1.0;             ///< omega of V_ref [rad/s]
+    double omega_amplitude_rad_per_s = 1.0;   ///< omega turning R's initial velocity into an amplitude [rad/s]
+    double w0_m = 0.0, wd0_m_per_s = 0.0;     ///< R's initial displacement [m] and velocity [m/s]
+    double deflection_m = 0.0;                ///< the loading's static deflection F_max / k [m]
+    double motion_max_m = 0.0;                ///< the base's or the rig's largest displacement [m]
+};
+
+/// The witness scales, one formula for every event stepper:
+///   L_ref = |w(0)| + |w'(0)| / omega_amplitude + F_max / k + y_max      [m]   (1e-3 m when 0: nothing moves)
+///   V_ref = omega L_ref                                                 [m/s]
+///   F_ref = max(largest clamp preload [N], k L_ref)                     [N, meshed part]
+/// The massless stepper (cvode_stepper.cpp) takes k = max(k_tied, k_free), omega = sqrt(k / m),
+/// omega_amplitude = sqrt(k_free / m), F_max the largest external force on R over the run;
+/// the steppers with leaf mass take leaf_mass_scale_inputs.
+EventScales event_scales(const System& system, const ScaleInputs& in);
+/// The inputs of the steppers with leaf mass (modal, massive): k and omega of the tied stack
+/// (k = System::tied_stiffness_n_per_m / f, omega = sqrt(k_tied / m_R)), the body's w(0), w'(0),
+/// F_max = the applied force's largest value + the weight of every mass (System::vertical_inertia_kg),
+/// y_max = the base's or the rig's largest displacement.
+ScaleInputs leaf_mass_scale_inputs(const System& system, const Loading& loading);
+/// The largest |F(t)| of a time function (mean + amplitude, table values) [its unit].
+double largest_value(const TimeFunction& F);
+
+/// What a stepper hands the driver once its operators are built (EventDriver::start).
+struct EventStart {
+    int nstate = 0;                      ///< CVODE's state size
+    Eigen::VectorXd y0;                  ///< the state at t = 0 (nstate entries)
+    EventScales scales;
+    Eigen::MatrixXd compliance;          ///< the instantaneous compliance W of the contact problem [m/N]
+    double event_tolerance_m = 0.0;      ///< the event decisions' tolerance on ||v|| [m]
+    double gap_margin = kMotionMargin;   ///< margin of the gap witnesses (relative to L_ref)
+    /// true: the forces at t = 0 are re-solved from the stage's (event solver, at the motion of
+    /// y0) and the modes built before they are decided; false: the stage's forces are those at y0.
+    bool resolve_initial_forces = true;
+    int stiff_max_order = 0;             ///< 0: Adams with fixed point; else BDF to this order, Newton hooks
+    int retained_modes = 0;              ///< CvodeStats (modal stepper)
+    double modal_cutoff_rad_per_s = 0.0; ///< CvodeStats (modal stepper)
+};
 
 class EventDriver {
 public:
     using Vec = Eigen::VectorXd;
     using State = Eigen::Ref<const Eigen::VectorXd>;
 
-    /// `who` prefixes the messages ("cvode mode", "cvode mode (leaf inertia)").
-    EventDriver(const System& system, const SimulationOptions& options, std::string who);
     virtual ~EventDriver();
     EventDriver(const EventDriver&) = delete;
     EventDriver& operator=(const EventDriver&) = delete;
 
-    /// The record of the next output time (Stepper::advance()).
+    /// The record of the next output time (Stepper::advance()). Throws SolverError on a
+    /// failure, RunStopped when the options' stop check asks for it.
     const StepRecord& advance();
-    const StepRecord& current() const noexcept { return record; }
-    long record_index() const noexcept { return out_index; }
-    /// The pairs at the current output from its forces and relative positions (rel:
-    /// s + d, all rows).
+    const StepRecord& current() const noexcept { return record_; }
+    long record_index() const noexcept { return out_index_; }
+    long num_outputs() const noexcept { return n_out_; }
+    /// The pairs at the current output from its forces and relative positions (rel: s + d, all rows).
     std::vector<PairRecord> pair_records_at(const Vec& rel) const;
+    /// The pairs at the current output with the relative positions of its record.
+    std::vector<PairRecord> pair_records() const { return pair_records_at(rel_out_); }
     /// Every leaf's nodes at the current output (Stepper::nodes()): displacements() at its state.
-    std::vector<LeafNodes> nodes_at_output() const { return sys.leaf_nodes(displacements(y_out, p_out)); }
-    RunReport report() const { return event_report(stats, events); }
+    std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements(y_out_, p_out_)); }
+    RunReport report() const;
+    const CvodeStats& stats() const noexcept { return stats_; }
+    const std::vector<ContactEvent>& events() const noexcept { return events_; }
+    /// Contact forces p [N] (all rows) and relative positions s + d [m] at the current output.
+    const Vec& contact_forces() const noexcept { return p_out_; }
+    const Vec& relative_positions() const noexcept { return rel_out_; }
+    const System& system() const noexcept { return sys_; }
 
-    // ---- what the steppers share, set up by their constructors ---------------------------
-    const System& sys;
-    SimulationOptions opt;
-    std::string who;
-    // from the system (constructor)
-    int n = 0;                  ///< contact rows
-    int np = 0;                 ///< pairs
-    int ndof = 0, w_dof = 0;    ///< reduced DOFs (System::num_reduced_dofs), R's DOF (the last)
-    double f = 1.0;             ///< whole-spring factor (System's model)
-    double m_body = 0.0;        ///< R's mass, whole spring [kg]
-    int nstate = 0;             ///< CVODE's state size
-    double F_ref = 1.0, L_ref = 1.0, V_ref = 1.0;  ///< force [N], length [m], velocity [m/s] scales
-    double gap_margin = kMotionMargin;             ///< margin of the gap witnesses (relative to L_ref)
-    ModeSet modes;                                 ///< the current modes
-    std::vector<signed char>& nmode = modes.nmode;  ///< per pair: CLOSED, OPEN (NONE: no normal row)
-    std::vector<signed char>& tmode = modes.tmode;  ///< per pair: STICK, SLIP_POS, SLIP_NEG, FREE (NONE)
-    Vec d;                      ///< gaps (normal rows) and anchors (tangential rows) [m]; the system's offsets at first
-    Vec d_chk;                  ///< anchors of the per-step check
-    struct Slot { int pair; bool normal; };
-    std::vector<Slot> slots;    ///< one witness per possible transition
-    ContactProblem chk_problem, ev_problem;  ///< the per-step check's and the event decisions' problems
-    std::unique_ptr<ContactSolver> chk_solver, ev_solver;
-    double ev_tolerance = 0.0;  ///< [m] the event decisions' tolerance on ||v||
-    std::unique_ptr<CvodeSession> cvode;
-    double t = 0.0;             ///< time of the last accepted point [s]
-    double t_final = 0.0, dt = 0.0;
-    long n_out = 0, out_index = 0;
-    StepRecord record;          ///< of the current output
-    Vec p_out, rel_out;         ///< its forces [N] and (modal) relative positions [m]
-    Vec y_out;                  ///< its state (CVODE's y at the output time)
-    double e0 = 0.0;            ///< initial energy [J]
-    bool root_finding = true;   ///< CVODE's root-finding on the witnesses (off only in tests: cvode_testing.hpp)
-    long iters_since = 0, facts_since = 0;  ///< contact iterations and factorisations since the last record
-    double last_check_residual = 0.0;
-    std::vector<ContactEvent> events;
-    CvodeStats stats;
+protected:
+    /// `who` prefixes the messages ("cvode mode", "cvode mode (leaf inertia)").
+    EventDriver(const System& system, const SimulationOptions& options, std::string who);
+    /// Starts the run (once, at the end of the stepper's constructor): the grid, the witness
+    /// slots, the contact problems on `s.compliance`, the anchors of the set-up stage, CVODE on
+    /// s.y0, the initial modes decided a look-ahead on (cause "start"), started() and
+    /// tolerances(), the record at t = 0.
+    void start(const InitialState& stage, const EventStart& s);
 
-    const std::vector<ContactPair>& pairs() const { return chk_problem.pairs; }
+    // ---- what the hooks read ------------------------------------------------------------
+    const SimulationOptions& options() const noexcept { return opt_; }
+    const std::string& who() const noexcept { return who_; }
+    int rows() const noexcept { return n_; }          ///< contact rows
+    int num_pairs() const noexcept { return np_; }
+    int ndof() const noexcept { return ndof_; }       ///< reduced DOFs (System::num_reduced_dofs)
+    int w_dof() const noexcept { return ndof_ - 1; }  ///< R's DOF (the last)
+    double spring_factor() const noexcept { return f_; }  ///< whole-spring factor (System's model)
+    double body_mass_kg() const noexcept { return m_body_; }  ///< R's mass, whole spring [kg]
+    int nstate() const noexcept { return nstate_; }
+    const EventScales& scales() const noexcept { return scales_; }
+    const ModeSet& modes() const noexcept { return modes_; }
+    /// Gaps (normal rows) and anchors (tangential rows) [m] of the current modes.
+    const Vec& anchors() const noexcept { return d_; }
+    /// The pairs and their laws (tau rule current), the check problem's W.
+    const ContactProblem& laws() const noexcept { return chk_problem_; }
+    const std::vector<ContactPair>& pairs() const { return chk_problem_.pairs; }
+    double time() const noexcept { return t_; }        ///< the last accepted time [s]
+    long steps() const noexcept { return stats_.steps; }
+    double initial_energy_j() const noexcept { return e0_; }
+    double jump_dissipation_j() const noexcept { return jump_dissipation_; }  ///< [J, whole spring]
+    /// A SolverError "<who>: <what> at t = .. s" at the current time and step.
+    SolverError failure(const std::string& what) const;
 
+    // ---- helpers the hooks may call -----------------------------------------------------
     /// Completes a record of a stepper with leaf inertia: the kinetic energy [J] of the leaves
     /// and R (the leaves' share apart), m w'' [N], the damping energy [J] and the balance
     /// with the record's external work, strain energy and dissipation.
     void finish_inertia_record(StepRecord& rec, double kinetic_j, double force_on_mass_n,
                                double damping_energy_j = 0.0) const;
-    /// The output grid t_i = i dt_s up to t_final = n_out dt_s (as the closed-form mode).
-    void init_grid();
-    /// The witness slots: every non-bonded pair's normal (unilateral, or a clamp with
-    /// friction) and tangential (friction) transitions.
-    void init_slots();
-    /// The check and event problems on the compliance W [m/N], their solvers (the event
-    /// solver to `event_tolerance_m`).
-    void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
-    /// A stiff stepper's integrator: BDF up to `max_order`, Newton on the stepper's exact
-    /// factorisation (psetup) and solve (psolve) of the Newton matrix, as a matrix-embedded
-    /// linear solver (CvodeSession::use_embedded_newton).
-    struct StiffIntegrator {
-        int max_order = 2;
-        CVLsPrecSetupFn psetup = nullptr;
-        CVLsPrecSolveFn psolve = nullptr;
-    };
-    /// CVODE on the state y() and atol() set by the stepper: Adams with fixed point (or
-    /// `stiff`), the user's limits, stop time t_final, the witnesses as roots (if
-    /// root-finding is on).
-    void start_cvode(CVRhsFn rhs, const StiffIntegrator* stiff = nullptr);
-    /// The contact forces at t = 0 (the initial contact state of every event stepper): the event
-    /// problem at s = motion0 - d [m] (motion0: the motion's part of s at t = 0) solved by the
-    /// event solver from the warm start p, the forces [N] left in p; throws SolverError
-    /// ("initial contact state") when the solve fails. The modes follow from p (the stepper then
-    /// decides them a look-ahead on: decide_modes).
-    void solve_initial_forces(const Vec& motion0, Vec& p);
-    /// The initial record: `make_record` at t = 0, its balance error 0, e0 from it.
-    void start_record(const Vec& y0);
+    /// The witnesses of the steppers whose modes give the forces `p` [N], the relative position
+    /// s [m] of a normal row (`s_of(row)`, > 0 interpenetration) and the slider rate ds/dt [m/s]
+    /// of a tangential row (`rate_of(row)`): a closed pair's compression, an open pair's gap, a
+    /// clamp's release or engagement, a sticking pair's margin to the cone, a slipping pair's
+    /// rate against its force; each positive while its modes hold, with its margin.
+    void witnesses_from(const Vec& p, const std::function<double(int)>& s_of, const std::function<double(int)>& rate_of,
+                        double* g) const;
+    /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
+    /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
+    /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
+    /// rate the look-ahead's motion is too short to resolve), the sign follows the rate.
+    /// At most three passes; the current modes and anchors are left as they were.
+    void signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
+                                 const std::function<Vec()>& rate);
+    /// Books a force jump at an event (a slip that reverses where sticking is not admissible)
+    /// that released `loss` [J, whole spring] of the contact layer's energy: friction work.
+    void book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new);
+    /// Notes the largest force jump at an event [N] without booking energy (the massless layer).
+    void note_force_jump(const Vec& p_cur, const Vec& p_new);
 
-    /// The contact iteration decides the modes at (te, y) with the forces p_cur there in
-    /// the old modes: CVODE's transitions (`triggered`: the witness slots it found) applied
-    /// to the old modes first, kept if the contact iteration's stop test and every witness
-    /// accept them a look-ahead away; otherwise the exact solver on that look-ahead
-    /// problem decides. Logs the transitions, enters the new modes.
-    void decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
-                      const std::vector<int>* triggered = nullptr);
-    /// Enters the modes (nm, tm): pairs that start to stick are anchored at rel [m].
-    void enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm);
-    /// Milliseconds-free wall clock for the stats' time split.
-    using Clock = std::chrono::steady_clock;
-    static double seconds_since(Clock::time_point t0);
-
-protected:
-    // ---- the hooks: what differs between the steppers --------------------------------
-    /// Factorises the current modes' linear conditions (counts the factorisation).
-    virtual void build_mode() = 0;
+    // ---- the hooks: what differs between the steppers -----------------------------------
+    /// Builds the current modes' operators from their linearisation (ModeSet::linearize of the
+    /// laws: held rows S, p = T p_S + e). The driver counts the factorisation.
+    virtual void build_mode(const ModeLinearization& lin) = 0;
     /// Contact forces p [N] of the current modes at state y.
     virtual Vec forces(const State& y) const = 0;
     /// s + d [m] of the current modes at y (affine in the state).
     virtual Vec relative(const State& y) const = 0;
     /// s + d [m] at an event from the forces p_cur (before the modes are decided).
     virtual Vec relative_at_event(const State& y, const Vec& p_cur) const = 0;
-    /// The motion's part of s + d: c w, or G Phi q [m].
+    /// The motion's part of s + d: c w, G Phi q, G z [m].
     virtual Vec motion(const State& y) const = 0;
     /// Witness functions at y, positive while the modes hold.
     virtual void witnesses(const State& y, double* g) const = 0;
@@ -166,34 +204,18 @@ protected:
     /// decision at the look-ahead that leaves a witness negative at the state would restart
     /// into the same missed event (default false).
     virtual bool settle_after_missed_event() const;
-    /// Runs `body` in the candidate modes (nm, tm): entered (pairs that start to stick anchored
-    /// at rel), factorised if `build`, then the current modes and anchors restored.
-    void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
-                            bool build, const std::function<void()>& body);
-    /// Applies to (nm, tm) the transition of every witness slot i with take(i) (a slip's
-    /// direction from p [N]); true when there was one.
-    bool apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
-                                std::vector<signed char>& nm, std::vector<signed char>& tm) const;
-    /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
-    /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
-    /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
-    /// rate the look-ahead's motion is too short to resolve), the sign follows the rate.
-    /// At most three passes; the current modes and anchors are left as they were.
-    void signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
-                                 const std::function<Vec()>& rate);
-    /// Books a force jump at an event (a slip that reverses where sticking is not admissible)
-    /// that released `loss` [J, whole spring] of the contact layer's energy: friction work.
-    void book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new);
-    double jump_dissipation = 0.0;  ///< friction work in force jumps at events [J, whole spring]
-    /// The witnesses of the steppers whose modes give the forces `p` [N], the relative position
-    /// s [m] of a normal row (`s_of(row)`, > 0 interpenetration) and the slider rate ds/dt [m/s]
-    /// of a tangential row (`rate_of(row)`): a closed pair's compression, an open pair's gap, a
-    /// clamp's release or engagement, a sticking pair's margin to the cone, a slipping pair's
-    /// rate against its force; each positive while its modes hold, with its margin.
-    void witnesses_from(const Vec& p, const std::function<double(int)>& s_of, const std::function<double(int)>& rate_of,
-                        double* g) const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
+    /// CVODE's right-hand side y' = f(t, y) of the current modes (nstate entries each).
+    virtual void derivatives(double t_s, const double* y, double* ydot) const = 0;
+    /// Stiff steppers (EventStart::stiff_max_order > 0): factorise CVODE's Newton matrix at gamma
+    /// (0 ok, > 0 recoverable) and solve it for r into x (CvodeSession::use_embedded_newton).
+    virtual int newton_setup(double gamma);
+    virtual int newton_solve(double t_s, const double* y, const double* r, double* x, double gamma) const;
+    /// Once the initial modes are decided, before the first record (default nothing).
+    virtual void started(const State& y0);
+    /// CVODE's absolute tolerances at the initial state y0 into atol (nstate entries).
+    virtual void tolerances(const State& y0, Eigen::Ref<Vec> atol) const = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
     /// the driver sets t, the counters and the residual.
     virtual StepRecord make_record(double tau, const State& y, Vec& p, Vec& rel) const = 0;
@@ -202,24 +224,73 @@ protected:
     virtual Vec displacements(const State& y, const Vec& p) const = 0;
 
 private:
+    using Clock = std::chrono::steady_clock;
+    static double seconds_since(Clock::time_point t0);
+    struct Slot { int pair; bool normal; };
     struct Output { StepRecord rec; Vec p, rel, y; };
-    std::deque<Output> pending;
-    double last_event_t = -1.0;
-    int events_at_this_time = 0;
 
-    static int roots(sunrealtype, N_Vector y, sunrealtype* g, void* user);
+    const System& sys_;
+    SimulationOptions opt_;
+    std::string who_;
+    int n_ = 0, np_ = 0, ndof_ = 0;  // contact rows, pairs, reduced DOFs
+    double f_ = 1.0, m_body_ = 0.0;
+    int nstate_ = 0;
+    EventScales scales_;
+    double gap_margin_ = kMotionMargin;
+    ModeSet modes_;
+    Vec d_, d_chk_;                // anchors of the modes and of the per-step check [m]
+    std::vector<Slot> slots_;      // one witness per possible transition
+    ContactProblem chk_problem_, ev_problem_;
+    std::unique_ptr<ContactSolver> chk_solver_, ev_solver_;
+    double ev_tolerance_ = 0.0;    // [m]
+    std::unique_ptr<CvodeSession> cvode_;
+    double t_ = 0.0, t_final_ = 0.0, dt_ = 0.0;
+    long n_out_ = 0, out_index_ = 0;
+    StepRecord record_;
+    Vec p_out_, rel_out_, y_out_;
+    double e0_ = 0.0;
+    double jump_dissipation_ = 0.0;
+    bool root_finding_ = true;     // off only in tests (cvode_testing.hpp)
+    long iters_since_ = 0, facts_since_ = 0;
+    long steps_at_stop_check_ = 0; // CVODE's steps at the last stop check
+    double last_check_residual_ = 0.0;
+    std::vector<ContactEvent> events_;
+    CvodeStats stats_;
+    std::deque<Output> pending_;
+    double last_event_t_ = -1.0;
+    int events_at_this_time_ = 0;
+
+    void init_grid();
+    void init_slots();
+    void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
+    void start_cvode(int stiff_max_order);
+    void rebuild();
+    void enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm);
+    void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
+                            bool build, const std::function<void()>& body);
+    bool apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
+                                std::vector<signed char>& nm, std::vector<signed char>& tm) const;
+    void decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
+                      const std::vector<int>* triggered = nullptr);
+    static int rhs_of(sunrealtype t, N_Vector y, N_Vector ydot, void* user);
+    static int roots_of(sunrealtype, N_Vector y, sunrealtype* g, void* user);
+    static int psetup_of(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
+                         void* user);
+    static int psolve_of(sunrealtype t, N_Vector y, N_Vector, N_Vector r, N_Vector x, sunrealtype gamma, sunrealtype,
+                         int, void* user);
     StepRecord record_at(double tau, const State& y, Vec& p, Vec& rel);
-    double output_time(long i) const { return i == n_out ? t_final : static_cast<double>(i) * dt; }
+    double output_time(long i) const { return i == n_out_ ? t_final_ : static_cast<double>(i) * dt_; }
     void emit_until(double upto);
     void note_event_time(double te);
     void reset_check_anchors(const State& y);
     bool modes_hold(const State& y, double& residual, bool* witnesses_ok = nullptr);
     void restart(double te, const Vec& y);
     bool step_once();
+    void check_stop();
 };
 
-/// The Stepper face of the event-driven steppers with leaf inertia (modal and massive): every
-/// call forwards to their EventDriver.
+/// The Stepper face of every event-driven cvode stepper with leaf inertia (modal, massive): every
+/// call forwards to its EventDriver.
 class EventStepper : public Stepper {
 public:
     ~EventStepper() override;

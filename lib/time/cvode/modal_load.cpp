@@ -59,27 +59,4 @@ ModalLoad::Values ModalLoad::at(double t_s) const {
     return v;
 }
 
-EventScales loaded_event_scales(const System& system, const Loading& L, const Eigen::VectorXd& inertia_kg) {
-    const auto& body = system.model().spec().rigid_body;
-    const double k_t = system.tied_stiffness_n_per_m(), f = system.model().whole_spring_factor();
-    auto largest = [](const TimeFunction& F) {
-        double v = std::abs(F.mean) + F.amplitude;
-        for (double x : F.values) v = std::max(v, std::abs(x));
-        return v;
-    };
-    EventScales s;
-    s.omega_t = std::sqrt(k_t / body.mass_kg);
-    const double force_scale = (L.kind == LoadingKind::applied_force ? largest(L.force_n) : 0.0) +
-                               f * L.gravity_m_per_s2 * inertia_kg.sum();
-    const double motion_scale = L.kind == LoadingKind::base_excitation ? largest(L.displacement_m) : 0.0;
-    s.L_ref = std::abs(body.initial_displacement_m) + std::abs(body.initial_velocity_m_per_s) / s.omega_t +
-              force_scale / k_t + motion_scale;
-    if (!(s.L_ref > 0.0)) s.L_ref = 1e-3;
-    s.V_ref = s.omega_t * s.L_ref;
-    double preload = 0.0;
-    for (const auto& cp : system.pairs()) preload = std::max(preload, cp.preload_n);
-    s.F_ref = std::max(preload, k_t / f * s.L_ref);
-    return s;
-}
-
 }  // namespace stackbeam::detail

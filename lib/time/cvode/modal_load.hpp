@@ -65,12 +65,4 @@ private:
     bool none_ = true;
 };
 
-/// The event scales of a stack under a loading: L_ref [m] R's amplitude on the tied stack from
-/// its initial conditions plus the loading's static deflection and the base's travel, V_ref
-/// [m/s] = omega_t L_ref, F_ref [N] the largest preload or the tied stack's force at L_ref.
-struct EventScales {
-    double L_ref = 1e-3, V_ref = 1.0, F_ref = 1.0, omega_t = 1.0;
-};
-EventScales loaded_event_scales(const System& system, const Loading& loading, const Eigen::VectorXd& inertia_kg);
-
 }  // namespace stackbeam::detail
