@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/run_report.hpp"
