@@ -1,23 +1,26 @@
 #pragma once
 /// @file stackbeam.hpp
-/// The whole public API in one include. The headers follow the data flow:
+/// The whole public API in one include. The headers follow the include order:
+///   contact/  the ground numerics layer (Eigen only): the pair laws, the per-step frictional
+///             contact problem (dense or sparse operator) and its solvers
 ///   model/    the spring as the user describes it (leaves, interfaces, clamps, body),
 ///             the paper's example, the loadings
 ///   fe/       the finite-element system built from it (stiffness, contact rows, mass)
 ///             and its natural frequencies
-///   contact/  the per-step frictional contact problem and its solvers
 ///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
 ///   io/       scenario files (TOML) and CSV output
 ///   post/     hysteresis-loop figures of a run, the Fancher model fitted to a loop
 ///   study/    sweeps: a base scenario at many points, on threads; the results directory
 #include "stackbeam/conventions.hpp"
 #include "stackbeam/errors.hpp"
+#include "stackbeam/contact/pair.hpp"
+#include "stackbeam/contact/contact.hpp"
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/model/model.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/model/loading.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/fe/modal.hpp"
-#include "stackbeam/contact/contact.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/option_table.hpp"
 #include "stackbeam/time/run_report.hpp"

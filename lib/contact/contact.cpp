@@ -12,6 +12,15 @@
 
 namespace stackbeam {
 
+const char* to_string(PairKind kind) {
+    switch (kind) {
+        case PairKind::bonded: return "bonded";
+        case PairKind::coulomb: return "coulomb";
+        case PairKind::clamp: return "clamp";
+    }
+    return "?";
+}
+
 const char* to_string(PairState state) {
     switch (state) {
         case PairState::stick: return "stick";

@@ -23,15 +23,6 @@ const char* to_string(SupportKind kind) {
     return "?";
 }
 
-const char* to_string(PairKind kind) {
-    switch (kind) {
-        case PairKind::bonded: return "bonded";
-        case PairKind::coulomb: return "coulomb";
-        case PairKind::clamp: return "clamp";
-    }
-    return "?";
-}
-
 const char* to_string(InterfaceContact contact) {
     switch (contact) {
         case InterfaceContact::rigid: return "rigid";

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
 #include "time/contact_state.hpp"
@@ -17,7 +18,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptio
     : ClosedFormStepper(system, detail::initial_state("closed-form", system, options)) {}
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const detail::InitialState& start)
-    : system_(system), options_(start.options), path_(start.path), problem_(start.laws), z_(start.z),
+    : system_(system), options_(start.options), problem_(start.laws), z_(start.z),
       solve_(start.solve), p_(start.p), d_(start.d), w_(start.w0_m), wd_(start.wd0_m_per_s), rig_(start.rig) {
     const Loading& load = options_.loading;
     const int n = system_.num_components();
@@ -34,34 +35,47 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const detail::Initial
     const Eigen::VectorXd& c = system_.coupling();
     w_dof_ = system_.num_reduced_dofs() - 1;
     // The initial state (the assembly, gravity, R held at w(0): initial_state.hpp) is the start's.
-    if (path_ == ContactPath::dense) {
-        solver_ = make_solver(options_.solver);
-        // The rig holds R: each step is quasi-static with R held (W = C'); otherwise eq. 16.
-        problem_.W = rig_ ? system_.compliance_held()
-                          : Eigen::MatrixXd(system_.compliance_held() + (gamma_ / k) * c * c.transpose());
-        problem_.q = Eigen::VectorXd::Zero(n);
-        rel_ = system_.compliance_held() * p_ + c * w_;
-    } else {
-        // Sparse path (see simulation.hpp): K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma,
-        // with 1 - gamma = sin(x)/x taken directly (no cancellation for small x).
-        if (!(sin_ > 0.0) && !rig_)
-            throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
-                                       " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
-        const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
-        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
-        const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
-        krw_ = Eigen::VectorXd(K.block(0, w_dof_, w_dof_, 1));
-        gw_ = Eigen::VectorXd(system_.contact_rows().col(w_dof_));
-        // the rig: R held at w_p(t) on z_r; otherwise R free on K_aug = K + k_R e_w e_w^T
-        sparse_problem_ = detail::sparse_problem(system_, problem_, {}, d_, rig_ ? w_ : std::nan(""));
-        if (!rig_) {
+    // The step's contact problem in both forms (closed_form_stepper.hpp); the operator takes one.
+    // u = [w_next]. Dense: W = C' + (gamma/k) c c^T (the rig holds R: W = C'), q = c w_next - d.
+    // Sparse: K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma, b = (k/gamma) w_next e_w; the
+    // rig: K_rr z_r = -K_rw w_next + G_r^T p, s = G_r z_r + c_L p - (d - G_w w_next).
+    StepSystem sys = rig_ ? detail::held_body_system(system_) : StepSystem{};
+    if (!rig_) {
+        sys.rows = n;
+        sys.dense = [&] {
+            DenseStepForm f;
+            f.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
+            f.Q = c;
+            return f;
+        };
+        sys.sparse = [&] {
+            // 1 - gamma = sin(x)/x taken directly (no cancellation for small x)
+            if (!(sin_ > 0.0))
+                throw InputError("dt", "value " + format_value(options_.dt_s) + " gives omega dt = " + format_value(x) +
+                                           " >= pi: the sparse contact path needs omega dt < pi (use the dense path)");
+            const double one_minus_gamma = x < 1e-3 ? 1.0 - x * x / 6.0 + x * x * x * x / 120.0 : sin_ / x;
+            SparseStepForm f;
+            f.K = system_.stiffness_reduced();
+            f.G = system_.contact_rows();
+            f.layer_compliance = detail::sparse_layer(system_);
             k_r_ = k * one_minus_gamma / gamma_;
-            sparse_problem_.K.coeffRef(w_dof_, w_dof_) += k_r_;
-            sparse_problem_.K.makeCompressed();
-        }
-        sparse_problem_.d = d_;
-        rel_ = detail::relative_positions(system_, z_, p_);
+            f.K.coeffRef(w_dof_, w_dof_) += k_r_;
+            f.K.makeCompressed();
+            f.B.resize(w_dof_ + 1, 1);
+            f.B.insert(w_dof_, 0) = k / gamma_;
+            f.B.makeCompressed();
+            return f;
+        };
     }
+    op_ = std::make_shared<const ContactOperator>(sys, options_.contact_path, options_.solver.kind);
+    contact_ = std::make_unique<StepContactSolver>(options_.solver, options_.sparse_tuning);
+    step_problem_.op = op_;
+    step_problem_.pairs = problem_.pairs;
+    step_problem_.tau_rule = problem_.tau_rule;
+    step_problem_.u = Eigen::VectorXd::Zero(1);
+    // relative positions at the start: from z where the operator gives z, else from C'
+    rel_ = op_->has_displacements() ? detail::relative_positions(system_, z_, p_)
+                                    : Eigen::VectorXd(system_.compliance_held() * p_ + c * w_);
     fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
     fill_record(0, 0);
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
@@ -73,11 +87,11 @@ void ClosedFormStepper::fill_record(int iterations, int factorizations, double s
     const double k = system_.stiffness_n_per_m();
     // U = z^T K z / 2 + p^T C_L p / 2 = (p^T C' p + k w^2) / 2 on the meshed part, leaves and
     // elastic layer (see system.hpp); the sparse path has z itself and never builds C'.
-    // step() passes the sparse path's U (strain_j >= 0), which it has without a product with K.
+    // step() passes the stiffness form's U (strain_j >= 0), which it has without a product with K.
     const double strain = strain_j >= 0.0 ? strain_j
-                          : path_ == ContactPath::dense
-                              ? 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_)
-                              : f * (0.5 * z_.dot(system_.stiffness_reduced() * z_) + detail::layer_energy_j(system_, p_));
+                          : op_->has_displacements()
+                              ? f * (0.5 * z_.dot(system_.stiffness_reduced() * z_) + detail::layer_energy_j(system_, p_))
+                              : 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
     detail::LoadState load;
     load.external_work_j = wext_;
     load.base_displacement_m = options_.loading.base_displacement_m(t_);
@@ -106,7 +120,7 @@ std::vector<PairRecord> ClosedFormStepper::pairs() const {
 }
 
 std::vector<LeafNodes> ClosedFormStepper::nodes() const {
-    return system_.leaf_nodes(path_ == ContactPath::sparse ? z_ : system_.reduced_displacements(p_, w_));
+    return system_.leaf_nodes(op_->has_displacements() ? z_ : system_.reduced_displacements(p_, w_));
 }
 
 const StepRecord& ClosedFormStepper::advance() {
@@ -122,33 +136,25 @@ const StepRecord& ClosedFormStepper::advance() {
     if (rig_) {
         // The rig: w(t+dt) prescribed, the contact problem quasi-static with R held there.
         w_next = load.displacement_m.value(t1);
-        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
     } else {
         // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
         // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
         fe1 = load.external_force_n(t1, m_whole_) / f_;
         F0 = cp0 + fe_;
         w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
-        // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16).
-        if (path_ == ContactPath::dense) problem_.q = c * w_next - d_;
     }
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
-    if (path_ == ContactPath::dense) {
-        solve_ = solver_->solve(problem_, p_);
-    } else if (rig_) {
-        sparse_problem_.b = -krw_ * w_next;
-        sparse_problem_.d = d_ - gw_ * w_next;
-        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-        Eigen::VectorXd zr = z_.head(w_dof_);
-        solve_ = sparse_solver_->solve(sparse_problem_, p_, zr, step_ > 0);  // the held K, G constant over the run
-        z_.head(w_dof_) = zr;
+    // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16), in the
+    // operator's form; K, G constant over the run. The displacements (where the operator gives
+    // them) are z, or z_r with R's w_next (the rig).
+    step_problem_.u[0] = w_next;
+    step_problem_.d = d_;
+    step_problem_.tau_previous_n = problem_.tau_previous_n;
+    solve_ = contact_->solve(step_problem_, p_, rig_ ? zr_ : z_);
+    if (rig_ && op_->has_displacements()) {
+        z_.head(w_dof_) = zr_;
         z_[w_dof_] = w_next;
-    } else {
-        sparse_problem_.b[w_dof_] = k / gamma_ * w_next;
-        sparse_problem_.d = d_;
-        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-        solve_ = sparse_solver_->solve(sparse_problem_, p_, z_, step_ > 0);  // K, G constant over the run
     }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
@@ -167,12 +173,7 @@ const StepRecord& ClosedFormStepper::advance() {
         wd1 = wd_ * cos_ - w_ * omega_ * sin_ + F0 / k * omega_ * sin_ + (F1 - F0) / (k * dt) * (1.0 - cos_);
     }
     // Friction work, trapezoidal in time (p linear over the step, eq. 14), on the slip increments.
-    // G z on the sparse path: the solver's s = G z - d at the solution, plus d (the rig's
-    // held problem is posed on z_r with d - G_w w: add R's part G_w w back)
-    Eigen::VectorXd rel1;
-    if (path_ == ContactPath::dense) rel1 = problem_.W * p_ + problem_.q + d_;
-    else if (rig_) rel1 = sparse_solver_->relative_positions() + sparse_problem_.d + gw_ * w_next;
-    else rel1 = sparse_solver_->relative_positions() + sparse_problem_.d;
+    const Eigen::VectorXd rel1 = contact_->relative_positions(p_);
     double work = 0.0;
     for (const auto& pr : problem_.pairs)
         if (pr.row_t >= 0 && pr.kind != PairKind::bonded)
@@ -192,7 +193,7 @@ const StepRecord& ClosedFormStepper::advance() {
     wd_ = wd1;
     t_ = step_ * dt;
     detail::reanchor(problem_, p_, rel_, d_);
-    // Sparse path: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
+    // Stiffness form: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
     // (the solved system, K_aug = K + k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2,
     // with G z = rel_ (made above; with an elastic layer the solved system is the augmented
     // one, sparse_solver.cpp, and p^T rel_ = p^T G z + p^T C_L p adds the layer's energy twice
@@ -200,9 +201,9 @@ const StepRecord& ClosedFormStepper::advance() {
     // (~1e2-1e3 at dt = 1 ms): the difference loses that factor of round-off, 1e-13 relative.
     // (The rig's held problem is another system: fill_record takes z^T K z there.)
     double strain = -1.0;
-    if (path_ == ContactPath::sparse && !rig_) {
+    if (op_->has_displacements() && !rig_) {
         const double zw = z_[w_dof_];
-        strain = 0.5 * f_ * (sparse_problem_.b[w_dof_] * zw + p_.dot(rel_) - k_r_ * zw * zw);
+        strain = 0.5 * f_ * (k / gamma_ * w_next * zw + p_.dot(rel_) - k_r_ * zw * zw);
     }
     fill_record(solve_.iterations, solve_.factorizations, strain);
     detail::count_step(record_, report_);

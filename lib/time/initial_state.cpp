@@ -19,19 +19,42 @@ void require_converged(const SolveResult& r) {
     if (!r.converged) throw SolverError("initial contact state: " + r.message, 0, 0.0, r.residual_m);
 }
 
+/// The contact state with R held at w0 (held_body_system) by `options`' solver on the start's
+/// path: p [N] on exit; z (w last) set where the operator gives displacements.
+void held_contact_state(const System& sys, InitialState& st, const SolverOptions& options) {
+    const int w_dof = sys.num_reduced_dofs() - 1;
+    StepProblem held;
+    held.op = std::make_shared<const ContactOperator>(held_body_system(sys), st.path, options.kind);
+    held.pairs = st.laws.pairs;
+    held.tau_rule = st.laws.tau_rule;
+    held.tau_previous_n = st.laws.tau_previous_n;
+    held.u = Eigen::VectorXd::Constant(1, st.w0_m);
+    held.d = st.d;
+    StepContactSolver solver(options, st.options.sparse_tuning);
+    Eigen::VectorXd zr;
+    st.solve = solver.solve(held, st.p, zr);
+    require_converged(st.solve);
+    if (held.op->has_displacements()) {
+        if (st.z.size() != w_dof + 1) st.z = Eigen::VectorXd::Zero(w_dof + 1);
+        st.z.head(w_dof) = zr;
+        st.z[w_dof] = st.w0_m;
+    }
+}
+
 /// The massless stack: the assembly and R's weight -m g as static steps (dense: on C' with `solver`;
 /// sparse: on the whole stack), then the contact state with R held at w0 (no re-anchoring).
-void start_massless(const System& sys, InitialState& st, ContactSolver& solver) {
+void start_massless(const System& sys, InitialState& st, const SolverOptions& options) {
     const int n = sys.num_components(), w_dof = sys.num_reduced_dofs() - 1;
     const Loading& L = st.options.loading;
     const double m = sys.mass_kg();
     if (st.path == ContactPath::dense) {
+        const auto solver = make_solver(options);
         const bool assemble = needs_assembly(sys.model().spec()) && n > 0;
         for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
             if (stage == 0 ? !assemble : !(L.gravity_m_per_s2 > 0.0)) continue;
             const double Fs = stage == 0 ? 0.0 : -m * L.gravity_m_per_s2;  // [N] on the meshed part
             const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
-            const StaticState s = static_equilibrium_dense(sys, st.laws, Fs, solver, st.p, st.d, what);
+            const StaticState s = static_equilibrium_dense(sys, st.laws, Fs, *solver, st.p, st.d, what);
             st.w_static_m = s.w_m;
             st.solve = s.solve;
             st.pre_stressed = true;
@@ -47,20 +70,7 @@ void start_massless(const System& sys, InitialState& st, ContactSolver& solver) 
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
     if (st.w0_m == st.w_static_m || n == 0) return;
     // the contact state with R held at w(0)
-    if (st.path == ContactPath::dense) {
-        ContactProblem held = st.laws;
-        held.W = sys.compliance_held();
-        held.q = sys.coupling() * st.w0_m - st.d;
-        st.solve = solver.solve(held, st.p);
-        require_converged(st.solve);
-    } else {
-        SparseContactSolver initial(st.options.solver, st.options.sparse_tuning);
-        Eigen::VectorXd zr;
-        st.solve = initial.solve(sparse_problem(sys, st.laws, {}, st.d, st.w0_m), st.p, zr);
-        require_converged(st.solve);
-        st.z.head(w_dof) = zr;
-        st.z[w_dof] = st.w0_m;
-    }
+    held_contact_state(sys, st, options);
 }
 
 /// The whole stack with leaf mass: the assembly and the weight of everything as static steps, then
@@ -78,19 +88,7 @@ void start_whole_stack(const System& sys, InitialState& st, bool always_static) 
         if (st.w0_m != st.w_static_m)
             st.z = static_state(sys, st.laws, weight, st.w0_m, st.options, st.p, st.d, "initial contact state", &st.solve);
     } else {
-        if (st.w0_m != 0.0 && n > 0) {
-            if (st.path == ContactPath::dense) {
-                ContactProblem held = st.laws;
-                held.W = sys.compliance_held();
-                held.q = sys.coupling() * st.w0_m - st.d;
-                st.solve = make_solver(st.options.solver)->solve(held, st.p);
-            } else {
-                SparseContactSolver initial(st.options.solver, st.options.sparse_tuning);
-                Eigen::VectorXd zr;
-                st.solve = initial.solve(sparse_problem(sys, st.laws, {}, st.d, st.w0_m), st.p, zr);
-            }
-            require_converged(st.solve);
-        }
+        if (st.w0_m != 0.0 && n > 0) held_contact_state(sys, st, st.options.solver);
         st.z = sys.reduced_displacements(st.p, st.w0_m);
     }
     st.v0 = Eigen::VectorXd::Zero(w_dof + 1);
@@ -121,9 +119,8 @@ InitialState initial_state(const StepperCapabilities& stepper, const System& sys
     st.wd0_m_per_s = st.rig ? L.displacement_m.derivative(0.0) : rb.initial_velocity_m_per_s - L.base_velocity_m_per_s(0.0);
     switch (stepper.start) {
         case StartKind::massless_stack: {
-            const auto solver = make_solver(stepper.exact_start ? event_solver_options(options.solver, options.solver.tolerance_m)
-                                                                : options.solver);
-            start_massless(system, st, *solver);
+            start_massless(system, st, stepper.exact_start ? event_solver_options(options.solver, options.solver.tolerance_m)
+                                                           : options.solver);
             break;
         }
         case StartKind::whole_stack: start_whole_stack(system, st, false); break;

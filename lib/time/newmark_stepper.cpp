@@ -6,6 +6,7 @@
 #include <Eigen/SparseLU>
 #include <cmath>
 
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
 #include "time/contact_state.hpp"
@@ -19,7 +20,7 @@
 namespace stackbeam {
 
 struct NewmarkStepper::Factor {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff (its check: positive definite)
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
     Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
 };
@@ -34,7 +35,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& op
                                                    system, options)) {}
 
 NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState& start)
-    : system_(system), options_(start.options), path_(start.path), factor_(std::make_unique<Factor>()),
+    : system_(system), options_(start.options), factor_(std::make_unique<Factor>()),
       problem_(start.laws), solve_(start.solve), z_(start.z), v_(start.v0), p_(start.p), d_(start.d), rig_(start.rig) {
     report_.mode = Mode::newmark;
     const auto& leaves = system_.model().spec().leaves;
@@ -55,15 +56,17 @@ NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState&
             throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
     }
     initial_accelerations();
-    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection
-    // (dense path; the sparse path factorises [M G_C^T; G_C 0] per held set instead).
+    factorise_step();
+    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection, dense
+    // where the step's contact operator is dense (m^2 doubles are affordable there); otherwise
+    // [M G_C^T; G_C 0] is factorised per held set (project_velocities).
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    if (massive_leaves_ && system_.num_components() > 0 && path_ == ContactPath::dense) {
+    dense_projection_ = op_->path() == ContactPath::dense;
+    if (massive_leaves_ && system_.num_components() > 0 && dense_projection_) {
         Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
         const Eigen::MatrixXd A = G * Z_;
         A_ = 0.5 * (A + A.transpose());
     }
-    factorise_step();
     solve_ = SolveResult{};
     solve_.converged = true;
     fill_record(0, 0);
@@ -129,25 +132,23 @@ void NewmarkStepper::factorise_step() {
     factor_->llt.compute(KeffF);
     if (factor_->llt.info() != Eigen::Success)
         throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
-    if (path_ == ContactPath::dense) {
-        solver_ = make_solver(options_.solver);
-        Y_ = kappa * factor_->llt.solve(Eigen::MatrixXd(GF.transpose()));
-        const Eigen::MatrixXd W = GF * Y_;
-        problem_.W = 0.5 * (W + W.transpose());
-        problem_.W.diagonal() += system_.layer_compliance_m_per_n();  // the elastic layer (system.hpp)
-        problem_.q = Eigen::VectorXd::Zero(m);
-    } else {
-        // (K_eff / kappa) z1 = r / kappa + G^T p1
-        sparse_solver_ = std::make_unique<SparseContactSolver>(options_.solver, options_.sparse_tuning);
-        sparse_problem_.K = (1.0 / kappa) * KeffF;
-        sparse_problem_.G = GF;
-        sparse_problem_.b = Eigen::VectorXd::Zero(nf);
-        sparse_problem_.d = d_;
-        sparse_problem_.layer_compliance = detail::sparse_layer(system_);
-        sparse_problem_.pairs = problem_.pairs;
-        sparse_problem_.tau_rule = problem_.tau_rule;
-        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-    }
+    // The step's contact problem, (K_eff / kappa) z1 = r / kappa + G^T p1, s = G z1 + c_L p1 - d:
+    // u = r / kappa (the load on z itself), the operator dense (W = G (K_eff / kappa)^-1 G^T + C_L
+    // from its factor) or sparse (step.hpp).
+    StepSystem sys;
+    sys.rows = m;
+    sys.sparse = [&] {
+        SparseStepForm f;
+        f.K = (1.0 / kappa) * KeffF;
+        f.G = GF;
+        f.layer_compliance = detail::sparse_layer(system_);
+        return f;
+    };
+    op_ = std::make_shared<const ContactOperator>(sys, options_.contact_path, options_.solver.kind);
+    contact_ = std::make_unique<StepContactSolver>(options_.solver, options_.sparse_tuning);
+    step_problem_.op = op_;
+    step_problem_.pairs = problem_.pairs;
+    step_problem_.tau_rule = problem_.tau_rule;
 }
 
 Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {
@@ -228,7 +229,7 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
             }
         }
     }
-    if (path_ == ContactPath::sparse) {
+    if (!dense_projection_) {
         // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
         const int n = static_cast<int>(v_.size());
         if (held != held_) {
@@ -309,17 +310,10 @@ const StepRecord& NewmarkStepper::advance() {
     const Eigen::VectorXd p0 = p_;
     const Eigen::VectorXd gv0 = massive_leaves_ && options_.restitution > 0.0 ? Eigen::VectorXd(G * v_) : Eigen::VectorXd();
     Eigen::VectorXd zF;
-    if (path_ == ContactPath::dense) {
-        const Eigen::VectorXd u = factor_->llt.solve(rF);
-        problem_.q = (rig_ ? Eigen::SparseMatrix<double>(G.leftCols(w_dof)) : G) * u - dF;
-        solve_ = solver_->solve(problem_, p_);
-        zF = u + Y_ * p_;
-    } else {
-        sparse_problem_.b = rF / kappa;
-        sparse_problem_.d = dF;
-        sparse_problem_.tau_previous_n = problem_.tau_previous_n;
-        solve_ = sparse_solver_->solve(sparse_problem_, p_, zF);
-    }
+    step_problem_.u = rF / kappa;
+    step_problem_.d = dF;
+    step_problem_.tau_previous_n = problem_.tau_previous_n;
+    solve_ = contact_->solve(step_problem_, p_, zF);
     Eigen::VectorXd z1 = zF;
     if (rig_) {
         z1.resize(w_dof + 1);

@@ -75,34 +75,8 @@ LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field
     throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed auto, massive, modal");
 }
 
-const char* to_string(ContactPath path) {
-    switch (path) {
-        case ContactPath::automatic: return "auto";
-        case ContactPath::dense: return "dense";
-        case ContactPath::sparse: return "sparse";
-    }
-    return "?";
-}
-
-ContactPath parse_contact_path(const std::string& text, const std::string& field) {
-    if (text == "auto") return ContactPath::automatic;
-    if (text == "dense") return ContactPath::dense;
-    if (text == "sparse") return ContactPath::sparse;
-    throw InputError(field, "value '" + text + "' is not a contact path: allowed auto, dense, sparse");
-}
-
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {
-    const bool exact = options.solver.kind == SolverKind::exact;
-    switch (options.contact_path) {
-        case ContactPath::dense: return ContactPath::dense;
-        case ContactPath::sparse:
-            if (!exact)
-                throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
-                                                     to_string(options.solver.kind) + "')");
-            return ContactPath::sparse;
-        case ContactPath::automatic: break;
-    }
-    return exact && system.num_components() >= kSparsePathMinComponents ? ContactPath::sparse : ContactPath::dense;
+    return resolve_contact_path(options.contact_path, system.num_components(), options.solver.kind);
 }
 
 void SimulationOptions::validate() const {

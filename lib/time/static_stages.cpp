@@ -28,6 +28,31 @@ detail::StaticState detail::static_equilibrium_dense(const System& system, const
     return out;
 }
 
+StepSystem detail::held_body_system(const System& system) {
+    StepSystem sys;
+    sys.rows = system.num_components();
+    sys.dense = [&system] {
+        DenseStepForm f;
+        f.W = system.compliance_held();
+        f.Q = system.coupling();
+        return f;
+    };
+    sys.sparse = [&system] {
+        const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
+        const Eigen::SparseMatrix<double>& G = system.contact_rows();
+        const int w_dof = static_cast<int>(K.rows()) - 1;
+        SparseStepForm f;
+        f.K = K.topLeftCorner(w_dof, w_dof);
+        f.G = G.leftCols(w_dof);
+        f.layer_compliance = sparse_layer(system);
+        const Eigen::VectorXd minus_krw = -Eigen::VectorXd(K.block(0, w_dof, w_dof, 1));
+        f.B = minus_krw.sparseView();
+        f.E = Eigen::VectorXd(G.col(w_dof)).sparseView();
+        return f;
+    };
+    return sys;
+}
+
 SparseContactProblem detail::sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
                                             const Eigen::VectorXd& d, double w_held_m) {
     const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
@@ -69,10 +94,27 @@ Eigen::VectorXd detail::static_state(const System& system, const ContactProblem&
     }
     SolverOptions exact = options.solver;
     exact.kind = SolverKind::exact;
-    SparseContactSolver solver(exact, options.sparse_tuning);
+    // the stiffness form whatever the model's size (a one-off solve): the operator forced sparse
+    StepSystem sys;
+    sys.rows = system.num_components();
+    sys.sparse = [&st] {
+        SparseStepForm f;
+        f.K = st.K;
+        f.G = st.G;
+        f.layer_compliance = st.layer_compliance;
+        return f;
+    };
+    StepProblem pr;
+    pr.op = std::make_shared<const ContactOperator>(sys, ContactPath::sparse, SolverKind::exact);
+    pr.pairs = st.pairs;
+    pr.tau_rule = st.tau_rule;
+    pr.tau_previous_n = st.tau_previous_n;
+    pr.u = st.b;
+    pr.d = st.d;
+    StepContactSolver solver(exact, options.sparse_tuning);
     Eigen::VectorXd z = Eigen::VectorXd::Zero(nz), zs;
     if (p.size() != system.num_components()) p = Eigen::VectorXd::Zero(system.num_components());
-    const SolveResult r = solver.solve(st, p, zs);
+    const SolveResult r = solver.solve(pr, p, zs);
     if (result) *result = r;
     if (!r.converged) throw SolverError(what + ": " + r.message, 0, 0.0, r.residual_m);
     if (held) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -15,10 +16,15 @@ namespace stackbeam::detail {
 /// (w last; empty: none) with the offsets d [m] and `laws`' pairs, tau rule and previous-step
 /// limits: with R free (w_held_m NaN) K z = G^T p + b, s = G z + c_L p - d on every DOF; with R
 /// held at w_held_m [m] on z_r alone, K_rr z_r = G_r^T p + b_r - K_rw w, s = G_r z_r + G_w w +
-/// c_L p - d. Every quasi-static solve of the sparse path poses it (static_state below, the
-/// initial contact state and the rig's steps of the massless modes).
+/// c_L p - d. static_state below poses it.
 SparseContactProblem sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
                                     const Eigen::VectorXd& d, double w_held_m);
+
+/// The contact problem of the massless stack with R held at w [m], the load parameter u = [w],
+/// in both forms (step.hpp; the operator takes one): dense W = C', q = c w - d; sparse (on z_r)
+/// K_rr z_r = -K_rw w + G_r^T p, s = G_r z_r + c_L p - (d - G_w w). The rig's steps of mode
+/// closed-form and the contact state at t = 0 with R held at w(0) pose it.
+StepSystem held_body_system(const System& system);
 
 /// The quasi-static state of the stack under a load b on the reduced DOFs [N, N m per DOF]
 /// (w last), one load step with friction from the warm start p with `laws`' pairs and tau rule

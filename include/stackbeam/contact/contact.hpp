@@ -17,25 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "stackbeam/model/model.hpp"
+#include "stackbeam/contact/pair.hpp"
 
 namespace stackbeam {
-
-/// One contact pair of the problem: its law and which rows of W/q/p are its
-/// normal and tangential components (-1: the component is absent, e.g. fixed by a support).
-struct ContactPair {
-    PairKind kind = PairKind::coulomb;
-    double friction_coefficient = 0.0;  ///< mu [-]
-    double preload_n = 0.0;             ///< clamp force F_c [N] (clamp pairs)
-    int row_n = -1;                     ///< row of the normal component, or -1
-    int row_t = -1;                     ///< row of the tangential component, or -1
-};
-
-/// How tau in the friction limit mu*tau is taken (paper, after eq. 17).
-enum class TauRule {
-    current,        ///< tau from the current normal force p_n^j: Coulomb exactly
-    previous_step,  ///< tau from the converged previous step (the paper's fallback)
-};
 
 /// The per-step contact problem: s = W p + q with the pair laws.
 struct ContactProblem {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "stackbeam/contact/pair.hpp"  // PairKind: the contact layer is below the model
+
 namespace stackbeam {
 
 /// Support at a leaf end.
@@ -177,13 +179,6 @@ struct ModelSpec {
     std::vector<ClipSpec> clips;             ///< rebound clips
 };
 
-/// Kind of a contact pair.
-enum class PairKind {
-    bonded,   ///< tied normally and tangentially
-    coulomb,  ///< unilateral normal, Coulomb friction with limit mu*|p_n|
-    clamp,    ///< bilateral normal (never opens), Coulomb friction with limit mu*max(0, F_c - p_n)
-};
-
 /// A contact pair: the facing surface points of adjacent leaves at one node.
 struct PairSpec {
     int interface_index = 0;  ///< interface i: leaf i above, leaf i+1 below
@@ -254,7 +249,6 @@ bool has_free_camber(const ModelSpec& spec);
 bool needs_assembly(const ModelSpec& spec);
 
 const char* to_string(SupportKind kind);
-const char* to_string(PairKind kind);
 const char* to_string(InterfaceContact contact);
 /// Parses "rigid" | "elastic"; throws InputError naming `field`.
 InterfaceContact parse_interface_contact(const std::string& text, const std::string& field);

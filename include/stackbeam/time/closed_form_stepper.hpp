@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/stepper.hpp"
@@ -64,11 +65,11 @@ public:
     std::vector<PairState> pair_states() const;
     /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
     /// On the sparse path W and q are empty (the pairs and tau rule are set): see last_sparse_problem().
-    const ContactProblem& last_problem() const noexcept { return problem_; }
+    const ContactProblem& last_problem() const noexcept { return contact_->last_dense_problem(); }
     /// The sparse contact problem of the last step (sparse path; empty on the dense path).
-    const SparseContactProblem& last_sparse_problem() const noexcept { return sparse_problem_; }
-    /// The path this stepper uses (never automatic).
-    ContactPath contact_path() const noexcept { return path_; }
+    const SparseContactProblem& last_sparse_problem() const noexcept { return contact_->last_sparse_problem(); }
+    /// The path this stepper's contact operator took (never automatic).
+    ContactPath contact_path() const noexcept { return op_->path(); }
     /// Reduced displacements z of the leaves [m, rad] at the current step (sparse path; empty on the dense path).
     const Eigen::VectorXd& reduced_displacements() const noexcept { return z_; }
     const SolveResult& last_solve() const noexcept { return solve_; }
@@ -78,14 +79,13 @@ public:
 private:
     const System& system_;
     SimulationOptions options_;
-    ContactPath path_ = ContactPath::dense;
-    std::unique_ptr<ContactSolver> solver_;
-    std::unique_ptr<SparseContactSolver> sparse_solver_;
-    ContactProblem problem_;
-    SparseContactProblem sparse_problem_;
-    Eigen::VectorXd z_;
+    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
+    std::unique_ptr<StepContactSolver> contact_;
+    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    StepProblem step_problem_;   // the step's problem: u = [w_next], d
+    Eigen::VectorXd z_, zr_;     // z, and the rig's z_r (R held at w_next)
     int w_dof_ = -1;
-    double k_r_ = 0.0;  // sparse path: the rigid body's spring k_R [N/m] in K_aug
+    double k_r_ = 0.0;  // stiffness form: the rigid body's spring k_R [N/m] in K_aug
     SolveResult solve_;
     Eigen::VectorXd p_, d_, rel_;
     double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
@@ -95,11 +95,9 @@ private:
     StepRecord record_;
     RunReport report_;
     // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
-    // external work [J, whole spring], and for the rig and the sparse path R's column of
-    // K (K_rw) and of G.
+    // external work [J, whole spring].
     bool rig_ = false;
     double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
-    Eigen::VectorXd krw_, gw_;
     void fill_record(int iterations, int factorizations, double strain_j = -1.0);
 };
 

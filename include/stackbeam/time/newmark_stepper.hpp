@@ -69,6 +69,7 @@
 #include <vector>
 
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/stepper.hpp"
 #include "stackbeam/fe/system.hpp"
@@ -109,20 +110,20 @@ public:
     /// Tangential anchors d_t and normal gaps d_n [m] per row.
     const Eigen::VectorXd& anchors() const noexcept { return d_; }
     const SolveResult& last_solve() const noexcept { return solve_; }
-    ContactPath contact_path() const noexcept { return path_; }
+    /// The path this stepper's contact operator took (never automatic).
+    ContactPath contact_path() const noexcept { return op_->path(); }
 
 private:
     struct Factor;  // sparse Cholesky of K_eff
     const System& system_;
     SimulationOptions options_;
-    ContactPath path_ = ContactPath::dense;
     std::unique_ptr<Factor> factor_;
     Eigen::SparseMatrix<double> K_, M_;
-    Eigen::MatrixXd Y_;  // K_eff^-1 G^T (dense path)
-    std::unique_ptr<ContactSolver> solver_;
-    std::unique_ptr<SparseContactSolver> sparse_solver_;
-    ContactProblem problem_;
-    SparseContactProblem sparse_problem_;
+    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
+    std::unique_ptr<StepContactSolver> contact_;
+    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    StepProblem step_problem_;   // the step's problem: u = r / kappa, d
+    bool dense_projection_ = false;  // the impact projection on the dense A = G M^-1 G^T
     SolveResult solve_;
     Eigen::VectorXd z_, v_, a_, p_, d_, rel_;
     std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
@@ -146,7 +147,7 @@ private:
     void fill_record(int iterations, int factorizations);
     /// The accelerations at t = 0 from the equations of motion (the massless DOFs condensed).
     void initial_accelerations();
-    /// K_eff factorised and the step's contact problem (W, or the sparse problem on K_eff / kappa).
+    /// K_eff factorised and the step's contact operator (on K_eff / kappa, dense or sparse).
     void factorise_step();
     /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
     Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;

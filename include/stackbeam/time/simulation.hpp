@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stackbeam/contact/contact.hpp"
+#include "stackbeam/contact/step.hpp"
 #include "stackbeam/model/loading.hpp"
 #include "stackbeam/fe/system.hpp"
 
@@ -61,23 +62,7 @@ enum class Mode {
 const char* to_string(Mode m);
 Mode parse_mode(const std::string& text, const std::string& field);
 
-/// How the closed-form stepper poses the per-step contact problem.
-enum class ContactPath {
-    automatic,  ///< dense for small problems, sparse for large ones (see choose_contact_path)
-    dense,      ///< ContactProblem: the dense W = C' + (gamma/k) c c^T (O(m^2) memory, O(m^3) set-up); every solver
-    sparse,     ///< SparseContactProblem on the banded stiffness, near-linear in the elements; exact solver only
-};
-const char* to_string(ContactPath path);
-/// Parses "auto" | "dense" | "sparse"; throws InputError naming `field`.
-ContactPath parse_contact_path(const std::string& text, const std::string& field);
-
-/// ContactPath::automatic takes the sparse path from this many contact components
-/// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
-/// 002-sparse-contact-path.md, friction case, the costliest): at 636 rows both paths take the same time per step,
-/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
-/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
-/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
-constexpr int kSparsePathMinComponents = 1000;
+// ContactPath, parse_contact_path and kSparsePathMinComponents: stackbeam/contact/step.hpp
 
 /// Mode cvode with leaf mass on a stack with friction: how the leaves' inertia is integrated
 /// (docs/time-integration.md, "Mode cvode with leaf mass").

@@ -58,7 +58,7 @@
 #include <limits>
 #include <string>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "fe/tied_shape.hpp"
 #include "stackbeam/errors.hpp"
 #include "time/cvode/cvode_massive.hpp"

@@ -39,7 +39,7 @@
 #include <limits>
 #include <string>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "time/cvode/cvode_modal.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/modal_load.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/time/run_report.hpp"
 

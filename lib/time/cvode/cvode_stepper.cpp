@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/cvode/cvode_massless.hpp"
 #include "time/cvode/event_driver.hpp"

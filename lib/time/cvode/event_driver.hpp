@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "contact/active_set.hpp"
+#include "stackbeam/contact/modes.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"

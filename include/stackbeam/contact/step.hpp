@@ -1,0 +1,140 @@
+#pragma once
+/// @file step.hpp
+/// One per-step contact problem and one solver entry point over both ways of posing it
+/// (docs/contact-solvers.md, "Dense and sparse contact path"; docs/decisions/030).
+///
+/// A stepper's step is, in stiffness form (z the step's degrees of freedom, p the forces):
+///     K z = B u + G^T p,    s = G z + c_L p - (d - E u)
+/// with u the step's load parameters (r entries), B (n x r) their load on z and E (m x r)
+/// their shift of the offsets d. Eliminating z gives the dense form of ContactProblem,
+///     s = W p + q,   W = G K^-1 G^T + diag(c_L),   q = Q u - d,   Q = G K^-1 B + E.
+/// The operator (ContactOperator, as Pinocchio's Delassus operators) holds one of the two:
+/// the dense W (and Q, or K's factor to form q and z), or the sparse K, G with the sparse
+/// solver's factors. Which one is decided once, when the operator is built, from the number
+/// of rows, the solver and the requested ContactPath; a stepper builds a StepProblem per step
+/// and calls StepContactSolver::solve, and never knows which form runs.
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "stackbeam/contact/contact.hpp"
+
+namespace stackbeam {
+
+/// How the per-step contact problem is posed.
+enum class ContactPath {
+    automatic,  ///< dense for small problems, sparse for large ones (resolve_contact_path)
+    dense,      ///< ContactProblem: the dense W (O(m^2) memory, O(m^3) set-up); every solver
+    sparse,     ///< SparseContactProblem on the banded stiffness, near-linear in the elements; exact solver only
+};
+const char* to_string(ContactPath path);
+/// Parses "auto" | "dense" | "sparse"; throws InputError naming `field`.
+ContactPath parse_contact_path(const std::string& text, const std::string& field);
+
+/// ContactPath::automatic takes the sparse path from this many contact components
+/// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
+/// 002-sparse-contact-path.md, friction case, the costliest): at 636 rows both paths take the same time per step,
+/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
+/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
+/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
+constexpr int kSparsePathMinComponents = 1000;
+
+/// The path `requested` resolves to for a problem of `rows` contact rows solved by `kind`:
+/// automatic gives sparse when the solver is exact and rows >= kSparsePathMinComponents, dense
+/// otherwise. Throws InputError (field "contact_path") for sparse with a solver other than exact.
+ContactPath resolve_contact_path(ContactPath requested, int rows, SolverKind kind);
+
+/// The sparse (stiffness) form of a step's operator: K z = B u + G^T p, s = G z + c_L p - (d - E u).
+struct SparseStepForm {
+    Eigen::SparseMatrix<double> K;     ///< n x n, symmetric positive definite (both triangles stored)
+    Eigen::SparseMatrix<double> G;     ///< m x n contact rows [-]
+    Eigen::VectorXd layer_compliance;  ///< c_L [m/N] per row, or empty (rigid contact)
+    Eigen::SparseMatrix<double> B;     ///< n x r load shape; empty: the identity (u is the load on z, r = n)
+    Eigen::SparseMatrix<double> E;     ///< m x r offset shift [m per unit u]; empty: none
+};
+
+/// The dense form of a step's operator, where its builder knows it in closed form.
+struct DenseStepForm {
+    Eigen::MatrixXd W;  ///< m x m compliance [m/N] = G K^-1 G^T + diag(c_L)
+    Eigen::MatrixXd Q;  ///< m x r: q = Q u - d (= G K^-1 B + E)
+};
+
+/// What a stepper's step is, given both ways; the operator builds only the form it takes.
+struct StepSystem {
+    int rows = 0;                            ///< m, the contact rows
+    std::function<SparseStepForm()> sparse;  ///< the stiffness form (required)
+    /// The dense form in closed form (optional; e.g. C' + (gamma/k) c c^T and c of the
+    /// closed-form step). Empty: the dense operator is built from the sparse form (K's sparse
+    /// factor; W = G K^-1 G^T + diag(c_L); q and z by one solve with it per step).
+    std::function<DenseStepForm()> dense;
+};
+
+/// The operator of a run's per-step problems, dense or sparse behind it (immutable once built).
+class ContactOperator {
+public:
+    /// Chooses the form (resolve_contact_path(requested, system.rows, solver)) and builds it.
+    ContactOperator(const StepSystem& system, ContactPath requested, SolverKind solver);
+    ~ContactOperator();
+    ContactOperator(const ContactOperator&) = delete;
+    ContactOperator& operator=(const ContactOperator&) = delete;
+
+    /// The form taken (dense or sparse; never automatic): for reports, not for branching on.
+    ContactPath path() const noexcept { return path_; }
+    int rows() const noexcept { return rows_; }
+    /// Whether a solve returns the displacements z (false for a dense form given without K).
+    bool has_displacements() const noexcept;
+
+    struct Dense;   // internal (lib/contact/step.cpp)
+    struct Sparse;  // internal
+    const Dense* dense() const noexcept { return dense_.get(); }
+    const Sparse* sparse() const noexcept { return sparse_.get(); }
+
+private:
+    ContactPath path_ = ContactPath::dense;
+    int rows_ = 0;
+    std::unique_ptr<Dense> dense_;
+    std::unique_ptr<Sparse> sparse_;
+};
+
+/// The per-step contact problem as a plain value: the operator (shared over a run), the pair
+/// laws, the step's load parameters u and the offsets d.
+struct StepProblem {
+    std::shared_ptr<const ContactOperator> op;
+    std::vector<ContactPair> pairs;   ///< the pairs and their rows
+    TauRule tau_rule = TauRule::current;
+    Eigen::VectorXd tau_previous_n;   ///< per pair tau [N] of the previous step (TauRule::previous_step)
+    Eigen::VectorXd u;                ///< the step's load parameters (SparseStepForm::B's columns)
+    Eigen::VectorXd d;                ///< offsets [m], one per row (normal gaps, tangential anchors)
+};
+
+/// The one solver entry point of a step over either form: the dense form by the solver of
+/// options.kind (make_solver), the sparse one by SparseContactSolver (exact only).
+class StepContactSolver {
+public:
+    /// Throws InputError for bad options or tuning (make_solver, SparseContactSolver).
+    explicit StepContactSolver(const SolverOptions& options, const SparsePathTuning& tuning = {});
+    ~StepContactSolver();
+    StepContactSolver(const StepContactSolver&) = delete;
+    StepContactSolver& operator=(const StepContactSolver&) = delete;
+
+    /// Solves `problem`; p is the warm start on entry and the forces [N] on exit; z receives the
+    /// displacements of the operator's degrees of freedom (left as they were when the operator
+    /// has none: ContactOperator::has_displacements). Keeps its factorisations while the operator
+    /// stays the same object.
+    SolveResult solve(const StepProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// The relative positions s + d [m] at the last solve (forces p: those it returned).
+    Eigen::VectorXd relative_positions(const Eigen::VectorXd& p) const;
+    /// The last step's problem in the form solved: the dense ContactProblem (W, q; empty W on
+    /// the sparse form) and the SparseContactProblem (K, G, b, d; empty on the dense form).
+    const ContactProblem& last_dense_problem() const noexcept;
+    const SparseContactProblem& last_sparse_problem() const noexcept;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace stackbeam

@@ -1,0 +1,171 @@
+// One per-step contact problem over the dense or the sparse form (step.hpp).
+#include "stackbeam/contact/step.hpp"
+
+#include <Eigen/SparseCholesky>
+
+#include "stackbeam/errors.hpp"
+
+namespace stackbeam {
+
+const char* to_string(ContactPath path) {
+    switch (path) {
+        case ContactPath::automatic: return "auto";
+        case ContactPath::dense: return "dense";
+        case ContactPath::sparse: return "sparse";
+    }
+    return "?";
+}
+
+ContactPath parse_contact_path(const std::string& text, const std::string& field) {
+    if (text == "auto") return ContactPath::automatic;
+    if (text == "dense") return ContactPath::dense;
+    if (text == "sparse") return ContactPath::sparse;
+    throw InputError(field, "value '" + text + "' is not a contact path: allowed auto, dense, sparse");
+}
+
+ContactPath resolve_contact_path(ContactPath requested, int rows, SolverKind kind) {
+    const bool exact = kind == SolverKind::exact;
+    switch (requested) {
+        case ContactPath::dense: return ContactPath::dense;
+        case ContactPath::sparse:
+            if (!exact)
+                throw InputError("contact_path", std::string("value 'sparse' needs the exact solver (solver is '") +
+                                                     to_string(kind) + "')");
+            return ContactPath::sparse;
+        case ContactPath::automatic: break;
+    }
+    return exact && rows >= kSparsePathMinComponents ? ContactPath::sparse : ContactPath::dense;
+}
+
+// The dense form: W, and either Q (given in closed form) or K's factor with Y = K^-1 G^T.
+struct ContactOperator::Dense {
+    Eigen::MatrixXd W, Q;
+    Eigen::SparseMatrix<double> G, B, E;  // from the sparse form when built from it
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+    Eigen::MatrixXd Y;                    // K^-1 G^T (from the sparse form)
+    bool factored = false;
+};
+
+struct ContactOperator::Sparse {
+    SparseStepForm form;
+};
+
+ContactOperator::ContactOperator(const StepSystem& system, ContactPath requested, SolverKind solver)
+    : path_(resolve_contact_path(requested, system.rows, solver)), rows_(system.rows) {
+    if (path_ == ContactPath::sparse) {
+        sparse_ = std::make_unique<Sparse>();
+        sparse_->form = system.sparse();
+        return;
+    }
+    dense_ = std::make_unique<Dense>();
+    if (system.dense) {
+        DenseStepForm f = system.dense();
+        dense_->W = std::move(f.W);
+        dense_->Q = std::move(f.Q);
+        return;
+    }
+    // From the stiffness form: W = G K^-1 G^T (symmetrised) + diag(c_L); q and z by K's factor.
+    const SparseStepForm f = system.sparse();
+    dense_->ldlt.compute(f.K);
+    if (dense_->ldlt.info() != Eigen::Success)
+        throw SolverError("contact operator: the step's stiffness K is not positive definite", 0, 0.0, 0.0);
+    dense_->Y = dense_->ldlt.solve(Eigen::MatrixXd(f.G.transpose()));
+    const Eigen::MatrixXd W = f.G * dense_->Y;
+    dense_->W = 0.5 * (W + W.transpose());
+    if (f.layer_compliance.size() > 0) dense_->W.diagonal() += f.layer_compliance;
+    dense_->G = f.G;
+    dense_->B = f.B;
+    dense_->E = f.E;
+    dense_->factored = true;
+}
+
+ContactOperator::~ContactOperator() = default;
+
+bool ContactOperator::has_displacements() const noexcept { return sparse_ || dense_->factored; }
+
+struct StepContactSolver::Impl {
+    SolverOptions options;
+    SparsePathTuning tuning;
+    std::unique_ptr<ContactSolver> dense_solver;
+    std::unique_ptr<SparseContactSolver> sparse_solver;
+    const ContactOperator* last_op = nullptr;  // the operator of the last solve (its structure kept)
+    std::shared_ptr<const ContactOperator> op;
+    ContactProblem dense;          // W set once per operator; q, pairs, tau per step
+    SparseContactProblem sparse;   // K, G, c_L once per operator; b, d, pairs, tau per step
+    Eigen::VectorXd d;             // the last problem's offsets
+    Eigen::VectorXd eu;            // E u of the last sparse step (empty: none)
+};
+
+StepContactSolver::StepContactSolver(const SolverOptions& options, const SparsePathTuning& tuning)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->options = options;
+    impl_->tuning = tuning;
+}
+
+StepContactSolver::~StepContactSolver() = default;
+
+SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    Impl& im = *impl_;
+    if (!problem.op) throw InputError("problem.op", "is empty: a StepProblem needs its ContactOperator");
+    const ContactOperator& op = *problem.op;
+    const bool same = im.last_op == &op;
+    if (!same) im.op = problem.op;  // keep the operator alive while its factors are cached
+    im.d = problem.d;
+    // the laws of the last problem (last_dense_problem() has them on either form)
+    im.dense.pairs = problem.pairs;
+    im.dense.tau_rule = problem.tau_rule;
+    im.dense.tau_previous_n = problem.tau_previous_n;
+    if (const ContactOperator::Dense* D = op.dense()) {
+        if (!im.dense_solver) im.dense_solver = make_solver(im.options);
+        ContactProblem& pr = im.dense;
+        if (!same) pr.W = D->W;
+        Eigen::VectorXd v;  // K^-1 B u (built from K)
+        if (D->factored) {
+            v = D->ldlt.solve(D->B.size() > 0 ? Eigen::VectorXd(D->B * problem.u) : problem.u);
+            pr.q = D->G * v - problem.d;
+            if (D->E.size() > 0) pr.q += D->E * problem.u;
+        } else {
+            pr.q = D->Q * problem.u - problem.d;
+        }
+        im.last_op = &op;
+        const SolveResult r = im.dense_solver->solve(pr, p);
+        if (D->factored) z = v + D->Y * p;  // else z is left as it was (no displacements)
+        return r;
+    }
+    const ContactOperator::Sparse& S = *op.sparse();
+    if (!im.sparse_solver) im.sparse_solver = std::make_unique<SparseContactSolver>(im.options, im.tuning);
+    SparseContactProblem& pr = im.sparse;
+    if (!same) {
+        pr.K = S.form.K;
+        pr.G = S.form.G;
+        pr.layer_compliance = S.form.layer_compliance;
+    }
+    pr.b = S.form.B.size() > 0 ? Eigen::VectorXd(S.form.B * problem.u) : problem.u;
+    if (S.form.E.size() > 0) {
+        im.eu = S.form.E * problem.u;
+        pr.d = problem.d - im.eu;
+    } else {
+        im.eu.resize(0);
+        pr.d = problem.d;
+    }
+    pr.pairs = problem.pairs;
+    pr.tau_rule = problem.tau_rule;
+    pr.tau_previous_n = problem.tau_previous_n;
+    // K, G and the pairs are those of the previous call on the same operator (fixed over a run)
+    const SolveResult r = im.sparse_solver->solve(pr, p, z, same);
+    im.last_op = &op;
+    return r;
+}
+
+Eigen::VectorXd StepContactSolver::relative_positions(const Eigen::VectorXd& p) const {
+    const Impl& im = *impl_;
+    if (im.last_op && im.last_op->dense()) return im.dense.W * p + im.dense.q + im.d;
+    Eigen::VectorXd rel = im.sparse_solver->relative_positions() + im.sparse.d;
+    if (im.eu.size() > 0) rel += im.eu;
+    return rel;
+}
+
+const ContactProblem& StepContactSolver::last_dense_problem() const noexcept { return impl_->dense; }
+const SparseContactProblem& StepContactSolver::last_sparse_problem() const noexcept { return impl_->sparse; }
+
+}  // namespace stackbeam
