@@ -309,7 +309,9 @@ System::System(const Model& model) : model_(model) {
 
 const Eigen::MatrixXd& System::compliance_held() const {
     std::call_once(C_held_->once, [this] {
-        const Eigen::MatrixXd X = Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose()));
+        // no rows (no contact): C' is 0 x 0 (Eigen's solve would permute the rows of an empty matrix)
+        const Eigen::MatrixXd X = Gr_.rows() > 0 ? Eigen::MatrixXd(Krr_llt_.solve(Eigen::MatrixXd(Gr_.transpose())))
+                                                 : Eigen::MatrixXd(Gr_.cols(), 0);
         Eigen::MatrixXd C = Gr_ * X;
         C_held_->C = 0.5 * (C + C.transpose());
         C_held_->C.diagonal() += layer_;  // the elastic interface layer (system.hpp)

@@ -120,7 +120,7 @@ Eigen::VectorXd selected_compliance_diagonal(const SpMat& K, const SpMat& G, con
                 t[-1 - ia] -= a.value();
                 continue;
             }
-            t += a.value() * X.row(ia).transpose();
+            if (h > 0) t += a.value() * X.row(ia).transpose();  // X is empty without held rows: no row view of it
             for (RowMat::InnerIterator b(Grow, r); b; ++b) {
                 const int ib = index[static_cast<std::size_t>(b.col())];
                 if (ib < 0) continue;
