@@ -168,4 +168,14 @@ Eigen::VectorXd StepContactSolver::relative_positions(const Eigen::VectorXd& p) 
 const ContactProblem& StepContactSolver::last_dense_problem() const noexcept { return impl_->dense; }
 const SparseContactProblem& StepContactSolver::last_sparse_problem() const noexcept { return impl_->sparse; }
 
+std::unique_ptr<StepContactSolver> start_step_contact(const StepSystem& system, ContactPath requested,
+                                                      const SolverOptions& options, const SparsePathTuning& tuning,
+                                                      const std::vector<ContactPair>& pairs, TauRule tau_rule,
+                                                      StepProblem& problem) {
+    problem.op = std::make_shared<const ContactOperator>(system, requested, options.kind);
+    problem.pairs = pairs;
+    problem.tau_rule = tau_rule;
+    return std::make_unique<StepContactSolver>(options, tuning);
+}
+
 }  // namespace stackbeam

@@ -67,11 +67,9 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const detail::Initial
             return f;
         };
     }
-    op_ = std::make_shared<const ContactOperator>(sys, options_.contact_path, options_.solver.kind);
-    contact_ = std::make_unique<StepContactSolver>(options_.solver, options_.sparse_tuning);
-    step_problem_.op = op_;
-    step_problem_.pairs = problem_.pairs;
-    step_problem_.tau_rule = problem_.tau_rule;
+    contact_ = start_step_contact(sys, options_.contact_path, options_.solver, options_.sparse_tuning, problem_.pairs,
+                                  problem_.tau_rule, step_problem_);
+    op_ = step_problem_.op;
     step_problem_.u = Eigen::VectorXd::Zero(1);
     // relative positions at the start: from z where the operator gives z, else from C'
     rel_ = op_->has_displacements() ? detail::relative_positions(system_, z_, p_)

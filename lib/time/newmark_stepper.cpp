@@ -144,11 +144,9 @@ void NewmarkStepper::factorise_step() {
         f.layer_compliance = detail::sparse_layer(system_);
         return f;
     };
-    op_ = std::make_shared<const ContactOperator>(sys, options_.contact_path, options_.solver.kind);
-    contact_ = std::make_unique<StepContactSolver>(options_.solver, options_.sparse_tuning);
-    step_problem_.op = op_;
-    step_problem_.pairs = problem_.pairs;
-    step_problem_.tau_rule = problem_.tau_rule;
+    contact_ = start_step_contact(sys, options_.contact_path, options_.solver, options_.sparse_tuning, problem_.pairs,
+                                  problem_.tau_rule, step_problem_);
+    op_ = step_problem_.op;
 }
 
 Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {

@@ -137,4 +137,12 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+/// A stepper's contact solve set up once per run: a new operator of `system` (its path chosen
+/// here, once: ContactOperator), `problem` over it with these pairs and tau rule (its u and d
+/// left to each step), and the solver it returns. Throws InputError as the two constructors.
+std::unique_ptr<StepContactSolver> start_step_contact(const StepSystem& system, ContactPath requested,
+                                                      const SolverOptions& options, const SparsePathTuning& tuning,
+                                                      const std::vector<ContactPair>& pairs, TauRule tau_rule,
+                                                      StepProblem& problem);
+
 }  // namespace stackbeam
