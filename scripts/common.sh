@@ -57,10 +57,13 @@ build() {
 # on a test file, the build's largest cost; the Release build stays GCC's), the library shared (the Release
 # build's is static, so the tests cover both kinds of installed package). Without the
 # Python module: an instrumented extension cannot load into the uninstrumented python3
-# (the sanitizer runtime must come first); the Release build tests it.
+# (the sanitizer runtime must come first); the Release build tests it. With the libFuzzer
+# targets of the readers (fuzz/): the sources they run get the fuzzer's coverage too, and
+# scripts/fuzz.sh runs them from this build (STACKBEAM_FUZZ_BUILD=build-asan), so the
+# library is compiled under the sanitizers once for both (decision 032).
 build_sanitized() {
   cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
-    -DSTACKBEAM_BUILD_PYTHON=OFF \
+    -DSTACKBEAM_BUILD_PYTHON=OFF -DSTACKBEAM_BUILD_FUZZERS=ON -DSTACKBEAM_FUZZ_PLAIN_REST=OFF \
     -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   cmake --build build-asan -j"$(nproc)"
 }

@@ -13,6 +13,9 @@
 # copying it into fuzz/regressions/<name>/ (and a bad-input test, docs/fuzzing.md).
 # STACKBEAM_FUZZ_JOBS=N runs N fuzzing processes per target (default 1: a shared machine);
 # STACKBEAM_FUZZ_SEED=S fixes libFuzzer's random seed (the CI's run: 1; default: random).
+# STACKBEAM_FUZZ_BUILD=DIR builds and runs the targets in DIR, a build already configured
+# with -DSTACKBEAM_BUILD_FUZZERS=ON (the CI's run: build-asan/, the sanitizer build of
+# scripts/common.sh, which has them), instead of configuring build-fuzz/.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
@@ -22,9 +25,17 @@ seconds=${1:-20}
 shift || true
 install_packages "${STACKBEAM_BUILD_PACKAGES[@]}" "${STACKBEAM_SANITIZER_PACKAGES[@]}"
 start=$(date +%s)
-# -O1 -g1: as the sanitizer build (common.sh), a third of the compile time of -O2 -g
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++-14 \
-  -DSTACKBEAM_BUILD_FUZZERS=ON -DSTACKBEAM_BUILD_TESTS=OFF -DSTACKBEAM_BUILD_DEMOS=OFF
+dir=${STACKBEAM_FUZZ_BUILD:-build-fuzz}
+if [ -n "${STACKBEAM_FUZZ_BUILD:-}" ]; then
+  if ! grep -q '^STACKBEAM_BUILD_FUZZERS:BOOL=ON' "$dir/CMakeCache.txt" 2>/dev/null; then
+    echo "STACKBEAM_FUZZ_BUILD=$dir: not a build configured with -DSTACKBEAM_BUILD_FUZZERS=ON" >&2
+    exit 2
+  fi
+else
+  # -O1 -g1: as the sanitizer build (common.sh), a third of the compile time of -O2 -g
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++-14 \
+    -DSTACKBEAM_BUILD_FUZZERS=ON -DSTACKBEAM_BUILD_TESTS=OFF -DSTACKBEAM_BUILD_DEMOS=OFF
+fi
 targets=("$@")
 if [ "${#targets[@]}" -eq 0 ]; then
   for src in fuzz/fuzz_*.cpp; do
@@ -32,16 +43,16 @@ if [ "${#targets[@]}" -eq 0 ]; then
     targets+=("${name#fuzz_}")
   done
 fi
-cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
+cmake --build "$dir" -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
 echo "fuzz build: $(( $(date +%s) - start )) s"
 
 jobs=${STACKBEAM_FUZZ_JOBS:-1}
 status=0
 for name in "${targets[@]}"; do
-  corpus=build-fuzz/corpus/$name
-  artifacts=build-fuzz/artifacts/$name
+  corpus=$dir/corpus/$name
+  artifacts=$dir/artifacts/$name
   mkdir -p "$corpus" "$artifacts"
-  mapfile -t seeds < "build-fuzz/fuzz/fuzz_$name.seeds"
+  mapfile -t seeds < "$dir/fuzz/fuzz_$name.seeds"
   dict=()
   [ -f "fuzz/$name.dict" ] && dict=(-dict="fuzz/$name.dict")
   echo "fuzz_$name: ${seconds} s, ${jobs} job(s), corpus $corpus, seeds ${seeds[*]}"
@@ -52,7 +63,7 @@ for name in "${targets[@]}"; do
   parallel=()
   [ "$jobs" -gt 1 ] && parallel=(-jobs="$jobs" -workers="$jobs")
   if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-      "build-fuzz/fuzz/fuzz_$name" "${parallel[@]}" "${seed[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      "$dir/fuzz/fuzz_$name" "${parallel[@]}" "${seed[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="$artifacts/" "${dict[@]}" "$corpus" "${seeds[@]}"; then
     echo "fuzz_$name: FAILED: the input is in $artifacts/ (docs/fuzzing.md: what to do with it)" >&2
     status=1

@@ -5,7 +5,7 @@
 # made it); then a third, small one in build-tsan/: the sweep's threads under
 # ThreadSanitizer (the library and test_sweep only). STACKBEAM_SANITIZERS=0 skips the
 # second and third (for a quick local run; CI runs all three).
-# Then the readers under libFuzzer for 20 s each (scripts/fuzz.sh, Clang, build-fuzz/;
+# Then the readers under libFuzzer for 20 s each (scripts/fuzz.sh, Clang, from build-asan/;
 # a crash, hang or sanitizer report fails the run; docs/fuzzing.md); STACKBEAM_FUZZ=0 skips it.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -41,5 +41,10 @@ fi
 
 if [ "${STACKBEAM_FUZZ:-1}" != 0 ]; then
   # a fixed seed: the same inputs on every CI run (a longer run: docs/fuzzing.md)
-  STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
+  # the targets are in the sanitizer build when it ran (build_sanitized), else in build-fuzz/
+  if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
+    STACKBEAM_FUZZ_BUILD=build-asan STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
+  else
+    STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
+  fi
 fi
