@@ -61,10 +61,12 @@ build() {
 # targets of the readers (fuzz/): the sources they run get the fuzzer's coverage too, and
 # scripts/fuzz.sh runs them from this build (STACKBEAM_FUZZ_BUILD=build-asan), so the
 # library is compiled under the sanitizers once for both (decision 032). The test programs
-# themselves at -O0 (half their compile time; the work they run is the library's, -O1).
+# themselves, the readers, writers and the CLI at -O0 (half their compile time; the work
+# the tests run is the library's solvers and steppers, -O1).
 build_sanitized() {
   cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
     -DSTACKBEAM_BUILD_PYTHON=OFF -DSTACKBEAM_BUILD_FUZZERS=ON -DSTACKBEAM_FUZZ_PLAIN_REST=OFF -DSTACKBEAM_TEST_COMPILE_OPTIONS=-O0 \
+    -DSTACKBEAM_COLD_COMPILE_OPTIONS=-O0 \
     -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   cmake --build build-asan -j"$(nproc)"
 }
