@@ -77,6 +77,7 @@ build_sanitized() {
 # library keeps no mutable state shared between runs: a data race fails the test.
 build_tsan() {
   cmake -S . -B build-tsan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
-    -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DSTACKBEAM_BUILD_DEMOS=OFF
+    -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DSTACKBEAM_BUILD_DEMOS=OFF \
+    -DSTACKBEAM_TEST_COMPILE_OPTIONS=-O0 -DSTACKBEAM_COLD_COMPILE_OPTIONS=-O0
   cmake --build build-tsan -j"$(nproc)" --target test_sweep
 }
