@@ -63,7 +63,7 @@ double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 /// pairs closed at the start, a third of the closed ones slipping.
 struct ModeWalk {
     ContactProblem laws;
-    detail::ModeSet modes;
+    modes::ModeSet modes;
     std::mt19937 rng{20261125};
 
     explicit ModeWalk(const SparseContactProblem& pr) {
@@ -71,14 +71,15 @@ struct ModeWalk {
         laws.pairs = pr.pairs;
         laws.tau_rule = TauRule::current;
         const int np = static_cast<int>(pr.pairs.size());
-        modes.nmode.assign(static_cast<std::size_t>(np), detail::NONE);
-        modes.tmode.assign(static_cast<std::size_t>(np), detail::NONE);
+        modes.nmode.assign(static_cast<std::size_t>(np), modes::NONE);
+        modes.tmode.assign(static_cast<std::size_t>(np), modes::NONE);
         std::uniform_real_distribution<double> u(0.0, 1.0);
         for (int k = 0; k < np; ++k) {
             const auto& c = laws.pairs[static_cast<std::size_t>(k)];
-            if (c.row_n >= 0) modes.nmode[k] = !detail::ModeSet::unilateral(c) || u(rng) < 0.85 ? detail::CLOSED : detail::OPEN;
+            if (c.row_n >= 0)
+                modes.nmode[k] = !modes::ModeSet::unilateral(c) || u(rng) < 0.85 ? modes::CLOSED : modes::OPEN;
             if (c.row_t >= 0 && c.kind != PairKind::bonded)
-                modes.tmode[k] = u(rng) < 0.33 ? (u(rng) < 0.5 ? detail::SLIP_POS : detail::SLIP_NEG) : detail::STICK;
+                modes.tmode[k] = u(rng) < 0.33 ? (u(rng) < 0.5 ? modes::SLIP_POS : modes::SLIP_NEG) : modes::STICK;
             modes.make_consistent(laws, k);
         }
     }
@@ -91,10 +92,10 @@ struct ModeWalk {
             const auto& c = laws.pairs[static_cast<std::size_t>(k)];
             const int w = what(rng);
             if (c.kind == PairKind::coulomb && c.row_n >= 0 && w == 0) {
-                modes.nmode[k] = modes.nmode[k] == detail::CLOSED ? detail::OPEN : detail::CLOSED;
+                modes.nmode[k] = modes.nmode[k] == modes::CLOSED ? modes::OPEN : modes::CLOSED;
             } else if (c.row_t >= 0 && c.kind != PairKind::bonded) {
-                const signed char next[] = {detail::STICK, detail::SLIP_POS, detail::SLIP_NEG,
-                                            c.kind == PairKind::clamp ? detail::FREE : detail::STICK};
+                const signed char next[] = {modes::STICK, modes::SLIP_POS, modes::SLIP_NEG,
+                                            c.kind == PairKind::clamp ? modes::FREE : modes::STICK};
                 modes.tmode[k] = next[w];
             }
             modes.make_consistent(laws, k);
@@ -114,7 +115,7 @@ struct Counts {
 template <class Bound>
 void compare(sp::ModeSolver& inc, sp::ModeSolver& ref, const ModeWalk& walk, const SparseContactProblem& pr,
              Counts& counts, double& worst, Bound bound_of) {
-    detail::ModeLinearization lin;
+    modes::ModeLinearization lin;
     walk.modes.linearize(walk.laws, lin);
     const std::vector<signed char> key = walk.modes.key();
     Eigen::VectorXd pi, zi, pr_, zr;
@@ -179,7 +180,7 @@ BOOST_AUTO_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random
     Counts counts;
     double worst = 0.0;
     int updates = 0;
-    std::vector<detail::ModeSet> earlier;
+    std::vector<modes::ModeSet> earlier;
     std::uniform_int_distribution<int> changes(1, 6);
     for (int i = 0; i < 1500; ++i) {
         if (i % 50 == 49) walk.modes = earlier[static_cast<std::size_t>(i / 7)];
@@ -219,7 +220,7 @@ BOOST_AUTO_TEST_CASE(incremental_solve_does_not_drift_over_ten_thousand_updates,
             compare(inc, ref, walk, pr, counts, worst);
             continue;
         }
-        detail::ModeLinearization lin;
+        modes::ModeLinearization lin;
         walk.modes.linearize(walk.laws, lin);
         Eigen::VectorXd p, z;
         inc.reset_updates();
@@ -303,7 +304,7 @@ BOOST_AUTO_TEST_CASE(primal_updates_equal_the_solve_from_scratch_over_random_mod
     ModeWalk walk(pr);
     Counts counts, counts_lu;
     double worst = 0.0, worst_lu = 0.0;
-    std::vector<detail::ModeSet> earlier;
+    std::vector<modes::ModeSet> earlier;
     std::uniform_int_distribution<int> changes(1, 6);
     const auto fixed = [](double b) { return [b](const sp::ModeSolver&) { return b; }; };
     int primal_sets = 0;
@@ -358,7 +359,7 @@ BOOST_AUTO_TEST_CASE(primal_updates_do_not_drift_over_ten_thousand_updates, *boo
             compare(inc, ref, walk, pr, counts, worst, bound);
             continue;
         }
-        detail::ModeLinearization lin;
+        modes::ModeLinearization lin;
         walk.modes.linearize(walk.laws, lin);
         Eigen::VectorXd p, z;
         try {
@@ -428,8 +429,8 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
         walk.change(changes(walk.rng));
         if (no_slip)
             for (std::size_t k = 0; k < walk.modes.tmode.size(); ++k)
-                if (walk.modes.tmode[k] == detail::SLIP_POS || walk.modes.tmode[k] == detail::SLIP_NEG) {
-                    walk.modes.tmode[k] = detail::STICK;
+                if (walk.modes.tmode[k] == modes::SLIP_POS || walk.modes.tmode[k] == modes::SLIP_NEG) {
+                    walk.modes.tmode[k] = modes::STICK;
                     walk.modes.make_consistent(walk.laws, static_cast<int>(k));
                 }
         // the Schur way's dense LU of the same set gives rcond(M) for the bound

@@ -91,7 +91,7 @@ double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 /// The linear problem of `lin` solved densely on W, q: p = e + E p_S (held rows p_S, slip
 /// rows coupled to their normal row) with (W p + q)_S = 0.
-Eigen::VectorXd dense_mode_solution(const ContactProblem& dense, const detail::ModeLinearization& lin) {
+Eigen::VectorXd dense_mode_solution(const ContactProblem& dense, const modes::ModeLinearization& lin) {
     const int m = dense.size(), ms = static_cast<int>(lin.S.size());
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(m, ms);
     std::vector<int> col(m, -1);
@@ -180,15 +180,15 @@ BOOST_AUTO_TEST_CASE(mode_solver_ways_equal_the_dense_solve) {
     const Recorded& rec = friction_steps();
     const SparseContactProblem& pr = rec.problems[10];
     const ContactProblem dense = pr.to_dense();
-    detail::ModeSet modes;
+    modes::ModeSet modes;
     modes.init(dense, rec.exact[10], dense.W * rec.exact[10] + dense.q);
     for (int k = 0; k < static_cast<int>(dense.pairs.size()); ++k) {
         const auto& c = dense.pairs[k];
-        if (c.row_n >= 0 && detail::ModeSet::unilateral(c)) modes.nmode[k] = k % 3 == 0 ? detail::OPEN : detail::CLOSED;
-        if (c.row_t >= 0 && c.kind != PairKind::bonded) modes.tmode[k] = k % 2 == 0 ? detail::STICK : detail::SLIP_POS;
+        if (c.row_n >= 0 && modes::ModeSet::unilateral(c)) modes.nmode[k] = k % 3 == 0 ? modes::OPEN : modes::CLOSED;
+        if (c.row_t >= 0 && c.kind != PairKind::bonded) modes.tmode[k] = k % 2 == 0 ? modes::STICK : modes::SLIP_POS;
         modes.make_consistent(dense, k);
     }
-    detail::ModeLinearization lin;
+    modes::ModeLinearization lin;
     modes.linearize(dense, lin);
     BOOST_TEST_REQUIRE(!lin.coupled.empty());  // slip coupling exercised
     const Eigen::VectorXd ref = dense_mode_solution(dense, lin);
@@ -223,7 +223,7 @@ BOOST_AUTO_TEST_CASE(mode_solver_bordered_update_equals_the_dense_solve) {
     const Recorded& rec = friction_steps();
     const SparseContactProblem& pr = rec.problems[10];
     const ContactProblem dense = pr.to_dense();
-    detail::ModeLinearization base, near;
+    modes::ModeLinearization base, near;
     base.e = Eigen::VectorXd::Zero(pr.size());
     for (int i = 0; i < pr.size(); ++i)
         if (i % 4 != 1) base.S.push_back(i);
@@ -261,7 +261,7 @@ BOOST_AUTO_TEST_CASE(box_qp_methods_agree_with_the_dense_method_and_the_kkt_cond
         Eigen::VectorXd lower = Eigen::VectorXd::Constant(pr.size(), -inf), upper = -lower;
         for (int k = 0; k < static_cast<int>(pr.pairs.size()); ++k) {
             const auto& c = pr.pairs[k];
-            if (c.row_n >= 0 && detail::ModeSet::unilateral(c)) upper[c.row_n] = 0.0;
+            if (c.row_n >= 0 && modes::ModeSet::unilateral(c)) upper[c.row_n] = 0.0;
             if (c.row_t >= 0 && c.kind != PairKind::bonded) {
                 const double limit = c.friction_coefficient * friction_normal_force(dense, k, pstar);
                 lower[c.row_t] = -limit;

@@ -22,7 +22,7 @@ namespace stackbeam::detail {
 /// `solve_modes(p)` solves the linear problem of the modes into p and returns the
 /// number of factorisations it made; `violations(p)` returns modes.count_violations(...).
 template <class SolveModes, class Violations>
-bool active_set_passes(ModeSet& modes, const ContactProblem& pr, Eigen::VectorXd& p, int max_passes,
+bool active_set_passes(modes::ModeSet& modes, const ContactProblem& pr, Eigen::VectorXd& p, int max_passes,
                        int budget_passes, SolveResult& r, SolveModes solve_modes, Violations violations) {
     int best = std::numeric_limits<int>::max(), budget = budget_passes;
     bool single = false;
@@ -107,7 +107,7 @@ private:
 ///   tangential_s(row) -> s_row at the final p   (only where a box of zero width, tau = 0
 ///                                                in the last QP, held a force without a sign)
 template <class BoxSolve, class Diagonal, class TangentialS>
-bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::VectorXd& p, double accept,
+bool tresca_fixed_point(modes::ModeSet& modes, const ContactProblem& pr, int n, Eigen::VectorXd& p, double accept,
                         int max_iterations, int anderson_depth, BoxSolve box_solve, Diagonal diagonal,
                         TangentialS tangential_s) {
     const int np = static_cast<int>(pr.pairs.size());
@@ -116,12 +116,12 @@ bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::
     std::vector<signed char> at_bound(n, 0);
     for (int k = 0; k < np; ++k) {
         const auto& c = pr.pairs[k];
-        if (c.row_n >= 0 && ModeSet::unilateral(c)) {
+        if (c.row_n >= 0 && modes::ModeSet::unilateral(c)) {
             upper[c.row_n] = 0.0;
-            if (modes.nmode[k] == OPEN) at_bound[c.row_n] = +1;
+            if (modes.nmode[k] == modes::OPEN) at_bound[c.row_n] = +1;
         }
-        if (c.row_t >= 0 && (modes.tmode[k] == SLIP_POS || modes.tmode[k] == SLIP_NEG))
-            at_bound[c.row_t] = modes.tmode[k] == SLIP_POS ? +1 : -1;
+        if (c.row_t >= 0 && (modes.tmode[k] == modes::SLIP_POS || modes.tmode[k] == modes::SLIP_NEG))
+            at_bound[c.row_t] = modes.tmode[k] == modes::SLIP_POS ? +1 : -1;
     }
     Eigen::VectorXd tau(np), scale_m = Eigen::VectorXd::Zero(np);  // scale_m = mu W_tt [m/N]
     std::vector<char> limited(np, 0);  // pairs with a friction limit (a tangential row, not bonded)
@@ -156,21 +156,22 @@ bool tresca_fixed_point(ModeSet& modes, const ContactProblem& pr, int n, Eigen::
         // (the normal forces of the last box QP; setting p's tangential rows leaves them)
         for (int k = 0; k < np; ++k) {
             const auto& c = pr.pairs[k];
-            if (c.row_n >= 0 && ModeSet::unilateral(c)) modes.nmode[k] = at_bound[c.row_n] == +1 ? OPEN : CLOSED;
+            if (c.row_n >= 0 && modes::ModeSet::unilateral(c))
+                modes.nmode[k] = at_bound[c.row_n] == +1 ? modes::OPEN : modes::CLOSED;
             if (!limited[k]) continue;
             const double limit = c.friction_coefficient * g[k];
             if (limit <= 0.0) {
-                modes.tmode[k] = FREE;
+                modes.tmode[k] = modes::FREE;
                 p[c.row_t] = 0.0;
             } else if (at_bound[c.row_t] != 0) {
                 // slip against the motion; a box that had zero width (tau was 0 in the
                 // last QP) held the force without a sign: take it from s_t.
                 const signed char sigma = lower[c.row_t] < upper[c.row_t] ? at_bound[c.row_t]
                                                                           : (tangential_s(c.row_t) > 0.0 ? -1 : +1);
-                modes.tmode[k] = sigma > 0 ? SLIP_POS : SLIP_NEG;
+                modes.tmode[k] = sigma > 0 ? modes::SLIP_POS : modes::SLIP_NEG;
                 p[c.row_t] = sigma * limit;
             } else {
-                modes.tmode[k] = STICK;
+                modes.tmode[k] = modes::STICK;
             }
             modes.make_consistent(pr, k);
         }

@@ -94,8 +94,8 @@ public:
 
 private:
     SolverOptions options_;
-    ModeSet modes_;
-    ModeLinearization lin_;
+    modes::ModeSet modes_;
+    modes::ModeLinearization lin_;
     Eigen::VectorXd diag_;        // diagonal of W: violations in metres
     std::vector<signed char> lu_modes_;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu_;

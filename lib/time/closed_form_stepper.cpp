@@ -11,13 +11,75 @@
 #include "time/record.hpp"
 #include "time/initial_state.hpp"
 #include "time/static_stages.hpp"
+#include "time/stepper_access.hpp"
 
 namespace stackbeam {
 
-ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
-    : ClosedFormStepper(system, detail::initial_state("closed-form", system, options)) {}
+// The stepper's state and its step (the public class forwards to it).
+struct ClosedFormStepper::Impl {
+    Impl(const System& system, const detail::InitialState& start);
 
-ClosedFormStepper::ClosedFormStepper(const System& system, const detail::InitialState& start)
+    const StepRecord& advance();
+    std::vector<PairRecord> pairs() const;
+    std::vector<LeafNodes> nodes() const;
+    std::vector<PairState> pair_states() const;
+
+    const System& system_;
+    SimulationOptions options_;
+    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
+    std::unique_ptr<StepContactSolver> contact_;
+    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    StepProblem step_problem_;   // the step's problem: u = [w_next], d
+    Eigen::VectorXd z_, zr_;     // z, and the rig's z_r (R held at w_next)
+    int w_dof_ = -1;
+    double k_r_ = 0.0;  // stiffness form: the rigid body's spring k_R [N/m] in K_aug
+    SolveResult solve_;
+    Eigen::VectorXd p_, d_, rel_;
+    double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
+    double omega_ = 0.0, cos_ = 1.0, sin_ = 0.0, gamma_ = 0.0;
+    double e0_ = 0.0, dissipated_ = 0.0;
+    long step_ = 0;
+    StepRecord record_;
+    RunReport report_;
+    // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
+    // external work [J, whole spring].
+    bool rig_ = false;
+    double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
+    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
+};
+
+ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
+    : impl_(std::make_unique<Impl>(system, detail::initial_state("closed-form", system, options))) {}
+
+ClosedFormStepper::ClosedFormStepper(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+std::unique_ptr<Stepper> ClosedFormStepperAccess::build(const System& system, const detail::InitialState& start) {
+    return std::unique_ptr<Stepper>(new ClosedFormStepper(std::make_unique<ClosedFormStepper::Impl>(system, start)));
+}
+
+ClosedFormStepper::~ClosedFormStepper() = default;
+
+const StepRecord& ClosedFormStepper::advance() { return impl_->advance(); }
+const StepRecord& ClosedFormStepper::current() const noexcept { return impl_->record_; }
+long ClosedFormStepper::record_index() const noexcept { return impl_->step_; }
+std::vector<PairRecord> ClosedFormStepper::pairs() const { return impl_->pairs(); }
+std::vector<LeafNodes> ClosedFormStepper::nodes() const { return impl_->nodes(); }
+RunReport ClosedFormStepper::report() const { return impl_->report_; }
+const Eigen::VectorXd& ClosedFormStepper::contact_forces() const noexcept { return impl_->p_; }
+const Eigen::VectorXd& ClosedFormStepper::relative_positions() const noexcept { return impl_->rel_; }
+const Eigen::VectorXd& ClosedFormStepper::anchors() const noexcept { return impl_->d_; }
+std::vector<PairState> ClosedFormStepper::pair_states() const { return impl_->pair_states(); }
+const ContactProblem& ClosedFormStepper::last_problem() const noexcept { return impl_->contact_->last_dense_problem(); }
+const SparseContactProblem& ClosedFormStepper::last_sparse_problem() const noexcept {
+    return impl_->contact_->last_sparse_problem();
+}
+ContactPath ClosedFormStepper::contact_path() const noexcept { return impl_->op_->path(); }
+const Eigen::VectorXd& ClosedFormStepper::reduced_displacements() const noexcept { return impl_->z_; }
+const SolveResult& ClosedFormStepper::last_solve() const noexcept { return impl_->solve_; }
+const System& ClosedFormStepper::system() const noexcept { return impl_->system_; }
+double ClosedFormStepper::omega_rad_per_s() const noexcept { return impl_->omega_; }
+
+ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& start)
     : system_(system), options_(start.options), problem_(start.laws), z_(start.z),
       solve_(start.solve), p_(start.p), d_(start.d), w_(start.w0_m), wd_(start.wd0_m_per_s), rig_(start.rig) {
     const Loading& load = options_.loading;
@@ -80,7 +142,7 @@ ClosedFormStepper::ClosedFormStepper(const System& system, const detail::Initial
     record_.energy_balance_error_j = 0.0;
 }
 
-void ClosedFormStepper::fill_record(int iterations, int factorizations, double strain_j) {
+void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, double strain_j) {
     const double f = f_;
     const double k = system_.stiffness_n_per_m();
     // U = z^T K z / 2 + p^T C_L p / 2 = (p^T C' p + k w^2) / 2 on the meshed part, leaves and
@@ -107,21 +169,21 @@ void ClosedFormStepper::fill_record(int iterations, int factorizations, double s
     record_.contact_residual_m = solve_.residual_m;
 }
 
-std::vector<PairState> ClosedFormStepper::pair_states() const {
+std::vector<PairState> ClosedFormStepper::Impl::pair_states() const {
     std::vector<PairState> s(problem_.pairs.size());
     for (std::size_t k = 0; k < s.size(); ++k) s[k] = pair_state(problem_, static_cast<int>(k), p_);
     return s;
 }
 
-std::vector<PairRecord> ClosedFormStepper::pairs() const {
+std::vector<PairRecord> ClosedFormStepper::Impl::pairs() const {
     return detail::pair_records(system_, problem_, p_, rel_);
 }
 
-std::vector<LeafNodes> ClosedFormStepper::nodes() const {
+std::vector<LeafNodes> ClosedFormStepper::Impl::nodes() const {
     return system_.leaf_nodes(op_->has_displacements() ? z_ : system_.reduced_displacements(p_, w_));
 }
 
-const StepRecord& ClosedFormStepper::advance() {
+const StepRecord& ClosedFormStepper::Impl::advance() {
     const double k = system_.stiffness_n_per_m();
     const double dt = options_.dt_s;
     const auto& c = system_.coupling();

@@ -15,32 +15,94 @@
 #include "time/rig_reaction.hpp"
 #include "time/stack_properties.hpp"
 #include "time/initial_state.hpp"
+#include "time/stepper_access.hpp"
 #include "fe/tied_shape.hpp"
 
 namespace stackbeam {
 
-struct NewmarkStepper::Factor {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff (its check: positive definite)
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
+// The stepper's state and its step (the public class forwards to it).
+struct NewmarkStepper::Impl {
+    Impl(const System& system, const detail::InitialState& start);
+
+    const StepRecord& advance();
+    std::vector<PairRecord> pairs() const;
+
+    struct Factor {
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff (its check: positive definite)
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
+        Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
+    };
+    const System& system_;
+    SimulationOptions options_;
+    Factor factor_;
+    Eigen::SparseMatrix<double> K_, M_;
+    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
+    std::unique_ptr<StepContactSolver> contact_;
+    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    StepProblem step_problem_;   // the step's problem: u = r / kappa, d
+    bool dense_projection_ = false;  // the impact projection on the dense A = G M^-1 G^T
+    SolveResult solve_;
+    Eigen::VectorXd z_, v_, a_, p_, d_, rel_;
+    std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
+    bool massive_leaves_ = false;
+    Eigen::MatrixXd Z_, A_;       // M^-1 G^T and G M^-1 G^T (impact law, massive leaves)
+    std::vector<int> held_;       // the held rows of the last projection
+    Eigen::LDLT<Eigen::MatrixXd> held_factor_;  // and A restricted to them
+    double t_ = 0.0;
+    double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
+    long step_ = 0;
+    StepRecord record_;
+    RunReport report_;
+    detail::ReducedLoad load_;                 // the loading's q(t) on the reduced DOFs
+    bool rig_ = false;                         // w prescribed (the rig)
+    Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
+    Eigen::VectorXd u_w_;                      // the rig: M^-1 e_w [1/kg]
+    double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
+    double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
+    Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)
+    double damping_energy_ = 0.0;              // its work [J, meshed part]
+    void fill_record(int iterations, int factorizations);
+    /// The accelerations at t = 0 from the equations of motion (the massless DOFs condensed).
+    void initial_accelerations();
+    /// K_eff factorised and the step's contact operator (on K_eff / kappa, dense or sparse).
+    void factorise_step();
+    /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
+    Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;
+    double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
 };
+
+NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
+    : impl_(std::make_unique<Impl>(system, detail::initial_state(detail::newmark_row(system).name, system, options))) {}
+
+NewmarkStepper::NewmarkStepper(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+std::unique_ptr<Stepper> NewmarkStepperAccess::build(const System& system, const detail::InitialState& start) {
+    return std::unique_ptr<Stepper>(new NewmarkStepper(std::make_unique<NewmarkStepper::Impl>(system, start)));
+}
 
 NewmarkStepper::~NewmarkStepper() = default;
 
-NewmarkStepper::NewmarkStepper(const System& system, const SimulationOptions& options)
-    : NewmarkStepper(system, detail::initial_state(system.model().spec().leaves.empty() ||
-                                                           !(system.model().spec().leaves[0].density_kg_per_m3 > 0.0)
-                                                       ? "newmark-massless"
-                                                       : "newmark-massive",
-                                                   system, options)) {}
+const StepRecord& NewmarkStepper::advance() { return impl_->advance(); }
+const StepRecord& NewmarkStepper::current() const noexcept { return impl_->record_; }
+long NewmarkStepper::record_index() const noexcept { return impl_->step_; }
+std::vector<PairRecord> NewmarkStepper::pairs() const { return impl_->pairs(); }
+std::vector<LeafNodes> NewmarkStepper::nodes() const { return impl_->system_.leaf_nodes(impl_->z_); }
+RunReport NewmarkStepper::report() const { return impl_->report_; }
+const Eigen::VectorXd& NewmarkStepper::displacements() const noexcept { return impl_->z_; }
+const Eigen::VectorXd& NewmarkStepper::velocities() const noexcept { return impl_->v_; }
+const Eigen::VectorXd& NewmarkStepper::accelerations() const noexcept { return impl_->a_; }
+const Eigen::VectorXd& NewmarkStepper::contact_forces() const noexcept { return impl_->p_; }
+const Eigen::VectorXd& NewmarkStepper::anchors() const noexcept { return impl_->d_; }
+const SolveResult& NewmarkStepper::last_solve() const noexcept { return impl_->solve_; }
+ContactPath NewmarkStepper::contact_path() const noexcept { return impl_->op_->path(); }
 
-NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState& start)
-    : system_(system), options_(start.options), factor_(std::make_unique<Factor>()),
-      problem_(start.laws), solve_(start.solve), z_(start.z), v_(start.v0), p_(start.p), d_(start.d), rig_(start.rig) {
+NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& start)
+    : system_(system), options_(start.options),
+      problem_(start.laws), solve_(start.solve), z_(start.z), v_(start.v0), p_(start.p), d_(start.d),
+      load_(system, start.options.loading), rig_(start.rig) {
     report_.mode = Mode::newmark;
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
-    load_ = std::make_unique<detail::ReducedLoad>(system_, options_.loading);
     K_ = system_.stiffness_reduced();
     M_ = system_.mass_reduced();
     if (options_.damping.active()) {  // structural damping C = alpha M + beta K (massive leaves)
@@ -51,8 +113,8 @@ NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState&
     // tied shape: initial_state.hpp) is the start's.
     rel_ = detail::relative_positions(system_, z_, p_);
     if (massive_leaves_) {
-        factor_->mass.compute(M_);
-        if (factor_->mass.info() != Eigen::Success)
+        factor_.mass.compute(M_);
+        if (factor_.mass.info() != Eigen::Success)
             throw SolverError("newmark: the mass matrix is singular", 0, 0.0, 0.0);
     }
     initial_accelerations();
@@ -63,7 +125,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState&
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     dense_projection_ = op_->path() == ContactPath::dense;
     if (massive_leaves_ && system_.num_components() > 0 && dense_projection_) {
-        Z_ = factor_->mass.solve(Eigen::MatrixXd(G.transpose()));
+        Z_ = factor_.mass.solve(Eigen::MatrixXd(G.transpose()));
         const Eigen::MatrixXd A = G * Z_;
         A_ = 0.5 * (A + A.transpose());
     }
@@ -74,7 +136,7 @@ NewmarkStepper::NewmarkStepper(const System& system, const detail::InitialState&
     record_.energy_balance_error_j = 0.0;
 }
 
-void NewmarkStepper::initial_accelerations() {
+void NewmarkStepper::Impl::initial_accelerations() {
     // DOFs without mass (leaves of density 0) are condensed statically: no velocity, no acceleration.
     const int n = static_cast<int>(K_.rows());
     massless_.assign(static_cast<std::size_t>(n), 0);
@@ -87,12 +149,12 @@ void NewmarkStepper::initial_accelerations() {
     // massless rows of the residual are zero: static shape); the rig's reaction keeps
     // w'' = w_p''(0) (accelerations_with_rig).
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    const Eigen::VectorXd r0 = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_->at(0.0) -
+    const Eigen::VectorXd r0 = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_.at(0.0) -
                                (C_.nonZeros() > 0 ? Eigen::VectorXd(C_ * v_) : Eigen::VectorXd::Zero(n));
     if (rig_) {  // M^-1 e_w, once: the rig's reaction per unit force
         Eigen::VectorXd ew = Eigen::VectorXd::Zero(n);
         ew[n - 1] = 1.0;
-        u_w_ = factor_->mass.solve(ew);
+        u_w_ = factor_.mass.solve(ew);
         a_ = accelerations_with_rig(0.0, r0, &rig_force_);
     } else {
         const int ns = static_cast<int>(massive.size());
@@ -110,7 +172,7 @@ void NewmarkStepper::initial_accelerations() {
         if (massless_[i]) v_[i] = a_[i] = 0.0;
 }
 
-void NewmarkStepper::factorise_step() {
+void NewmarkStepper::Impl::factorise_step() {
     // K_eff = K + 4 M / dt^2, factorised once. The contact force enters the step as
     // kappa G^T p1: kappa = 1 (massless leaves: the trapezoidal rule) or 2 (massive leaves:
     // the contact impulse over the step is dt p1, newmark_stepper.hpp).
@@ -129,8 +191,8 @@ void NewmarkStepper::factorise_step() {
         keff_w_ = Eigen::VectorXd(Keff.block(0, w_dof, w_dof, 1));
         g_w_ = Eigen::VectorXd(G.col(w_dof));
     }
-    factor_->llt.compute(KeffF);
-    if (factor_->llt.info() != Eigen::Success)
+    factor_.llt.compute(KeffF);
+    if (factor_.llt.info() != Eigen::Success)
         throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
     // The step's contact problem, (K_eff / kappa) z1 = r / kappa + G^T p1, s = G z1 + c_L p1 - d:
     // u = r / kappa (the load on z itself), the operator dense (W = G (K_eff / kappa)^-1 G^T + C_L
@@ -149,15 +211,16 @@ void NewmarkStepper::factorise_step() {
     op_ = step_problem_.op;
 }
 
-Eigen::VectorXd NewmarkStepper::accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const {
+Eigen::VectorXd NewmarkStepper::Impl::accelerations_with_rig(double t_s, const Eigen::VectorXd& r,
+                                                             double* lambda_n) const {
     // M a = r + lambda e_w with a_w = w_p''(t)
-    Eigen::VectorXd a = factor_->mass.solve(r);
+    Eigen::VectorXd a = factor_.mass.solve(r);
     const double lambda = detail::prescribe_w_acceleration(a, u_w_, options_.loading.displacement_m.second_derivative(t_s));
     if (lambda_n) *lambda_n = lambda;
     return a;
 }
 
-void NewmarkStepper::fill_record(int iterations, int factorizations) {
+void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
     const double f = system_.model().whole_spring_factor();
     const auto& body = system_.model().spec().rigid_body;
     const int w_dof = static_cast<int>(z_.size()) - 1;
@@ -189,7 +252,7 @@ void NewmarkStepper::fill_record(int iterations, int factorizations) {
     record_.contact_residual_m = solve_.residual_m;
 }
 
-double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0) {
+double NewmarkStepper::Impl::project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0) {
     // The held components at t1: normal rows of closed pairs (compressed, or bilateral),
     // tangential rows of sticking and bonded pairs. Their relative velocity is set to zero
     // by the impulse G_C^T l that changes the kinetic energy least (M-orthogonal projection):
@@ -244,8 +307,8 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
             Eigen::SparseMatrix<double> S(n + nh, n + nh);
             S.setFromTriplets(t.begin(), t.end());
             S.makeCompressed();
-            factor_->saddle.compute(S);
-            if (factor_->saddle.info() != Eigen::Success)
+            factor_.saddle.compute(S);
+            if (factor_.saddle.info() != Eigen::Success)
                 throw SolverError("newmark: the impact projection's matrix is singular at step " + std::to_string(step_),
                                   step_, step_ * options_.dt_s, 0.0);
             held_ = held;
@@ -253,7 +316,7 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
         Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
         rhs.head(n) = M_ * v_;
         rhs.tail(nh) = b;
-        const Eigen::VectorXd x = factor_->saddle.solve(rhs);
+        const Eigen::VectorXd x = factor_.saddle.solve(rhs);
         const Eigen::VectorXd dv = v_ - x.head(n);
         v_ = x.head(n);
         if (e == 0.0) return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
@@ -279,9 +342,11 @@ double NewmarkStepper::project_velocities(const Eigen::VectorXd& p0, const Eigen
     return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
 }
 
-std::vector<PairRecord> NewmarkStepper::pairs() const { return detail::pair_records(system_, problem_, p_, rel_); }
+std::vector<PairRecord> NewmarkStepper::Impl::pairs() const {
+    return detail::pair_records(system_, problem_, p_, rel_);
+}
 
-const StepRecord& NewmarkStepper::advance() {
+const StepRecord& NewmarkStepper::Impl::advance() {
     const double dt = options_.dt_s;
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     // r: the step's load with p1 = 0 (newmark_stepper.hpp). Massive leaves: the elastic force
@@ -291,9 +356,9 @@ const StepRecord& NewmarkStepper::advance() {
     // q0 + q1 = 2 qbar), at t1 with massless ones (Newmark as printed).
     const double t1 = (step_ + 1) * dt;
     const int w_dof = static_cast<int>(z_.size()) - 1;
-    const bool loaded = !load_->none();
-    const Eigen::VectorXd q0 = loaded ? load_->at(t_) : Eigen::VectorXd();
-    const Eigen::VectorXd q1 = loaded ? load_->at(t1) : Eigen::VectorXd();
+    const bool loaded = !load_.none();
+    const Eigen::VectorXd q0 = loaded ? load_.at(t_) : Eigen::VectorXd();
+    const Eigen::VectorXd q1 = loaded ? load_.at(t1) : Eigen::VectorXd();
     Eigen::VectorXd r = massive_leaves_
                             ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
                             : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
@@ -373,7 +438,7 @@ const StepRecord& NewmarkStepper::advance() {
         Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 - C v1 + q1 (+ the rig's lambda1 e_w)
         if (loaded) r1 += q1;
         if (damped) r1 -= C_ * v_;
-        a_ = rig_ ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_->mass.solve(r1));
+        a_ = rig_ ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_.mass.solve(r1));
     } else {
         const Eigen::VectorXd a1 = (4.0 / (dt * dt)) * (z1 - z_ - dt * v_) - a_;
         v_ += 0.5 * dt * (a_ + a1);

@@ -7,15 +7,14 @@
 #include <stdexcept>
 
 #include "stackbeam/errors.hpp"
-#include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
-#include "stackbeam/time/newmark_stepper.hpp"
 #include "time/cvode/cvode_held.hpp"
 #include "time/cvode/cvode_massless.hpp"
 #include "time/cvode/cvode_massive.hpp"
 #include "time/cvode/cvode_modal.hpp"
 #include "time/initial_state.hpp"
 #include "time/stack_properties.hpp"
+#include "time/stepper_access.hpp"
 
 namespace stackbeam::detail {
 
@@ -37,7 +36,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.applied_force = c.base_excitation = c.gravity = c.rig = c.rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
     c.start = StartKind::massless_stack;
-    c.build = &build<ClosedFormStepper>;
+    c.build = &ClosedFormStepperAccess::build;
     rows.push_back(c);
 
     c = StepperCapabilities{};
@@ -47,7 +46,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.applied_force = c.base_excitation = c.gravity = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
     c.start = StartKind::whole_stack;
-    c.build = &build<NewmarkStepper>;
+    c.build = &NewmarkStepperAccess::build;
     rows.push_back(c);
 
     c.name = "newmark-massive";
@@ -258,14 +257,16 @@ const StepperCapabilities& registered_stepper(const std::string& name) {
     throw std::out_of_range("no stepper '" + name + "' in the registry");
 }
 
+const StepperCapabilities& newmark_row(const System& system) {
+    const auto& leaves = system.model().spec().leaves;
+    return registered_stepper(!leaves.empty() && leaves[0].density_kg_per_m3 > 0.0 ? "newmark-massive"
+                                                                                   : "newmark-massless");
+}
+
 const StepperCapabilities& choose_stepper(const System& system, const SimulationOptions& options) {
     switch (options.mode) {
         case Mode::closed_form: break;
-        case Mode::newmark: {
-            const auto& leaves = system.model().spec().leaves;
-            return registered_stepper(!leaves.empty() && leaves[0].density_kg_per_m3 > 0.0 ? "newmark-massive"
-                                                                                           : "newmark-massless");
-        }
+        case Mode::newmark: return newmark_row(system);
         case Mode::cvode: {
             if (!has_leaf_mass(system)) return registered_stepper("cvode-massless");
             // leaf inertia (docs/time-integration.md "Which leaf-inertia stepper"): with friction the

@@ -71,6 +71,10 @@ const std::vector<StepperCapabilities>& stepper_registry();
 /// The row named `name` (StepperCapabilities::name); throws std::out_of_range if none.
 const StepperCapabilities& registered_stepper(const std::string& name);
 
+/// The row of mode newmark for `system`: by leaves[0]'s density (a mix of massive and massless
+/// leaves is refused by either row's check).
+const StepperCapabilities& newmark_row(const System& system);
+
 /// The row of the stepper for options.mode and `system` (make_stepper's choice, stepper.hpp).
 const StepperCapabilities& choose_stepper(const System& system, const SimulationOptions& options);
 

@@ -145,7 +145,7 @@ struct SparseContactProblem {
     /// Throws InputError if the sizes, rows or laws are inconsistent.
     void validate() const;
     /// The equivalent dense problem (W = G K^-1 G^T + diag(c_L), q = G K^-1 b - d): m solves and
-    /// m^2 doubles; for tests and for the sparse solver's last-resort fallback.
+    /// m^2 doubles: to replay the problem with a dense solver, and the sparse solver's last-resort fallback.
     ContactProblem to_dense() const;
 };
 

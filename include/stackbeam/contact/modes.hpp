@@ -197,7 +197,3 @@ private:
 };
 
 }  // namespace stackbeam::modes
-
-namespace stackbeam::detail {
-using namespace stackbeam::modes;  // the library's code names the modes detail:: (their home before)
-}

@@ -87,12 +87,12 @@ public:
     /// Whether a solve returns the displacements z (false for a dense form given without K).
     bool has_displacements() const noexcept;
 
-    struct Dense;   // internal (lib/contact/step.cpp)
-    struct Sparse;  // internal
+private:
+    friend class StepContactSolver;  // solves on the form built (lib/contact/step.cpp)
+    struct Dense;
+    struct Sparse;
     const Dense* dense() const noexcept { return dense_.get(); }
     const Sparse* sparse() const noexcept { return sparse_.get(); }
-
-private:
     ContactPath path_ = ContactPath::dense;
     int rows_ = 0;
     std::unique_ptr<Dense> dense_;

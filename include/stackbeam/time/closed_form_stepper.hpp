@@ -22,9 +22,6 @@
 #include "stackbeam/time/stepper.hpp"
 
 namespace stackbeam {
-namespace detail {
-struct InitialState;  // internal: the shared set-up stage (lib/time/initial_state.hpp)
-}
 
 /// The paper's closed-form stepping (mode "closed-form").
 ///
@@ -40,65 +37,46 @@ public:
     /// Checks `options` (SimulationOptions::validate and what the mode takes: InputError) and
     /// starts from the shared initial state (the assembly, gravity, R held at w(0)).
     ClosedFormStepper(const System& system, const SimulationOptions& options);
-    /// From the shared set-up stage's state (make_stepper).
-    ClosedFormStepper(const System& system, const detail::InitialState& start);
+    ~ClosedFormStepper() override;
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
     /// contact solve fails and options.stop_on_nonconvergence.
     const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override { return record_; }
-    long record_index() const noexcept override { return step_; }
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
     std::vector<PairRecord> pairs() const override;
     /// The leaves' nodes: z of the sparse path, or of the forces and w on the dense path
     /// (System::reduced_displacements: the massless leaves are in equilibrium with p and w).
     std::vector<LeafNodes> nodes() const override;
     /// Steps, and the contact iterations and factorisations summed over the records.
-    RunReport report() const override { return report_; }
+    RunReport report() const override;
 
     /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
-    const Eigen::VectorXd& contact_forces() const noexcept { return p_; }
+    const Eigen::VectorXd& contact_forces() const noexcept;
     /// Relative surface positions s + d [m] per row (normal: approach, tangential: slip position).
-    const Eigen::VectorXd& relative_positions() const noexcept { return rel_; }
+    const Eigen::VectorXd& relative_positions() const noexcept;
     /// Tangential anchors d_t and normal gaps d_n [m] per row.
-    const Eigen::VectorXd& anchors() const noexcept { return d_; }
+    const Eigen::VectorXd& anchors() const noexcept;
     /// State of each pair of system().pairs().
     std::vector<PairState> pair_states() const;
     /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
     /// On the sparse path W and q are empty (the pairs and tau rule are set): see last_sparse_problem().
-    const ContactProblem& last_problem() const noexcept { return contact_->last_dense_problem(); }
+    const ContactProblem& last_problem() const noexcept;
     /// The sparse contact problem of the last step (sparse path; empty on the dense path).
-    const SparseContactProblem& last_sparse_problem() const noexcept { return contact_->last_sparse_problem(); }
+    const SparseContactProblem& last_sparse_problem() const noexcept;
     /// The path this stepper's contact operator took (never automatic).
-    ContactPath contact_path() const noexcept { return op_->path(); }
+    ContactPath contact_path() const noexcept;
     /// Reduced displacements z of the leaves [m, rad] at the current step (sparse path; empty on the dense path).
-    const Eigen::VectorXd& reduced_displacements() const noexcept { return z_; }
-    const SolveResult& last_solve() const noexcept { return solve_; }
-    const System& system() const noexcept { return system_; }
-    double omega_rad_per_s() const noexcept { return omega_; }
+    const Eigen::VectorXd& reduced_displacements() const noexcept;
+    const SolveResult& last_solve() const noexcept;
+    const System& system() const noexcept;
+    double omega_rad_per_s() const noexcept;
 
 private:
-    const System& system_;
-    SimulationOptions options_;
-    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
-    std::unique_ptr<StepContactSolver> contact_;
-    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
-    StepProblem step_problem_;   // the step's problem: u = [w_next], d
-    Eigen::VectorXd z_, zr_;     // z, and the rig's z_r (R held at w_next)
-    int w_dof_ = -1;
-    double k_r_ = 0.0;  // stiffness form: the rigid body's spring k_R [N/m] in K_aug
-    SolveResult solve_;
-    Eigen::VectorXd p_, d_, rel_;
-    double w_ = 0.0, wd_ = 0.0, t_ = 0.0;
-    double omega_ = 0.0, cos_ = 1.0, sin_ = 0.0, gamma_ = 0.0;
-    double e0_ = 0.0, dissipated_ = 0.0;
-    long step_ = 0;
-    StepRecord record_;
-    RunReport report_;
-    // Loading (loading.hpp): the external force on R of the meshed part at t [N], the
-    // external work [J, whole spring].
-    bool rig_ = false;
-    double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
-    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
+    struct Impl;
+    friend struct ClosedFormStepperAccess;  // internal: make_stepper builds it from the set-up stage
+    explicit ClosedFormStepper(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace stackbeam

@@ -49,7 +49,7 @@
 /// Loadings (loading.hpp): q(t) on the right-hand side, by the trapezoidal rule with massive
 /// leaves (r gains q0 + q1, the step's work is (q0 + q1)^T (z1 - z0) / 2, exact in the balance)
 /// and at t1 with massless ones. Gravity starts from the static equilibrium of the whole stack
-/// under its weight (detail::static_state). The rig (massive leaves, elastic interfaces): the
+/// under its weight (the shared set-up stage's static step). The rig (massive leaves, elastic interfaces): the
 /// step solves z_r with w1 = w_p(t1) given; its mean force over the step follows from R's row of
 /// the step's momentum balance (its work closes the balance), its force at t1 from
 /// M a1 = G^T p1 - K z1 + q1 + lambda1 e_w with a1_w = w_p''(t1).
@@ -64,7 +64,6 @@
 /// bilateral one; unilateral ones with a closed gap; their tangential component too when it
 /// carries friction or is bonded): the stack moves with the body, no initial impact.
 #include <Eigen/Dense>
-#include <Eigen/Sparse>
 #include <memory>
 #include <vector>
 
@@ -75,10 +74,6 @@
 #include "stackbeam/fe/system.hpp"
 
 namespace stackbeam {
-namespace detail {
-class ReducedLoad;
-struct InitialState;  // internal: the shared set-up stage (lib/time/initial_state.hpp)
-}
 
 class NewmarkStepper final : public Stepper {
 public:
@@ -86,72 +81,36 @@ public:
     /// the stack's leaf mass; on the sparse path a solver other than exact); starts from the
     /// shared initial state (the assembly, gravity, R held at w(0)).
     NewmarkStepper(const System& system, const SimulationOptions& options);
-    /// From the shared set-up stage's state (make_stepper).
-    NewmarkStepper(const System& system, const detail::InitialState& start);
     ~NewmarkStepper() override;
 
     /// Advances one step of dt. Throws SolverError (step, time, residual) if the
     /// contact solve fails and options.stop_on_nonconvergence.
     const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override { return record_; }
-    long record_index() const noexcept override { return step_; }
+    const StepRecord& current() const noexcept override;
+    long record_index() const noexcept override;
     std::vector<PairRecord> pairs() const override;
     /// The leaves' nodes of displacements() (System::leaf_nodes).
-    std::vector<LeafNodes> nodes() const override { return system_.leaf_nodes(z_); }
+    std::vector<LeafNodes> nodes() const override;
     /// Steps, and the contact iterations and factorisations summed over the records.
-    RunReport report() const override { return report_; }
+    RunReport report() const override;
 
     /// Reduced displacements z [m, rad] (w last), velocities [m/s, rad/s], accelerations [m/s^2, rad/s^2].
-    const Eigen::VectorXd& displacements() const noexcept { return z_; }
-    const Eigen::VectorXd& velocities() const noexcept { return v_; }
-    const Eigen::VectorXd& accelerations() const noexcept { return a_; }
+    const Eigen::VectorXd& displacements() const noexcept;
+    const Eigen::VectorXd& velocities() const noexcept;
+    const Eigen::VectorXd& accelerations() const noexcept;
     /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
-    const Eigen::VectorXd& contact_forces() const noexcept { return p_; }
+    const Eigen::VectorXd& contact_forces() const noexcept;
     /// Tangential anchors d_t and normal gaps d_n [m] per row.
-    const Eigen::VectorXd& anchors() const noexcept { return d_; }
-    const SolveResult& last_solve() const noexcept { return solve_; }
+    const Eigen::VectorXd& anchors() const noexcept;
+    const SolveResult& last_solve() const noexcept;
     /// The path this stepper's contact operator took (never automatic).
-    ContactPath contact_path() const noexcept { return op_->path(); }
+    ContactPath contact_path() const noexcept;
 
 private:
-    struct Factor;  // sparse Cholesky of K_eff
-    const System& system_;
-    SimulationOptions options_;
-    std::unique_ptr<Factor> factor_;
-    Eigen::SparseMatrix<double> K_, M_;
-    std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
-    std::unique_ptr<StepContactSolver> contact_;
-    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
-    StepProblem step_problem_;   // the step's problem: u = r / kappa, d
-    bool dense_projection_ = false;  // the impact projection on the dense A = G M^-1 G^T
-    SolveResult solve_;
-    Eigen::VectorXd z_, v_, a_, p_, d_, rel_;
-    std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
-    bool massive_leaves_ = false;
-    Eigen::MatrixXd Z_, A_;       // M^-1 G^T and G M^-1 G^T (impact law, massive leaves)
-    std::vector<int> held_;       // the held rows of the last projection
-    Eigen::LDLT<Eigen::MatrixXd> held_factor_;  // and A restricted to them
-    double t_ = 0.0;
-    double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
-    long step_ = 0;
-    StepRecord record_;
-    RunReport report_;
-    std::unique_ptr<detail::ReducedLoad> load_;  // the loading's q(t) on the reduced DOFs
-    bool rig_ = false;                         // w prescribed (the rig)
-    Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
-    Eigen::VectorXd u_w_;                      // the rig: M^-1 e_w [1/kg]
-    double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
-    double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
-    Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)
-    double damping_energy_ = 0.0;              // its work [J, meshed part]
-    void fill_record(int iterations, int factorizations);
-    /// The accelerations at t = 0 from the equations of motion (the massless DOFs condensed).
-    void initial_accelerations();
-    /// K_eff factorised and the step's contact operator (on K_eff / kappa, dense or sparse).
-    void factorise_step();
-    /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
-    Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;
-    double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
+    struct Impl;
+    friend struct NewmarkStepperAccess;  // internal: make_stepper builds it from the set-up stage
+    explicit NewmarkStepper(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace stackbeam

@@ -43,7 +43,7 @@ bool box_qp_pivoting(SparsePath& path, const BoxQp& box, Eigen::VectorXd& x, Eig
         if (at_bound[i] == -1 && !std::isfinite(lower[i])) at_bound[i] = 0;
         if (at_bound[i] == +1 && !std::isfinite(upper[i])) at_bound[i] = 0;
     }
-    ModeLinearization qp;
+    modes::ModeLinearization qp;
     std::vector<int> viol;
     int best = std::numeric_limits<int>::max(), budget = kBoxBudget;
     for (int pass = 0; pass < max_passes; ++pass) {
@@ -94,7 +94,7 @@ bool box_qp_primal(SparsePath& path, const BoxQp& box, Eigen::VectorXd& x, Eigen
     const int m = static_cast<int>(x.size());
     detail::project_onto_box(lower, upper, x, at_bound);
     z = st.k_llt.solve(b + st.G.transpose() * x);
-    ModeLinearization qp;
+    modes::ModeLinearization qp;
     Eigen::VectorXd y, zy;
     struct Blocking { int row; double t; signed char side; };
     std::vector<Blocking> blocking_rows;

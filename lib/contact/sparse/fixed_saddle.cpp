@@ -191,7 +191,8 @@ void FixedSaddle::build_pattern() {
     analysed_ = false;
 }
 
-bool FixedSaddle::factor(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& row_scale) {
+bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<int>& pos,
+                         const Eigen::VectorXd& row_scale) {
     const SparseStiffness& st = *st_;
     const int m = st.rows();
     // a coupling outside the pattern (not among the pairs given to reset): extend it

@@ -67,7 +67,7 @@ public:
     /// Factorises the system of lin's held set (pos: row -> index in lin.S or -1; row_scale:
     /// the held rows' scaling). A coupling outside the pattern extends it (a new analysis).
     /// False if the matrix is singular.
-    bool factor(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& row_scale);
+    bool factor(const modes::ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& row_scale);
     /// x = A_S^-1 r for the variable system's layout (n DOFs, then the held rows in lin.S's
     /// order), with one step of iterative refinement against the fixed-pattern matrix.
     Eigen::VectorXd solve(const Eigen::VectorXd& r);

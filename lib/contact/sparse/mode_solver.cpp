@@ -26,6 +26,8 @@
 
 namespace stackbeam::detail::sparse {
 
+using modes::ModeLinearization;
+
 #ifndef STACKBEAM_HAVE_CHOLMOD
 // a build without CHOLMOD: no primal route (held sets above the Schur way's limit take the sparse LU)
 bool primal_route_built() { return false; }

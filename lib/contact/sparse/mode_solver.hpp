@@ -105,7 +105,7 @@ public:
     /// while `key` names it; returns 1 if it factorised (a sparse LU or the Schur
     /// complement's dense LU), 0 otherwise (cached, or a bordered update: updates()).
     /// Throws SingularModes if the held rows are dependent.
-    int solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
+    int solve(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
               const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
     /// The current set of modes is the caller's accepted answer: on the Schur way, its
     /// Schur complement is factorised densely (if it was solved by an update) and becomes
@@ -129,21 +129,22 @@ public:
     const FixedSaddle* fixed() const { return fixed_.get(); }
 
 private:
-    bool try_border(const ModeLinearization& lin);
-    void border_solve(const ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+    bool try_border(const modes::ModeLinearization& lin);
+    void border_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
                       Eigen::VectorXd& p, Eigen::VectorXd& z);
-    void load_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS, Eigen::VectorXd& zf);
+    void load_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& f, Eigen::VectorXd& pS,
+                    Eigen::VectorXd& zf);
     void ensure_columns(const std::vector<int>& rows);
-    void factor_schur(const ModeLinearization& lin);
-    int factor_schur_update(const ModeLinearization& lin);
+    void factor_schur(const modes::ModeLinearization& lin);
+    int factor_schur_update(const modes::ModeLinearization& lin);
     void make_schur_base();
     Eigen::VectorXd schur_inverse(const Eigen::VectorXd& r) const;
-    void schur_solve(const ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
+    void schur_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
     Eigen::VectorXd apply_A(const Eigen::VectorXd& x) const;
-    void factor_lu(const ModeLinearization& lin);
-    void direct_solve(const ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
+    void factor_lu(const modes::ModeLinearization& lin);
+    void direct_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,
                       Eigen::VectorXd& pS, Eigen::VectorXd& zf);
 
     ModeSolverTuning tuning_;

@@ -107,8 +107,8 @@ struct CholmodPrimal final : PrimalSolver {
     void reset(const SparseStiffness& st) override;
     int layer_rows() const override { return nlayer; }
     bool is_layer(int row) const override { return layer_dof[static_cast<std::size_t>(row)] >= 0; }
-    bool factor(const ModeLinearization& lin, const std::vector<int>& pos) override;
-    bool solve(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
+    bool factor(const modes::ModeLinearization& lin, const std::vector<int>& pos) override;
+    bool solve(const modes::ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
                const Eigen::VectorXd& dS, Eigen::VectorXd& pS, Eigen::VectorXd& z) override;
     void refresh() override {
         if (factored && updated_rank_since_factor > 0) numeric_factor();
@@ -298,7 +298,7 @@ std::shared_ptr<PrimalSolver> make_primal_solver(PrimalOrdering ordering) {
     return std::make_shared<CholmodPrimal>(ordering);
 }
 
-bool CholmodPrimal::factor(const ModeLinearization& lin, const std::vector<int>& pos) {
+bool CholmodPrimal::factor(const modes::ModeLinearization& lin, const std::vector<int>& pos) {
     CholmodPrimal& s = *this;
     std::vector<int> added, removed;
     s.rigid.clear();
@@ -346,7 +346,7 @@ bool CholmodPrimal::factor(const ModeLinearization& lin, const std::vector<int>&
     return M.allFinite() && s.Mlu.rcond() > 1e-14;
 }
 
-bool CholmodPrimal::solve(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
+bool CholmodPrimal::solve(const modes::ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
                          const Eigen::VectorXd& dS, Eigen::VectorXd& pS, Eigen::VectorXd& z) {
     CholmodPrimal& s = *this;
     ++s.stats_.solves;

@@ -64,11 +64,11 @@ public:
 
     /// Makes the factor and the rigid rows' Schur complement for the held set of `lin`
     /// (pos: row -> index in lin.S, or -1). False if the held rigid rows are dependent.
-    virtual bool factor(const ModeLinearization& lin, const std::vector<int>& pos) = 0;
+    virtual bool factor(const modes::ModeLinearization& lin, const std::vector<int>& pos) = 0;
     /// Solves the set's linear problem for the load f = b + G'^T e (n' entries) and the held
     /// rows' offsets dS (lin.S order) into their forces pS and z (n' entries). False if the
     /// Krylov iteration did not reach its tolerance (the caller then solves another way).
-    virtual bool solve(const ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
+    virtual bool solve(const modes::ModeLinearization& lin, const std::vector<int>& pos, const Eigen::VectorXd& f,
                        const Eigen::VectorXd& dS, Eigen::VectorXd& pS, Eigen::VectorXd& z) = 0;
     /// Refactorises P from scratch for the current held set if it was reached by updates
     /// (the caller's accepted step), so updates never accumulate over a run.

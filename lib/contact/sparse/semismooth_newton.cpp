@@ -23,8 +23,8 @@ constexpr int kNewtonNonmonotone = 5;
 void set_open_modes(SparsePath& path) {
     for (int k = 0; k < static_cast<int>(path.laws.pairs.size()); ++k) {
         const auto& c = path.laws.pairs[k];
-        if (c.row_n >= 0) path.modes.nmode[k] = detail::ModeSet::unilateral(c) ? detail::OPEN : detail::CLOSED;
-        if (c.row_t >= 0) path.modes.tmode[k] = detail::STICK;
+        if (c.row_n >= 0) path.modes.nmode[k] = modes::ModeSet::unilateral(c) ? modes::OPEN : modes::CLOSED;
+        if (c.row_t >= 0) path.modes.tmode[k] = modes::STICK;
         path.modes.make_consistent(path.laws, k);
     }
 }

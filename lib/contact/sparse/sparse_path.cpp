@@ -104,13 +104,13 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
             const double a = pn - s[c.row_n] / w;
             F[c.row_n] = w * (pn - std::min(0.0, a));
             closed = a < 0.0;
-            if (set_modes) modes.nmode[k] = closed ? detail::CLOSED : detail::OPEN;
+            if (set_modes) modes.nmode[k] = closed ? modes::CLOSED : modes::OPEN;
         } else if (c.kind == PairKind::coulomb) {
             closed = false;  // no normal row: the unilateral pair has no normal force
         }
         if (c.row_t < 0) continue;
         if (c.kind == PairKind::bonded) {
-            if (set_modes) modes.tmode[k] = detail::STICK;
+            if (set_modes) modes.tmode[k] = modes::STICK;
             continue;
         }
         const double w = diag[c.row_t], pt = p[c.row_t];
@@ -122,10 +122,10 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
         bool carries = c.friction_coefficient > 0.0;
         if (c.kind == PairKind::coulomb) carries = carries && closed && (!prev || limit > 0.0);
         else if (c.kind == PairKind::clamp) carries = carries && (prev ? limit > 0.0 : c.preload_n - (c.row_n >= 0 ? p[c.row_n] : 0.0) > 0.0);
-        signed char mode = detail::FREE;
+        signed char mode = modes::FREE;
         if (carries) {
-            if (std::abs(a) < limit || a == 0.0) mode = detail::STICK;
-            else mode = a > 0.0 ? detail::SLIP_POS : detail::SLIP_NEG;
+            if (std::abs(a) < limit || a == 0.0) mode = modes::STICK;
+            else mode = a > 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
         }
         modes.tmode[k] = mode;
         modes.make_consistent(laws, k);

@@ -42,7 +42,7 @@ struct SparsePath {
     Switches switches;       ///< the test-only switches (switches.hpp)
     ModeSolver solver;       ///< the linear problem of a set of modes on the current (K, G)
     ContactProblem laws;     ///< pairs and tau rule; W empty, q zero (sizes only)
-    ModeSet modes;           ///< the current modes
+    modes::ModeSet modes;    ///< the current modes
     Eigen::VectorXd s;       ///< s = G z - d [m] where the last unit left it (the solver's answer's at the end)
     Eigen::VectorXd best_p;  ///< the semismooth Newton method's iterate of smallest ||F|| (its last run)
     // workspaces made once per (K, G): the interior-point method's LDL^T of K + G^T Sigma^-1 G
@@ -77,7 +77,7 @@ struct SparsePath {
 
 private:
     // the linearisation of the modes solve_modes last solved (kept while they stay)
-    ModeLinearization lin_;
+    modes::ModeLinearization lin_;
     bool lin_ok_ = false;
     std::vector<signed char> lin_nmode_, lin_tmode_, lin_key_;
     TauRule lin_tau_rule_ = TauRule::current;

@@ -91,16 +91,9 @@ struct CvodeModalStepper::Impl final : EventDriver {
         const int n = rows();
         const Eigen::VectorXd& d = anchors();
         const std::vector<int>& S = lin.S;
-        const int ms = static_cast<int>(S.size());
-        std::vector<int> pos(n, -1);
-        for (int i = 0; i < ms; ++i) pos[S[i]] = i;
-        struct Link { int row, col; double coef; };
-        std::vector<Link> T;
-        for (int i = 0; i < ms; ++i) T.push_back({S[i], i, 1.0});
-        for (std::size_t i = 0; i < lin.coupled.size(); ++i)
-            if (pos[lin.coupled[i].second] >= 0) T.push_back({lin.coupled[i].first, pos[lin.coupled[i].second], lin.coef[i]});
-        Eigen::MatrixXd WT = Eigen::MatrixXd::Zero(n, ms);
-        for (const auto& l : T) WT.col(l.col) += l.coef * W.col(l.row);
+        const ModeMap T(lin, n);
+        const int ms = T.columns;
+        const Eigen::MatrixXd WT = T.compliance_times(W);
         const Eigen::VectorXd We = W * lin.e;
         Eigen::MatrixXd A(ms, ms), B1(ms, r), Bu(ms, 2);
         Eigen::VectorXd b0(ms);
@@ -123,7 +116,7 @@ struct CvodeModalStepper::Impl final : EventDriver {
         P = Eigen::MatrixXd::Zero(n, r);
         Pu = Eigen::MatrixXd::Zero(n, 2);
         p0 = lin.e;
-        for (const auto& l : T) {
+        for (const auto& l : T.links) {
             P.row(l.row) += l.coef * X1.row(l.col);
             Pu.row(l.row) += l.coef * Xu.row(l.col);
             p0[l.row] += l.coef * x0[l.col];

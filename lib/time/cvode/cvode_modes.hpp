@@ -17,6 +17,18 @@
 
 namespace stackbeam::detail {
 
+// The cvode layer (this header, the event driver and the event steppers) names the modes of
+// contact/modes.hpp unqualified: their using-declarations, here once.
+using modes::CLOSED;
+using modes::FREE;
+using modes::ModeLinearization;
+using modes::ModeSet;
+using modes::NONE;
+using modes::OPEN;
+using modes::SLIP_NEG;
+using modes::SLIP_POS;
+using modes::STICK;
+
 /// Every witness is positive by a margin (relative to its scale) while its mode
 /// holds, so that pairs that merely touch (p = s = 0 up to round-off) do not chatter.
 /// Forces come from an LU of the mode's conditions (cond(C') ~ 1e5: round-off
@@ -62,6 +74,30 @@ inline RunReport event_report(const CvodeStats& stats, const std::vector<Contact
     rep.factorizations = stats.mode_factorizations;
     return rep;
 }
+
+/// The map p = T p_S + e of a set of modes (ModeSet::linearize): the held rows S and the slip rows
+/// p_t = e_t + coef p_n whose normal row is held, as (row, column, coefficient) links; row S[i] is
+/// column i with coefficient 1. The steppers whose forces are affine in their state build their
+/// mode's operators from it (cvode_stepper.cpp, cvode_modal.cpp).
+struct ModeMap {
+    struct Link { int row, col; double coef; };
+    std::vector<Link> links;
+    int columns = 0;  ///< |S|
+
+    ModeMap(const ModeLinearization& lin, int rows) : columns(static_cast<int>(lin.S.size())) {
+        std::vector<int> pos(static_cast<std::size_t>(rows), -1);
+        for (int i = 0; i < columns; ++i) pos[lin.S[i]] = i;
+        for (int i = 0; i < columns; ++i) links.push_back({lin.S[i], i, 1.0});
+        for (std::size_t i = 0; i < lin.coupled.size(); ++i)
+            if (pos[lin.coupled[i].second] >= 0) links.push_back({lin.coupled[i].first, pos[lin.coupled[i].second], lin.coef[i]});
+    }
+    /// W T (rows x |S|) for a compliance W (rows x rows).
+    Eigen::MatrixXd compliance_times(const Eigen::MatrixXd& W) const {
+        Eigen::MatrixXd WT = Eigen::MatrixXd::Zero(W.rows(), columns);
+        for (const Link& l : links) WT.col(l.col) += l.coef * W.col(l.row);
+        return WT;
+    }
+};
 
 /// Label of a pair's modes (nm, tm) for the event log.
 inline std::string mode_label(const ContactPair& cp, signed char nm, signed char tm) {

@@ -20,10 +20,10 @@
 namespace stackbeam {
 namespace {
 
-// Pair modes: those of the active-set solvers (active_set.hpp).
-using detail::SLIP_NEG;
-using detail::SLIP_POS;
-using detail::STICK;
+// Pair modes: those of the active-set solvers (contact/modes.hpp).
+using modes::SLIP_NEG;
+using modes::SLIP_POS;
+using modes::STICK;
 using detail::kLookahead;
 
 }  // namespace
@@ -100,22 +100,14 @@ struct CvodeStepper::Impl final : detail::EventDriver {
     /// pair's normal force (coulomb: -p_n; clamp: F_c - p_n). So p = T p_S + e and
     ///     (C'_S: T) p_S = d_S - c_S w - C'_S: e,
     /// an |S| x |S| LU (|S| is small when most pairs are open or slipping).
-    void build_mode(const detail::ModeLinearization& lin) override {
+    void build_mode(const modes::ModeLinearization& lin) override {
         const int n = rows();
         const Eigen::VectorXd& d = anchors();
         const std::vector<int>& S = lin.S;
-        std::vector<int> pos(n, -1);
-        const int ms = static_cast<int>(S.size());
-        for (int i = 0; i < ms; ++i) pos[S[i]] = i;
-        // p = T p_S + e: T as (row, column, coefficient) triplets
-        Eigen::MatrixXd CT = Eigen::MatrixXd::Zero(n, ms);  // C' T, all rows
+        const detail::ModeMap T(lin, n);  // p = T p_S + e
+        const int ms = T.columns;
+        const Eigen::MatrixXd CT = T.compliance_times(C);  // C' T, all rows
         const Eigen::VectorXd& e = lin.e;
-        struct Link { int row, col; double coef; };
-        std::vector<Link> T;
-        for (int i = 0; i < ms; ++i) T.push_back({S[i], i, 1.0});
-        for (std::size_t i = 0; i < lin.coupled.size(); ++i)
-            if (pos[lin.coupled[i].second] >= 0) T.push_back({lin.coupled[i].first, pos[lin.coupled[i].second], lin.coef[i]});
-        for (const auto& l : T) CT.col(l.col) += l.coef * C.col(l.row);
         const Eigen::VectorXd Ce = C * e;
         Eigen::MatrixXd A(ms, ms);
         Eigen::VectorXd b1(ms), b0(ms);
@@ -133,7 +125,7 @@ struct CvodeStepper::Impl final : detail::EventDriver {
         }
         P = Eigen::VectorXd::Zero(n);
         r = e;
-        for (const auto& l : T) {
+        for (const auto& l : T.links) {
             P[l.row] += l.coef * x1[l.col];
             r[l.row] += l.coef * x0[l.col];
         }
