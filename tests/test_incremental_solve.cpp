@@ -413,6 +413,7 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
     sp::ModeSolverTuning tf{0, border, true, 0};
     tf.fixed_pattern = lu;
     tf.fixed_max_rigid_rows = 100000;  // the rigid stack's sets too
+    tf.fixed_max_border_rows = -1;     // the bordered update up to `border` rows (its default limit on KLU: 8)
     sp::ModeSolver fixed(tf), ref(sp::ModeSolverTuning{0, 0, true, 0}), schur(sp::ModeSolverTuning{100000, 0, false});
     fixed.reset(pr.K, pr.G, pass_couplings ? couplings_of(pr) : std::vector<std::pair<int, int>>{});
     ref.reset(pr.K, pr.G);
@@ -443,7 +444,8 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
     analyses = fixed.fixed()->analyses();
     if (reused) *reused = fixed.fixed()->lu().reused;
     BOOST_TEST_MESSAGE("  LU: " << fixed.fixed()->lu().pivoted << " with pivoting, " << fixed.fixed()->lu().reused
-                                << " on the previous pivot sequence");
+                                << " on the previous pivot sequence, " << fixed.fixed()->lu().repivoted
+                                << " of them rejected by the backward error");
     return worst;
 }
 
