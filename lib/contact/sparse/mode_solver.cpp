@@ -794,10 +794,7 @@ Eigen::VectorXd ModeSolver::apply_A(const Eigen::VectorXd& x) const {
 
 Eigen::VectorXd ModeSolver::refined_solve(const Eigen::VectorXd& r) {
     if (lu_fixed) return fixed_->solve(r);
-    Eigen::VectorXd y = lu.solve(r);
-    const Eigen::VectorXd res = r - A * y;
-    y += lu.solve(res);
-    return y;
+    return refined_solve(Eigen::MatrixXd(r)).col(0);
 }
 
 Eigen::MatrixXd ModeSolver::refined_solve(const Eigen::MatrixXd& R) {
