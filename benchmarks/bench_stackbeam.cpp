@@ -406,7 +406,10 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// -1 its default (0: off), 0 off: the large held sets on the sparse LU; > 0 the primal
 /// route from that many held rows, docs/decisions/027), fixed (Switches::fixed_pattern: -1 its
 /// default; 0 the variable saddle-point LU per held set, 1 Eigen's SparseLU on the fixed
-/// pattern, 2 KLU on it, docs/decisions/031). Counters: wall
+/// pattern, 2 KLU on it, docs/decisions/031), border (SparsePathTuning::max_border_rows; -1 its
+/// default), lu (docs/decisions/035, a bit mask: 1 Switches::block_border_solves, 2
+/// Switches::residual_refactor_check, 4 Switches::fixed_border_rows at its default; -1 the
+/// defaults, all on; 0 the way before), fborder (Switches::fixed_border_rows; -1 as lu says). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -426,6 +429,12 @@ void ElasticRuns(benchmark::State& state) {
     detail::sparse::Switches sw;
     sw.incremental = state.range(5) != 0;
     if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
+    if (state.range(10) >= 0) {
+        sw.block_border_solves = (state.range(10) & 1) != 0;
+        sw.residual_refactor_check = (state.range(10) & 2) != 0;
+        if ((state.range(10) & 4) == 0) sw.fixed_border_rows = -1;
+    }
+    if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
     const detail::sparse::ScopedSwitches scoped(sw);
     double total = 0.0, cpu = 0.0, factorizations = 0.0, newton = 0.0, mode_solves = 0.0;
     long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_tresca = 0;
@@ -441,6 +450,7 @@ void ElasticRuns(benchmark::State& state) {
         if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
         if (state.range(6) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(6));
         if (state.range(7) >= 0) so.sparse_tuning.primal_min_rows = static_cast<int>(state.range(7));
+        if (state.range(9) >= 0) so.sparse_tuning.max_border_rows = static_cast<int>(state.range(9));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = mode_solves = 0.0;
@@ -479,37 +489,52 @@ void ElasticRuns(benchmark::State& state) {
     state.counters["by_tresca"] = static_cast<double>(by_tresca);
 }
 BENCHMARK(ElasticRuns)
-    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal", "fixed"})
+    ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal", "fixed", "border", "lu", "fborder"})
     // the reference: the paper example, rigid and elastic, 1 s
-    ->Args({20, 0, 0, 1000, 0, 1, 0, -1, -1})->Args({20, 0, 1, 1000, 0, 1, 0, -1, -1})
+    ->Args({20, 0, 0, 1000, 0, 1, 0, -1, -1, -1, -1, -1})->Args({20, 0, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})
     // graduated and identical 10 leaves, elastic, 100 / 200 / 400 elements per half leaf, 1 s
     // (the target's measure: the first 50 ms, from rest at 2 m/s, are not typical of the second)
-    ->Args({100, 1, 1, 1000, 0, 1, 0, -1, -1})->Args({200, 1, 1, 1000, 0, 1, 0, -1, -1})->Args({400, 1, 1, 1000, 0, 1, 0, -1, -1})
-    ->Args({100, 2, 1, 1000, 0, 1, 0, -1, -1})->Args({200, 2, 1, 1000, 0, 1, 0, -1, -1})->Args({400, 2, 1, 1000, 0, 1, 0, -1, -1})
+    ->Args({100, 1, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})->Args({200, 1, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})->Args({400, 1, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})
+    ->Args({100, 2, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})->Args({200, 2, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})->Args({400, 2, 1, 1000, 0, 1, 0, -1, -1, -1, -1, -1})
     // issue 27's targets: 100 ms, graduated / identical 10 x 400 elastic against the same mesh
     // bonded, the incremental solve and the way before; graduated 50 / 100 / 200 / 400
-    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1})->Args({400, 1, 1, 100, 0, 0, 0, -1, -1})->Args({400, 3, 0, 100, 0, 1, 0, -1, -1})
-    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1, -1})
-    ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, -1})
-    ->Args({50, 1, 1, 100, 0, 0, 0, -1, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({400, 1, 1, 100, 0, 0, 0, -1, -1, -1, -1, -1})->Args({400, 3, 0, 100, 0, 1, 0, -1, -1, -1, -1, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({400, 2, 1, 100, 0, 0, 0, -1, -1, -1, -1, -1})->Args({400, 4, 0, 100, 0, 1, 0, -1, -1, -1, -1, -1})
+    ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})
+    ->Args({50, 1, 1, 100, 0, 0, 0, -1, -1, -1, -1, -1})->Args({100, 1, 1, 100, 0, 0, 0, -1, -1, -1, -1, -1})->Args({200, 1, 1, 100, 0, 0, 0, -1, -1, -1, -1, -1})
     // the primal route (docs/decisions/027; off by default) from 401 held rows: 10 x 400
     // graduated and identical, graduated 100 / 200; and its threshold 100 / 200 / 800
-    ->Args({400, 1, 1, 100, 0, 1, 0, 401, -1})->Args({400, 2, 1, 100, 0, 1, 0, 401, -1})
-    ->Args({100, 1, 1, 100, 0, 1, 0, 401, -1})->Args({200, 1, 1, 100, 0, 1, 0, 401, -1})
-    ->Args({400, 1, 1, 30, 0, 1, 0, 100, -1})->Args({400, 1, 1, 30, 0, 1, 0, 200, -1})->Args({400, 1, 1, 30, 0, 1, 0, 800, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, 401, -1, -1, -1, -1})->Args({400, 2, 1, 100, 0, 1, 0, 401, -1, -1, -1, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, 401, -1, -1, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, 401, -1, -1, -1, -1})
+    ->Args({400, 1, 1, 30, 0, 1, 0, 100, -1, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 0, 200, -1, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 0, 800, -1, -1, -1, -1})
     // the Schur way's limit (SparsePathTuning::schur_max_rows) with the incremental solve
-    ->Args({400, 1, 1, 30, 0, 1, 0, -1, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1, -1})
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, -1, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 1200, -1, -1, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 2500, -1, -1, -1, -1, -1})
     // the fixed-pattern LU (docs/decisions/031): off / Eigen / KLU, graduated and identical
     // 10 x 400, 30 ms (quick) and 100 ms (the targets' measure), graduated 100 / 200
-    ->Args({400, 1, 1, 30, 0, 1, 0, -1, 0})->Args({400, 1, 1, 30, 0, 1, 0, -1, 1})->Args({400, 1, 1, 30, 0, 1, 0, -1, 2})
-    ->Args({400, 1, 1, 100, 0, 1, 0, -1, 0})->Args({400, 1, 1, 100, 0, 1, 0, -1, 1})->Args({400, 1, 1, 100, 0, 1, 0, -1, 2})
-    ->Args({400, 2, 1, 100, 0, 1, 0, -1, 0})->Args({400, 2, 1, 100, 0, 1, 0, -1, 1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 2})
-    ->Args({100, 1, 1, 100, 0, 1, 0, -1, 0})->Args({100, 1, 1, 100, 0, 1, 0, -1, 2})
-    ->Args({200, 1, 1, 100, 0, 1, 0, -1, 0})->Args({200, 1, 1, 100, 0, 1, 0, -1, 2})
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, 0, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 0, -1, 1, -1, -1, -1})->Args({400, 1, 1, 30, 0, 1, 0, -1, 2, -1, -1, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, 0, -1, -1, -1})->Args({400, 1, 1, 100, 0, 1, 0, -1, 1, -1, -1, -1})->Args({400, 1, 1, 100, 0, 1, 0, -1, 2, -1, -1, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, 0, -1, -1, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 1, -1, -1, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 2, -1, -1, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, 0, -1, -1, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, 2, -1, -1, -1})
+    ->Args({200, 1, 1, 100, 0, 1, 0, -1, 0, -1, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, 2, -1, -1, -1})
+    // docs/decisions/035: the bordered update's block solves (lu bit 1), the KLU
+    // refactorisation kept by the backward error (lu bit 2) and the bordered update's limit on
+    // the fixed pattern (lu bit 4), all on by default, against the way before (lu:0);
+    // graduated and identical 10 x 400, 30 / 100 ms; the bordered update's limits (border,
+    // fborder) on the identical stack; graduated 50 / 100 / 200 before
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, -1, -1, 0, -1})->Args({400, 1, 1, 30, 0, 1, 0, -1, -1, -1, 1, -1})
+    ->Args({400, 1, 1, 30, 0, 1, 0, -1, -1, -1, 2, -1})->Args({400, 1, 1, 30, 0, 1, 0, -1, -1, -1, 3, -1})
+    ->Args({400, 2, 1, 30, 0, 1, 0, -1, -1, -1, 0, -1})->Args({400, 2, 1, 30, 0, 1, 0, -1, -1, -1, 3, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, 40, -1, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, 20, -1, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, 0, -1, -1})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 0})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 20})
+    ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 3, -1})
+    ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
+    ->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
-    ->Args({100, 1, 1, 300, 1, 1, 0, -1, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1, -1})
-    ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1})
+    ->Args({100, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
+    ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -414,6 +414,7 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
     sp::ModeSolverTuning tf{0, border, true, 0};
     tf.fixed_pattern = lu;
     tf.fixed_max_rigid_rows = 100000;  // the rigid stack's sets too
+    tf.fixed_max_border_rows = -1;     // the bordered update up to `border` rows (its default limit on KLU: 8)
     sp::ModeSolver fixed(tf), ref(sp::ModeSolverTuning{0, 0, true, 0}), schur(sp::ModeSolverTuning{100000, 0, false});
     fixed.reset(pr.K, pr.G, pass_couplings ? couplings_of(pr) : std::vector<std::pair<int, int>>{});
     ref.reset(pr.K, pr.G);
@@ -444,7 +445,8 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
     analyses = fixed.fixed()->analyses();
     if (reused) *reused = fixed.fixed()->lu().reused;
     BOOST_TEST_MESSAGE("  LU: " << fixed.fixed()->lu().pivoted << " with pivoting, " << fixed.fixed()->lu().reused
-                                << " on the previous pivot sequence");
+                                << " on the previous pivot sequence, " << fixed.fixed()->lu().repivoted
+                                << " of them rejected by the backward error");
     return worst;
 }
 
@@ -499,4 +501,77 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_extends_its_pattern_and_borders_its_factor
     BOOST_TEST(no_slip.solves > 180);
     BOOST_TEST(updates > 100);
     BOOST_TEST(worst < 1.0);
+}
+
+namespace {
+/// A PatternLu whose "refactorisation" is unchecked and whose solves are off by a relative
+/// `error` (a pivot sequence that no longer suits the matrix, made to order) until it is
+/// pivoted afresh: Eigen's SparseLU underneath.
+class PerturbedLu final : public sp::PatternLu {
+    Eigen::SparseLU<sp::SpMat, Eigen::COLAMDOrdering<int>> lu_;
+    bool bad_ = true;
+    double error_;
+
+public:
+    explicit PerturbedLu(double error) : error_(error) {}
+    void analyze(const sp::SpMat& A) override { lu_.analyzePattern(A); }
+    bool factorize(const sp::SpMat& A) override {
+        lu_.factorize(A);
+        bad_ = true;
+        ++reused;
+        return lu_.info() == Eigen::Success;
+    }
+    void solve_in_place(Eigen::VectorXd& x) override {
+        const Eigen::VectorXd b = x;
+        x = lu_.solve(b);
+        if (bad_) x *= 1.0 + error_;
+    }
+    void solve_in_place(Eigen::MatrixXd& X) override {
+        const Eigen::MatrixXd B = X;
+        X = lu_.solve(B);
+        if (bad_) X *= 1.0 + error_;
+    }
+    bool unchecked() const override { return bad_; }
+    bool repivot(const sp::SpMat& A) override {
+        ++repivoted;
+        bad_ = false;
+        lu_.factorize(A);
+        return lu_.info() == Eigen::Success;
+    }
+};
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(refactorisation_kept_by_the_backward_error_of_its_solves) {
+    // PatternLu::refined_solve on an unchecked refactorisation (docs/decisions/035): a first
+    // solve whose backward error exceeds kMaxBackwardError (here a relative error of 1e-6 made
+    // to order) makes it pivot afresh, and the refined answer is the exact one to round-off;
+    // one within it (1e-14) is kept (no new factorisation), its refinement removing the error.
+    // The matrix: a tridiagonal, diagonally dominant one (cond ~ 3), so round-off is ~1e-15.
+    const int n = 200;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < n; ++i) {
+        t.emplace_back(i, i, 4.0 + 0.01 * i);
+        if (i > 0) t.emplace_back(i, i - 1, -1.0);
+        if (i + 1 < n) t.emplace_back(i, i + 1, -1.5);
+    }
+    sp::SpMat A(n, n);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    Eigen::MatrixXd B(n, 3);
+    for (int i = 0; i < n; ++i) B.row(i) << std::sin(0.1 * i), 1.0, i % 7 - 3.0;
+    Eigen::SparseLU<sp::SpMat> exact(A);
+    const Eigen::MatrixXd X_exact = exact.solve(B);
+    for (const double error : {1e-6, 1e-14}) {
+        PerturbedLu lu(error);
+        lu.analyze(A);
+        BOOST_TEST_REQUIRE(lu.factorize(A));
+        Eigen::MatrixXd X = B;
+        BOOST_TEST_REQUIRE(lu.refined_solve(A, X));
+        Eigen::VectorXd x = B.col(1);
+        BOOST_TEST_REQUIRE(lu.refined_solve(A, x));
+        BOOST_TEST(lu.repivoted == (error > sp::PatternLu::kMaxBackwardError ? 1 : 0));
+        // refined once: the kept solve's error 1e-14 becomes ~1e-28 + round-off
+        BOOST_TEST((X - X_exact).norm() / X_exact.norm() < 1e-13);
+        BOOST_TEST((x - X_exact.col(1)).norm() / X_exact.col(1).norm() < 1e-13);
+    }
 }

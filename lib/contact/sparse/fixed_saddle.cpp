@@ -30,6 +30,7 @@ class EigenPatternLu final : public PatternLu {
 public:
     void analyze(const SpMat& A) override { lu_.analyzePattern(A); }
     bool factorize(const SpMat& A) override {
+        norm_valid_ = false;
         lu_.factorize(A);
         ++pivoted;
         return lu_.info() == Eigen::Success;
@@ -37,6 +38,10 @@ public:
     void solve_in_place(Eigen::VectorXd& x) override {
         const Eigen::VectorXd b = x;
         x = lu_.solve(b);
+    }
+    void solve_in_place(Eigen::MatrixXd& X) override {
+        const Eigen::MatrixXd B = X;
+        X = lu_.solve(B);
     }
 };
 
@@ -49,9 +54,13 @@ public:
 /// pivot ratio (klu_rcond: min / max |u_ii|) at least kRefactorKeep of that one's. Else
 /// (a held set whose new rows the old pivots do not suit) klu_factor pivots afresh.
 /// The solves are refined against the explicit matrix by the caller either way.
+/// With `residual_check` (Switches::residual_refactor_check, the default) a refactorisation
+/// is kept on its pivot ratio alone (klu_rcond, O(n)) and marked unchecked: its solves'
+/// backward error decides (PatternLu::refined_solve), instead of klu_rgrowth's O(nnz(U))
+/// pass per factorisation (7 % of the 10 x 400 runs, docs/decisions/035).
 class KluPatternLu final : public PatternLu {
 public:
-    KluPatternLu() { klu_defaults(&common_); }
+    explicit KluPatternLu(bool residual_check) : residual_check_(residual_check) { klu_defaults(&common_); }
     ~KluPatternLu() override { release(); }
     KluPatternLu(const KluPatternLu&) = delete;
     KluPatternLu& operator=(const KluPatternLu&) = delete;
@@ -65,6 +74,8 @@ private:
     klu_symbolic* symbolic_ = nullptr;
     klu_numeric* numeric_ = nullptr;
     double fresh_rgrowth_ = 0.0, fresh_rcond_ = 0.0;  // of the last klu_factor
+    bool residual_check_ = true;
+    bool unchecked_ = false;  // the current factor: a refactorisation kept on klu_rcond alone
     void release() {
         if (numeric_) klu_free_numeric(&numeric_, &common_);
         if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
@@ -75,30 +86,19 @@ private:
     static double* vp(const double* p) { return const_cast<double*>(p); }
     /// The pivot quality of the current factor of A: (rgrowth, rcond), or false.
     bool quality(const SpMat& A, double& rgrowth, double& rcond) {
-        if (!klu_rgrowth(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_, numeric_,
-                         &common_) ||
-            !klu_rcond(symbolic_, numeric_, &common_))
-            return false;
-        rgrowth = common_.rgrowth;
+        if (!klu_rcond(symbolic_, numeric_, &common_)) return false;
         rcond = common_.rcond;
+        rgrowth = 1.0;
+        if (!residual_check_) {
+            if (!klu_rgrowth(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_, numeric_,
+                             &common_))
+                return false;
+            rgrowth = common_.rgrowth;
+        }
         return std::isfinite(rgrowth) && std::isfinite(rcond);
     }
-
-public:
-    void analyze(const SpMat& A) override {
-        release();
-        symbolic_ = klu_analyze(static_cast<int>(A.rows()), ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), &common_);
-    }
-    bool factorize(const SpMat& A) override {
-        if (!symbolic_) return false;
+    bool pivot(const SpMat& A) {
         double rgrowth = 0.0, rcond = 0.0;
-        if (numeric_ && klu_refactor(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_,
-                                     numeric_, &common_) &&
-            common_.status == KLU_OK && quality(A, rgrowth, rcond) && rgrowth >= kRefactorKeep * fresh_rgrowth_ &&
-            rcond >= kRefactorKeep * fresh_rcond_) {
-            ++reused;
-            return true;
-        }
         if (numeric_) klu_free_numeric(&numeric_, &common_);
         numeric_ = klu_factor(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_, &common_);
         if (numeric_ == nullptr || common_.status != KLU_OK || !quality(A, rgrowth, rcond)) {
@@ -110,8 +110,39 @@ public:
         ++pivoted;
         return true;
     }
+
+public:
+    void analyze(const SpMat& A) override {
+        release();
+        symbolic_ = klu_analyze(static_cast<int>(A.rows()), ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), &common_);
+    }
+    bool factorize(const SpMat& A) override {
+        if (!symbolic_) return false;
+        norm_valid_ = false;
+        unchecked_ = false;
+        double rgrowth = 0.0, rcond = 0.0;
+        if (numeric_ && klu_refactor(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_,
+                                     numeric_, &common_) &&
+            common_.status == KLU_OK && quality(A, rgrowth, rcond) && rgrowth >= kRefactorKeep * fresh_rgrowth_ &&
+            rcond >= kRefactorKeep * fresh_rcond_) {
+            ++reused;
+            unchecked_ = residual_check_;
+            return true;
+        }
+        return pivot(A);
+    }
+    bool unchecked() const override { return unchecked_; }
+    bool repivot(const SpMat& A) override {
+        unchecked_ = false;
+        ++repivoted;
+        return pivot(A);
+    }
     void solve_in_place(Eigen::VectorXd& x) override {
         klu_solve(symbolic_, numeric_, static_cast<int>(x.size()), 1, x.data(), &common_);
+    }
+    void solve_in_place(Eigen::MatrixXd& X) override {
+        if (X.cols() == 0) return;
+        klu_solve(symbolic_, numeric_, static_cast<int>(X.rows()), static_cast<int>(X.cols()), X.data(), &common_);
     }
 };
 #endif
@@ -126,12 +157,51 @@ bool klu_built() {
 #endif
 }
 
-std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu) {
+std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu, bool residual_check) {
 #ifdef STACKBEAM_HAVE_KLU
-    if (lu == FixedPatternLu::klu) return std::make_unique<KluPatternLu>();
+    if (lu == FixedPatternLu::klu) return std::make_unique<KluPatternLu>(residual_check);
 #endif
     (void)lu;
+    (void)residual_check;
     return std::make_unique<EigenPatternLu>();
+}
+
+bool PatternLu::accept_solve(const SpMat& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& X) {
+    if (!unchecked()) return true;
+    if (!norm_valid_) {  // ||A||_inf: the largest row sum of |A|
+        Eigen::VectorXd rows = Eigen::VectorXd::Zero(A.rows());
+        for (int j = 0; j < A.outerSize(); ++j)
+            for (SpMat::InnerIterator it(A, j); it; ++it) rows[it.row()] += std::abs(it.value());
+        a_norm_ = rows.size() > 0 ? rows.maxCoeff() : 0.0;
+        norm_valid_ = true;
+    }
+    for (Eigen::Index c = 0; c < X.cols(); ++c) {
+        const double r = (B.col(c) - A * X.col(c)).lpNorm<Eigen::Infinity>();
+        const double scale = a_norm_ * X.col(c).lpNorm<Eigen::Infinity>() + B.col(c).lpNorm<Eigen::Infinity>();
+        if (!(r <= kMaxBackwardError * scale)) return false;
+    }
+    return true;
+}
+
+bool PatternLu::refined_solve(const SpMat& A, Eigen::VectorXd& x) {
+    Eigen::MatrixXd X = x;  // (one column: the same code as the multi-column solve)
+    if (!refined_solve(A, X)) return false;
+    x = X.col(0);
+    return true;
+}
+
+bool PatternLu::refined_solve(const SpMat& A, Eigen::MatrixXd& X) {
+    const Eigen::MatrixXd B = X;
+    solve_in_place(X);
+    if (!accept_solve(A, B, X)) {  // the old pivots no longer suit this matrix: pivot afresh
+        if (!repivot(A)) return false;
+        X = B;
+        solve_in_place(X);
+    }
+    Eigen::MatrixXd res = B - A * X;  // one step of iterative refinement
+    solve_in_place(res);
+    X += res;
+    return true;
 }
 
 void FixedSaddle::reset(const SparseStiffness& st, const std::vector<std::pair<int, int>>& couplings) {
@@ -257,13 +327,21 @@ Eigen::VectorXd FixedSaddle::gather(const Eigen::VectorXd& full) const {
 Eigen::VectorXd FixedSaddle::multiply(const Eigen::VectorXd& x) const { return gather(A_ * scatter(x)); }
 
 Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
-    const Eigen::VectorXd rhs = scatter(r);
-    Eigen::VectorXd x = rhs;
-    lu_->solve_in_place(x);
-    Eigen::VectorXd res = rhs - A_ * x;  // one step of iterative refinement
-    lu_->solve_in_place(res);
-    x += res;
+    Eigen::VectorXd x = scatter(r);
+    if (!lu_->refined_solve(A_, x)) throw SingularModes{};
     return gather(x);
+}
+
+Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R) {
+    const int n = st_->dofs(), m = st_->rows();
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n + m, R.cols());
+    X.topRows(n) = R.topRows(n);
+    for (std::size_t i = 0; i < held_.size(); ++i) X.row(n + held_[i]) = R.row(n + static_cast<Eigen::Index>(i));
+    if (!lu_->refined_solve(A_, X)) throw SingularModes{};
+    Eigen::MatrixXd out(n + static_cast<Eigen::Index>(held_.size()), R.cols());
+    out.topRows(n) = X.topRows(n);
+    for (std::size_t i = 0; i < held_.size(); ++i) out.row(n + static_cast<Eigen::Index>(i)) = X.row(n + held_[i]);
+    return out;
 }
 
 }  // namespace stackbeam::detail::sparse

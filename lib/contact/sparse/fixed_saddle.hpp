@@ -50,17 +50,46 @@ public:
     virtual bool factorize(const SpMat& A) = 0;
     /// x = A^-1 x with the last factorisation.
     virtual void solve_in_place(Eigen::VectorXd& x) = 0;
-    long pivoted = 0;  ///< numeric factorisations with pivoting
-    long reused = 0;   ///< refactorisations on the previous pivot sequence (KLU)
+    /// X = A^-1 X, every column (one pass over the factor for several columns where the LU can).
+    virtual void solve_in_place(Eigen::MatrixXd& X) = 0;
+    /// Whether the current factor is a refactorisation on an old pivot sequence whose pivots
+    /// were not checked (Switches::residual_refactor_check): its solves' backward error is.
+    virtual bool unchecked() const { return false; }
+    /// Factorises A (the matrix of the current factor) afresh with pivoting.
+    virtual bool repivot(const SpMat& A) { return factorize(A); }
+    /// x = A^-1 x (A: the matrix last factorised) with one step of iterative refinement
+    /// against A. On an unchecked refactorisation, a first solve whose normwise backward
+    /// error ||x - A y|| / (||A|| ||y|| + ||x||) (infinity norms) exceeds kMaxBackwardError
+    /// makes it pivot afresh (repivot) and solve again. False if that factorisation failed
+    /// (A singular).
+    bool refined_solve(const SpMat& A, Eigen::VectorXd& x);
+    bool refined_solve(const SpMat& A, Eigen::MatrixXd& X);
+    /// The largest backward error kept from an unchecked refactorisation: a pivoted LU's is
+    /// a few eps times the growth; 1e-11 leaves the refinement step a contraction of at
+    /// least that times the conditioning, the answers those of a fresh factor to round-off.
+    static constexpr double kMaxBackwardError = 1e-11;
+    long pivoted = 0;     ///< numeric factorisations with pivoting
+    long reused = 0;      ///< refactorisations on the previous pivot sequence (KLU)
+    long repivoted = 0;   ///< unchecked refactorisations rejected by the backward error (then pivoted)
+
+protected:
+    bool norm_valid_ = false;  ///< a_norm_ is the current factor's matrix's (reset by factorize)
+
+private:
+    bool accept_solve(const SpMat& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& X);
+    double a_norm_ = 0.0;
 };
 
-/// A PatternLu on `lu` (not off; klu only when klu_built(), else Eigen's).
-std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu);
+/// A PatternLu on `lu` (not off; klu only when klu_built(), else Eigen's). `residual_check`:
+/// KLU keeps a refactorisation on the last pivot sequence by its solves' backward error
+/// (PatternLu::refined_solve) instead of its pivot growth (klu_rgrowth, an O(nnz(U)) pass
+/// per factorisation; Switches::residual_refactor_check).
+std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu, bool residual_check = true);
 
 /// The numeric factorisations of the fixed-pattern system of one (K, G, pairs).
 class FixedSaddle {
 public:
-    explicit FixedSaddle(FixedPatternLu lu) : lu_(make_pattern_lu(lu)) {}
+    explicit FixedSaddle(FixedPatternLu lu, bool residual_check = true) : lu_(make_pattern_lu(lu, residual_check)) {}
     /// A new structure: the pattern of K, of every contact row and of the couplings
     /// (tangential row, normal row) of `couplings`; the ordering is made at the first factor().
     void reset(const SparseStiffness& st, const std::vector<std::pair<int, int>>& couplings);
@@ -71,6 +100,8 @@ public:
     /// x = A_S^-1 r for the variable system's layout (n DOFs, then the held rows in lin.S's
     /// order), with one step of iterative refinement against the fixed-pattern matrix.
     Eigen::VectorXd solve(const Eigen::VectorXd& r);
+    /// The same for each column of R (one multi-column solve).
+    Eigen::MatrixXd solve(const Eigen::MatrixXd& R);
     /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
     /// Orderings and symbolic analyses made since reset() (tests, benchmark).

@@ -152,7 +152,7 @@ void ModeSolver::reset(const SpMat& K, const SpMat& G, const std::vector<std::pa
     lu_primal = false;
     fixed_.reset();
     if (tuning_.fixed_pattern != FixedPatternLu::off) {
-        fixed_ = std::make_unique<FixedSaddle>(tuning_.fixed_pattern);
+        fixed_ = std::make_unique<FixedSaddle>(tuning_.fixed_pattern, tuning_.residual_refactor_check);
         fixed_->reset(st_, couplings);
         const std::vector<int> dof = layer_dofs(st_.K, st_.G);
         layer_row_.assign(m, 0);
@@ -377,17 +377,23 @@ void ModeSolver::direct_solve(const ModeLinearization& lin, const Eigen::VectorX
 /// than tuning_.max_border_rows rows differ.
 bool ModeSolver::try_border(const ModeLinearization& lin) {
     const auto& S = lin.S;
-    if (tuning_.max_border_rows == 0 || !base_valid || !lin.coupled.empty() ||
-        static_cast<int>(S.size()) <= tuning_.schur_max_rows)
+    // on KLU's fixed pattern a new factorisation is a refactorisation (about 10 ms at
+    // 10 x 400) and each changed row a solve of the whole fixed system: a smaller limit
+    // (measured, identical 10 x 400: 150 rows 243, none 194 CPU s per simulated second;
+    // docs/decisions/035)
+    const int limit = lu_fixed && tuning_.fixed_max_border_rows >= 0
+                          ? std::min(tuning_.max_border_rows, tuning_.fixed_max_border_rows)
+                          : tuning_.max_border_rows;
+    if (limit == 0 || !base_valid || !lin.coupled.empty() || static_cast<int>(S.size()) <= tuning_.schur_max_rows)
         return false;
     std::vector<int> rows;
     for (int i : base_S)
         if (pos[i] < 0) rows.push_back(i);
     const int nr = static_cast<int>(rows.size());
-    if (nr > tuning_.max_border_rows) return false;
+    if (nr > limit) return false;
     for (int i : S)
         if (base_pos[i] < 0) rows.push_back(i);
-    if (static_cast<int>(rows.size()) > tuning_.max_border_rows) return false;
+    if (static_cast<int>(rows.size()) > limit) return false;
     border_rows = std::move(rows);
     border_nr = nr;
     border_active = true;
@@ -425,14 +431,38 @@ void ModeSolver::border_solve(const ModeLinearization& lin, const Eigen::VectorX
         for (auto& c : bcol) c.resize(0);
         bcol_count = 0;
     }
+    auto border_column = [&](int j, Eigen::Ref<Eigen::VectorXd> u) {  // U_j
+        const int i = border_rows[static_cast<std::size_t>(j)];
+        u.setZero();
+        if (j < border_nr) u[n + base_pos[i]] = 1.0;
+        else u.head(n) = -scale_of(i) * st_.Gt_scaled.col(i);
+    };
+    if (tuning_.block_border_solves) {
+        // the columns not cached, in blocks: one multi-column solve (and refinement) each,
+        // one pass over the LU's factors per few columns instead of per column
+        std::vector<int> missing;
+        for (int j = 0; j < k; ++j)
+            if (bcol[static_cast<std::size_t>(border_rows[static_cast<std::size_t>(j)])].size() == 0) missing.push_back(j);
+        constexpr std::size_t kBlock = 32;
+        Eigen::MatrixXd Ublk;
+        for (std::size_t j0 = 0; j0 < missing.size(); j0 += kBlock) {
+            const auto nb = static_cast<Eigen::Index>(std::min(kBlock, missing.size() - j0));
+            Ublk.resize(n + ms0, nb);
+            for (Eigen::Index c = 0; c < nb; ++c) border_column(missing[j0 + static_cast<std::size_t>(c)], Ublk.col(c));
+            const Eigen::MatrixXd Y = refined_solve(Ublk);
+            for (Eigen::Index c = 0; c < nb; ++c) {
+                bcol[static_cast<std::size_t>(border_rows[static_cast<std::size_t>(missing[j0 + static_cast<std::size_t>(c)])])] = Y.col(c);
+                ++bcol_count;
+            }
+        }
+    }
     Eigen::MatrixXd C(k, k);
     for (int j = 0; j < k; ++j) {
         const int i = border_rows[static_cast<std::size_t>(j)];
         Eigen::VectorXd& col = bcol[static_cast<std::size_t>(i)];
         if (col.size() == 0) {
-            Eigen::VectorXd u = Eigen::VectorXd::Zero(n + ms0);
-            if (j < border_nr) u[n + base_pos[i]] = 1.0;
-            else u.head(n) = -scale_of(i) * st_.Gt_scaled.col(i);
+            Eigen::VectorXd u(n + ms0);
+            border_column(j, u);
             col = refined_solve(u);
             ++bcol_count;
         }
@@ -766,10 +796,15 @@ Eigen::VectorXd ModeSolver::apply_A(const Eigen::VectorXd& x) const {
 
 Eigen::VectorXd ModeSolver::refined_solve(const Eigen::VectorXd& r) {
     if (lu_fixed) return fixed_->solve(r);
-    Eigen::VectorXd y = lu.solve(r);
-    const Eigen::VectorXd res = r - A * y;
-    y += lu.solve(res);
-    return y;
+    return refined_solve(Eigen::MatrixXd(r)).col(0);
+}
+
+Eigen::MatrixXd ModeSolver::refined_solve(const Eigen::MatrixXd& R) {
+    if (lu_fixed) return fixed_->solve(R);
+    Eigen::MatrixXd Y = lu.solve(R);
+    const Eigen::MatrixXd res = R - A * Y;
+    Y += lu.solve(res);
+    return Y;
 }
 
 }  // namespace stackbeam::detail::sparse

@@ -87,6 +87,16 @@ struct ModeSolverTuning {
     /// each forces an off-diagonal pivot that the pattern's ordering (made for diagonal
     /// pivots) does not foresee (measured: bonded 10 x 400, every row rigid and held, 20x slower)
     int fixed_max_rigid_rows = 200;
+    /// KLU keeps a refactorisation on the old pivot sequence by its solves' backward error,
+    /// not by klu_rgrowth (Switches::residual_refactor_check; docs/decisions/035)
+    bool residual_refactor_check = true;
+    /// the bordered update's new columns A0^-1 U solved together, one multi-column solve
+    /// (Switches::block_border_solves; false: one refined solve per changed row, as before)
+    bool block_border_solves = true;
+    /// the bordered update's limit when the base LU is KLU's on the fixed pattern (the
+    /// smaller of this and max_border_rows; -1: max_border_rows alone, as before;
+    /// Switches::fixed_border_rows)
+    int fixed_max_border_rows = 8;
 };
 
 class ModeSolver {
@@ -142,6 +152,7 @@ private:
     void schur_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
                      Eigen::VectorXd& pS, Eigen::VectorXd& zout);
     Eigen::VectorXd refined_solve(const Eigen::VectorXd& r);
+    Eigen::MatrixXd refined_solve(const Eigen::MatrixXd& R);
     Eigen::VectorXd apply_A(const Eigen::VectorXd& x) const;
     void factor_lu(const modes::ModeLinearization& lin);
     void direct_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& f, const Eigen::VectorXd& dS,

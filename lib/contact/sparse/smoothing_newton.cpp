@@ -118,12 +118,8 @@ bool smoothing_direction(SparsePath& path, const std::vector<SmoothRow>& J, cons
     if (!path.js_lu->factorize(path.Js)) return false;
     Eigen::VectorXd rhs_s = Eigen::VectorXd::Zero(n + m);
     for (int i = 0; i < m; ++i) rhs_s[n + i] = -F[i] / st.row_h[i];
-    Eigen::VectorXd y = rhs_s;
-    path.js_lu->solve_in_place(y);
-    Eigen::VectorXd res = rhs_s - path.Js * y;  // one step of iterative refinement
-    path.js_lu->solve_in_place(res);
-    y += res;
-    if (!y.allFinite()) return false;
+    Eigen::VectorXd y = rhs_s;  // one step of iterative refinement
+    if (!path.js_lu->refined_solve(path.Js, y) || !y.allFinite()) return false;
     dzv = st.dz.cwiseProduct(y.head(n));
     dp = y.tail(m).cwiseQuotient(st.row_h);
     return true;

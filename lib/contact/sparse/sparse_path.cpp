@@ -29,7 +29,8 @@ void SparsePath::reset(const SparseContactProblem& pr) {
     const auto rigid = std::count(layer.begin(), layer.end(), -1);
     js_lu = make_pattern_lu(switches.fixed_pattern == 2 && rigid <= ModeSolverTuning{}.fixed_max_rigid_rows
                                 ? FixedPatternLu::klu
-                                : FixedPatternLu::eigen);
+                                : FixedPatternLu::eigen,
+                            switches.residual_refactor_check);
     const int m = pr.size();
     laws.W.resize(0, 0);
     laws.q = Eigen::VectorXd::Zero(m);

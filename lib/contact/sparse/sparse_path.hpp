@@ -34,6 +34,9 @@ inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& s
     tuning.fixed_pattern = sw.fixed_pattern == 1                 ? FixedPatternLu::eigen
                            : sw.fixed_pattern == 2 && klu_built() ? FixedPatternLu::klu
                                                                   : FixedPatternLu::off;
+    tuning.residual_refactor_check = sw.residual_refactor_check;
+    tuning.block_border_solves = sw.block_border_solves;
+    tuning.fixed_max_border_rows = sw.fixed_border_rows;
     return tuning;
 }
 

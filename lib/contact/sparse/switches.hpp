@@ -48,6 +48,18 @@ struct Switches {
     /// (measured slower than 0); 0 the way before: each held set's own saddle-point system
     /// ordered and factorised from scratch, and Eigen's SparseLU for the smoothing method.
     int fixed_pattern = 2;
+    /// KLU's refactorisation on the last pivot sequence kept by its solves' backward error
+    /// (PatternLu::refined_solve; a rejected one pivots afresh) instead of its pivot growth
+    /// (klu_rgrowth per factorisation): docs/decisions/035. false: the way before.
+    bool residual_refactor_check = true;
+    /// The bordered update of the sparse LU solves its new columns A0^-1 U together (one
+    /// multi-column solve, refined together) instead of one refined solve per changed row
+    /// (docs/decisions/035). false: the way before.
+    bool block_border_solves = true;
+    /// The bordered update's limit (changed rows) when the base LU is KLU's on the fixed
+    /// pattern, whose refactorisation is cheap: at most this many (docs/decisions/035);
+    /// -1: SparsePathTuning::max_border_rows alone, the way before.
+    int fixed_border_rows = 8;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
