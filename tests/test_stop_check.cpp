@@ -1,6 +1,6 @@
 // The caller's stop check (SimulationOptions::stop_requested): a run asked to stop ends
 // promptly with RunStopped at the time it reached, inside the event driver's step loop in mode
-// cvode (between two outputs) and between outputs in every mode.
+// cvode (between two outputs; the event steppers and the held one) and between outputs in every mode.
 #define BOOST_TEST_MODULE stop_check
 #include <boost/test/unit_test.hpp>
 
@@ -43,6 +43,26 @@ BOOST_AUTO_TEST_CASE(cvode_run_stops_inside_a_step) {
         BOOST_TEST(e.time_s() > 0.0);
         BOOST_TEST(e.time_s() < o.t_end_s);
         BOOST_TEST(std::string(e.what()).find("stopped on request") != std::string::npos);
+    }
+}
+
+// The held stepper (steel leaves on the bonded stack: every pair held, no events) runs in the
+// same driver loop: asked to stop at the 3rd poll, it stops after 128 of its CVODE steps (the
+// 0.6 s take about 20,000: BDF on the leaf modes), inside the single output interval.
+BOOST_AUTO_TEST_CASE(cvode_held_run_stops_inside_a_step) {
+    const System s(Model::build(paper_with_mass(PaperCase::bonded, 7850.0, false)));
+    SimulationOptions o = cvode_options();
+    int polls = 0;
+    o.stop_requested = [&polls] { return ++polls >= 3; };
+    try {
+        simulate(s, o);
+        BOOST_FAIL("the run did not stop");
+    } catch (const RunStopped& e) {
+        BOOST_TEST(polls == 3);
+        BOOST_TEST(e.step() >= 2 * 64);
+        BOOST_TEST(e.step() < 3 * 64);
+        BOOST_TEST(e.time_s() > 0.0);
+        BOOST_TEST(e.time_s() < o.t_end_s);
     }
 }
 

@@ -543,7 +543,12 @@ bool EventDriver::step_once() {
     if (t_ >= t_final_) return false;
     double tret = t_;
     const auto t_cv = Clock::now();
-    const int flag = cvode_->advance(t_final_, CV_ONE_STEP, opt_.cvode.max_steps, tret);
+    // CVODE's tout matters only to its estimate of a first step (at most a tenth of the distance
+    // to tout): with events, the run's end, so that a restart at an event just before an output
+    // is not held to a tiny first step; without events (one start, no restart) the first output,
+    // the horizon an output-to-output loop gives it (the held stepper's figures were made so).
+    const double tout = ev_ ? t_final_ : output_time(out_index_ + 1);
+    const int flag = cvode_->advance(tout, CV_ONE_STEP, opt_.cvode.max_steps, tret);
     stats_.cvode_time_s += seconds_since(t_cv);
     const CvodeCounters& cc = cvode_->counters();
     stats_.steps = cc.steps;
