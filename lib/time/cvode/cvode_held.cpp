@@ -3,8 +3,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "fe/tied_shape.hpp"
 #include "stackbeam/errors.hpp"

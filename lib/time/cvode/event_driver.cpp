@@ -198,7 +198,7 @@ void EventDriver::decide_initial_modes(const InitialState& stage, const EventSta
     init_slots();
     chk_solver_ = make_solver(opt_.solver);
     ev_solver_ = make_solver(event_solver_options(opt_.solver, ev_tolerance_));
-    const Vec y0 = s.y0;
+    const Vec& y0 = s.y0;
     Vec p = stage.p;
     if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
         ev_problem_.q = ev_->motion(y0) - d_;

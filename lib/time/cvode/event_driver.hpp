@@ -1,7 +1,7 @@
 #pragma once
-// Internal: the one event driver of the event-driven cvode steppers (cvode_stepper.hpp for
-// the method; docs/decisions/029-event-driver-hooks.md): CVODE between contact events with
-// root-finding on the witnesses (decreasing crossings), the contact iteration deciding the
+// Internal: the one driver of every cvode stepper (cvode_stepper.hpp for the method;
+// docs/decisions/029-event-driver-hooks.md, 033-held-stepper-in-the-driver.md): CVODE
+// between contact events with root-finding on the witnesses (decreasing crossings), the contact iteration deciding the
 // modes at an event on the look-ahead problem, the per-step check of every accepted step,
 // bisection of a missed event on CVODE's dense output, restarts (CVodeReInit), the event log,
 // the records on the dt grid and the caller's stop check (SimulationOptions::stop_requested).
@@ -10,12 +10,16 @@
 // (CVODE's memory, the modes and anchors, the contact problems and solvers, the pending
 // records, the clocks and counters). A stepper derives from it, builds its operators in its
 // constructor, hands the driver one EventStart value (start()) and implements the fixed hooks
-// below, which read the driver's state through const accessors and never write it:
+// below (the ODE's; those of the contact events in ContactEventHooks, which a stepper whose
+// pairs never change mode leaves out), which read the driver's state through const accessors
+// and never write it:
 //  - the massless stepper (cvode_stepper.cpp): y = [w, w', D (, W_e)], the contact
 //    problem driven by R's displacement, s = C'p + c w - d;
 //  - the modal one with leaf inertia (cvode_modal.cpp): y = [q, q', D (, X, t)], driven by
 //    the retained modes, s = W p + G Phi q (+ Hq u(t)) - d;
-//  - the massive stack (cvode_massive.cpp): y = [z, z', D, D_c, W], s = G z + C_L p - d.
+//  - the massive stack (cvode_massive.cpp): y = [z, z', D, D_c, W], s = G z + C_L p - d;
+//  - the held stack (cvode_held.cpp): y = the held stack's modes in energy-norm coordinates,
+//    every pair held for good: no event hooks, SUNDIALS' band solver (NewtonSolver::band).
 #include <Eigen/Dense>
 #include <chrono>
 #include <deque>
@@ -179,10 +183,10 @@ public:
 protected:
     /// `who` prefixes the messages ("cvode mode", "cvode mode (leaf inertia)").
     EventDriver(const System& system, const SimulationOptions& options, std::string who);
-    /// Starts the run (once, at the end of the stepper's constructor): the grid, the witness
-    /// slots, the contact problems on `s.compliance`, the anchors of the set-up stage, CVODE on
-    /// s.y0, the initial modes decided a look-ahead on (cause "start"), started() and
-    /// tolerances(), the record at t = 0.
+    /// Starts the run (once, at the end of the stepper's constructor): the grid, the contact
+    /// problems on `s.compliance`, the anchors of the set-up stage, CVODE on s.y0; with event
+    /// hooks (s.events) the witness slots, the contact solvers and the initial modes decided a
+    /// look-ahead on (cause "start"); then started() and tolerances(), the record at t = 0.
     void start(const InitialState& stage, const EventStart& s);
 
     // ---- what the hooks read ------------------------------------------------------------
