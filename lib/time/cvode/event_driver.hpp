@@ -1,10 +1,11 @@
 #pragma once
 // Internal: the one driver of every cvode stepper (cvode_stepper.hpp for the method;
 // docs/decisions/029-event-driver-hooks.md, 033-held-stepper-in-the-driver.md): CVODE
-// between contact events with root-finding on the witnesses (decreasing crossings), the contact iteration deciding the
-// modes at an event on the look-ahead problem, the per-step check of every accepted step,
-// bisection of a missed event on CVODE's dense output, restarts (CVodeReInit), the event log,
-// the records on the dt grid and the caller's stop check (SimulationOptions::stop_requested).
+// between contact events with root-finding on the witnesses (decreasing crossings), the
+// contact iteration deciding the modes at an event on the look-ahead problem, the per-step
+// check of every accepted step, bisection of a missed event on CVODE's dense output, restarts
+// (CVodeReInit), the event log, the records on the dt grid and the caller's stop check
+// (SimulationOptions::stop_requested).
 //
 // As Drake's IntegratorBase and its DoStep: the driver owns every piece of run state privately
 // (CVODE's memory, the modes and anchors, the contact problems and solvers, the pending
@@ -155,7 +156,6 @@ struct EventStart {
 
 class EventDriver : public EventTypes {
 public:
-
     virtual ~EventDriver();
     EventDriver(const EventDriver&) = delete;
     EventDriver& operator=(const EventDriver&) = delete;
