@@ -13,39 +13,26 @@
 // analytic (constant) Jacobian [0 I; -B 0], B = (N^T M N)^-1 N^T K N; in the modal
 // coordinates of B it is block diagonal (2 x 2 blocks), so the direct solver is a band one
 // (half-bandwidths 1, 1).
+// The event driver (event_driver.hpp) runs it with no contact event hooks (EventStart::events
+// null: zero witnesses, no per-step contact check) and SUNDIALS' band solver on the Jacobian
+// above (NewtonSolver::band).
 // Stacks with friction (pairs that may stick or slip) run CvodeModalStepper (cvode_modal.hpp);
 // its row of the registry (stepper_registry.hpp) takes no friction.
-#include <Eigen/Dense>
-#include <memory>
-#include <vector>
-
-#include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
-#include "stackbeam/time/stepper.hpp"
+#include "time/cvode/event_driver.hpp"
 #include "time/initial_state.hpp"
 
 namespace stackbeam::detail {
 
-class CvodeHeldStepper final : public Stepper {
+/// Mode "cvode" with leaf inertia on bonded and frictionless stacks (above): the event driver
+/// (event_driver.hpp) without contact events, CVODE's BDF with the band direct solver.
+class CvodeHeldStepper final : public EventStepper {
 public:
     /// From the shared set-up stage's state (initial_state.hpp; the options checked there).
     CvodeHeldStepper(const System& system, const InitialState& start);
-    ~CvodeHeldStepper() override;
-    /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    /// The pairs at the last output: the held components' forces, relative positions G z.
-    std::vector<PairRecord> pairs() const override;
-    /// The leaves' nodes at the last output: z = z_p + N Phi xi.
-    std::vector<LeafNodes> nodes() const override;
-    /// CVODE's steps and counters (no contact iterations, no events: the modes never change).
-    RunReport report() const override;
-    const CvodeStats& stats() const noexcept;
 
 private:
     struct Impl;
-    std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace stackbeam::detail

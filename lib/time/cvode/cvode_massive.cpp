@@ -80,7 +80,7 @@ using RowSpMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 }  // namespace
 
-struct CvodeMassiveStepper::Impl final : EventDriver {
+struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     Impl(const System& system, const InitialState& start);
 
     SpMat K, M, Gt;
@@ -394,6 +394,7 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * cL.maxCoeff();
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
     es.stiff_max_order = 2;  // BDF order <= 2, Newton on newton_setup / newton_solve (file comment)
+    es.events = this;  // contact events (ContactEventHooks)
     this->start(start, es);
 }
 

@@ -49,7 +49,7 @@
 
 namespace stackbeam::detail {
 
-struct CvodeModalStepper::Impl final : EventDriver {
+struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
     Impl(const System& system, const InitialState& start);
 
     int r = 0;                // retained modes
@@ -372,6 +372,7 @@ CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
     // the gap witnesses' margin: kMotionMargin, or ten times the decisions' displacement
     // resolution if that is coarser (a gap the contact iteration cannot see closing must not count as closed)
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
+    es.events = this;  // contact events (ContactEventHooks)
     this->start(start, es);
 }
 

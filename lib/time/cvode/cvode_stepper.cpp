@@ -33,7 +33,7 @@ bool ContactEvent::is_stick_slip() const {
     return fr(from) && fr(to);
 }
 
-struct CvodeStepper::Impl final : detail::EventDriver {
+struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks {
     const Eigen::MatrixXd& C;  // C' [m/N]
     Eigen::VectorXd c;         // coupling [-]
     double k = 0, m = 0;       // R's spring [N/m] and mass [kg] of the meshed part
@@ -68,6 +68,7 @@ struct CvodeStepper::Impl final : detail::EventDriver {
         // ||v|| of an exact active-set answer is LU round-off, ~cond(C') 1e-16 L_ref ~ 1e-11 L_ref;
         // 1e-10 L_ref accepts it and still resolves the look-ahead (1e-7 L_ref) a thousandfold.
         es.event_tolerance_m = 1e-10 * es.scales.L_ref_m;
+        es.events = this;  // contact events (ContactEventHooks)
         es.resolve_initial_forces = false;  // the stage solved the forces with R held at w(0) (exact)
         this->start(start, es);
     }

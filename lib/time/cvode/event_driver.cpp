@@ -106,16 +106,15 @@ void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance
     chk_problem_.tau_previous_n = Vec::Zero(np_);
     chk_problem_.q = Vec::Zero(n_);  // sized: ModeSet::linearize takes n from it
     ev_problem_ = chk_problem_;
-    chk_solver_ = make_solver(opt_.solver);
     ev_tolerance_ = event_tolerance_m;
-    ev_solver_ = make_solver(event_solver_options(opt_.solver, ev_tolerance_));
 }
 
-void EventDriver::start_cvode(int stiff_max_order) {
-    cvode_->create(stiff_max_order > 0 ? CV_BDF : CV_ADAMS, &EventDriver::rhs_of, this, opt_.cvode.rtol);
-    if (stiff_max_order > 0) {
-        cvode_->use_embedded_newton(&EventDriver::psetup_of, &EventDriver::psolve_of, this);
-        cvode_->set_max_order(stiff_max_order);
+void EventDriver::start_cvode(const EventStart& s) {
+    cvode_->create(s.stiff_max_order > 0 ? CV_BDF : CV_ADAMS, &EventDriver::rhs_of, this, opt_.cvode.rtol);
+    if (s.stiff_max_order > 0) {
+        if (s.newton == NewtonSolver::band) cvode_->use_band_newton(s.band_upper, s.band_lower, &EventDriver::band_jacobian_of);
+        else cvode_->use_embedded_newton(&EventDriver::psetup_of, &EventDriver::psolve_of, this);
+        cvode_->set_max_order(s.stiff_max_order);
     } else {
         cvode_->use_fixed_point();
     }
@@ -131,7 +130,7 @@ int EventDriver::rhs_of(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
 
 int EventDriver::roots_of(sunrealtype, N_Vector y, sunrealtype* g, void* user) {
     const auto* self = static_cast<const EventDriver*>(user);
-    self->witnesses(Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate_), g);
+    self->ev_->witnesses(Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate_), g);
     return 0;
 }
 
@@ -147,14 +146,23 @@ int EventDriver::psolve_of(sunrealtype t, N_Vector y, N_Vector, N_Vector r, N_Ve
                                                                 N_VGetArrayPointer(x), gamma);
 }
 
+int EventDriver::band_jacobian_of(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
+                                  N_Vector) {
+    const auto* self = static_cast<const EventDriver*>(user);
+    BandMatrixView view(J);
+    if (view.set_zero() != SUNMAT_SUCCESS) return -1;
+    return self->band_jacobian(t, Eigen::Map<const Vec>(N_VGetArrayPointer(y), self->nstate_), view);
+}
+
 int EventDriver::newton_setup(double) { return -1; }
 int EventDriver::newton_solve(double, const double*, const double*, double*, double) const { return -1; }
+int EventDriver::band_jacobian(double, const State&, BandMatrixView) const { return -1; }
 void EventDriver::started(const State&) {}
 
 void EventDriver::rebuild() {
     ModeLinearization lin;
     modes_.linearize(chk_problem_, lin);
-    build_mode(lin);
+    ev_->build_mode(lin);
     ++stats_.mode_factorizations;
     ++facts_since_;
 }
@@ -165,33 +173,41 @@ SolverError EventDriver::failure(const std::string& what) const {
 
 void EventDriver::start(const InitialState& stage, const EventStart& s) {
     nstate_ = s.nstate;
+    ev_ = s.events;
     scales_ = s.scales;
     gap_margin_ = s.gap_margin;
     stats_.retained_modes = s.retained_modes;
     stats_.modal_cutoff_rad_per_s = s.modal_cutoff_rad_per_s;
     init_grid();  // as the closed-form mode's steps
-    init_slots();
     init_problems(s.compliance, s.event_tolerance_m);
     d_ = stage.d;  // the anchors of the set-up stage (gravity's static step, R held at w(0))
     cvode_ = std::make_unique<CvodeSession>(who_, nstate_);
     cvode_->y() = s.y0;
     const Vec y0 = s.y0;
-    Vec p = stage.p;
-    if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
-        ev_problem_.q = motion(y0) - d_;
-        const SolveResult r0 = ev_solver_->solve(ev_problem_, p);
-        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
-    }
-    modes_from_solution(chk_problem_, p, 1e-12 * scales_.F_ref_n, modes_.nmode, modes_.tmode);
-    if (s.resolve_initial_forces) rebuild();
-    decide_modes(0.0, y0, p, "start");
+    if (ev_) decide_initial_modes(stage, s);  // without events the stage's modes hold throughout
     started(y0);
     tolerances(y0, cvode_->atol());
     record_ = record_at(0.0, y0, p_out_, rel_out_);
     y_out_ = y0;
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
-    start_cvode(s.stiff_max_order);
+    start_cvode(s);
+}
+
+void EventDriver::decide_initial_modes(const InitialState& stage, const EventStart& s) {
+    init_slots();
+    chk_solver_ = make_solver(opt_.solver);
+    ev_solver_ = make_solver(event_solver_options(opt_.solver, ev_tolerance_));
+    const Vec& y0 = s.y0;
+    Vec p = stage.p;
+    if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
+        ev_problem_.q = ev_->motion(y0) - d_;
+        const SolveResult r0 = ev_solver_->solve(ev_problem_, p);
+        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
+    }
+    modes_from_solution(chk_problem_, p, 1e-12 * scales_.F_ref_n, modes_.nmode, modes_.tmode);
+    if (s.resolve_initial_forces) rebuild();
+    decide_modes(0.0, y0, p, "start");
 }
 
 StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) {
@@ -199,7 +215,7 @@ StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) 
     rec.t_s = tau;
     rec.contact_iterations = static_cast<int>(iters_since_);
     rec.factorizations = static_cast<int>(facts_since_);
-    rec.contact_residual_m = last_check_residual_;
+    if (ev_) rec.contact_residual_m = last_check_residual_;  // else the stepper's (EventStart::events)
     iters_since_ = facts_since_ = 0;
     return rec;
 }
@@ -218,10 +234,10 @@ void EventDriver::enter(const Vec& rel, const std::vector<signed char>& nm, cons
     modes_.tmode = tm;
 }
 
-void EventDriver::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
+void ContactEventHooks::correct_decision(const State&, const Vec&, std::vector<signed char>&, std::vector<signed char>&) {}
 
-bool EventDriver::settle_at_state() const { return false; }
-bool EventDriver::settle_after_missed_event() const { return false; }
+bool ContactEventHooks::settle_at_state() const { return false; }
+bool ContactEventHooks::settle_after_missed_event() const { return false; }
 
 void EventDriver::in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm,
                                      const std::vector<signed char>& tm, bool build, const std::function<void()>& body) {
@@ -313,16 +329,16 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
                                const std::vector<int>* triggered) {
     const auto t_start = Clock::now();
     const double contact_before = stats_.contact_time_s;
-    const Vec rel = relative_at_event(y, p_cur);  // s + d
+    const Vec rel = ev_->relative_at_event(y, p_cur);  // s + d
     // Incremental problem a look-ahead away: stuck pairs keep their anchors, every
     // other pair is anchored where it is (paper, section 5).
-    const Vec y_la = look_ahead(te, y, p_cur);
+    const Vec y_la = ev_->look_ahead(te, y, p_cur);
     Vec d_la = d_;
     for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
         if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
     }
-    ev_problem_.q = motion(y_la) - d_la;
+    ev_problem_.q = ev_->motion(y_la) - d_la;
 
     std::vector<signed char> nm, tm;
     bool decided = false;
@@ -333,10 +349,10 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         // restored either way: the log below compares with the old modes
         in_candidate_modes(rel, nm, tm, true, [&] {
             // the stop test of the contact iteration at the look-ahead, and every witness
-            const Vec pl = forces(y_la);
-            const double v = error_vector(ev_problem_, pl, Vec(relative(y_la) - d_la)).norm();
+            const Vec pl = ev_->forces(y_la);
+            const double v = error_vector(ev_problem_, pl, Vec(ev_->relative(y_la) - d_la)).norm();
             std::vector<double> g(slots_.size());
-            if (!slots_.empty()) witnesses(y_la, g.data());
+            if (!slots_.empty()) ev_->witnesses(y_la, g.data());
             decided = v < ev_tolerance_ && std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
         });
         ++stats_.contact_iterations;
@@ -355,7 +371,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
                                   ") did not converge: " + res.message + mesh_note(sys_.model()),
                               stats_.steps, t_, res.residual_m);
         modes_from_solution(chk_problem_, p_sol, 1e-12 * scales_.F_ref_n, nm, tm);
-        correct_decision(y, rel, nm, tm);
+        ev_->correct_decision(y, rel, nm, tm);
     };
     if (!decided) decide_by_solving("deciding the modes");
 
@@ -369,13 +385,13 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     // The modal stepper does this only at a missed event (settle_after_missed_event): there the
     // look-ahead's decision can leave a witness negative at y (a force grazing its cone, back
     // inside a look-ahead later), and root-finding, seeing no sign change, would never leave it.
-    if ((settle_at_state() || (settle_after_missed_event() && cause == "check")) && !slots_.empty()) {
+    if ((ev_->settle_at_state() || (ev_->settle_after_missed_event() && cause == "check")) && !slots_.empty()) {
         std::vector<double> g(slots_.size());
         for (int pass = 0; pass < kSettlePasses; ++pass) {
             bool changed = false;
             in_candidate_modes(rel, nm, tm, pass > 0 || !decided, [&] {
-                witnesses(y, g.data());
-                changed = apply_slot_transitions([&](std::size_t i) { return g[i] < 0.0; }, forces(y), nm, tm);
+                ev_->witnesses(y, g.data());
+                changed = apply_slot_transitions([&](std::size_t i) { return g[i] < 0.0; }, ev_->forces(y), nm, tm);
             });
             decided = true;  // the factorisation is of (nm, tm)
             if (!changed) break;
@@ -389,12 +405,12 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         if (!decided) {
             bool holds = false;
             in_candidate_modes(rel, nm, tm, true, [&] {
-                witnesses(y, g.data());
+                ev_->witnesses(y, g.data());
                 holds = std::all_of(g.begin(), g.end(), [](double x) { return x >= 0.0; });
             });
             decided = true;
             if (!holds) {
-                ev_problem_.q = motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
+                ev_problem_.q = ev_->motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
                 decide_by_solving("at the state");
                 decided = false;
                 ++stats_.settled_transitions;
@@ -404,7 +420,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
 
     // Log the transitions, enter the new modes, refactorise (unless the candidate was).
     double w = 0.0, wd = 0.0;
-    body_motion(y, p_cur, w, wd);
+    ev_->body_motion(y, p_cur, w, wd);
     for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
         if (cp.kind == PairKind::bonded) continue;
@@ -424,15 +440,15 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     }
     enter(rel, nm, tm);
     if (!decided) rebuild();
-    after_event(cause, p_cur, forces(y));
+    ev_->after_event(cause, p_cur, ev_->forces(y));
     reset_check_anchors(y);
     stats_.event_time_s += seconds_since(t_start) - (stats_.contact_time_s - contact_before);
 }
 
 void EventDriver::reset_check_anchors(const State& y) {
     d_chk_ = d_;
-    if (n_ == 0) return;
-    const Vec rel = relative(y);
+    if (n_ == 0 || !ev_) return;
+    const Vec rel = ev_->relative(y);
     for (int kk = 0; kk < np_; ++kk) {
         const auto& cp = pairs()[kk];
         if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_chk_[cp.row_t] = rel[cp.row_t];
@@ -444,13 +460,13 @@ void EventDriver::reset_check_anchors(const State& y) {
 /// `residual` gets ||v|| (eq. 9).
 bool EventDriver::modes_hold(const State& y, double& residual, bool* witnesses_ok) {
     std::vector<double> g(slots_.size());
-    if (!slots_.empty()) witnesses(y, g.data());
+    if (!slots_.empty()) ev_->witnesses(y, g.data());
     residual = 0.0;
     if (n_ > 0) {
-        const Vec p = forces(y);
-        chk_problem_.q = motion(y) - d_chk_;
+        const Vec p = ev_->forces(y);
+        chk_problem_.q = ev_->motion(y) - d_chk_;
         // s = (s + d) - d_chk, affine in the state: no product with the compliance
-        residual = error_vector(chk_problem_, p, Vec(relative(y) - d_chk_)).norm();
+        residual = error_vector(chk_problem_, p, Vec(ev_->relative(y) - d_chk_)).norm();
     }
     const bool positive = std::all_of(g.begin(), g.end(), [](double v) { return v >= 0.0; });
     if (witnesses_ok) *witnesses_ok = positive;
@@ -492,30 +508,8 @@ void EventDriver::note_event_time(double te) {
     ++stats_.events;
 }
 
-/// One CVODE step and what follows it; returns false at the end of the run.
-bool EventDriver::step_once() {
-    if (t_ >= t_final_) return false;
-    double tret = t_;
-    const auto t_cv = Clock::now();
-    const int flag = cvode_->advance(t_final_, CV_ONE_STEP, opt_.cvode.max_steps, tret);
-    stats_.cvode_time_s += seconds_since(t_cv);
-    const CvodeCounters& cc = cvode_->counters();
-    stats_.steps = cc.steps;
-    stats_.rhs_evaluations = cc.rhs_evaluations;
-    stats_.root_evaluations = cc.root_evaluations;
-    const Vec y = cvode_->y();
-
-    if (flag == CV_ROOT_RETURN) {
-        emit_until(tret);  // the old modes hold up to the root
-        t_ = tret;
-        note_event_time(tret);
-        std::vector<int> found(slots_.size(), 0);
-        cvode_->root_info(found);
-        decide_modes(tret, y, forces(y), "root", &found);
-        restart(tret, y);
-        return true;
-    }
-
+/// The per-step check of an accepted step at state y; true when the modes hold there.
+bool EventDriver::step_keeps_modes(const Vec& y) {
     // The contact iteration at the accepted step (the configured solver; the paper's
     // projected iteration by default) on the paper's incremental problem, warm-started
     // at the mode solution. Its first act is its stop test, ||v|| < tolerance at the
@@ -529,7 +523,7 @@ bool EventDriver::step_once() {
     stats_.max_check_residual_m = std::max(stats_.max_check_residual_m, residual);
     last_check_residual_ = residual;
     if (!ok && witnesses_ok && n_ > 0) {
-        const Vec pm = forces(y);
+        const Vec pm = ev_->forces(y);
         Vec p = pm;
         const SolveResult res = chk_solver_->solve(chk_problem_, p);  // q was set by modes_hold
         stats_.contact_iterations += res.iterations;
@@ -541,7 +535,40 @@ bool EventDriver::step_once() {
         if (ok) stats_.max_check_force_difference_n = std::max(stats_.max_check_force_difference_n, (p - pm).lpNorm<Eigen::Infinity>());
     }
     stats_.contact_time_s += seconds_since(t_check);
-    if (ok) {
+    return ok;
+}
+
+/// One CVODE step and what follows it; returns false at the end of the run.
+bool EventDriver::step_once() {
+    if (t_ >= t_final_) return false;
+    double tret = t_;
+    const auto t_cv = Clock::now();
+    // CVODE's tout matters only to its estimate of a first step (at most a tenth of the distance
+    // to tout): with events, the run's end, so that a restart at an event just before an output
+    // is not held to a tiny first step; without events (one start, no restart) the first output,
+    // the horizon an output-to-output loop gives it (the held stepper's figures were made so).
+    const double tout = ev_ ? t_final_ : output_time(out_index_ + 1);
+    const int flag = cvode_->advance(tout, CV_ONE_STEP, opt_.cvode.max_steps, tret);
+    stats_.cvode_time_s += seconds_since(t_cv);
+    const CvodeCounters& cc = cvode_->counters();
+    stats_.steps = cc.steps;
+    stats_.rhs_evaluations = cc.rhs_evaluations;
+    stats_.root_evaluations = cc.root_evaluations;
+    const Vec y = cvode_->y();
+
+    if (flag == CV_ROOT_RETURN) {
+        emit_until(tret);  // the old modes hold up to the root
+        t_ = tret;
+        note_event_time(tret);
+        std::vector<int> found(slots_.size(), 0);
+        cvode_->root_info(found);
+        decide_modes(tret, y, ev_->forces(y), "root", &found);
+        restart(tret, y);
+        return true;
+    }
+
+    // Without events (EventStart::events null) every accepted step keeps the modes.
+    if (!ev_ || step_keeps_modes(y)) {
         emit_until(tret);
         t_ = tret;
         reset_check_anchors(y);
@@ -565,7 +592,7 @@ bool EventDriver::step_once() {
     t_ = hi;
     ++stats_.missed_events;
     note_event_time(hi);
-    decide_modes(hi, ye, forces(ye), "check");
+    decide_modes(hi, ye, ev_->forces(ye), "check");
     restart(hi, ye);
     return true;
 }

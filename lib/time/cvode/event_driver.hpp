@@ -1,21 +1,26 @@
 #pragma once
-// Internal: the one event driver of the event-driven cvode steppers (cvode_stepper.hpp for
-// the method; docs/decisions/029-event-driver-hooks.md): CVODE between contact events with
-// root-finding on the witnesses (decreasing crossings), the contact iteration deciding the
-// modes at an event on the look-ahead problem, the per-step check of every accepted step,
-// bisection of a missed event on CVODE's dense output, restarts (CVodeReInit), the event log,
-// the records on the dt grid and the caller's stop check (SimulationOptions::stop_requested).
+// Internal: the one driver of every cvode stepper (cvode_stepper.hpp for the method;
+// docs/decisions/029-event-driver-hooks.md, 033-held-stepper-in-the-driver.md): CVODE
+// between contact events with root-finding on the witnesses (decreasing crossings), the
+// contact iteration deciding the modes at an event on the look-ahead problem, the per-step
+// check of every accepted step, bisection of a missed event on CVODE's dense output, restarts
+// (CVodeReInit), the event log, the records on the dt grid and the caller's stop check
+// (SimulationOptions::stop_requested).
 //
 // As Drake's IntegratorBase and its DoStep: the driver owns every piece of run state privately
 // (CVODE's memory, the modes and anchors, the contact problems and solvers, the pending
 // records, the clocks and counters). A stepper derives from it, builds its operators in its
 // constructor, hands the driver one EventStart value (start()) and implements the fixed hooks
-// below, which read the driver's state through const accessors and never write it:
+// below (the ODE's; those of the contact events in ContactEventHooks, which a stepper whose
+// pairs never change mode leaves out), which read the driver's state through const accessors
+// and never write it:
 //  - the massless stepper (cvode_stepper.cpp): y = [w, w', D (, W_e)], the contact
 //    problem driven by R's displacement, s = C'p + c w - d;
 //  - the modal one with leaf inertia (cvode_modal.cpp): y = [q, q', D (, X, t)], driven by
 //    the retained modes, s = W p + G Phi q (+ Hq u(t)) - d;
-//  - the massive stack (cvode_massive.cpp): y = [z, z', D, D_c, W], s = G z + C_L p - d.
+//  - the massive stack (cvode_massive.cpp): y = [z, z', D, D_c, W], s = G z + C_L p - d;
+//  - the held stack (cvode_held.cpp): y = the held stack's modes in energy-norm coordinates,
+//    every pair held for good: no event hooks, SUNDIALS' band solver (NewtonSolver::band).
 #include <Eigen/Dense>
 #include <chrono>
 #include <deque>
@@ -71,6 +76,61 @@ ScaleInputs leaf_mass_scale_inputs(const System& system, const Loading& loading)
 /// The largest |F(t)| of a time function (mean + amplitude, table values) [its unit].
 double largest_value(const TimeFunction& F);
 
+/// The driver's and the hooks' vector types (one declaration, so a stepper deriving from both
+/// names them unambiguously).
+struct EventTypes {
+    using Vec = Eigen::VectorXd;
+    using State = Eigen::Ref<const Eigen::VectorXd>;
+};
+
+/// The hooks of a stepper whose contact modes change at events (EventStart::events): the
+/// contact side of the modes, the witnesses and the decisions at an event. A stepper whose
+/// pairs keep their modes for the whole run (every pair held in its operators) has none: it
+/// leaves EventStart::events null and the driver integrates its ODE without witnesses, per-step
+/// contact check or mode decisions. The hooks read the driver's state through its const
+/// accessors (the stepper derives from both) and never write it.
+class ContactEventHooks : public EventTypes {
+public:
+    virtual ~ContactEventHooks() = default;
+
+    /// Builds the current modes' operators from their linearisation (ModeSet::linearize of the
+    /// laws: held rows S, p = T p_S + e). The driver counts the factorisation.
+    virtual void build_mode(const ModeLinearization& lin) = 0;
+    /// Contact forces p [N] of the current modes at state y.
+    virtual Vec forces(const State& y) const = 0;
+    /// s + d [m] of the current modes at y (affine in the state).
+    virtual Vec relative(const State& y) const = 0;
+    /// s + d [m] at an event from the forces p_cur (before the modes are decided).
+    virtual Vec relative_at_event(const State& y, const Vec& p_cur) const = 0;
+    /// The motion's part of s + d: c w, G Phi q, G z [m].
+    virtual Vec motion(const State& y) const = 0;
+    /// Witness functions at y, positive while the modes hold.
+    virtual void witnesses(const State& y, double* g) const = 0;
+    /// The state a short look-ahead after (te, y): the contact points move by ~kLookahead L_ref.
+    virtual Vec look_ahead(double te, const State& y, const Vec& p_cur) const = 0;
+    /// R's displacement and velocity at y (for the event log).
+    virtual void body_motion(const State& y, const Vec& p_cur, double& w, double& wd) const = 0;
+    /// After the exact solver's decision (nm, tm) at y (rel: s + d there): corrections of
+    /// the stepper (default none).
+    virtual void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
+                                  std::vector<signed char>& tm);
+    /// True when the state y alone decides every pair's modes (no instantaneous coupling but
+    /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
+    virtual bool settle_at_state() const;
+    /// As settle_at_state, only at the events the per-step check found (cause "check"): a
+    /// decision at the look-ahead that leaves a witness negative at the state would restart
+    /// into the same missed event (default false).
+    virtual bool settle_after_missed_event() const;
+    /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
+    virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
+};
+
+/// How CVODE's Newton iteration solves its linear systems (EventStart::newton).
+enum class NewtonSolver {
+    stepper,  ///< the stepper's newton_setup / newton_solve (a matrix-embedded linear solver)
+    band,     ///< SUNDIALS' band direct solver on the stepper's band_jacobian
+};
+
 /// What a stepper hands the driver once its operators are built (EventDriver::start).
 struct EventStart {
     int nstate = 0;                      ///< CVODE's state size
@@ -82,16 +142,20 @@ struct EventStart {
     /// true: the forces at t = 0 are re-solved from the stage's (event solver, at the motion of
     /// y0) and the modes built before they are decided; false: the stage's forces are those at y0.
     bool resolve_initial_forces = true;
-    int stiff_max_order = 0;             ///< 0: Adams with fixed point; else BDF to this order, Newton hooks
+    /// The stepper's event hooks (a stepper deriving from ContactEventHooks: `this`); null: every
+    /// pair keeps the set-up stage's mode for the whole run, held in the stepper's operators, so
+    /// there are zero witness functions, no per-step contact check, no mode decisions and no
+    /// events; the records' contact residual is then the stepper's own (make_record).
+    ContactEventHooks* events = nullptr;
+    int stiff_max_order = 0;             ///< 0: Adams with fixed point; else BDF to this order with Newton
+    NewtonSolver newton = NewtonSolver::stepper;  ///< BDF's linear solver
+    int band_upper = 0, band_lower = 0;  ///< the band solver's half-bandwidths (NewtonSolver::band)
     int retained_modes = 0;              ///< CvodeStats (modal stepper)
     double modal_cutoff_rad_per_s = 0.0; ///< CvodeStats (modal stepper)
 };
 
-class EventDriver {
+class EventDriver : public EventTypes {
 public:
-    using Vec = Eigen::VectorXd;
-    using State = Eigen::Ref<const Eigen::VectorXd>;
-
     virtual ~EventDriver();
     EventDriver(const EventDriver&) = delete;
     EventDriver& operator=(const EventDriver&) = delete;
@@ -119,10 +183,10 @@ public:
 protected:
     /// `who` prefixes the messages ("cvode mode", "cvode mode (leaf inertia)").
     EventDriver(const System& system, const SimulationOptions& options, std::string who);
-    /// Starts the run (once, at the end of the stepper's constructor): the grid, the witness
-    /// slots, the contact problems on `s.compliance`, the anchors of the set-up stage, CVODE on
-    /// s.y0, the initial modes decided a look-ahead on (cause "start"), started() and
-    /// tolerances(), the record at t = 0.
+    /// Starts the run (once, at the end of the stepper's constructor): the grid, the contact
+    /// problems on `s.compliance`, the anchors of the set-up stage, CVODE on s.y0; with event
+    /// hooks (s.events) the witness slots, the contact solvers and the initial modes decided a
+    /// look-ahead on (cause "start"); then started() and tolerances(), the record at t = 0.
     void start(const InitialState& stage, const EventStart& s);
 
     // ---- what the hooks read ------------------------------------------------------------
@@ -175,43 +239,18 @@ protected:
     /// Notes the largest force jump at an event [N] without booking energy (the massless layer).
     void note_force_jump(const Vec& p_cur, const Vec& p_new);
 
-    // ---- the hooks: what differs between the steppers -----------------------------------
-    /// Builds the current modes' operators from their linearisation (ModeSet::linearize of the
-    /// laws: held rows S, p = T p_S + e). The driver counts the factorisation.
-    virtual void build_mode(const ModeLinearization& lin) = 0;
-    /// Contact forces p [N] of the current modes at state y.
-    virtual Vec forces(const State& y) const = 0;
-    /// s + d [m] of the current modes at y (affine in the state).
-    virtual Vec relative(const State& y) const = 0;
-    /// s + d [m] at an event from the forces p_cur (before the modes are decided).
-    virtual Vec relative_at_event(const State& y, const Vec& p_cur) const = 0;
-    /// The motion's part of s + d: c w, G Phi q, G z [m].
-    virtual Vec motion(const State& y) const = 0;
-    /// Witness functions at y, positive while the modes hold.
-    virtual void witnesses(const State& y, double* g) const = 0;
-    /// The state a short look-ahead after (te, y): the contact points move by ~kLookahead L_ref.
-    virtual Vec look_ahead(double te, const State& y, const Vec& p_cur) const = 0;
-    /// R's displacement and velocity at y (for the event log).
-    virtual void body_motion(const State& y, const Vec& p_cur, double& w, double& wd) const = 0;
-    /// After the exact solver's decision (nm, tm) at y (rel: s + d there): corrections of
-    /// the stepper (default none).
-    virtual void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
-                                  std::vector<signed char>& tm);
-    /// True when the state y alone decides every pair's modes (no instantaneous coupling but
-    /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
-    virtual bool settle_at_state() const;
-    /// As settle_at_state, only at the events the per-step check found (cause "check"): a
-    /// decision at the look-ahead that leaves a witness negative at the state would restart
-    /// into the same missed event (default false).
-    virtual bool settle_after_missed_event() const;
-    /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
-    virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
+    // ---- the hooks of every stepper: the ODE between events and its records ------------
     /// CVODE's right-hand side y' = f(t, y) of the current modes (nstate entries each).
     virtual void derivatives(double t_s, const double* y, double* ydot) const = 0;
-    /// Stiff steppers (EventStart::stiff_max_order > 0): factorise CVODE's Newton matrix at gamma
-    /// (0 ok, > 0 recoverable) and solve it for r into x (CvodeSession::use_embedded_newton).
+    /// Stiff steppers (EventStart::stiff_max_order > 0) that solve CVODE's Newton systems
+    /// themselves (EventStart::newton == NewtonSolver::stepper): factorise the Newton matrix at
+    /// gamma (0 ok, > 0 recoverable) and solve it for r into x (CvodeSession::use_embedded_newton).
     virtual int newton_setup(double gamma);
     virtual int newton_solve(double t_s, const double* y, const double* r, double* x, double gamma) const;
+    /// Stiff steppers with SUNDIALS' band direct solver (EventStart::newton == NewtonSolver::band):
+    /// the Jacobian df/dy at (t, y) into J, zero on entry, within the half-bandwidths of
+    /// EventStart (0 ok, > 0 recoverable).
+    virtual int band_jacobian(double t_s, const State& y, BandMatrixView J) const;
     /// Once the initial modes are decided, before the first record (default nothing).
     virtual void started(const State& y0);
     /// CVODE's absolute tolerances at the initial state y0 into atol (nstate entries).
@@ -236,6 +275,7 @@ private:
     double f_ = 1.0, m_body_ = 0.0;
     int nstate_ = 0;
     EventScales scales_;
+    ContactEventHooks* ev_ = nullptr;  // EventStart::events (null: no events)
     double gap_margin_ = kMotionMargin;
     ModeSet modes_;
     Vec d_, d_chk_;                // anchors of the modes and of the per-step check [m]
@@ -263,7 +303,8 @@ private:
     void init_grid();
     void init_slots();
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
-    void start_cvode(int stiff_max_order);
+    void start_cvode(const EventStart& s);
+    void decide_initial_modes(const InitialState& stage, const EventStart& s);
     void rebuild();
     void enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm);
     void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
@@ -274,6 +315,8 @@ private:
                       const std::vector<int>* triggered = nullptr);
     static int rhs_of(sunrealtype t, N_Vector y, N_Vector ydot, void* user);
     static int roots_of(sunrealtype, N_Vector y, sunrealtype* g, void* user);
+    static int band_jacobian_of(sunrealtype t, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector,
+                                N_Vector);
     static int psetup_of(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
                          void* user);
     static int psolve_of(sunrealtype t, N_Vector y, N_Vector, N_Vector r, N_Vector x, sunrealtype gamma, sunrealtype,
@@ -285,11 +328,12 @@ private:
     void reset_check_anchors(const State& y);
     bool modes_hold(const State& y, double& residual, bool* witnesses_ok = nullptr);
     void restart(double te, const Vec& y);
+    bool step_keeps_modes(const Vec& y);
     bool step_once();
     void check_stop();
 };
 
-/// The Stepper face of every event-driven cvode stepper with leaf inertia (modal, massive): every
+/// The Stepper face of every cvode stepper with leaf inertia (held, modal, massive): every
 /// call forwards to its EventDriver.
 class EventStepper : public Stepper {
 public:

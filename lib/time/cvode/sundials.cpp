@@ -70,6 +70,9 @@ struct CvodeSession::Embedded {
     }
 };
 
+int BandMatrixView::set_zero() { return SUNMatZero(J_); }
+double& BandMatrixView::operator()(int i, int j) { return SM_ELEMENT_B(J_, i, j); }
+
 std::string cvode_flag_name(int flag) {
     char* name = CVodeGetReturnFlagName(flag);
     std::string out = name ? name : "unknown flag";

@@ -35,6 +35,20 @@ struct CvodeCounters {
     long steps = 0, rhs_evaluations = 0, root_evaluations = 0, jacobian_evaluations = 0, linear_setups = 0;
 };
 
+/// Write access to a SUNDIALS band matrix (a band Jacobian: CvodeSession::use_band_newton), so
+/// that the code filling it needs no SUNDIALS header.
+class BandMatrixView {
+public:
+    explicit BandMatrixView(SUNMatrix J) : J_(J) {}
+    /// Every entry 0: SUNMatZero's flag (0 on success).
+    int set_zero();
+    /// Entry (i, j), within the matrix's half-bandwidths.
+    double& operator()(int i, int j);
+
+private:
+    SUNMatrix J_;
+};
+
 class CvodeSession {
 public:
     /// `who` prefixes every message ("cvode mode", "cvode mode (leaf inertia)"); n: the
