@@ -42,9 +42,6 @@ fi
 if [ "${STACKBEAM_FUZZ:-1}" != 0 ]; then
   # a fixed seed: the same inputs on every CI run (a longer run: docs/fuzzing.md)
   # the targets are in the sanitizer build when it ran (build_sanitized), else in build-fuzz/
-  if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then
-    STACKBEAM_FUZZ_BUILD=build-asan STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
-  else
-    STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
-  fi
+  if [ "${STACKBEAM_SANITIZERS:-1}" != 0 ]; then export STACKBEAM_FUZZ_BUILD=build-asan; fi
+  STACKBEAM_FUZZ_SEED=1 scripts/fuzz.sh 20
 fi
