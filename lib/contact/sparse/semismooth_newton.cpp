@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "contact/sparse/trace.hpp"
 #include "contact/sparse/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -232,6 +233,12 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     const Eigen::VectorXd& d = step.d;
     const int m = static_cast<int>(d.size());
     path.best_p.resize(0);
+    TransitionTrace* const trace = path.switches.trace;
+    StepTrace* const tr = trace ? trace->current : nullptr;
+    auto end = [&](int how, bool result) {
+        if (tr) tr->newton_end = how;
+        return result;
+    };
     if (m > 0 && p.isZero(0.0)) {
         // a start from rest (no force anywhere, the first step of a run): the linear problem
         // of the open modes (set_open_modes) instead of the natural map's modes at p = 0, where
@@ -243,7 +250,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             r.factorizations += path.solve_modes(step, p, z);
         } catch (const SingularModes&) {
             path.solver.forget();
-            return false;
+            return end(4, false);
         }
     }
     Eigen::VectorXd sk = st.Grow * z - d, F, F1, pa, sa, p1, z1, s1;
@@ -261,17 +268,33 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             // the modes for the passes that follow: those of the last full step (its linear
             // problem gave p, so the passes reuse its factorisation), else those at p
             if (!full_step) path.natural_residual(p, sk, F, true);
-            return true;
+            return end(1, true);
         }
         ++r.iterations;
         ++r.newton_iterations;
-        path.natural_residual(p, sk, F, true);
+        // the study (docs/decisions/036), Switches::study bits 8 / 16: pairs within a band of
+        // 0.1 / 0.01 x ||F||_inf of their kink keep their modes (hysteresis against flips)
+        const int study = path.switches.study;
+        const double band = (study & 8) != 0 ? 0.1 * F.lpNorm<Eigen::Infinity>()
+                            : (study & 16) != 0 ? 0.01 * F.lpNorm<Eigen::Infinity>()
+                                                : 0.0;
+        path.natural_residual(p, sk, F, true, band);
+        NewtonIterationTrace* itr = nullptr;
+        if (tr) {
+            if (trace->first_n.empty()) {
+                trace->first_n = path.modes.nmode;
+                trace->first_t = path.modes.tmode;
+            }
+            tr->iterations.emplace_back();
+            itr = &tr->iterations.back();
+            trace->iterate(path.modes.nmode, path.modes.tmode, *itr);
+        }
         p1 = p;
         try {
             r.factorizations += path.solve_modes(step, p1, z1);
         } catch (const SingularModes&) {
             path.solver.forget();
-            return false;
+            return end(4, false);
         }
         s1 = st.Grow * z1 - d;
         // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
@@ -283,7 +306,18 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         double a = 1.0, grid_theta = std::numeric_limits<double>::infinity();
         const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
         bool searched = false;
-        if (path.switches.incremental) {
+        if ((path.switches.study & 1) != 0) {
+            // the study (docs/decisions/036), Switches::study bit 1: the full step wherever it
+            // lowers theta (p is then the linear solution of its modes)
+            path.natural_residual(p1, s1, F1, false);
+            const double t1 = F1.squaredNorm();
+            if (t1 < theta) {
+                grid_theta = t1;
+                a = 1.0;
+                searched = true;
+            }
+        }
+        if (!searched && path.switches.incremental) {
             // the exact minimiser over the grid's range (breakpoint_search), checked by one
             // evaluation of F (the sweep's sums are exact up to their round-off); the full
             // step where it is as good (p is then the linear solution of its modes)
@@ -313,9 +347,11 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             }
         }
         if (!(grid_theta < theta)) {
-            if (++nonmonotone > kNewtonNonmonotone) break;
+            if (itr) itr->nonmonotone = true;
+            if (++nonmonotone > kNewtonNonmonotone) return end(3, false);
             a = 1.0;
         }
+        if (itr) itr->step = a;
         full_step = a == 1.0;
         if (full_step) {
             p = p1;
@@ -328,12 +364,16 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         }
         path.natural_residual(p, sk, F, false);
         theta = F.squaredNorm();
+        if (itr) {
+            const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
+            for (int i = 0; i < m; ++i) itr->violations += std::abs(F[i]) > acc;
+        }
         if (theta < best_theta) {
             best_theta = theta;
             path.best_p = p;
         }
     }
-    return false;
+    return end(2, false);
 }
 
 }  // namespace stackbeam::detail::sparse

@@ -101,6 +101,7 @@
 #include <string>
 
 #include "contact/solvers.hpp"
+#include "contact/sparse/trace.hpp"
 #include "contact/sparse/transitions.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
@@ -218,6 +219,7 @@ struct SparseContactSolver::Impl {
     // the solutions of the last two solves (the semismooth Newton method's start is their
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
+    Eigen::VectorXd previous_s, last_s;  // their s (kept only with Switches::trace, for its prediction)
 
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
         : path(options,
@@ -250,10 +252,24 @@ struct SparseContactSolver::Impl {
         const TransitionMethod tm = path.switches.transition;
         const Eigen::VectorXd p_passes = p;
         const std::vector<signed char> nmode_passes = path.modes.nmode, tmode_passes = path.modes.tmode;
+        StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr;
         auto confirmed = [&](TransitionFn method, const Eigen::VectorXd& start) {
             p = start;
             path.s = path.stiffness().positions(step.b, step.d, p, z);
-            return method(path, step, p, z, r) && passes_from_modes(path, step, p, z, r);
+            const int smooth0 = r.smoothing_iterations;
+            const bool ok = method(path, step, p, z, r);
+            if (tr && method == smoothing_newton) {
+                tr->smoothing_iterations += r.smoothing_iterations - smooth0;
+                tr->smoothing_ok = ok;
+            }
+            if (!ok) return false;
+            const int it0 = r.iterations;
+            const bool conf = passes_from_modes(path, step, p, z, r);
+            if (tr) {
+                tr->confirm_solves += r.iterations - it0;
+                if (method == semismooth_newton) tr->newton_confirmed = conf;
+            }
+            return conf;
         };
         if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
             // the start: the previous step's forces extrapolated linearly from the two solves
@@ -263,7 +279,12 @@ struct SparseContactSolver::Impl {
             // passes before keep the previous modes (modes read from the extrapolation cost
             // more: 27.7 iterations per step)
             const bool extrapolate = previous_p.size() == m && last_p.size() == m && p_start == last_p;
-            if (confirmed(semismooth_newton, extrapolate ? Eigen::VectorXd(2.0 * last_p - previous_p) : p_start))
+            // the study (docs/decisions/036), Switches::study bit 2: from the one pass's answer
+            // (the previous modes' linear solution for this step)
+            const bool from_pass = (path.switches.study & 2) != 0 && !path.switches.newton_first && p_passes.size() == m;
+            if (confirmed(semismooth_newton, from_pass      ? p_passes
+                                             : extrapolate ? Eigen::VectorXd(2.0 * last_p - previous_p)
+                                                           : p_start))
                 return true;
         }
         // the smoothing method from the semismooth method's best iterate (measured on the
@@ -369,9 +390,37 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};
+    // the study's trace (Switches::trace, trace.hpp): the start modes and a prediction
+    TransitionTrace* const trace = path.switches.trace;
+    StepTrace* tr = nullptr;
+    std::vector<signed char> start_n, start_t, pred_n, pred_t, passes_n, passes_t;
+    if (trace) {
+        trace->steps.emplace_back();
+        tr = trace->current = &trace->steps.back();
+        start_n = path.modes.nmode;
+        start_t = path.modes.tmode;
+        trace->begin(start_n, start_t);
+        if (im.previous_p.size() == m && im.last_p.size() == m && im.previous_s.size() == m && im.last_s.size() == m) {
+            Eigen::VectorXd F;
+            path.natural_residual(2.0 * im.last_p - im.previous_p, 2.0 * im.last_s - im.previous_s, F, true);
+            pred_n = path.modes.nmode;
+            pred_t = path.modes.tmode;
+            path.modes.nmode = start_n;
+            path.modes.tmode = start_t;
+        }
+    }
     try {
         // 1. From the previous step's modes: most steps end here in one pass.
-        if (!path.switches.newton_first) r.converged = passes_from_modes(path, step, p, z, r);
+        //    (the study, docs/decisions/036: Switches::study bit 2 one pass, bit 4 two)
+        const int study = path.switches.study;
+        const int max_passes = (study & 2) != 0 ? 1 : (study & 4) != 0 ? 2 : path.options.max_active_set_iterations;
+        if (!path.switches.newton_first) r.converged = path.passes(step, p, z, max_passes, r);
+        if (tr) {
+            tr->pass_solves = r.iterations;
+            tr->passes_settled = r.converged;
+            passes_n = path.modes.nmode;
+            passes_t = path.modes.tmode;
+        }
         // 2a. A transition the passes do not settle: the semismooth Newton method on the
         //     natural map from the previous step's forces, extrapolated (for the first
         //     step: the stepper's start), then the active-set passes from its modes
@@ -427,6 +476,30 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         path.solver.accept();  // the accepted modes: the base of the next step's updates
         im.previous_p = im.last_p;
         im.last_p = p;
+        if (trace) {
+            im.previous_s = im.last_s;
+            im.last_s = path.s;
+        }
+    }
+    if (tr) {
+        tr->solves = r.factorizations + r.updates;
+        tr->factorizations = r.factorizations;
+        for (const auto& c : path.laws.pairs) tr->pairs += c.row_n >= 0 || c.row_t >= 0;
+        for (const int c : trace->changes) {
+            tr->pairs_changed += c > 0;
+            tr->max_changes_per_pair = std::max(tr->max_changes_per_pair, c);
+        }
+        if (r.converged) {
+            const auto& fn = path.modes.nmode;
+            const auto& ft = path.modes.tmode;
+            TransitionTrace::distance(start_n, start_t, fn, ft, tr->start_n, tr->start_t);
+            if (!pred_n.empty()) TransitionTrace::distance(pred_n, pred_t, fn, ft, tr->pred_n, tr->pred_t);
+            if (!passes_n.empty()) TransitionTrace::distance(passes_n, passes_t, fn, ft, tr->passes_n, tr->passes_t);
+            if (!trace->first_n.empty())
+                TransitionTrace::distance(trace->first_n, trace->first_t, fn, ft, tr->first_n, tr->first_t);
+        }
+        trace->first_n.clear();
+        trace->current = nullptr;
     }
     return r;
 }

@@ -4,6 +4,8 @@
 // the benchmark force each way through ScopedSwitches to check or measure it alone.
 namespace stackbeam::detail::sparse {
 
+struct TransitionTrace;  // trace.hpp
+
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class TransitionMethod {
@@ -60,6 +62,17 @@ struct Switches {
     /// pattern, whose refactorisation is cheap: at most this many (docs/decisions/035);
     /// -1: SparsePathTuning::max_border_rows alone, the way before.
     int fixed_border_rows = 8;
+    /// A study aid (docs/decisions/036): where not null, every solve records its transition's
+    /// statistics there (trace.hpp). The caller owns it; nullptr (default): nothing recorded.
+    TransitionTrace* trace = nullptr;
+    /// The study's changes of a transition step (docs/decisions/036), a bit mask, 0 none (the
+    /// default): 1 the semismooth Newton method takes the full step wherever it lowers
+    /// ||F||^2 (else the line search as before); 2 one active-set pass from the previous modes
+    /// (not max_active_set_iterations), the Newton method from its answer (not the
+    /// extrapolated forces); 4 two passes from the previous modes (without bit 2); 8 / 16
+    /// the semismooth Newton method's pairs within 0.1 / 0.01 x ||F||_inf of their kink keep
+    /// their modes (SparsePath::natural_residual's band).
+    int study = 0;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
