@@ -661,7 +661,7 @@ void TransitionStudy(benchmark::State& state) {
 }
 BENCHMARK(TransitionStudy)
     ->ArgNames({"el", "stack", "ms", "study", "trace"})
-    ->ArgsProduct({{200, 400}, {1, 2}, {30, 100}, {0, 1, 4, 5, 8, 12, 16, 20}, {0, 1}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 4, 32, 96, 192, 196, 256, 512, 2048, 2240, 2560, 2592, 6144, 10752, 18944, 27136, 27392, 43520, 59904, 125440, 190976}, {0, 1}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
