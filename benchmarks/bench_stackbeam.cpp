@@ -552,22 +552,35 @@ BENCHMARK(ElasticRuns)
     ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
-/// A study of the transition steps (docs/decisions/036): ElasticRuns' figures on the graduated
-/// (stack 1) or identical (stack 2) 10-leaf spring, elastic interfaces, with one change of the
-/// sparse path's transition method by `study` (Switches::study, 0: the default) and, with
-/// trace 1, the statistics of every transition step (Switches::trace, trace.hpp) printed to
-/// stderr: mode changes per Newton iteration, pairs back in a mode they had left, the
-/// distances of the start, a predicted start and the Newton method's first modes to the
-/// step's final modes, how the semismooth method ended. args: elements per half leaf, stack,
-/// simulated ms, study, trace.
+/// A study of the transition steps (docs/decisions/036, 037): ElasticRuns' figures on the
+/// graduated (stack 1) or identical (stack 2) 10-leaf spring with elastic interfaces, or the same
+/// meshes bonded with rigid interfaces (stacks 3 / 4: the targets' reference), with the
+/// transition method of decision 037 in part or whole (`way`, a bit mask of its changes, each
+/// bit the Switches field at its default, else the way before: 1 newton_passes, 2
+/// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 31 the
+/// default, 0 the way before) and, with trace 1, the statistics of every transition step
+/// (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton iteration, pairs back
+/// in a mode they had left, the distances of the start, a predicted start and the Newton
+/// method's first modes to the step's final modes, how the semismooth method ended.
+/// args: elements per half leaf, stack, simulated ms, way, trace.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
-    ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : paper_stack(PaperCase::friction, elements, 10);
-    for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
+    const int stack = static_cast<int>(state.range(1));
+    ModelSpec spec = stack == 1 || stack == 3 ? graduated_stack(elements, 10) : paper_stack(PaperCase::friction, elements, 10);
+    for (auto& f : spec.interfaces) {
+        if (stack <= 2) f.contact = InterfaceContact::elastic;
+        else f.law = InterfaceLaw::bonded;
+    }
     const double t_sim = 1e-3 * static_cast<double>(state.range(2));
+    const int way = static_cast<int>(state.range(3));
     detail::sparse::TransitionTrace trace;
-    detail::sparse::Switches sw;
-    sw.study = static_cast<int>(state.range(3));
+    const detail::sparse::Switches now, before = detail::sparse::Switches::before_037();
+    detail::sparse::Switches sw = before;
+    if ((way & 1) != 0) sw.newton_passes = now.newton_passes;
+    if ((way & 2) != 0) sw.smoothing_from_rest = now.smoothing_from_rest;
+    if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
+    if ((way & 8) != 0) sw.creep_limit = now.creep_limit;
+    if ((way & 16) != 0) sw.nonmonotone_memory = now.nonmonotone_memory;
     if (state.range(4) == 1) sw.trace = &trace;
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
@@ -582,8 +595,8 @@ void TransitionStudy(benchmark::State& state) {
     if (state.range(4) != 1) return;
     // the statistics over the steps with a Newton method (and over those the passes settled)
     const auto& steps = trace.steps;
-    std::fprintf(stderr, "\n# TransitionStudy el:%d stack:%d ms:%d study:%d: %zu solves\n", elements,
-                 static_cast<int>(state.range(1)), static_cast<int>(state.range(2)), sw.study, steps.size());
+    std::fprintf(stderr, "\n# TransitionStudy el:%d stack:%d ms:%d way:%d: %zu solves\n", elements, stack,
+                 static_cast<int>(state.range(2)), way, steps.size());
     std::fprintf(stderr, "# step solves fact passes settled newton end conf confsolves smooth ok | start(n,t) pred(n,t) first(n,t) passes(n,t) | pairs changed maxch | per iteration: n+t changes/returns/step/violations\n");
     struct Sum { double n = 0, v = 0; void add(double x) { n += 1; v += x; } double mean() const { return n > 0 ? v / n : 0.0; } };
     Sum newton_its, pass_solves, confirm, smooth, solves, start_n, start_t, pred_n, pred_t, first_n, first_t, passes_n,
@@ -660,8 +673,16 @@ void TransitionStudy(benchmark::State& state) {
     std::fprintf(stderr, "\n");
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "study", "trace"})
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 4, 32, 96, 192, 196, 256, 512, 2048, 2240, 2560, 2592, 6144, 10752, 18944, 27136, 27392, 43520, 59904, 125440, 190976}, {0, 1}})
+    ->ArgNames({"el", "stack", "ms", "way", "trace"})
+    // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}})
+    ->Args({400, 2, 30, 29, 1})->Args({400, 2, 100, 29, 0})->Args({400, 1, 100, 29, 0})
+    // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
+    // meshes bonded (the targets' reference)
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 31}, {0}})
+    ->ArgsProduct({{400}, {1, 2}, {30}, {0, 31}, {0, 1}})
+    ->Args({400, 2, 100, 0, 0})->Args({400, 2, 100, 31, 0})->Args({400, 2, 100, 31, 1})
+    ->Args({400, 3, 100, 31, 0})->Args({400, 4, 100, 31, 0})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

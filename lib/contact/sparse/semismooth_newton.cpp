@@ -16,10 +16,10 @@ namespace {
 constexpr int kNewtonIterations = 60;
 constexpr int kLineSearchOctaves = 12;
 constexpr int kNewtonNonmonotone = 5;
-constexpr double kCreepStep = 0.01;   // Switches::study bit 16384: a step length this small,
-constexpr int kCreepIterations = 5;   //   this many times in a row: the smoothing method
-constexpr std::size_t kCachedSets = 3;
-constexpr std::size_t kRecentTheta = 5;  // Switches::study bit 32768: the nonmonotone search's memory  // Switches::study bit 256: mode sets whose solutions are kept
+// the creeping search's step length (Switches::creep_limit); the nonmonotone search's
+// sufficient decrease (Switches::nonmonotone_memory)
+constexpr double kCreepStep = 0.01;
+constexpr double kNonmonotoneDecrease = 1e-4;
 
 /// The modes of a start from rest: every unilateral pair open, only the bilateral rows
 /// held (clamps sticking, bonds). On identical leaves most pairs open in the first steps
@@ -265,14 +265,9 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     path.best_p = p;
     double best_theta = theta;
     bool full_step = false;  // p is the linear solution of the current modes
-    struct CachedSet {
-        std::vector<signed char> key;
-        Eigen::VectorXd p, z;
-    };
-    std::vector<CachedSet> cache;  // Switches::study bit 256, oldest first
-    int creeping = 0;              // consecutive steps below kCreepStep (Switches::study bit 16384)
-    std::vector<double> recent{theta};  // the last iterates' theta (Switches::study bit 32768)
-    std::vector<signed char> key;
+    int creeping = 0;                 // consecutive steps below kCreepStep (Switches::creep_limit)
+    const int memory = path.switches.nonmonotone_memory;
+    std::vector<double> recent{theta};  // the last iterates' theta, at most `memory` (the nonmonotone search)
     for (int it = 0; it < kNewtonIterations; ++it) {
         const double roundoff = st.roundoff(d, z);
         const double accept = std::max(0.5 * kAccept * path.options.tolerance_m, roundoff);
@@ -286,13 +281,10 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         ++r.newton_iterations;
         // the study (docs/decisions/036), Switches::study bits 8 / 16: pairs within a band of
         // 0.1 / 0.01 x ||F||_inf of their kink keep their modes (hysteresis against flips)
-        // (bit 128: a band of `accept`, the stopping test's: a kept pair's component is then
-        // within it after the full step of its modes)
         const int study = path.switches.study;
-        double band = (study & 8) != 0 ? 0.1 * F.lpNorm<Eigen::Infinity>()
-                      : (study & 16) != 0 ? 0.01 * F.lpNorm<Eigen::Infinity>()
-                                          : 0.0;
-        if ((study & 128) != 0) band = std::max(band, accept);
+        const double band = (study & 8) != 0 ? 0.1 * F.lpNorm<Eigen::Infinity>()
+                            : (study & 16) != 0 ? 0.01 * F.lpNorm<Eigen::Infinity>()
+                                                : 0.0;
         path.natural_residual(p, sk, F, true, band);
         NewtonIterationTrace* itr = nullptr;
         if (tr) {
@@ -304,32 +296,12 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             itr = &tr->iterations.back();
             trace->iterate(path.modes.nmode, path.modes.tmode, *itr);
         }
-        // the study (docs/decisions/036), Switches::study bit 256: the linear solutions of the
-        // last kCachedSets mode sets of this step kept, so a return to a set just left costs
-        // no solve (within one step b and d stay: a set's solution is fixed)
-        bool cached = false;
-        if ((study & 256) != 0) {
-            key = path.modes.key();
-            for (const auto& c : cache)
-                if (c.key == key) {
-                    p1 = c.p;
-                    z1 = c.z;
-                    cached = true;
-                    break;
-                }
-        }
-        if (!cached) {
-            p1 = p;
-            try {
-                r.factorizations += path.solve_modes(step, p1, z1);
-            } catch (const SingularModes&) {
-                path.solver.forget();
-                return end(4, false);
-            }
-            if ((study & 256) != 0) {
-                if (cache.size() == kCachedSets) cache.erase(cache.begin());
-                cache.push_back(CachedSet{key, p1, z1});
-            }
+        p1 = p;
+        try {
+            r.factorizations += path.solve_modes(step, p1, z1);
+        } catch (const SingularModes&) {
+            path.solver.forget();
+            return end(4, false);
         }
         s1 = st.Grow * z1 - d;
         // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
@@ -341,16 +313,19 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         double a = 1.0, grid_theta = std::numeric_limits<double>::infinity();
         const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
         bool searched = false;
-        if ((path.switches.study & 32768) != 0 && !recent.empty()) {
-            // the study (docs/decisions/036), Switches::study bit 32768: a nonmonotone search
-            // (Grippo, Lampariello and Lucidi): the full step wherever it lowers theta below the
-            // largest of the last kRecentTheta iterates' (else the exact search)
+        bool nonmonotone_full = false;
+        if (memory > 0) {
+            // the nonmonotone search (Grippo, Lampariello and Lucidi, SIAM J. Numer. Anal. 23
+            // (1986)): the full step wherever it lowers theta below the largest of the last
+            // `memory` iterates' (Switches::nonmonotone_memory; docs/decisions/037: the exact
+            // minimiser creeps, 0.1-0.3 of the step per iteration for tens of iterations, where
+            // the full step is the linear solution of the new modes), else the exact search
             path.natural_residual(p1, s1, F1, false);
             const double t1 = F1.squaredNorm();
-            if (t1 < (1.0 - 1e-4) * *std::max_element(recent.begin(), recent.end())) {
+            if (t1 < (1.0 - kNonmonotoneDecrease) * *std::max_element(recent.begin(), recent.end())) {
                 grid_theta = t1;
                 a = 1.0;
-                searched = true;
+                searched = nonmonotone_full = true;
             }
         }
         if (!searched && (path.switches.study & 1) != 0) {
@@ -393,16 +368,17 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
                 a = aj;
             }
         }
-        if (!(grid_theta < theta) && !(searched && (path.switches.study & 32768) != 0)) {
+        if (!(grid_theta < theta) && !nonmonotone_full) {
             if (itr) itr->nonmonotone = true;
             if (++nonmonotone > kNewtonNonmonotone) return end(3, false);
             a = 1.0;
         }
         if (itr) itr->step = a;
-        // the study (docs/decisions/036), Switches::study bit 16384: a creeping search (the step
-        // below kCreepStep kCreepIterations times in a row) is left to the smoothing method
+        // a creeping search (the step below kCreepStep Switches::creep_limit times in a row: a
+        // kink of F next to the iterate at every step) is left to the smoothing method, which
+        // has no kinks (docs/decisions/037)
         creeping = a < kCreepStep ? creeping + 1 : 0;
-        if ((study & 16384) != 0 && creeping >= kCreepIterations) {
+        if (path.switches.creep_limit > 0 && creeping >= path.switches.creep_limit) {
             // the step is taken first (it lowered theta), so best_p is the latest iterate
             p += a * (p1 - p);
             z += a * (z1 - z);
@@ -423,9 +399,10 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         }
         path.natural_residual(p, sk, F, false);
         theta = F.squaredNorm();
-        recent.push_back(theta);
-        if (recent.size() > ((study & 65536) != 0 ? 2 * kRecentTheta : (study & 131072) != 0 ? 3 : kRecentTheta))
-            recent.erase(recent.begin());
+        if (memory > 0) {
+            recent.push_back(theta);
+            if (recent.size() > static_cast<std::size_t>(memory)) recent.erase(recent.begin());
+        }
         if (itr) {
             const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
             for (int i = 0; i < m; ++i) itr->violations += std::abs(F[i]) > acc;

@@ -105,9 +105,8 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
             const double a = pn - s[c.row_n] / w;
             F[c.row_n] = w * (pn - std::min(0.0, a));
             closed = a < 0.0;
-            const signed char ref = band_reference ? band_reference->nmode[k] : modes.nmode[k];
-            if (set_modes && band_m > 0.0 && w * std::abs(a) < band_m && ref != modes::NONE)
-                closed = ref == modes::CLOSED;  // within the band: kept
+            if (set_modes && band_m > 0.0 && w * std::abs(a) < band_m && modes.nmode[k] != modes::NONE)
+                closed = modes.nmode[k] == modes::CLOSED;  // within the band: kept
             if (set_modes) modes.nmode[k] = closed ? modes::CLOSED : modes::OPEN;
         } else if (c.kind == PairKind::coulomb) {
             closed = false;  // no normal row: the unilateral pair has no normal force
@@ -130,7 +129,7 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
         if (carries) {
             if (std::abs(a) < limit || a == 0.0) mode = modes::STICK;
             else mode = a > 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
-            const signed char old = band_reference ? band_reference->tmode[k] : modes.tmode[k];
+            const signed char old = modes.tmode[k];
             if (band_m > 0.0 && mode != old && (old == modes::STICK || old == modes::SLIP_POS || old == modes::SLIP_NEG) &&
                 w * std::abs(std::abs(a) - limit) < band_m && (old == modes::STICK || (old == modes::SLIP_POS) == (a > 0.0)))
                 mode = old;  // within the band of the stick / slip kink: kept

@@ -80,9 +80,6 @@ struct SparsePath {
     /// whose mode decision is within band_m [m] of its kink keeps its current mode.
     void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes,
                           double band_m = 0.0);
-    /// The modes a pair within natural_residual's band keeps: these where not null (the
-    /// previous step's, Switches::study bit 64), else the current ones.
-    const modes::ModeSet* band_reference = nullptr;
 
 private:
     // the linearisation of the modes solve_modes last solved (kept while they stay)

@@ -220,12 +220,9 @@ struct SparseContactSolver::Impl {
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
     Eigen::VectorXd previous_s, last_s;  // their s (kept only with Switches::trace, for its prediction)
-    // the study (docs/decisions/036), Switches::study bits 32 / 64: this step's previous
-    // modes (the step's start) and their linear solution (the first pass's), when the passes
-    // did not settle; whether the last solve needed the smoothing method (bit 1024)
-    modes::ModeSet previous_modes;
+    // the previous modes' linear solution for this step (the first active-set pass's), kept
+    // where the passes did not settle (Switches::first_pass_start)
     Eigen::VectorXd p_first_pass;
-    bool last_smoothing = false;
 
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
         : path(options,
@@ -277,6 +274,13 @@ struct SparseContactSolver::Impl {
             }
             return conf;
         };
+        // a start from rest (p = 0, the first step of a run): the smoothing method first
+        // (Switches::smoothing_from_rest; graduated 10 x 400 at 2 m/s: 21 iterations where the
+        // semismooth method ran its 60 and then the smoothing method's, docs/decisions/037);
+        // where it fails, the semismooth method as before
+        const bool smoothed_from_start =
+            tm == TransitionMethod::newton && path.switches.smoothing_from_rest && p_start.isZero(0.0);
+        if (smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
             // the start: the previous step's forces extrapolated linearly from the two solves
             // before, when the warm start is the last solve's answer (measured, 10 x 100
@@ -287,43 +291,18 @@ struct SparseContactSolver::Impl {
             const bool extrapolate = previous_p.size() == m && last_p.size() == m && p_start == last_p;
             // the study (docs/decisions/036), Switches::study bit 2: from the one pass's answer
             // (the previous modes' linear solution for this step)
-            const int study = path.switches.study;
-            const bool from_pass = (study & 2) != 0 && !path.switches.newton_first && p_passes.size() == m;
-            // bit 32: from the previous step's modes and their linear solution (the first pass's)
-            bool from_previous = (study & 32) != 0 && p_first_pass.size() == m;
-            // bit 8192: the same where there is no extrapolation (the step after the first: one
-            // solve before) and the start is not rest: the first pass's solution is the previous
-            // modes' answer to this step's load, the warm start only the last step's
-            if ((study & 8192) != 0 && !extrapolate && p_first_pass.size() == m && !p_start.isZero(0.0))
-                from_previous = true;
-            // bit 4096: from whichever of the extrapolated forces and the first pass's solution
-            // has the smaller natural residual ||F||
-            if ((study & 4096) != 0 && !from_previous && extrapolate && p_first_pass.size() == m) {
-                Eigen::VectorXd F, zx;
-                const Eigen::VectorXd px = 2.0 * last_p - previous_p;
-                path.natural_residual(px, path.stiffness().positions(step.b, step.d, px, zx), F, false);
-                const double theta_x = F.squaredNorm();
-                path.natural_residual(p_first_pass, path.stiffness().positions(step.b, step.d, p_first_pass, zx), F, false);
-                from_previous = F.squaredNorm() < theta_x;
-            }
-            // bits 512 / 1024: the smoothing method at once from rest (p = 0) / after a solve
-            // that needed it
-            const bool smoothing_first =
-                ((study & 512) != 0 && p_start.isZero(0.0)) || ((study & 1024) != 0 && last_smoothing);
-            if (from_previous) {
-                path.modes.nmode = previous_modes.nmode;
-                path.modes.tmode = previous_modes.tmode;
-            }
-            // bit 64: pairs within the band keep the previous step's modes
-            if ((study & 64) != 0 && previous_modes.nmode.size() == path.modes.nmode.size())
-                path.band_reference = &previous_modes;
-            const bool ok = !smoothing_first && confirmed(semismooth_newton, from_previous  ? p_first_pass
-                                                                             : from_pass    ? p_passes
-                                                                             : extrapolate ? Eigen::VectorXd(2.0 * last_p - previous_p)
-                                                                                           : p_start);
-            path.band_reference = nullptr;
-            if (smoothing_first) path.best_p.resize(0);
-            if (ok) return true;
+            const bool from_pass = (path.switches.study & 2) != 0 && !path.switches.newton_first && p_passes.size() == m;
+            // without an extrapolation (the step after the first: one solve before) and not from
+            // rest, the first pass's solution, the previous modes' answer to this step's load, not
+            // the warm start, the last step's (Switches::first_pass_start; graduated 10 x 400,
+            // 100 ms: the second step 92 -> 18 mode-set solves, docs/decisions/037)
+            const bool from_first_pass = path.switches.first_pass_start && !extrapolate && p_first_pass.size() == m &&
+                                         !p_start.isZero(0.0);
+            if (confirmed(semismooth_newton, from_pass         ? p_passes
+                                             : from_first_pass ? p_first_pass
+                                             : extrapolate     ? Eigen::VectorXd(2.0 * last_p - previous_p)
+                                                               : p_start))
+                return true;
         }
         // the smoothing method from the semismooth method's best iterate (measured on the
         // graduated 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s from the
@@ -331,7 +310,7 @@ struct SparseContactSolver::Impl {
         if (tm == TransitionMethod::newton || tm == TransitionMethod::smoothing) {
             if (tm == TransitionMethod::newton && path.best_p.size() == m && confirmed(smoothing_newton, path.best_p))
                 return true;
-            if (confirmed(smoothing_newton, p_start)) return true;
+            if (!smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         }
         p = p_passes;  // the Tresca fixed point starts where the passes ended
         path.modes.nmode = nmode_passes;
@@ -447,23 +426,29 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             path.modes.tmode = start_t;
         }
     }
-    path.band_reference = nullptr;
     im.p_first_pass.resize(0);
     try {
-        // 1. From the previous step's modes: most steps end here in one pass.
-        //    (the study, docs/decisions/036: Switches::study bit 2 one pass, bit 4 two; bits
-        //    32 / 64 keep the previous modes and the first pass's solution for the Newton method)
+        // 1. From the previous step's modes: most steps end here in one pass. Where a Newton
+        //    method follows, Switches::newton_passes of them (1: its start is not the passes'
+        //    answer, and further passes switch every violated row and move away from the step's
+        //    answer, docs/decisions/036 / 037), else max_active_set_iterations.
+        //    (the study, docs/decisions/036: Switches::study bit 2 one pass, bit 4 two)
         const int study = path.switches.study;
-        const int max_passes = (study & 2050) != 0 ? 1 : (study & 4) != 0 ? 2 : path.options.max_active_set_iterations;
-        if (!path.switches.newton_first && (study & (96 | 4096 | 8192)) != 0) {
-            im.previous_modes = path.modes;
+        const bool newton_follows = path.switches.transition != TransitionMethod::tresca && m >= im.newton_min_rows;
+        const int max_passes = (study & 2) != 0                                      ? 1
+                               : (study & 4) != 0                                    ? 2
+                               : newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
+                                                                                     : path.options.max_active_set_iterations;
+        if (!path.switches.newton_first && max_passes > 4) {
+            r.converged = path.passes(step, p, z, max_passes, r);
+        } else if (!path.switches.newton_first) {
+            // the first pass alone, then the rest: the same sequence (the passes' budget before
+            // Murty's rule, 3 passes without fewer violations, cannot run out within 4)
             r.converged = path.passes(step, p, z, 1, r);
             if (!r.converged) {
                 im.p_first_pass = p;
                 if (max_passes > 1) r.converged = path.passes(step, p, z, max_passes - 1, r);
             }
-        } else if (!path.switches.newton_first) {
-            r.converged = path.passes(step, p, z, max_passes, r);
         }
         if (tr) {
             tr->pass_solves = r.iterations;
@@ -523,7 +508,6 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
                     format_value(r.natural_residual_m) + " m)";
     }
     if (r.converged) {
-        im.last_smoothing = r.smoothing_iterations > 0;
         path.solver.accept();  // the accepted modes: the base of the next step's updates
         im.previous_p = im.last_p;
         im.last_p = p;

@@ -62,6 +62,35 @@ struct Switches {
     /// pattern, whose refactorisation is cheap: at most this many (docs/decisions/035);
     /// -1: SparsePathTuning::max_border_rows alone, the way before.
     int fixed_border_rows = 8;
+    /// The transition steps' method (docs/decisions/037; each measured on the graduated
+    /// 10 x 400 spring, the way before in brackets):
+    /// active-set passes from the previous modes before a Newton method (0:
+    /// SolverOptions::max_active_set_iterations, 3): one, the previous modes' solution; more
+    /// switch every violated row and move away from the step's answer
+    int newton_passes = 1;
+    /// a start from rest (p = 0) takes the smoothing Newton method first, then (where it
+    /// fails) the semismooth method (false: the semismooth method first, its 60 iterations)
+    bool smoothing_from_rest = true;
+    /// without an extrapolation (one solve before), the semismooth method starts from the
+    /// first pass's solution (false: from the warm start, the last step's answer)
+    bool first_pass_start = true;
+    /// the semismooth method gives way to the smoothing method after this many line-search
+    /// steps below 0.01 in a row (0: never; it ran its 60 iterations)
+    int creep_limit = 5;
+    /// the semismooth method's line search takes the full step wherever it lowers ||F||^2
+    /// below the largest of the last this many iterates' (nonmonotone; 0: the exact
+    /// minimiser along the step, monotone)
+    int nonmonotone_memory = 10;
+    /// All of the above the way before decision 037 (the benchmark's before).
+    static Switches before_037() {
+        Switches s;
+        s.newton_passes = 0;
+        s.smoothing_from_rest = false;
+        s.first_pass_start = false;
+        s.creep_limit = 0;
+        s.nonmonotone_memory = 0;
+        return s;
+    }
     /// A study aid (docs/decisions/036): where not null, every solve records its transition's
     /// statistics there (trace.hpp). The caller owns it; nullptr (default): nothing recorded.
     TransitionTrace* trace = nullptr;
