@@ -557,8 +557,8 @@ BENCHMARK(ElasticRuns)
 /// meshes bonded with rigid interfaces (stacks 3 / 4: the targets' reference), with the
 /// transition method of decision 037 in part or whole (`way`, a bit mask of its changes, each
 /// bit the Switches field at its default, else the way before: 1 newton_passes, 2
-/// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 31 the
-/// default, 0 the way before) and, with trace 1, the statistics of every transition step
+/// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 29 the
+/// default (smoothing_from_rest is off), 0 the way before) and, with trace 1, the statistics of every transition step
 /// (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton iteration, pairs back
 /// in a mode they had left, the distances of the start, a predicted start and the Newton
 /// method's first modes to the step's final modes, how the semismooth method ended.
@@ -574,10 +574,10 @@ void TransitionStudy(benchmark::State& state) {
     const double t_sim = 1e-3 * static_cast<double>(state.range(2));
     const int way = static_cast<int>(state.range(3));
     detail::sparse::TransitionTrace trace;
-    const detail::sparse::Switches now, before = detail::sparse::Switches::before_037();
-    detail::sparse::Switches sw = before;
+    const detail::sparse::Switches now;
+    detail::sparse::Switches sw = detail::sparse::Switches::before_037();
     if ((way & 1) != 0) sw.newton_passes = now.newton_passes;
-    if ((way & 2) != 0) sw.smoothing_from_rest = now.smoothing_from_rest;
+    if ((way & 2) != 0) sw.smoothing_from_rest = true;
     if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
     if ((way & 8) != 0) sw.creep_limit = now.creep_limit;
     if ((way & 16) != 0) sw.nonmonotone_memory = now.nonmonotone_memory;
@@ -676,13 +676,11 @@ BENCHMARK(TransitionStudy)
     ->ArgNames({"el", "stack", "ms", "way", "trace"})
     // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
     ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}})
-    ->Args({400, 2, 30, 29, 1})->Args({400, 2, 100, 29, 0})->Args({400, 1, 100, 29, 0})
     // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
     // meshes bonded (the targets' reference)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 31}, {0}})
-    ->ArgsProduct({{400}, {1, 2}, {30}, {0, 31}, {0, 1}})
-    ->Args({400, 2, 100, 0, 0})->Args({400, 2, 100, 31, 0})->Args({400, 2, 100, 31, 1})
-    ->Args({400, 3, 100, 31, 0})->Args({400, 4, 100, 31, 0})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}})
+    ->Args({400, 3, 100, 29, 0})->Args({400, 4, 100, 29, 0})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
