@@ -63,14 +63,14 @@ struct Switches {
     /// -1: SparsePathTuning::max_border_rows alone, the way before.
     int fixed_border_rows = 8;
     /// The transition steps' method (docs/decisions/037; each measured on the graduated
-    /// 10 x 400 spring, the way before in brackets):
+    /// 10 x 400 spring; before_037() below sets the way before):
     /// active-set passes from the previous modes before a Newton method (0:
     /// SolverOptions::max_active_set_iterations, 3): one, the previous modes' solution; more
     /// switch every violated row and move away from the step's answer
     int newton_passes = 1;
     /// a start from rest (p = 0) takes the smoothing Newton method first, then (where it
     /// fails) the semismooth method. Off (the way before: the semismooth method first): on the
-    /// graduated 10 x 400 it saves 45 mode-set solves but no CPU time (a smoothing iteration
+    /// graduated 10 x 400 it saves 40 mode-set solves but no CPU time (a smoothing iteration
     /// factorises the whole Jacobian), on identical leaves it fails first (25 iterations)
     bool smoothing_from_rest = false;
     /// without an extrapolation (one solve before), the semismooth method starts from the
