@@ -32,6 +32,8 @@
 #include <vector>
 
 #include "contact/sparse/switches.hpp"  // the sparse path's internal switches (lib/)
+#include "contact/sparse/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
+#include <cstdio>
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
@@ -415,44 +417,21 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
 /// sparse path's chain settled each step: the active-set passes alone, the semismooth Newton
 /// method, the smoothing Newton method, the Tresca fixed point (its answer or the dense fallback).
-void ElasticRuns(benchmark::State& state) {
-    const int elements = static_cast<int>(state.range(0));
-    const int stack = static_cast<int>(state.range(1));
-    ModelSpec spec = stack == 0                ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
-                     : stack == 1 || stack == 3 ? graduated_stack(elements, 10)
-                                                : paper_stack(PaperCase::friction, elements, 10);
-    if (state.range(2) == 1)
-        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
-    if (stack >= 3)
-        for (auto& f : spec.interfaces) f.law = InterfaceLaw::bonded;
-    const double t_sim = 1e-3 * static_cast<double>(state.range(3));
-    detail::sparse::Switches sw;
-    sw.incremental = state.range(5) != 0;
-    if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
-    if (state.range(10) >= 0) {
-        sw.block_border_solves = (state.range(10) & 1) != 0;
-        sw.residual_refactor_check = (state.range(10) & 2) != 0;
-        if ((state.range(10) & 4) == 0) sw.fixed_border_rows = -1;
-    }
-    if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
-    const detail::sparse::ScopedSwitches scoped(sw);
+/// The figures of one ElasticRuns-style run (closed-form stepper, dt = 1 ms, every step made
+/// even if it does not converge): CPU and wall time, factorisations and Newton iterations per
+/// step, mode-set solves per transition step, and which step of the sparse chain settled each.
+struct ElasticFigures {
     double total = 0.0, cpu = 0.0, factorizations = 0.0, newton = 0.0, mode_solves = 0.0;
     long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_tresca = 0;
     long transition_steps = 0;
     int components = 0;
-    for (auto _ : state) {
+
+    void run(const ModelSpec& spec, const SimulationOptions& so) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
         const System s(Model::build(spec));
-        SimulationOptions so;
-        so.t_end_s = t_sim;
-        so.stop_on_nonconvergence = false;
-        if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
-        if (state.range(6) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(6));
-        if (state.range(7) >= 0) so.sparse_tuning.primal_min_rows = static_cast<int>(state.range(7));
-        if (state.range(9) >= 0) so.sparse_tuning.max_border_rows = static_cast<int>(state.range(9));
         ClosedFormStepper st(s, so);
-        steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
+        steps = static_cast<long>(std::ceil(so.t_end_s / so.dt_s - 1e-9));
         factorizations = newton = mode_solves = 0.0;
         failed = by_passes = by_semismooth = by_smoothing = by_tresca = transition_steps = 0;
         for (long i = 0; i < steps; ++i) {
@@ -474,19 +453,55 @@ void ElasticRuns(benchmark::State& state) {
         cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         components = s.num_components();
     }
-    state.counters["components"] = components;
-    state.counters["s_per_sim_s"] = total / t_sim;
-    state.counters["cpu_s_per_sim_s"] = cpu / t_sim;
-    state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
-    state.counters["transition_steps"] = static_cast<double>(transition_steps);  // steps with a factorisation or update
-    state.counters["solves_per_transition"] =
-        transition_steps > 0 ? mode_solves / static_cast<double>(transition_steps) : 0.0;
-    state.counters["newton_per_step"] = newton / static_cast<double>(steps);
-    state.counters["failed_steps"] = static_cast<double>(failed);
-    state.counters["by_passes"] = static_cast<double>(by_passes);
-    state.counters["by_semismooth"] = static_cast<double>(by_semismooth);
-    state.counters["by_smoothing"] = static_cast<double>(by_smoothing);
-    state.counters["by_tresca"] = static_cast<double>(by_tresca);
+
+    void put(benchmark::State& state, double t_sim) const {
+        state.counters["components"] = components;
+        state.counters["s_per_sim_s"] = total / t_sim;
+        state.counters["cpu_s_per_sim_s"] = cpu / t_sim;
+        state.counters["fact_per_step"] = factorizations / static_cast<double>(steps);
+        state.counters["transition_steps"] = static_cast<double>(transition_steps);  // steps with a factorisation or update
+        state.counters["solves_per_transition"] =
+            transition_steps > 0 ? mode_solves / static_cast<double>(transition_steps) : 0.0;
+        state.counters["newton_per_step"] = newton / static_cast<double>(steps);
+        state.counters["failed_steps"] = static_cast<double>(failed);
+        state.counters["by_passes"] = static_cast<double>(by_passes);
+        state.counters["by_semismooth"] = static_cast<double>(by_semismooth);
+        state.counters["by_smoothing"] = static_cast<double>(by_smoothing);
+        state.counters["by_tresca"] = static_cast<double>(by_tresca);
+    }
+};
+
+void ElasticRuns(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    const int stack = static_cast<int>(state.range(1));
+    ModelSpec spec = stack == 0                ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
+                     : stack == 1 || stack == 3 ? graduated_stack(elements, 10)
+                                                : paper_stack(PaperCase::friction, elements, 10);
+    if (state.range(2) == 1)
+        for (auto& f : spec.interfaces) f.contact = InterfaceContact::elastic;
+    if (stack >= 3)
+        for (auto& f : spec.interfaces) f.law = InterfaceLaw::bonded;
+    const double t_sim = 1e-3 * static_cast<double>(state.range(3));
+    detail::sparse::Switches sw;
+    sw.incremental = state.range(5) != 0;
+    if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
+    if (state.range(10) >= 0) {
+        sw.block_border_solves = (state.range(10) & 1) != 0;
+        sw.residual_refactor_check = (state.range(10) & 2) != 0;
+        if ((state.range(10) & 4) == 0) sw.fixed_border_rows = -1;
+    }
+    if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
+    const detail::sparse::ScopedSwitches scoped(sw);
+    SimulationOptions so;
+    so.t_end_s = t_sim;
+    so.stop_on_nonconvergence = false;
+    if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
+    if (state.range(6) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(6));
+    if (state.range(7) >= 0) so.sparse_tuning.primal_min_rows = static_cast<int>(state.range(7));
+    if (state.range(9) >= 0) so.sparse_tuning.max_border_rows = static_cast<int>(state.range(9));
+    ElasticFigures fig;
+    for (auto _ : state) fig.run(spec, so);
+    fig.put(state, t_sim);
 }
 BENCHMARK(ElasticRuns)
     ->ArgNames({"el", "stack", "elastic", "ms", "sparse", "inc", "schur", "primal", "fixed", "border", "lu", "fborder"})
@@ -535,6 +550,137 @@ BENCHMARK(ElasticRuns)
     // elements, rigid and elastic at 50 (rigid kappa 0.5), 300 ms, sparse path
     ->Args({100, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({100, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
     ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+
+/// A study of the transition steps (docs/decisions/036, 037): ElasticRuns' figures on the
+/// graduated (stack 1) or identical (stack 2) 10-leaf spring with elastic interfaces, or the same
+/// meshes bonded with rigid interfaces (stacks 3 / 4: the targets' reference), with the
+/// transition method of decision 037 in part or whole (`way`, a bit mask of its changes, each
+/// bit the Switches field at its default, else the way before: 1 newton_passes, 2
+/// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 29 the
+/// default (smoothing_from_rest is off), 0 the way before) and, with trace 1, the statistics of every transition step
+/// (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton iteration, pairs back
+/// in a mode they had left, the distances of the start, a predicted start and the Newton
+/// method's first modes to the step's final modes, how the semismooth method ended.
+/// args: elements per half leaf, stack, simulated ms, way, trace.
+void TransitionStudy(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    const int stack = static_cast<int>(state.range(1));
+    ModelSpec spec = stack == 1 || stack == 3 ? graduated_stack(elements, 10) : paper_stack(PaperCase::friction, elements, 10);
+    for (auto& f : spec.interfaces) {
+        if (stack <= 2) f.contact = InterfaceContact::elastic;
+        else f.law = InterfaceLaw::bonded;
+    }
+    const double t_sim = 1e-3 * static_cast<double>(state.range(2));
+    const int way = static_cast<int>(state.range(3));
+    detail::sparse::TransitionTrace trace;
+    const detail::sparse::Switches now;
+    detail::sparse::Switches sw = detail::sparse::Switches::before_037();
+    if ((way & 1) != 0) sw.newton_passes = now.newton_passes;
+    if ((way & 2) != 0) sw.smoothing_from_rest = true;
+    if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
+    if ((way & 8) != 0) sw.creep_limit = now.creep_limit;
+    if ((way & 16) != 0) sw.nonmonotone_memory = now.nonmonotone_memory;
+    if (state.range(4) == 1) sw.trace = &trace;
+    const detail::sparse::ScopedSwitches scoped(sw);
+    SimulationOptions so;
+    so.t_end_s = t_sim;
+    so.stop_on_nonconvergence = false;
+    ElasticFigures fig;
+    for (auto _ : state) {
+        trace.steps.clear();
+        fig.run(spec, so);
+    }
+    fig.put(state, t_sim);
+    if (state.range(4) != 1) return;
+    // the statistics over the steps with a Newton method (and over those the passes settled)
+    const auto& steps = trace.steps;
+    std::fprintf(stderr, "\n# TransitionStudy el:%d stack:%d ms:%d way:%d: %zu solves\n", elements, stack,
+                 static_cast<int>(state.range(2)), way, steps.size());
+    std::fprintf(stderr, "# step solves fact passes settled newton end conf confsolves smooth ok | start(n,t) pred(n,t) first(n,t) passes(n,t) | pairs changed maxch | per iteration: n+t changes/returns/step/violations\n");
+    struct Sum { double n = 0, v = 0; void add(double x) { n += 1; v += x; } double mean() const { return n > 0 ? v / n : 0.0; } };
+    Sum newton_its, pass_solves, confirm, smooth, solves, start_n, start_t, pred_n, pred_t, first_n, first_t, passes_n,
+        passes_t, changed, maxch, set_start_n, set_start_t, set_pred_n, set_pred_t, pairs_sum, returns;
+    std::map<int, int> ends;
+    std::vector<Sum> it_changes(20), it_returns(20), it_full(20), it_viol(20);
+    int idx = 0, newton_steps = 0, settled_steps = 0, smoothing_steps = 0, smoothing_ok = 0, revisit_steps = 0;
+    for (const auto& t : steps) {
+        ++idx;
+        if (t.solves == 0) continue;
+        std::fprintf(stderr, "%4d %3d %3d %2d %d %2zu %d %d %d %3d %d | %4d %4d  %4d %4d  %4d %4d  %4d %4d | %4d %4d %2d |", idx,
+                     t.solves, t.factorizations, t.pass_solves, t.passes_settled, t.iterations.size(), t.newton_end,
+                     t.newton_confirmed, t.confirm_solves, t.smoothing_iterations, t.smoothing_ok, t.start_n, t.start_t,
+                     t.pred_n, t.pred_t, t.first_n, t.first_t, t.passes_n, t.passes_t, t.pairs, t.pairs_changed,
+                     t.max_changes_per_pair);
+        for (const auto& it : t.iterations)
+            std::fprintf(stderr, " %d/%d/%.2g/%d", it.n_changes + it.t_changes, it.returns, it.step, it.violations);
+        std::fprintf(stderr, "\n");
+        pairs_sum.add(t.pairs);
+        if (t.passes_settled) {
+            ++settled_steps;
+            if (t.start_n >= 0) { set_start_n.add(t.start_n); set_start_t.add(t.start_t); }
+            if (t.pred_n >= 0) { set_pred_n.add(t.pred_n); set_pred_t.add(t.pred_t); }
+            continue;
+        }
+        if (t.iterations.empty() && t.newton_end == 0) continue;
+        ++newton_steps;
+        ++ends[t.newton_end];
+        newton_its.add(static_cast<double>(t.iterations.size()));
+        pass_solves.add(t.pass_solves);
+        confirm.add(t.confirm_solves);
+        solves.add(t.solves);
+        if (t.smoothing_iterations > 0) {
+            ++smoothing_steps;
+            smoothing_ok += t.smoothing_ok;
+            smooth.add(t.smoothing_iterations);
+        }
+        if (t.start_n >= 0) { start_n.add(t.start_n); start_t.add(t.start_t); }
+        if (t.pred_n >= 0) { pred_n.add(t.pred_n); pred_t.add(t.pred_t); }
+        if (t.first_n >= 0) { first_n.add(t.first_n); first_t.add(t.first_t); }
+        if (t.passes_n >= 0) { passes_n.add(t.passes_n); passes_t.add(t.passes_t); }
+        changed.add(t.pairs_changed);
+        maxch.add(t.max_changes_per_pair);
+        int ret = 0;
+        for (std::size_t k = 0; k < t.iterations.size(); ++k) {
+            const auto& it = t.iterations[k];
+            ret += it.returns;
+            const std::size_t b = std::min<std::size_t>(k, it_changes.size() - 1);
+            it_changes[b].add(it.n_changes + it.t_changes);
+            it_returns[b].add(it.returns);
+            it_full[b].add(it.step == 1.0 ? 1.0 : 0.0);
+            it_viol[b].add(it.violations);
+        }
+        returns.add(ret);
+        revisit_steps += ret > 0;
+    }
+    std::fprintf(stderr, "# pairs %.0f; steps with a solve: passes settled %d (start->final n %.1f t %.1f, predicted->final n %.1f t %.1f)\n",
+                 pairs_sum.mean(), settled_steps, set_start_n.mean(), set_start_t.mean(), set_pred_n.mean(), set_pred_t.mean());
+    std::fprintf(stderr, "# Newton steps %d: solves %.2f = passes %.2f + Newton iterations %.2f + confirming passes %.2f (+ smoothing)\n",
+                 newton_steps, solves.mean(), pass_solves.mean(), newton_its.mean(), confirm.mean());
+    std::fprintf(stderr, "#   semismooth ends:");
+    for (const auto& e : ends) std::fprintf(stderr, " [%d]=%d", e.first, e.second);
+    std::fprintf(stderr, " (1 converged, 2 iteration limit, 3 no decrease, 4 singular); smoothing in %d steps (%d settled), %.1f iterations each\n",
+                 smoothing_steps, smoothing_ok, smooth.mean());
+    std::fprintf(stderr, "#   distance to the final modes (pairs, normal / tangential): start %.1f / %.1f, predicted %.1f / %.1f, Newton's first %.1f / %.1f, after the passes %.1f / %.1f\n",
+                 start_n.mean(), start_t.mean(), pred_n.mean(), pred_t.mean(), first_n.mean(), first_t.mean(), passes_n.mean(), passes_t.mean());
+    std::fprintf(stderr, "#   pairs that changed in the Newton iterations %.1f, most changes of one pair %.1f, returns to a left mode %.1f per step (%d of %d steps)\n",
+                 changed.mean(), maxch.mean(), returns.mean(), revisit_steps, newton_steps);
+    std::fprintf(stderr, "#   per iteration (1..): changes / returns / full steps / violations after:");
+    for (std::size_t k = 0; k < it_changes.size(); ++k)
+        if (it_changes[k].n > 0)
+            std::fprintf(stderr, " %zu:%.1f/%.1f/%.2f/%.0f(n%.0f)", k + 1, it_changes[k].mean(), it_returns[k].mean(),
+                         it_full[k].mean(), it_viol[k].mean(), it_changes[k].n);
+    std::fprintf(stderr, "\n");
+}
+BENCHMARK(TransitionStudy)
+    ->ArgNames({"el", "stack", "ms", "way", "trace"})
+    // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}})
+    // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
+    // meshes bonded (the targets' reference)
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}})
+    ->Args({400, 3, 100, 29, 0})->Args({400, 4, 100, 29, 0})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

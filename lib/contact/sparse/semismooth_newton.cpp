@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "contact/sparse/trace.hpp"
 #include "contact/sparse/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -15,6 +16,10 @@ namespace {
 constexpr int kNewtonIterations = 60;
 constexpr int kLineSearchOctaves = 12;
 constexpr int kNewtonNonmonotone = 5;
+// the creeping search's step length (Switches::creep_limit); the nonmonotone search's
+// sufficient decrease (Switches::nonmonotone_memory)
+constexpr double kCreepStep = 0.01;
+constexpr double kNonmonotoneDecrease = 1e-4;
 
 /// The modes of a start from rest: every unilateral pair open, only the bilateral rows
 /// held (clamps sticking, bonds). On identical leaves most pairs open in the first steps
@@ -232,6 +237,12 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     const Eigen::VectorXd& d = step.d;
     const int m = static_cast<int>(d.size());
     path.best_p.resize(0);
+    TransitionTrace* const trace = path.switches.trace;
+    StepTrace* const tr = trace ? trace->current : nullptr;
+    auto end = [&](int how, bool result) {
+        if (tr) tr->newton_end = how;
+        return result;
+    };
     if (m > 0 && p.isZero(0.0)) {
         // a start from rest (no force anywhere, the first step of a run): the linear problem
         // of the open modes (set_open_modes) instead of the natural map's modes at p = 0, where
@@ -243,7 +254,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             r.factorizations += path.solve_modes(step, p, z);
         } catch (const SingularModes&) {
             path.solver.forget();
-            return false;
+            return end(4, false);
         }
     }
     Eigen::VectorXd sk = st.Grow * z - d, F, F1, pa, sa, p1, z1, s1;
@@ -254,6 +265,9 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     path.best_p = p;
     double best_theta = theta;
     bool full_step = false;  // p is the linear solution of the current modes
+    int creeping = 0;                 // consecutive steps below kCreepStep (Switches::creep_limit)
+    const int memory = path.switches.nonmonotone_memory;
+    std::vector<double> recent{theta};  // the last iterates' theta, at most `memory` (the nonmonotone search)
     for (int it = 0; it < kNewtonIterations; ++it) {
         const double roundoff = st.roundoff(d, z);
         const double accept = std::max(0.5 * kAccept * path.options.tolerance_m, roundoff);
@@ -261,17 +275,33 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             // the modes for the passes that follow: those of the last full step (its linear
             // problem gave p, so the passes reuse its factorisation), else those at p
             if (!full_step) path.natural_residual(p, sk, F, true);
-            return true;
+            return end(1, true);
         }
         ++r.iterations;
         ++r.newton_iterations;
-        path.natural_residual(p, sk, F, true);
+        // the study (docs/decisions/036), Switches::study bits 8 / 16: pairs within a band of
+        // 0.1 / 0.01 x ||F||_inf of their kink keep their modes (hysteresis against flips)
+        const int study = path.switches.study;
+        const double band = (study & 8) != 0 ? 0.1 * F.lpNorm<Eigen::Infinity>()
+                            : (study & 16) != 0 ? 0.01 * F.lpNorm<Eigen::Infinity>()
+                                                : 0.0;
+        path.natural_residual(p, sk, F, true, band);
+        NewtonIterationTrace* itr = nullptr;
+        if (tr) {
+            if (trace->first_n.empty()) {
+                trace->first_n = path.modes.nmode;
+                trace->first_t = path.modes.tmode;
+            }
+            tr->iterations.emplace_back();
+            itr = &tr->iterations.back();
+            trace->iterate(path.modes.nmode, path.modes.tmode, *itr);
+        }
         p1 = p;
         try {
             r.factorizations += path.solve_modes(step, p1, z1);
         } catch (const SingularModes&) {
             path.solver.forget();
-            return false;
+            return end(4, false);
         }
         s1 = st.Grow * z1 - d;
         // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
@@ -283,7 +313,33 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         double a = 1.0, grid_theta = std::numeric_limits<double>::infinity();
         const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
         bool searched = false;
-        if (path.switches.incremental) {
+        bool nonmonotone_full = false;
+        if (memory > 0) {
+            // the nonmonotone search (Grippo, Lampariello and Lucidi, SIAM J. Numer. Anal. 23
+            // (1986)): the full step wherever it lowers theta below the largest of the last
+            // `memory` iterates' (Switches::nonmonotone_memory; docs/decisions/037: the exact
+            // minimiser creeps, 0.1-0.3 of the step per iteration for tens of iterations, where
+            // the full step is the linear solution of the new modes), else the exact search
+            path.natural_residual(p1, s1, F1, false);
+            const double t1 = F1.squaredNorm();
+            if (t1 < (1.0 - kNonmonotoneDecrease) * *std::max_element(recent.begin(), recent.end())) {
+                grid_theta = t1;
+                a = 1.0;
+                searched = nonmonotone_full = true;
+            }
+        }
+        if (!searched && (path.switches.study & 1) != 0) {
+            // the study (docs/decisions/036), Switches::study bit 1: the full step wherever it
+            // lowers theta (p is then the linear solution of its modes)
+            path.natural_residual(p1, s1, F1, false);
+            const double t1 = F1.squaredNorm();
+            if (t1 < theta) {
+                grid_theta = t1;
+                a = 1.0;
+                searched = true;
+            }
+        }
+        if (!searched && path.switches.incremental) {
             // the exact minimiser over the grid's range (breakpoint_search), checked by one
             // evaluation of F (the sweep's sums are exact up to their round-off); the full
             // step where it is as good (p is then the linear solution of its modes)
@@ -312,9 +368,24 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
                 a = aj;
             }
         }
-        if (!(grid_theta < theta)) {
-            if (++nonmonotone > kNewtonNonmonotone) break;
+        if (!(grid_theta < theta) && !nonmonotone_full) {
+            if (itr) itr->nonmonotone = true;
+            if (++nonmonotone > kNewtonNonmonotone) return end(3, false);
             a = 1.0;
+        }
+        if (itr) itr->step = a;
+        // a creeping search (the step below kCreepStep Switches::creep_limit times in a row: a
+        // kink of F next to the iterate at every step) is left to the smoothing method, which
+        // has no kinks (docs/decisions/037)
+        creeping = a < kCreepStep ? creeping + 1 : 0;
+        if (path.switches.creep_limit > 0 && creeping >= path.switches.creep_limit) {
+            // the step is taken first (it lowered theta), so best_p is the latest iterate
+            p += a * (p1 - p);
+            z += a * (z1 - z);
+            sk += a * (s1 - sk);
+            path.natural_residual(p, sk, F, false);
+            if (F.squaredNorm() < best_theta) path.best_p = p;
+            return end(2, false);
         }
         full_step = a == 1.0;
         if (full_step) {
@@ -328,12 +399,20 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         }
         path.natural_residual(p, sk, F, false);
         theta = F.squaredNorm();
+        if (memory > 0) {
+            recent.push_back(theta);
+            if (recent.size() > static_cast<std::size_t>(memory)) recent.erase(recent.begin());
+        }
+        if (itr) {
+            const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
+            for (int i = 0; i < m; ++i) itr->violations += std::abs(F[i]) > acc;
+        }
         if (theta < best_theta) {
             best_theta = theta;
             path.best_p = p;
         }
     }
-    return false;
+    return end(2, false);
 }
 
 }  // namespace stackbeam::detail::sparse

@@ -93,7 +93,7 @@ bool passes_from_modes(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
 /// With w = W_kk (diag) both parts of each component are in metres, so the Newton step
 /// of the modes (the linear problem solve_modes solves) zeroes F for those modes.
 void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F,
-                                  bool set_modes) {
+                                  bool set_modes, double band_m) {
     const Eigen::VectorXd& diag = this->diag();
     F = s;
     const bool prev = laws.tau_rule == TauRule::previous_step;
@@ -105,6 +105,8 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
             const double a = pn - s[c.row_n] / w;
             F[c.row_n] = w * (pn - std::min(0.0, a));
             closed = a < 0.0;
+            if (set_modes && band_m > 0.0 && w * std::abs(a) < band_m && modes.nmode[k] != modes::NONE)
+                closed = modes.nmode[k] == modes::CLOSED;  // within the band: kept
             if (set_modes) modes.nmode[k] = closed ? modes::CLOSED : modes::OPEN;
         } else if (c.kind == PairKind::coulomb) {
             closed = false;  // no normal row: the unilateral pair has no normal force
@@ -127,6 +129,10 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
         if (carries) {
             if (std::abs(a) < limit || a == 0.0) mode = modes::STICK;
             else mode = a > 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
+            const signed char old = modes.tmode[k];
+            if (band_m > 0.0 && mode != old && (old == modes::STICK || old == modes::SLIP_POS || old == modes::SLIP_NEG) &&
+                w * std::abs(std::abs(a) - limit) < band_m && (old == modes::STICK || (old == modes::SLIP_POS) == (a > 0.0)))
+                mode = old;  // within the band of the stick / slip kink: kept
         }
         modes.tmode[k] = mode;
         modes.make_consistent(laws, k);

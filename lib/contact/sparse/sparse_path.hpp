@@ -76,7 +76,10 @@ struct SparsePath {
     bool passes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, int max_passes, SolveResult& r);
     /// The natural map F(p, s) of the contact laws per component in metres, and with
     /// `set_modes` the modes of its generalised Jacobian at (p, s) (sparse_path.cpp).
-    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes);
+    /// With band_m > 0 (the study, docs/decisions/036: Switches::study bits 8 / 16) a pair
+    /// whose mode decision is within band_m [m] of its kink keeps its current mode.
+    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes,
+                          double band_m = 0.0);
 
 private:
     // the linearisation of the modes solve_modes last solved (kept while they stay)

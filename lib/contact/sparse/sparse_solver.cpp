@@ -71,7 +71,11 @@
 //    linear problem (one factorisation, update or cached Schur solve, as a pass) and
 //    searches along the step on ||F||^2 (s is affine in p: O(m) per trial). From rest it
 //    starts from the open modes (set_open_modes). Its final modes are confirmed by the
-//    passes, so its answer is the exact solver's. At 10 leaves x 100 elements it took the
+//    passes, so its answer is the exact solver's. Where the Newton method follows, one
+//    pass from the previous modes comes first (not max_active_set_iterations), the line
+//    search takes the full step where it stays below the last 10 iterates' worst, and a
+//    creeping search goes to the smoothing method early (Switches, decision 037: graduated
+//    10 x 400 14.4 -> 9.3 mode-set solves per transition step). At 10 leaves x 100 elements it took the
 //    friction run from 50-53 to 2.4 factorisations per step; at 10 x 400 its first step
 //    still does not converge (docs/decisions/003-semismooth-newton-transitions.md).
 //    Where the semismooth method stalls (60 iterations, or no decrease of ||F||): the
@@ -101,6 +105,7 @@
 #include <string>
 
 #include "contact/solvers.hpp"
+#include "contact/sparse/trace.hpp"
 #include "contact/sparse/transitions.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
@@ -218,6 +223,10 @@ struct SparseContactSolver::Impl {
     // the solutions of the last two solves (the semismooth Newton method's start is their
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
+    Eigen::VectorXd previous_s, last_s;  // their s (kept only with Switches::trace, for its prediction)
+    // the previous modes' linear solution for this step (the first active-set pass's), kept
+    // where the passes did not settle (Switches::first_pass_start)
+    Eigen::VectorXd p_first_pass;
 
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
         : path(options,
@@ -250,11 +259,32 @@ struct SparseContactSolver::Impl {
         const TransitionMethod tm = path.switches.transition;
         const Eigen::VectorXd p_passes = p;
         const std::vector<signed char> nmode_passes = path.modes.nmode, tmode_passes = path.modes.tmode;
+        StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr;
         auto confirmed = [&](TransitionFn method, const Eigen::VectorXd& start) {
             p = start;
             path.s = path.stiffness().positions(step.b, step.d, p, z);
-            return method(path, step, p, z, r) && passes_from_modes(path, step, p, z, r);
+            const int smooth0 = r.smoothing_iterations;
+            const bool ok = method(path, step, p, z, r);
+            if (tr && method == smoothing_newton) {
+                tr->smoothing_iterations += r.smoothing_iterations - smooth0;
+                tr->smoothing_ok = ok;
+            }
+            if (!ok) return false;
+            const int it0 = r.iterations;
+            const bool conf = passes_from_modes(path, step, p, z, r);
+            if (tr) {
+                tr->confirm_solves += r.iterations - it0;
+                if (method == semismooth_newton) tr->newton_confirmed = conf;
+            }
+            return conf;
         };
+        // a start from rest (p = 0, the first step of a run): the smoothing method first
+        // (Switches::smoothing_from_rest; graduated 10 x 400 at 2 m/s: 21 iterations where the
+        // semismooth method ran its 60 and then the smoothing method's, docs/decisions/037);
+        // where it fails, the semismooth method as before
+        const bool smoothed_from_start =
+            tm == TransitionMethod::newton && path.switches.smoothing_from_rest && p_start.isZero(0.0);
+        if (smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
             // the start: the previous step's forces extrapolated linearly from the two solves
             // before, when the warm start is the last solve's answer (measured, 10 x 100
@@ -263,7 +293,19 @@ struct SparseContactSolver::Impl {
             // passes before keep the previous modes (modes read from the extrapolation cost
             // more: 27.7 iterations per step)
             const bool extrapolate = previous_p.size() == m && last_p.size() == m && p_start == last_p;
-            if (confirmed(semismooth_newton, extrapolate ? Eigen::VectorXd(2.0 * last_p - previous_p) : p_start))
+            // the study (docs/decisions/036), Switches::study bit 2: from the one pass's answer
+            // (the previous modes' linear solution for this step)
+            const bool from_pass = (path.switches.study & 2) != 0 && !path.switches.newton_first && p_passes.size() == m;
+            // without an extrapolation (the step after the first: one solve before) and not from
+            // rest, the first pass's solution, the previous modes' answer to this step's load, not
+            // the warm start, the last step's (Switches::first_pass_start; graduated 10 x 400,
+            // 100 ms: the second step 92 -> 18 mode-set solves, docs/decisions/037)
+            const bool from_first_pass = path.switches.first_pass_start && !extrapolate && p_first_pass.size() == m &&
+                                         !p_start.isZero(0.0);
+            if (confirmed(semismooth_newton, from_pass         ? p_passes
+                                             : from_first_pass ? p_first_pass
+                                             : extrapolate     ? Eigen::VectorXd(2.0 * last_p - previous_p)
+                                                               : p_start))
                 return true;
         }
         // the smoothing method from the semismooth method's best iterate (measured on the
@@ -272,7 +314,7 @@ struct SparseContactSolver::Impl {
         if (tm == TransitionMethod::newton || tm == TransitionMethod::smoothing) {
             if (tm == TransitionMethod::newton && path.best_p.size() == m && confirmed(smoothing_newton, path.best_p))
                 return true;
-            if (confirmed(smoothing_newton, p_start)) return true;
+            if (!smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         }
         p = p_passes;  // the Tresca fixed point starts where the passes ended
         path.modes.nmode = nmode_passes;
@@ -369,9 +411,55 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};
+    // the study's trace (Switches::trace, trace.hpp): the start modes and a prediction
+    TransitionTrace* const trace = path.switches.trace;
+    StepTrace* tr = nullptr;
+    std::vector<signed char> start_n, start_t, pred_n, pred_t, passes_n, passes_t;
+    if (trace) {
+        trace->steps.emplace_back();
+        tr = trace->current = &trace->steps.back();
+        start_n = path.modes.nmode;
+        start_t = path.modes.tmode;
+        trace->begin(start_n, start_t);
+        if (im.previous_p.size() == m && im.last_p.size() == m && im.previous_s.size() == m && im.last_s.size() == m) {
+            Eigen::VectorXd F;
+            path.natural_residual(2.0 * im.last_p - im.previous_p, 2.0 * im.last_s - im.previous_s, F, true);
+            pred_n = path.modes.nmode;
+            pred_t = path.modes.tmode;
+            path.modes.nmode = start_n;
+            path.modes.tmode = start_t;
+        }
+    }
+    im.p_first_pass.resize(0);
     try {
-        // 1. From the previous step's modes: most steps end here in one pass.
-        if (!path.switches.newton_first) r.converged = passes_from_modes(path, step, p, z, r);
+        // 1. From the previous step's modes: most steps end here in one pass. Where a Newton
+        //    method follows, Switches::newton_passes of them (1: its start is not the passes'
+        //    answer, and further passes switch every violated row and move away from the step's
+        //    answer, docs/decisions/036 / 037), else max_active_set_iterations.
+        //    (the study, docs/decisions/036: Switches::study bit 2 one pass, bit 4 two)
+        const int study = path.switches.study;
+        const bool newton_follows = path.switches.transition != TransitionMethod::tresca && m >= im.newton_min_rows;
+        const int max_passes = (study & 2) != 0                                      ? 1
+                               : (study & 4) != 0                                    ? 2
+                               : newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
+                                                                                     : path.options.max_active_set_iterations;
+        if (!path.switches.newton_first && max_passes > 4) {
+            r.converged = path.passes(step, p, z, max_passes, r);
+        } else if (!path.switches.newton_first) {
+            // the first pass alone, then the rest: the same sequence (the passes' budget before
+            // Murty's rule, 3 passes without fewer violations, cannot run out within 4)
+            r.converged = path.passes(step, p, z, 1, r);
+            if (!r.converged) {
+                im.p_first_pass = p;
+                if (max_passes > 1) r.converged = path.passes(step, p, z, max_passes - 1, r);
+            }
+        }
+        if (tr) {
+            tr->pass_solves = r.iterations;
+            tr->passes_settled = r.converged;
+            passes_n = path.modes.nmode;
+            passes_t = path.modes.tmode;
+        }
         // 2a. A transition the passes do not settle: the semismooth Newton method on the
         //     natural map from the previous step's forces, extrapolated (for the first
         //     step: the stepper's start), then the active-set passes from its modes
@@ -427,6 +515,30 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         path.solver.accept();  // the accepted modes: the base of the next step's updates
         im.previous_p = im.last_p;
         im.last_p = p;
+        if (trace) {
+            im.previous_s = im.last_s;
+            im.last_s = path.s;
+        }
+    }
+    if (tr) {
+        tr->solves = r.factorizations + r.updates;
+        tr->factorizations = r.factorizations;
+        for (const auto& c : path.laws.pairs) tr->pairs += c.row_n >= 0 || c.row_t >= 0;
+        for (const int c : trace->changes) {
+            tr->pairs_changed += c > 0;
+            tr->max_changes_per_pair = std::max(tr->max_changes_per_pair, c);
+        }
+        if (r.converged) {
+            const auto& fn = path.modes.nmode;
+            const auto& ft = path.modes.tmode;
+            TransitionTrace::distance(start_n, start_t, fn, ft, tr->start_n, tr->start_t);
+            if (!pred_n.empty()) TransitionTrace::distance(pred_n, pred_t, fn, ft, tr->pred_n, tr->pred_t);
+            if (!passes_n.empty()) TransitionTrace::distance(passes_n, passes_t, fn, ft, tr->passes_n, tr->passes_t);
+            if (!trace->first_n.empty())
+                TransitionTrace::distance(trace->first_n, trace->first_t, fn, ft, tr->first_n, tr->first_t);
+        }
+        trace->first_n.clear();
+        trace->current = nullptr;
     }
     return r;
 }

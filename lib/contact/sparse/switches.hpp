@@ -4,6 +4,8 @@
 // the benchmark force each way through ScopedSwitches to check or measure it alone.
 namespace stackbeam::detail::sparse {
 
+struct TransitionTrace;  // trace.hpp
+
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class TransitionMethod {
@@ -60,6 +62,48 @@ struct Switches {
     /// pattern, whose refactorisation is cheap: at most this many (docs/decisions/035);
     /// -1: SparsePathTuning::max_border_rows alone, the way before.
     int fixed_border_rows = 8;
+    /// The transition steps' method (docs/decisions/037; each measured on the graduated
+    /// 10 x 400 spring; before_037() below sets the way before):
+    /// active-set passes from the previous modes before a Newton method (0:
+    /// SolverOptions::max_active_set_iterations, 3): one, the previous modes' solution; more
+    /// switch every violated row and move away from the step's answer
+    int newton_passes = 1;
+    /// a start from rest (p = 0) takes the smoothing Newton method first, then (where it
+    /// fails) the semismooth method. Off (the way before: the semismooth method first): on the
+    /// graduated 10 x 400 it saves 40 mode-set solves but no CPU time (a smoothing iteration
+    /// factorises the whole Jacobian), on identical leaves it fails first (25 iterations)
+    bool smoothing_from_rest = false;
+    /// without an extrapolation (one solve before), the semismooth method starts from the
+    /// first pass's solution (false: from the warm start, the last step's answer)
+    bool first_pass_start = true;
+    /// the semismooth method gives way to the smoothing method after this many line-search
+    /// steps below 0.01 in a row (0: never; it ran its 60 iterations)
+    int creep_limit = 5;
+    /// the semismooth method's line search takes the full step wherever it lowers ||F||^2
+    /// below the largest of the last this many iterates' (nonmonotone; 0: the exact
+    /// minimiser along the step, monotone)
+    int nonmonotone_memory = 10;
+    /// All of the above the way before decision 037 (the benchmark's before).
+    static Switches before_037() {
+        Switches s;
+        s.newton_passes = 0;
+        s.smoothing_from_rest = false;
+        s.first_pass_start = false;
+        s.creep_limit = 0;
+        s.nonmonotone_memory = 0;
+        return s;
+    }
+    /// A study aid (docs/decisions/036): where not null, every solve records its transition's
+    /// statistics there (trace.hpp). The caller owns it; nullptr (default): nothing recorded.
+    TransitionTrace* trace = nullptr;
+    /// The study's changes of a transition step (docs/decisions/036), a bit mask, 0 none (the
+    /// default): 1 the semismooth Newton method takes the full step wherever it lowers
+    /// ||F||^2 (else the line search as before); 2 one active-set pass from the previous modes
+    /// (not max_active_set_iterations), the Newton method from its answer (not the
+    /// extrapolated forces); 4 two passes from the previous modes (without bit 2); 8 / 16
+    /// the semismooth Newton method's pairs within 0.1 / 0.01 x ||F||_inf of their kink keep
+    /// their modes (SparsePath::natural_residual's band).
+    int study = 0;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
