@@ -558,8 +558,10 @@ BENCHMARK(ElasticRuns)
 /// trace 1, the statistics of every transition step (Switches::trace, trace.hpp) printed to
 /// stderr: mode changes per Newton iteration, pairs back in a mode they had left, the
 /// distances of the start, a predicted start and the Newton method's first modes to the
-/// step's final modes, how the semismooth method ended. args: elements per half leaf, stack,
-/// simulated ms, study, trace.
+/// step's final modes, how the semismooth method ended; per phase and route the mode solver's
+/// calls and their CPU time (docs/decisions/038). args: elements per half leaf, stack,
+/// simulated ms, study, trace, schur (> 0: SparsePathTuning::schur_max_rows; 0 its default),
+/// fixed (Switches::fixed_pattern; -1 its default).
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     ModelSpec spec = state.range(1) == 1 ? graduated_stack(elements, 10) : paper_stack(PaperCase::friction, elements, 10);
@@ -569,10 +571,12 @@ void TransitionStudy(benchmark::State& state) {
     detail::sparse::Switches sw;
     sw.study = static_cast<int>(state.range(3));
     if (state.range(4) == 1) sw.trace = &trace;
+    if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
+    if (state.range(5) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(5));
     ElasticFigures fig;
     for (auto _ : state) {
         trace.steps.clear();
@@ -658,10 +662,52 @@ void TransitionStudy(benchmark::State& state) {
             std::fprintf(stderr, " %zu:%.1f/%.1f/%.2f/%.0f(n%.0f)", k + 1, it_changes[k].mean(), it_returns[k].mean(),
                          it_full[k].mean(), it_viol[k].mean(), it_changes[k].n);
     std::fprintf(stderr, "\n");
+    // where the mode-set solves go (docs/decisions/038): per phase and route, the calls, their
+    // mean held rows and CPU time, over the first two steps (from rest) and the rest
+    auto routes_table = [&](const char* label, std::size_t from, std::size_t to) {
+        detail::sparse::RouteStats sum[detail::sparse::phase_count];
+        double phase_s[detail::sparse::phase_count] = {};
+        long transition = 0, recallable = 0, seen_earlier = 0;
+        for (std::size_t i = from; i < std::min(to, steps.size()); ++i) {
+            recallable += steps[i].recallable;
+            seen_earlier += steps[i].seen_earlier;
+            if (steps[i].solves == 0) continue;
+            ++transition;
+            for (int ph = 0; ph < detail::sparse::phase_count; ++ph) {
+                sum[ph].add(steps[i].phase[ph]);
+                phase_s[ph] += steps[i].phase_s[ph];
+            }
+        }
+        std::fprintf(stderr, "# routes, %s (%ld transition steps; sets solved again in the same step %ld, solved in an earlier step %ld): per phase calls / mean held rows / CPU s per route; new-set solves per transition step; the phase's CPU s\n",
+                     label, transition, recallable, seen_earlier);
+        detail::sparse::RouteStats all;
+        double all_s = 0.0;
+        for (int ph = 0; ph < detail::sparse::phase_count; ++ph) {
+            all.add(sum[ph]);
+            all_s += phase_s[ph];
+        }
+        for (int ph = 0; ph <= detail::sparse::phase_count; ++ph) {
+            const auto& rs = ph < detail::sparse::phase_count ? sum[ph] : all;
+            std::fprintf(stderr, "#   %-10s", ph < detail::sparse::phase_count ? detail::sparse::phase_name(ph) : "all");
+            for (int r = 0; r < detail::sparse::route_count; ++r)
+                if (rs.count[r] > 0)
+                    std::fprintf(stderr, " %s %ld/%.0f/%.2fs", detail::sparse::route_name(r), rs.count[r],
+                                 rs.held[r] / static_cast<double>(rs.count[r]), rs.seconds[r]);
+            std::fprintf(stderr, " | %.2f per step | %.2f s (KLU pivoted %ld)\n",
+                         transition > 0 ? static_cast<double>(rs.solves()) / static_cast<double>(transition) : 0.0,
+                         ph < detail::sparse::phase_count ? phase_s[ph] : all_s, rs.fixed_pivoted);
+        }
+    };
+    routes_table("steps 1-2", 0, 2);
+    routes_table("steps 3-", 2, steps.size());
+    routes_table("all steps", 0, steps.size());
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "study", "trace"})
-    ->ArgsProduct({{200, 400}, {1, 2}, {30, 100}, {0, 1, 4, 5, 8, 12, 16, 20}, {0, 1}})
+    ->ArgNames({"el", "stack", "ms", "study", "trace", "schur", "fixed"})
+    ->ArgsProduct({{200, 400}, {1, 2}, {30, 100}, {0, 1, 4, 5, 8, 12, 16, 20}, {0, 1}, {0}, {-1}})
+    // decision 038: the identical (and graduated) 10 x 400 stack's routes: recall (study 64),
+    // the held sets' own KLU systems (fixed 3, 4), the Schur way's limit
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 64, 128}, {0, 1}, {0, 1, 200, 300, 600, 1000}, {2, 3, 4}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -456,8 +456,12 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
     // 300 sets of modes of the rigid and of the elastic 6-leaf stack (1-6 pair changes each,
     // a third of the closed pairs slipping: the slip couplings in the pattern), every set on
     // the sparse LU (schur_max_rows 0), on Eigen's SparseLU and (in builds with it) KLU.
+    // (KLU's held-set systems, decision 038: each set's own system, under the fixed pattern's
+    // ordering restricted to it or AMD's per set, the default)
     std::vector<sp::FixedPatternLu> lus{sp::FixedPatternLu::eigen};
-    if (sp::klu_built()) lus.push_back(sp::FixedPatternLu::klu);
+    if (sp::klu_built())
+        for (const auto lu : {sp::FixedPatternLu::klu, sp::FixedPatternLu::klu_held, sp::FixedPatternLu::klu_held_amd})
+            lus.push_back(lu);
     for (const SparseContactProblem* pr : {&stack_problem(), &elastic_problem()})
         for (const auto lu : lus) {
             Counts counts;
@@ -465,7 +469,11 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
             long reused = 0;
             const double worst =
                 fixed_pattern_walk(*pr, lu, 0, false, true, 300, counts, analyses, updates, &reused);
-            BOOST_TEST_MESSAGE("fixed pattern (" << (lu == sp::FixedPatternLu::klu ? "KLU" : "Eigen") << ", "
+            const char* name = lu == sp::FixedPatternLu::klu            ? "KLU"
+                               : lu == sp::FixedPatternLu::klu_held     ? "KLU, held set, restricted order"
+                               : lu == sp::FixedPatternLu::klu_held_amd ? "KLU, held set, AMD"
+                                                                        : "Eigen";
+            BOOST_TEST_MESSAGE("fixed pattern (" << name << ", "
                                                  << pr->G.rows() << " rows): solves " << counts.solves
                                                  << ", with slip coupling " << counts.slip_coupled
                                                  << ", analyses " << analyses << ", largest relative difference "
@@ -499,6 +507,17 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_extends_its_pattern_and_borders_its_factor
                                                              << updates << ", largest relative difference "
                                                              << no_slip.largest << ", against its bound " << worst);
     BOOST_TEST(no_slip.solves > 180);
+    BOOST_TEST(updates > 100);
+    BOOST_TEST(worst < 1.0);
+    if (!sp::klu_built()) return;
+    // the same on KLU's held-set systems (the default, decision 038): the border on a held set's own LU
+    Counts held;
+    worst = fixed_pattern_walk(stack_problem(), sp::FixedPatternLu::klu_held_amd, 150, true, true, 200, held,
+                               analyses, updates);
+    BOOST_TEST_MESSAGE("held-set LU without slip: solves " << held.solves << ", by a bordered update " << updates
+                                                           << ", largest relative difference " << held.largest
+                                                           << ", against its bound " << worst);
+    BOOST_TEST(held.solves > 180);
     BOOST_TEST(updates > 100);
     BOOST_TEST(worst < 1.0);
 }

@@ -258,6 +258,7 @@ struct SparseContactSolver::Impl {
             path.s = path.stiffness().positions(step.b, step.d, p, z);
             const int smooth0 = r.smoothing_iterations;
             const bool ok = method(path, step, p, z, r);
+            if (tr) path.switches.trace->close_phase(method == smoothing_newton ? phase_smoothing : phase_semismooth);
             if (tr && method == smoothing_newton) {
                 tr->smoothing_iterations += r.smoothing_iterations - smooth0;
                 tr->smoothing_ok = ok;
@@ -266,6 +267,7 @@ struct SparseContactSolver::Impl {
             const int it0 = r.iterations;
             const bool conf = passes_from_modes(path, step, p, z, r);
             if (tr) {
+                path.switches.trace->close_phase(phase_confirm);
                 tr->confirm_solves += r.iterations - it0;
                 if (method == semismooth_newton) tr->newton_confirmed = conf;
             }
@@ -387,6 +389,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     }
     SolveResult r;
     path.solver.reset_updates();
+    path.begin_step();
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};
@@ -408,6 +411,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             path.modes.nmode = start_n;
             path.modes.tmode = start_t;
         }
+        trace->open_phase();
     }
     try {
         // 1. From the previous step's modes: most steps end here in one pass.
@@ -416,6 +420,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         const int max_passes = (study & 2) != 0 ? 1 : (study & 4) != 0 ? 2 : path.options.max_active_set_iterations;
         if (!path.switches.newton_first) r.converged = path.passes(step, p, z, max_passes, r);
         if (tr) {
+            trace->close_phase(phase_passes);
             tr->pass_solves = r.iterations;
             tr->passes_settled = r.converged;
             passes_n = path.modes.nmode;
@@ -432,7 +437,10 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             (m >= im.newton_min_rows || path.switches.newton_first))
             r.converged = im.newton_transition(step, p_start, p, z, r);
         // 2b. Otherwise (or if it failed): the Tresca fixed point.
-        if (!r.converged) r.converged = im.tresca_transition(step, p, z, r);
+        if (!r.converged) {
+            r.converged = im.tresca_transition(step, p, z, r);
+            if (tr) trace->close_phase(phase_tresca);
+        }
     } catch (const SingularModes&) {
         singular = true;  // a set of modes with dependent held rows: leave it to the dense solver
         path.solver.forget();
