@@ -410,8 +410,9 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// default; 0 the variable saddle-point LU per held set, 1 Eigen's SparseLU on the fixed
 /// pattern, 2 KLU on it, docs/decisions/031), border (SparsePathTuning::max_border_rows; -1 its
 /// default), lu (docs/decisions/035, a bit mask: 1 Switches::block_border_solves, 2
-/// Switches::residual_refactor_check, 4 Switches::fixed_border_rows at its default; -1 the
-/// defaults, all on; 0 the way before), fborder (Switches::fixed_border_rows; -1 as lu says). Counters: wall
+/// Switches::residual_refactor_check, 4 Switches::fixed_border_rows at its default, 8
+/// Switches::schur_fresh_max_rows at its default (docs/decisions/038); -1 the defaults, all
+/// on; 0 the way before), fborder (Switches::fixed_border_rows; -1 as lu says). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -489,6 +490,7 @@ void ElasticRuns(benchmark::State& state) {
         sw.block_border_solves = (state.range(10) & 1) != 0;
         sw.residual_refactor_check = (state.range(10) & 2) != 0;
         if ((state.range(10) & 4) == 0) sw.fixed_border_rows = -1;
+        if ((state.range(10) & 8) == 0) sw.schur_fresh_max_rows = -1;
     }
     if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
     const detail::sparse::ScopedSwitches scoped(sw);
@@ -544,6 +546,13 @@ BENCHMARK(ElasticRuns)
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, 0, -1, -1})
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 0})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 20})
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 3, -1})
+    // docs/decisions/038: the held sets' own KLU systems (fixed 4, the default) and the Schur
+    // way's fresh-LU limit (lu bit 8) against the way before (fixed:2, lu:7); graduated and
+    // identical 10 x 400, 100 ms, and graduated 100 / 200 (per doubling)
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1, -1, 7, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 7, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})
     ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
     ->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
@@ -707,7 +716,7 @@ BENCHMARK(TransitionStudy)
     ->ArgsProduct({{200, 400}, {1, 2}, {30, 100}, {0, 1, 4, 5, 8, 12, 16, 20}, {0, 1}, {0}, {-1}})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: recall (study 64),
     // the held sets' own KLU systems (fixed 3, 4), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 64, 128}, {0, 1}, {0, 1, 200, 300, 600, 1000}, {2, 3, 4}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 64}, {0, 1}, {0, 1, 200, 300, 600, 1000}, {2, 3, 4}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -100,7 +100,7 @@ struct ModeSolverTuning {
     int fixed_max_border_rows = 8;
     /// the Schur way's fresh dense LU (no update of the base possible) only for held sets of
     /// at most this many rows; larger ones take the sparse LU instead (docs/decisions/038;
-    /// Switches::study bit 128 sets 200; -1: no limit, as before)
+    /// the solver takes Switches::schur_fresh_max_rows, 200; -1: no limit, as before)
     int schur_fresh_max_rows = -1;
 };
 

@@ -39,7 +39,7 @@ inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& s
     tuning.residual_refactor_check = sw.residual_refactor_check;
     tuning.block_border_solves = sw.block_border_solves;
     tuning.fixed_max_border_rows = sw.fixed_border_rows;
-    if ((sw.study & 128) != 0) tuning.schur_fresh_max_rows = 200;  // decision 038
+    tuning.schur_fresh_max_rows = sw.schur_fresh_max_rows;
     return tuning;
 }
 

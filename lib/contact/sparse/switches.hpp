@@ -77,10 +77,12 @@ struct Switches {
     /// the semismooth Newton method's pairs within 0.1 / 0.01 x ||F||_inf of their kink keep
     /// their modes (SparsePath::natural_residual's band). Bits 64 and above are decision 038's:
     /// 64 a set of modes solved earlier in the same step is recalled (SparsePath::solve_modes
-    /// keeps this step's solutions), not solved again; 128 the Schur way's fresh dense LU only
-    /// up to 200 held rows, larger sets that no update reaches on the sparse LU
-    /// (ModeSolverTuning::schur_fresh_max_rows).
+    /// keeps this step's solutions), not solved again (measured: no set recurs; not landed).
     int study = 0;
+    /// The Schur way's fresh dense LU (a held set no low-rank update of the base reaches) only
+    /// up to this many held rows; larger sets take the sparse LU (ModeSolverTuning::
+    /// schur_fresh_max_rows; docs/decisions/038). -1: no limit, the way before.
+    int schur_fresh_max_rows = 200;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
