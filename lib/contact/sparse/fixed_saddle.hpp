@@ -16,6 +16,11 @@
 // whose value changed from 1 to 0 between sets is pivoted as it must be). The solution is
 // the same as the variable system's: the rows outside S only add pi_i = 0, which the load
 // f = b + G^T e already accounts for.
+// That pattern's factor carries the fill of every contact row's coupling, held or not (on
+// the identical 10 x 400 stack a two-dimensional grid of 10 leaves x 801 nodes). With
+// FixedPatternLu::klu_held_amd (the default, docs/decisions/038) each set's own system is
+// taken out of the pattern's values (the DOFs and the held rows only) and ordered by AMD and
+// factorised by KLU per set: 13 ms per set there against 18 ms on the whole pattern.
 #include <Eigen/Dense>
 #include <memory>
 #include <utility>
