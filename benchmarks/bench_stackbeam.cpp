@@ -410,8 +410,9 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// default; 0 the variable saddle-point LU per held set, 1 Eigen's SparseLU on the fixed
 /// pattern, 2 KLU on it, docs/decisions/031), border (SparsePathTuning::max_border_rows; -1 its
 /// default), lu (docs/decisions/035, a bit mask: 1 Switches::block_border_solves, 2
-/// Switches::residual_refactor_check, 4 Switches::fixed_border_rows at its default; -1 the
-/// defaults, all on; 0 the way before), fborder (Switches::fixed_border_rows; -1 as lu says). Counters: wall
+/// Switches::residual_refactor_check, 4 Switches::fixed_border_rows at its default, 8
+/// Switches::schur_fresh_max_rows at its default (docs/decisions/038); -1 the defaults, all
+/// on; 0 the way before), fborder (Switches::fixed_border_rows; -1 as lu says). Counters: wall
 /// and CPU time per simulated second (set-up plus stepping), factorisations and Newton
 /// iterations per step, mode-set solves (factorisations plus updates) per transition step,
 /// failed steps (residual above the tolerance; the run does not stop), and which step of the
@@ -489,6 +490,7 @@ void ElasticRuns(benchmark::State& state) {
         sw.block_border_solves = (state.range(10) & 1) != 0;
         sw.residual_refactor_check = (state.range(10) & 2) != 0;
         if ((state.range(10) & 4) == 0) sw.fixed_border_rows = -1;
+        if ((state.range(10) & 8) == 0) sw.schur_fresh_max_rows = -1;
     }
     if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
     const detail::sparse::ScopedSwitches scoped(sw);
@@ -544,6 +546,13 @@ BENCHMARK(ElasticRuns)
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, 0, -1, -1})
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 0})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, -1, 20})
     ->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 3, -1})
+    // docs/decisions/038: the held sets' own KLU systems (fixed 4, the default) and the Schur
+    // way's fresh-LU limit (lu bit 8) against the way before (fixed:2, lu:7); graduated and
+    // identical 10 x 400, 100 ms, and graduated 100 / 200 (per doubling)
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})
+    ->Args({400, 1, 1, 100, 0, 1, 0, -1, -1, -1, 7, -1})->Args({400, 2, 1, 100, 0, 1, 0, -1, -1, -1, 7, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, 2, -1, 7, -1})
+    ->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, -1, -1})
     ->Args({50, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})->Args({100, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
     ->Args({200, 1, 1, 100, 0, 1, 0, -1, -1, -1, 0, -1})
     // which step of the sparse chain settles the steps (docs/decisions/014): elastic at 100
@@ -552,17 +561,20 @@ BENCHMARK(ElasticRuns)
     ->Args({50, 1, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 0, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 1, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})->Args({50, 2, 1, 300, 1, 1, 0, -1, -1, -1, -1, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
-/// A study of the transition steps (docs/decisions/036, 037): ElasticRuns' figures on the
+/// A study of the transition steps (docs/decisions/036, 037, 038): ElasticRuns' figures on the
 /// graduated (stack 1) or identical (stack 2) 10-leaf spring with elastic interfaces, or the same
 /// meshes bonded with rigid interfaces (stacks 3 / 4: the targets' reference), with the
 /// transition method of decision 037 in part or whole (`way`, a bit mask of its changes, each
 /// bit the Switches field at its default, else the way before: 1 newton_passes, 2
 /// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 29 the
-/// default (smoothing_from_rest is off), 0 the way before) and, with trace 1, the statistics of every transition step
-/// (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton iteration, pairs back
-/// in a mode they had left, the distances of the start, a predicted start and the Newton
-/// method's first modes to the step's final modes, how the semismooth method ended.
-/// args: elements per half leaf, stack, simulated ms, way, trace.
+/// default (smoothing_from_rest is off), 0 the way before) and, with trace 1, the statistics of
+/// every transition step (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton
+/// iteration, pairs back in a mode they had left, the distances of the start, a predicted start
+/// and the Newton method's first modes to the step's final modes, how the semismooth method
+/// ended; per phase and route the mode solver's calls and their CPU time (decision 038).
+/// args: elements per half leaf, stack, simulated ms, way, trace, schur (> 0:
+/// SparsePathTuning::schur_max_rows; 0 its default), fixed (Switches::fixed_pattern; -1 its
+/// default).
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const int stack = static_cast<int>(state.range(1));
@@ -582,10 +594,12 @@ void TransitionStudy(benchmark::State& state) {
     if ((way & 8) != 0) sw.creep_limit = now.creep_limit;
     if ((way & 16) != 0) sw.nonmonotone_memory = now.nonmonotone_memory;
     if (state.range(4) == 1) sw.trace = &trace;
+    if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
+    if (state.range(5) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(5));
     ElasticFigures fig;
     for (auto _ : state) {
         trace.steps.clear();
@@ -671,16 +685,58 @@ void TransitionStudy(benchmark::State& state) {
             std::fprintf(stderr, " %zu:%.1f/%.1f/%.2f/%.0f(n%.0f)", k + 1, it_changes[k].mean(), it_returns[k].mean(),
                          it_full[k].mean(), it_viol[k].mean(), it_changes[k].n);
     std::fprintf(stderr, "\n");
+    // where the mode-set solves go (docs/decisions/038): per phase and route, the calls, their
+    // mean held rows and CPU time, over the first two steps (from rest) and the rest
+    auto routes_table = [&](const char* label, std::size_t from, std::size_t to) {
+        detail::sparse::RouteStats sum[detail::sparse::phase_count];
+        double phase_s[detail::sparse::phase_count] = {};
+        long transition = 0, recallable = 0, seen_earlier = 0;
+        for (std::size_t i = from; i < std::min(to, steps.size()); ++i) {
+            recallable += steps[i].recallable;
+            seen_earlier += steps[i].seen_earlier;
+            if (steps[i].solves == 0) continue;
+            ++transition;
+            for (int ph = 0; ph < detail::sparse::phase_count; ++ph) {
+                sum[ph].add(steps[i].phase[ph]);
+                phase_s[ph] += steps[i].phase_s[ph];
+            }
+        }
+        std::fprintf(stderr, "# routes, %s (%ld transition steps; sets solved again in the same step %ld, solved in an earlier step %ld): per phase calls / mean held rows / CPU s per route; new-set solves per transition step; the phase's CPU s\n",
+                     label, transition, recallable, seen_earlier);
+        detail::sparse::RouteStats all;
+        double all_s = 0.0;
+        for (int ph = 0; ph < detail::sparse::phase_count; ++ph) {
+            all.add(sum[ph]);
+            all_s += phase_s[ph];
+        }
+        for (int ph = 0; ph <= detail::sparse::phase_count; ++ph) {
+            const auto& rs = ph < detail::sparse::phase_count ? sum[ph] : all;
+            std::fprintf(stderr, "#   %-10s", ph < detail::sparse::phase_count ? detail::sparse::phase_name(ph) : "all");
+            for (int r = 0; r < detail::sparse::route_count; ++r)
+                if (rs.count[r] > 0)
+                    std::fprintf(stderr, " %s %ld/%.0f/%.2fs", detail::sparse::route_name(r), rs.count[r],
+                                 rs.held[r] / static_cast<double>(rs.count[r]), rs.seconds[r]);
+            std::fprintf(stderr, " | %.2f per step | %.2f s (KLU pivoted %ld)\n",
+                         transition > 0 ? static_cast<double>(rs.solves()) / static_cast<double>(transition) : 0.0,
+                         ph < detail::sparse::phase_count ? phase_s[ph] : all_s, rs.fixed_pivoted);
+        }
+    };
+    routes_table("steps 1-2", 0, 2);
+    routes_table("steps 3-", 2, steps.size());
+    routes_table("all steps", 0, steps.size());
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "way", "trace"})
+    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed"})
     // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
-    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}})
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}})
     // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
     // meshes bonded (the targets' reference)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}})
-    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}})
-    ->Args({400, 3, 100, 29, 0})->Args({400, 4, 100, 29, 0})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}})
+    ->Args({400, 3, 100, 29, 0, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1})
+    // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
+    // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {29}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -81,12 +81,11 @@ double fixed_pattern_walk(const SparseContactProblem& pr, sp::FixedPatternLu lu,
 
 }  // namespace
 
-BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_mode_changes) {
-    // 300 sets of modes of the rigid and of the elastic 6-leaf stack (1-6 pair changes each,
-    // a third of the closed pairs slipping: the slip couplings in the pattern), every set on
-    // the sparse LU (schur_max_rows 0), on Eigen's SparseLU and (in builds with it) KLU.
-    std::vector<sp::FixedPatternLu> lus{sp::FixedPatternLu::eigen};
-    if (sp::klu_built()) lus.push_back(sp::FixedPatternLu::klu);
+namespace {
+/// 300 sets of modes of the rigid and of the elastic 6-leaf stack (1-6 pair changes each, a
+/// third of the closed pairs slipping: the slip couplings in the pattern), every set on the
+/// sparse LU (schur_max_rows 0) `lu`, against the variable LU from scratch.
+void check_fixed_pattern_walks(const std::vector<sp::FixedPatternLu>& lus) {
     for (const SparseContactProblem* pr : {&stack_problem(), &elastic_problem()})
         for (const auto lu : lus) {
             Counts counts;
@@ -94,7 +93,11 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
             long reused = 0;
             const double worst =
                 fixed_pattern_walk(*pr, lu, 0, false, true, 300, counts, analyses, updates, &reused);
-            BOOST_TEST_MESSAGE("fixed pattern (" << (lu == sp::FixedPatternLu::klu ? "KLU" : "Eigen") << ", "
+            const char* name = lu == sp::FixedPatternLu::klu            ? "KLU"
+                               : lu == sp::FixedPatternLu::klu_held     ? "KLU, held set, restricted order"
+                               : lu == sp::FixedPatternLu::klu_held_amd ? "KLU, held set, AMD"
+                                                                        : "Eigen";
+            BOOST_TEST_MESSAGE("fixed pattern (" << name << ", "
                                                  << pr->G.rows() << " rows): solves " << counts.solves
                                                  << ", with slip coupling " << counts.slip_coupled
                                                  << ", analyses " << analyses << ", largest relative difference "
@@ -109,6 +112,23 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_
             if (lu == sp::FixedPatternLu::klu && pr == &elastic_problem()) BOOST_TEST(reused > 150);
             BOOST_TEST(worst < 1.0);
         }
+}
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(fixed_pattern_lu_equals_the_solve_from_scratch_over_random_mode_changes) {
+    // Eigen's SparseLU on the fixed pattern and (in builds with it) KLU on it and on each held
+    // set's own system ordered by AMD (the default, decision 038)
+    std::vector<sp::FixedPatternLu> lus{sp::FixedPatternLu::eigen};
+    if (sp::klu_built())
+        for (const auto lu : {sp::FixedPatternLu::klu, sp::FixedPatternLu::klu_held_amd}) lus.push_back(lu);
+    check_fixed_pattern_walks(lus);
+}
+
+BOOST_AUTO_TEST_CASE(held_set_lu_under_the_restricted_order_equals_the_solve_from_scratch,
+                     *boost::unit_test::label("slow")) {
+    // the study variant of decision 038 (not the default): each held set's own system under
+    // the fixed pattern's ordering restricted to it
+    if (sp::klu_built()) check_fixed_pattern_walks({sp::FixedPatternLu::klu_held});
 }
 
 BOOST_AUTO_TEST_CASE(fixed_pattern_lu_extends_its_pattern_and_borders_its_factor) {
@@ -128,6 +148,17 @@ BOOST_AUTO_TEST_CASE(fixed_pattern_lu_extends_its_pattern_and_borders_its_factor
                                                              << updates << ", largest relative difference "
                                                              << no_slip.largest << ", against its bound " << worst);
     BOOST_TEST(no_slip.solves > 180);
+    BOOST_TEST(updates > 100);
+    BOOST_TEST(worst < 1.0);
+    if (!sp::klu_built()) return;
+    // the same on KLU's held-set systems (the default, decision 038): the border on a held set's own LU
+    Counts held;
+    worst = fixed_pattern_walk(stack_problem(), sp::FixedPatternLu::klu_held_amd, 150, true, true, 200, held,
+                               analyses, updates);
+    BOOST_TEST_MESSAGE("held-set LU without slip: solves " << held.solves << ", by a bordered update " << updates
+                                                           << ", largest relative difference " << held.largest
+                                                           << ", against its bound " << worst);
+    BOOST_TEST(held.solves > 180);
     BOOST_TEST(updates > 100);
     BOOST_TEST(worst < 1.0);
 }

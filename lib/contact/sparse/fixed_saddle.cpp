@@ -131,6 +131,31 @@ public:
         }
         return pivot(A);
     }
+    /// klu_held: the set's own system under the given order (no BTF: one block in that order).
+    void analyze_given(const SpMat& A, const std::vector<int>& order) override {
+        release();
+        const int btf = common_.btf;
+        common_.btf = 0;
+        const int n = static_cast<int>(A.rows());
+        int* q = order.empty() ? nullptr : const_cast<int*>(order.data());
+        symbolic_ = q ? klu_analyze_given(n, ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), q, q, &common_)
+                      : klu_analyze(n, ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), &common_);
+        common_.btf = btf;
+    }
+    /// AMD's ordering of A + A^T (klu_analyze without BTF: one block).
+    std::vector<int> ordering(const SpMat& A) override {
+        const int btf = common_.btf;
+        common_.btf = 0;
+        const int n = static_cast<int>(A.rows());
+        klu_symbolic* sym = klu_analyze(n, ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), &common_);
+        common_.btf = btf;
+        std::vector<int> order;
+        if (sym) {
+            order.assign(sym->Q, sym->Q + n);
+            klu_free_symbolic(&sym, &common_);
+        }
+        return order;
+    }
     bool unchecked() const override { return unchecked_; }
     bool repivot(const SpMat& A) override {
         unchecked_ = false;
@@ -160,6 +185,10 @@ bool klu_built() {
 std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu, bool residual_check) {
 #ifdef STACKBEAM_HAVE_KLU
     if (lu == FixedPatternLu::klu) return std::make_unique<KluPatternLu>(residual_check);
+    // the held set's own system: a fresh pattern per set, so every factorisation pivots (and
+    // no klu_rgrowth: it only judges refactorisations)
+    if (lu == FixedPatternLu::klu_held || lu == FixedPatternLu::klu_held_amd)
+        return std::make_unique<KluPatternLu>(true);
 #endif
     (void)lu;
     (void)residual_check;
@@ -254,6 +283,7 @@ void FixedSaddle::build_pattern() {
         }
         diag_slot_[static_cast<std::size_t>(i)] = slot(A_, n + i, n + i);
     }
+    order_.clear();  // (klu_held: the ordering of this pattern, made at the first factor)
     cpl_slot_.assign(couplings_.size(), {});
     for (std::size_t a = 0; a < couplings_.size(); ++a)
         for (SpMat::InnerIterator it(st.Gt_scaled, couplings_[a].first); it; ++it)
@@ -297,13 +327,70 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
         for (SpMat::InnerIterator it(st.Gt_scaled, lin.coupled[a].first); it; ++it, ++q)
             v[slots[q]] += -lin.coef[a] * it.value() * row_scale[col];
     }
+    held_ = lin.S;
+    if (held_system_) {
+        // the held set's own system under the fixed pattern's ordering restricted to its
+        // unknowns: eliminating a subset of a graph's vertices in the induced order fills no
+        // more than in the whole graph, and the rows not held add no fill at all
+        if (!analysed_) {
+            if (!held_amd_) order_ = lu_->ordering(A_);
+            analysed_ = true;
+            ++analyses_;
+        }
+        extract_held(pos);
+        std::vector<int> order;
+        if (!held_amd_) {
+            order.reserve(static_cast<std::size_t>(As_.rows()));
+            for (const int k : order_)
+                if (sub_of_[static_cast<std::size_t>(k)] >= 0) order.push_back(sub_of_[static_cast<std::size_t>(k)]);
+        }
+        lu_->analyze_given(As_, order);
+        return lu_->factorize(As_);
+    }
     if (!analysed_) {
         lu_->analyze(A_);
         analysed_ = true;
         ++analyses_;
     }
-    held_ = lin.S;
     return lu_->factorize(A_);
+}
+
+/// As_: the rows and columns of A_ of the DOFs and the held rows (in held_'s order), its
+/// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left out.
+void FixedSaddle::extract_held(const std::vector<int>& pos) {
+    const int n = st_->dofs(), m = st_->rows();
+    const int ms = static_cast<int>(held_.size());
+    sub_of_.resize(static_cast<std::size_t>(n + m));
+    for (int i = 0; i < n; ++i) sub_of_[static_cast<std::size_t>(i)] = i;
+    for (int r = 0; r < m; ++r) {
+        const int at = pos[static_cast<std::size_t>(r)];
+        sub_of_[static_cast<std::size_t>(n + r)] = at >= 0 ? n + at : -1;
+    }
+    const int ns = n + ms;
+    std::vector<int> outer(static_cast<std::size_t>(ns) + 1, 0), inner;
+    std::vector<double> values;
+    inner.reserve(static_cast<std::size_t>(A_.nonZeros()));
+    values.reserve(static_cast<std::size_t>(A_.nonZeros()));
+    std::vector<std::pair<int, double>> col;
+    for (int c = 0; c < ns; ++c) {
+        const int full = c < n ? c : n + held_[static_cast<std::size_t>(c - n)];
+        col.clear();
+        bool sorted = true;
+        for (SpMat::InnerIterator it(A_, full); it; ++it) {
+            const int r = sub_of_[static_cast<std::size_t>(it.row())];
+            if (r < 0 || it.value() == 0.0) continue;
+            if (!col.empty() && r < col.back().first) sorted = false;
+            col.emplace_back(r, it.value());
+        }
+        if (!sorted) std::sort(col.begin(), col.end());
+        for (const auto& e : col) {
+            inner.push_back(e.first);
+            values.push_back(e.second);
+        }
+        outer[static_cast<std::size_t>(c) + 1] = static_cast<int>(inner.size());
+    }
+    As_ = Eigen::Map<const SpMat>(ns, ns, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(),
+                                  values.data());
 }
 
 /// The variable system's layout (n DOFs, then the held rows in lin.S's order) to the fixed
@@ -324,15 +411,28 @@ Eigen::VectorXd FixedSaddle::gather(const Eigen::VectorXd& full) const {
     return x;
 }
 
-Eigen::VectorXd FixedSaddle::multiply(const Eigen::VectorXd& x) const { return gather(A_ * scatter(x)); }
+Eigen::VectorXd FixedSaddle::multiply(const Eigen::VectorXd& x) const {
+    if (held_system_) return As_ * x;
+    return gather(A_ * scatter(x));
+}
 
 Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
+    if (held_system_) {
+        Eigen::VectorXd x = r;
+        if (!lu_->refined_solve(As_, x)) throw SingularModes{};
+        return x;
+    }
     Eigen::VectorXd x = scatter(r);
     if (!lu_->refined_solve(A_, x)) throw SingularModes{};
     return gather(x);
 }
 
 Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R) {
+    if (held_system_) {
+        Eigen::MatrixXd X = R;
+        if (!lu_->refined_solve(As_, X)) throw SingularModes{};
+        return X;
+    }
     const int n = st_->dofs(), m = st_->rows();
     Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n + m, R.cols());
     X.topRows(n) = R.topRows(n);

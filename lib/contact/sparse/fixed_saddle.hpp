@@ -16,6 +16,11 @@
 // whose value changed from 1 to 0 between sets is pivoted as it must be). The solution is
 // the same as the variable system's: the rows outside S only add pi_i = 0, which the load
 // f = b + G^T e already accounts for.
+// That pattern's factor carries the fill of every contact row's coupling, held or not (on
+// the identical 10 x 400 stack a two-dimensional grid of 10 leaves x 801 nodes). With
+// FixedPatternLu::klu_held_amd (the default, docs/decisions/038) each set's own system is
+// taken out of the pattern's values (the DOFs and the held rows only) and ordered by AMD and
+// factorised by KLU per set: 13 ms per set there against 18 ms on the whole pattern.
 #include <Eigen/Dense>
 #include <memory>
 #include <utility>
@@ -34,6 +39,11 @@ enum class FixedPatternLu {
     eigen,  ///< Eigen::SparseLU: COLAMD and the symbolic analysis once, factorize() per set
     klu,    ///< SuiteSparse's KLU (AMD ordering once; per set klu_refactor on the last pivot sequence
             ///< where its pivots stay good, else klu_factor; builds with KLU only)
+    /// KLU on each held set's own system (the held rows only), ordered by the fixed pattern's
+    /// AMD ordering (made once) restricted to the set's unknowns: no ordering per set, and no
+    /// fill from the rows not held (docs/decisions/038; builds with KLU only)
+    klu_held,
+    klu_held_amd,  ///< the same, each set's own system ordered by AMD (a study: the ordering's cost and quality)
 };
 
 /// Whether this build has SuiteSparse's KLU (STACKBEAM_HAVE_KLU).
@@ -57,6 +67,17 @@ public:
     virtual bool unchecked() const { return false; }
     /// Factorises A (the matrix of the current factor) afresh with pivoting.
     virtual bool repivot(const SpMat& A) { return factorize(A); }
+    /// The symbolic analysis of A's pattern under the given symmetric ordering (order[k]: the
+    /// unknown eliminated k-th; empty: the LU's own ordering). Default: analyze(A).
+    virtual void analyze_given(const SpMat& A, const std::vector<int>& order) {
+        (void)order;
+        analyze(A);
+    }
+    /// The fill-reducing ordering the LU makes for A's pattern (empty where it does not say).
+    virtual std::vector<int> ordering(const SpMat& A) {
+        (void)A;
+        return {};
+    }
     /// x = A^-1 x (A: the matrix last factorised) with one step of iterative refinement
     /// against A. On an unchecked refactorisation, a first solve whose normwise backward
     /// error ||x - A y|| / (||A|| ||y|| + ||x||) (infinity norms) exceeds kMaxBackwardError
@@ -89,7 +110,10 @@ std::unique_ptr<PatternLu> make_pattern_lu(FixedPatternLu lu, bool residual_chec
 /// The numeric factorisations of the fixed-pattern system of one (K, G, pairs).
 class FixedSaddle {
 public:
-    explicit FixedSaddle(FixedPatternLu lu, bool residual_check = true) : lu_(make_pattern_lu(lu, residual_check)) {}
+    explicit FixedSaddle(FixedPatternLu lu, bool residual_check = true)
+        : lu_(make_pattern_lu(lu, residual_check)),
+          held_system_(lu == FixedPatternLu::klu_held || lu == FixedPatternLu::klu_held_amd),
+          held_amd_(lu == FixedPatternLu::klu_held_amd) {}
     /// A new structure: the pattern of K, of every contact row and of the couplings
     /// (tangential row, normal row) of `couplings`; the ordering is made at the first factor().
     void reset(const SparseStiffness& st, const std::vector<std::pair<int, int>>& couplings);
@@ -126,6 +150,14 @@ private:
     bool analysed_ = false;
     int analyses_ = 0;
     std::vector<int> held_;                       // the held rows of the current factorisation
+    // FixedPatternLu::klu_held(_amd): the held set's own system (n DOFs, then the held rows in
+    // lin.S's order) taken from A_, and the fixed pattern's ordering (klu_held)
+    bool held_system_ = false;
+    bool held_amd_ = false;
+    SpMat As_;
+    std::vector<int> order_;                      // the fixed pattern's elimination order
+    std::vector<int> sub_of_;                     // per unknown of A_: its index in As_, or -1
+    void extract_held(const std::vector<int>& pos);
 };
 
 }  // namespace stackbeam::detail::sparse

@@ -191,6 +191,20 @@ void ModeSolver::accept() {
 /// Both cache the affine map of the load: (z, p_S) = (zc, pc) + b_w (zu, pu).
 int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
                       const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    if (!routes_) return solve_key(lin, key, b, d, p, z);
+    const double t0 = thread_cpu_s();
+    const long pivoted0 = fixed_ ? fixed_->lu().pivoted : 0;
+    route_ = route_cached;
+    const int f = solve_key(lin, key, b, d, p, z);
+    routes_->count[route_] += 1;
+    routes_->seconds[route_] += thread_cpu_s() - t0;
+    routes_->held[route_] += static_cast<double>(lin.S.size());
+    if (fixed_) routes_->fixed_pivoted += fixed_->lu().pivoted - pivoted0;
+    return f;
+}
+
+int ModeSolver::solve_key(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
+                          const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
     const int n = static_cast<int>(st_.K.rows()), m = static_cast<int>(d.size());
     const auto& S = lin.S;
     const int ms = static_cast<int>(S.size());
@@ -199,6 +213,7 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
     int factorised = 0;
     if (key != lu_key_ && try_border(lin)) {
         ++updates_;
+        route_ = route_border;
         lu_key_ = key;
         key_uses = 0;
         const_ok = false;
@@ -221,16 +236,26 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
             lu_ok = primal_->factor(lin, pos);
             factorised = primal_->stats().factorisations > before ? 1 : 0;
             if (factorised == 0) ++updates_;
+            route_ = route_primal;
         } else if (lu_schur) {
-            factorised = factor_schur_update(lin);
-            if (factorised < 0) {
+            // a fresh dense Schur LU only up to schur_fresh_max_rows held rows (docs/decisions/038):
+            // a larger set that no update of the base reaches takes the sparse LU
+            const bool fresh = tuning_.schur_fresh_max_rows < 0 || ms <= tuning_.schur_fresh_max_rows;
+            factorised = factor_schur_update(lin, fresh);
+            if (factorised < 0 && !fresh) {
+                lu_schur = false;
+                factorised = 1;
+            } else if (factorised < 0) {
                 factor_schur(lin);
                 factorised = 1;
             } else if (factorised == 0) {
                 ++updates_;
             }
-        } else {
+            if (lu_schur) route_ = factorised == 1 ? route_schur_lu : wb_active ? route_schur_update : route_schur_base;
+        }
+        if (!lu_primal && !lu_schur) {
             factor_lu(lin);
+            route_ = lu_fixed ? route_fixed_lu : route_lu;
         }
         lu_key_ = key;
         key_uses = 0;
@@ -615,7 +640,10 @@ void ModeSolver::make_schur_base() {
 /// entries, exact. Each solve is refined against the explicit new M (schur_solve), and the
 /// base is the last set factorised (accept() refreshes it at each accepted step), so
 /// updates never compound.
-int ModeSolver::factor_schur_update(const ModeLinearization& lin) {
+///
+/// With may_factorise false (ModeSolverTuning::schur_fresh_max_rows) a set that needs a
+/// fresh dense LU returns -1 before anything is computed (the caller takes the sparse LU).
+int ModeSolver::factor_schur_update(const ModeLinearization& lin, bool may_factorise) {
     if (!tuning_.schur_updates || !base_schur) return -1;
     const auto& S = lin.S;
     const int ms = static_cast<int>(S.size()), nb = static_cast<int>(bs_S.size());
@@ -643,6 +671,11 @@ int ModeSolver::factor_schur_update(const ModeLinearization& lin) {
     }
     for (int j = 0; j < nb; ++j)
         if (pos[static_cast<std::size_t>(bs_S[static_cast<std::size_t>(j)])] < 0) removed.push_back(j);
+    if (!may_factorise) {  // (the rank test of the update below, before its work)
+        const int na = static_cast<int>(added.size());
+        const int k = static_cast<int>(removed.size()) + 2 * na + changed_kept;
+        if (ms < kMinUpdateRows || nb == 0 || kUpdateRankFraction * k > ms) return -1;
+    }
     ensure_columns(needed);
     // g_a K^-1 g_b^T from whichever of the two columns is cached (every entry computed below
     // has one: an added row's, a changed column's or its coupled slip row's)

@@ -32,6 +32,7 @@
 #include "contact/sparse/common.hpp"
 #include "contact/sparse/fixed_saddle.hpp"
 #include "contact/sparse/primal_solver.hpp"
+#include "contact/sparse/trace.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -97,6 +98,10 @@ struct ModeSolverTuning {
     /// smaller of this and max_border_rows; -1: max_border_rows alone, as before;
     /// Switches::fixed_border_rows)
     int fixed_max_border_rows = 8;
+    /// the Schur way's fresh dense LU (no update of the base possible) only for held sets of
+    /// at most this many rows; larger ones take the sparse LU instead (docs/decisions/038;
+    /// the solver takes Switches::schur_fresh_max_rows, 200; -1: no limit, as before)
+    int schur_fresh_max_rows = -1;
 };
 
 class ModeSolver {
@@ -137,8 +142,13 @@ public:
     bool on_primal_route() const { return lu_primal; }
     /// The fixed-pattern LU (null when ModeSolverTuning::fixed_pattern is off; tests, benchmark).
     const FixedSaddle* fixed() const { return fixed_.get(); }
+    /// A study aid (docs/decisions/038): where not null, every solve() adds its route, CPU
+    /// time and held rows there (trace.hpp). nullptr (default): nothing recorded.
+    void set_route_stats(RouteStats* stats) { routes_ = stats; }
 
 private:
+    int solve_key(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
+                  const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
     bool try_border(const modes::ModeLinearization& lin);
     void border_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
                       Eigen::VectorXd& p, Eigen::VectorXd& z);
@@ -146,7 +156,7 @@ private:
                     Eigen::VectorXd& zf);
     void ensure_columns(const std::vector<int>& rows);
     void factor_schur(const modes::ModeLinearization& lin);
-    int factor_schur_update(const modes::ModeLinearization& lin);
+    int factor_schur_update(const modes::ModeLinearization& lin, bool may_factorise = true);
     void make_schur_base();
     Eigen::VectorXd schur_inverse(const Eigen::VectorXd& r) const;
     void schur_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& z0, const Eigen::VectorXd& target,
@@ -215,6 +225,8 @@ private:
     std::unique_ptr<FixedSaddle> fixed_;
     std::vector<char> layer_row_;        // per contact row: a layer row (layer_dofs)
     bool lu_fixed = false;               // the current sparse LU is fixed_'s
+    RouteStats* routes_ = nullptr;       // the study's route statistics (set_route_stats)
+    int route_ = route_cached;           // the route of the last solve_key
 };
 
 }  // namespace stackbeam::detail::sparse

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "contact/solvers.hpp"
+#include "contact/sparse/trace.hpp"
 #include "contact/sparse/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -27,7 +28,7 @@ void SparsePath::reset(const SparseContactProblem& pr) {
     // fixed_max_rigid_rows: a rigid row near its held mode has a zero diagonal there)
     const std::vector<int> layer = layer_dofs(pr.K, pr.G);
     const auto rigid = std::count(layer.begin(), layer.end(), -1);
-    js_lu = make_pattern_lu(switches.fixed_pattern == 2 && rigid <= ModeSolverTuning{}.fixed_max_rigid_rows
+    js_lu = make_pattern_lu(switches.fixed_pattern >= 2 && klu_built() && rigid <= ModeSolverTuning{}.fixed_max_rigid_rows
                                 ? FixedPatternLu::klu
                                 : FixedPatternLu::eigen,
                             switches.residual_refactor_check);
@@ -59,8 +60,32 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
         lin_tau_rule_ = laws.tau_rule;
         lin_ok_ = true;
     }
+    // the study (docs/decisions/038): the sets solved earlier in this step (the same load and
+    // offsets, so the same solution), recalled with Switches::study bit 64; the trace counts them
+    const bool recall = (switches.study & 64) != 0;
+    StepTrace* const tr = switches.trace ? switches.trace->current : nullptr;
+    Solved* found = nullptr;
+    if ((recall || tr) && !solver.is_current(lin_key_)) {
+        for (auto& sv : recall_)
+            if (sv.key == lin_key_) found = &sv;
+        if (tr) {
+            if (found) ++tr->recallable;
+            else if (switches.trace->seen(lin_key_)) ++tr->seen_earlier;
+        }
+        if (found && recall) {
+            p = found->p;
+            z = found->z;
+            return 0;
+        }
+    }
     const int f = solver.solve(lin_, lin_key_, step.b, step.d, p, z);
     modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
+    if ((recall || tr) && !found) {
+        constexpr std::size_t kRecallSets = 64;
+        if (recall_.size() >= kRecallSets) recall_.erase(recall_.begin());
+        recall_.push_back(Solved{lin_key_, p, z});
+        if (tr) switches.trace->remember(lin_key_);
+    }
     return f;
 }
 

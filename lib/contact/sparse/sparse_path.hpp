@@ -33,10 +33,13 @@ bool layer_structure(const SparseContactProblem& pr, SparseContactProblem& layer
 inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& sw) {
     tuning.fixed_pattern = sw.fixed_pattern == 1                 ? FixedPatternLu::eigen
                            : sw.fixed_pattern == 2 && klu_built() ? FixedPatternLu::klu
+                           : sw.fixed_pattern == 3 && klu_built() ? FixedPatternLu::klu_held
+                           : sw.fixed_pattern == 4 && klu_built() ? FixedPatternLu::klu_held_amd
                                                                   : FixedPatternLu::off;
     tuning.residual_refactor_check = sw.residual_refactor_check;
     tuning.block_border_solves = sw.block_border_solves;
     tuning.fixed_max_border_rows = sw.fixed_border_rows;
+    tuning.schur_fresh_max_rows = sw.schur_fresh_max_rows;
     return tuning;
 }
 
@@ -54,11 +57,13 @@ struct SparsePath {
     bool ipm_analysed = false;
     Eigen::Index ipm_nnz = 0;
     SpMat Js;
-    std::unique_ptr<PatternLu> js_lu;  ///< Eigen's SparseLU, or KLU with Switches::fixed_pattern 2
+    std::unique_ptr<PatternLu> js_lu;  ///< Eigen's SparseLU, or KLU with Switches::fixed_pattern >= 2
     bool js_analysed = false;
 
     SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
-        : options(o), switches(sw), solver(with_switches(tuning, sw)) {}
+        : options(o), switches(sw), solver(with_switches(tuning, sw)) {
+        if (sw.trace) solver.set_route_stats(&sw.trace->routes);  // the study's routes (decision 038)
+    }
 
     /// A new structure (K, G, pairs): validates `pr` (InputError), refactorises, forgets the modes.
     void reset(const SparseContactProblem& pr);
@@ -66,8 +71,11 @@ struct SparsePath {
     const Eigen::VectorXd& diag() const { return solver.stiffness().diag; }
 
     /// Solves the linear problem of the current modes for `step` into p and z; returns 1
-    /// if it factorised. Throws SingularModes.
+    /// if it factorised. Throws SingularModes. With Switches::study bit 64 (docs/decisions/038)
+    /// a set of modes already solved in this step is recalled (its p and z copied), not solved.
     int solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// A new step (a new load and offsets): forgets the sets solve_modes solved.
+    void begin_step() { recall_.clear(); }
     /// Sets s = G z - d and returns the number of violated modes at (p, s) (threshold
     /// kAccept x tolerance, or the round-off of s if larger).
     int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z);
@@ -87,6 +95,12 @@ private:
     bool lin_ok_ = false;
     std::vector<signed char> lin_nmode_, lin_tmode_, lin_key_;
     TauRule lin_tau_rule_ = TauRule::current;
+    // the sets of modes solved in this step and their solutions (most recent last)
+    struct Solved {
+        std::vector<signed char> key;
+        Eigen::VectorXd p, z;
+    };
+    std::vector<Solved> recall_;
 };
 
 }  // namespace stackbeam::detail::sparse

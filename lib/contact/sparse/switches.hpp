@@ -44,12 +44,16 @@ struct Switches {
     /// 49-point line search, the way before (kept for comparison in the benchmark and tests).
     bool incremental = true;
     /// The sparse LU of the mode solver's held sets above the Schur way's limit and of the
-    /// smoothing Newton method's Jacobian (docs/decisions/031): 2 (default) KLU on the fixed
-    /// pattern, ordered once per (K, G), refactorised on the last pivot sequence where it
-    /// fits (builds with KLU; without it as 0); 1 Eigen's SparseLU on the fixed pattern
-    /// (measured slower than 0); 0 the way before: each held set's own saddle-point system
-    /// ordered and factorised from scratch, and Eigen's SparseLU for the smoothing method.
-    int fixed_pattern = 2;
+    /// smoothing Newton method's Jacobian (docs/decisions/031): 4 (default, docs/decisions/038)
+    /// KLU on each held set's own system (the held rows only), ordered by AMD per set, the
+    /// smoothing method's Jacobian on KLU's fixed pattern as with 2; 2 KLU on the fixed
+    /// pattern of every contact row, ordered once per (K, G), refactorised on the last pivot
+    /// sequence where it fits (the way before 038); 3 as 4 under the fixed pattern's ordering
+    /// restricted to the set (measured no faster than 2); 1 Eigen's SparseLU on the fixed
+    /// pattern (measured slower than 0); 0 each held set's own saddle-point system ordered
+    /// and factorised from scratch by Eigen's SparseLU, and Eigen's SparseLU for the smoothing
+    /// method. 2-4 need KLU (builds without it: as 0).
+    int fixed_pattern = 4;
     /// KLU's refactorisation on the last pivot sequence kept by its solves' backward error
     /// (PatternLu::refined_solve; a rejected one pivots afresh) instead of its pivot growth
     /// (klu_rgrowth per factorisation): docs/decisions/035. false: the way before.
@@ -102,8 +106,14 @@ struct Switches {
     /// (not max_active_set_iterations), the Newton method from its answer (not the
     /// extrapolated forces); 4 two passes from the previous modes (without bit 2); 8 / 16
     /// the semismooth Newton method's pairs within 0.1 / 0.01 x ||F||_inf of their kink keep
-    /// their modes (SparsePath::natural_residual's band).
+    /// their modes (SparsePath::natural_residual's band). Bits 64 and above are decision 038's:
+    /// 64 a set of modes solved earlier in the same step is recalled (SparsePath::solve_modes
+    /// keeps this step's solutions), not solved again (measured: no set recurs; not landed).
     int study = 0;
+    /// The Schur way's fresh dense LU (a held set no low-rank update of the base reaches) only
+    /// up to this many held rows; larger sets take the sparse LU (ModeSolverTuning::
+    /// schur_fresh_max_rows; docs/decisions/038). -1: no limit, the way before.
+    int schur_fresh_max_rows = 200;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,

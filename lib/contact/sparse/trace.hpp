@@ -3,9 +3,73 @@
 // recorded per step when Switches::trace points at a TransitionTrace (the benchmark's
 // `trace` argument). Off (nullptr) by default: nothing is recorded and nothing costs.
 #include <algorithm>
+#include <ctime>
+#include <functional>
+#include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace stackbeam::detail::sparse {
+
+/// The thread's CPU time [s] (the trace's phase and route times).
+inline double thread_cpu_s() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// How ModeSolver::solve answered one call (docs/decisions/038): the current key's cached
+/// factorisation; the Schur way's dense LU, its low-rank (Woodbury) update of the base's LU,
+/// or the base's own set again; a sparse LU (KLU on the fixed pattern, or the held set's own
+/// system); the bordered update of the last sparse LU; the primal route.
+enum Route : int {
+    route_cached,
+    route_schur_lu,
+    route_schur_update,
+    route_schur_base,
+    route_fixed_lu,
+    route_lu,
+    route_border,
+    route_primal,
+    route_count
+};
+inline const char* route_name(int r) {
+    static const char* const names[route_count] = {"cached", "schur-LU", "schur-update", "schur-base",
+                                                   "fixed-LU", "own-LU", "border", "primal"};
+    return names[r];
+}
+
+/// Per route: the calls, their CPU time [s] (ModeSolver::solve, factorisation and solves) and
+/// their held rows summed (a mean set size per route); a fixed-pattern LU's pivoted
+/// factorisations (the rest are refactorisations on the last pivot sequence).
+struct RouteStats {
+    long count[route_count] = {};
+    double seconds[route_count] = {};
+    double held[route_count] = {};
+    long fixed_pivoted = 0;
+    void add(const RouteStats& o, double sign = 1.0) {
+        for (int r = 0; r < route_count; ++r) {
+            count[r] += static_cast<long>(sign) * o.count[r];
+            seconds[r] += sign * o.seconds[r];
+            held[r] += sign * o.held[r];
+        }
+        fixed_pivoted += static_cast<long>(sign) * o.fixed_pivoted;
+    }
+    long solves() const {  // calls that made a new set's solve (all but the cached ones)
+        long s = 0;
+        for (int r = 1; r < route_count; ++r) s += count[r];
+        return s;
+    }
+};
+
+/// The phases of a solve: the passes from the previous modes, the semismooth Newton method,
+/// the passes that confirm a Newton method's answer, the smoothing Newton method, the Tresca
+/// fixed point (its box QPs and the passes after it).
+enum Phase : int { phase_passes, phase_semismooth, phase_confirm, phase_smoothing, phase_tresca, phase_count };
+inline const char* phase_name(int p) {
+    static const char* const names[phase_count] = {"passes", "semismooth", "confirm", "smoothing", "tresca"};
+    return names[p];
+}
 
 /// One iteration of the semismooth Newton method.
 struct NewtonIterationTrace {
@@ -38,11 +102,41 @@ struct StepTrace {
     int pred_n = -1, pred_t = -1;    ///< the modes at the last two steps' (p, s) extrapolated
     int first_n = -1, first_t = -1;  ///< the semismooth method's first modes (extrapolated p, its s)
     int passes_n = -1, passes_t = -1;  ///< the modes the passes from the previous modes ended with
+    int recallable = 0;    ///< new-set solves of a set already solved in this step (docs/decisions/038)
+    int seen_earlier = 0;  ///< new-set solves of a set solved in an earlier step, not this one
+    RouteStats phase[phase_count];     ///< the mode solver's calls per phase (docs/decisions/038)
+    double phase_s[phase_count] = {};  ///< CPU time per phase [s] (its solves and everything else)
 };
 
 struct TransitionTrace {
     std::vector<StepTrace> steps;
     StepTrace* current = nullptr;  ///< the step being recorded (the solver's)
+    RouteStats routes;             ///< the mode solver's calls so far (ModeSolver::solve adds to it)
+    std::unordered_set<std::size_t> keys;  ///< hashes of the sets of modes solved so far (all steps)
+    static std::size_t hash(const std::vector<signed char>& key) {
+        return std::hash<std::string>()(std::string(key.begin(), key.end()));
+    }
+    void remember(const std::vector<signed char>& key) { keys.insert(hash(key)); }
+    bool seen(const std::vector<signed char>& key) const { return keys.count(hash(key)) > 0; }
+    // the open phase's start: the routes and the CPU time then
+    RouteStats mark;
+    double mark_s = 0.0;
+    /// Starts a phase (after the previous one was closed).
+    void open_phase() {
+        mark = routes;
+        mark_s = thread_cpu_s();
+    }
+    /// Adds what happened since open_phase() to the current step's phase `ph`, and opens the next.
+    void close_phase(int ph) {
+        const double now = thread_cpu_s();
+        if (current) {
+            current->phase[ph].add(routes);
+            current->phase[ph].add(mark, -1.0);
+            current->phase_s[ph] += now - mark_s;
+        }
+        mark = routes;
+        mark_s = now;
+    }
     // the Newton iterations' bookkeeping within the current step: the last modes and, per
     // pair, the modes visited (bit nmode * 5 + tmode) and its number of changes
     std::vector<signed char> last_n, last_t;
