@@ -567,7 +567,8 @@ BENCHMARK(ElasticRuns)
 /// transition method of decision 037 in part or whole (`way`, a bit mask of its changes, each
 /// bit the Switches field at its default, else the way before: 1 newton_passes, 2
 /// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 29 the
-/// default (smoothing_from_rest is off), 0 the way before) and, with trace 1, the statistics of
+/// default (smoothing_from_rest is off), 0 the way before; bit 32 decision 038's routes,
+/// Switches::fixed_pattern 4 and schur_fresh_max_rows 200, else 2 and none; 61 every default) and, with trace 1, the statistics of
 /// every transition step (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton
 /// iteration, pairs back in a mode they had left, the distances of the start, a predicted start
 /// and the Newton method's first modes to the step's final modes, how the semismooth method
@@ -593,6 +594,10 @@ void TransitionStudy(benchmark::State& state) {
     if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
     if ((way & 8) != 0) sw.creep_limit = now.creep_limit;
     if ((way & 16) != 0) sw.nonmonotone_memory = now.nonmonotone_memory;
+    if ((way & 32) == 0) {  // decision 038's routes off: the fixed pattern's KLU, no fresh-LU limit
+        sw.fixed_pattern = 2;
+        sw.schur_fresh_max_rows = -1;
+    }
     if (state.range(4) == 1) sw.trace = &trace;
     if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const detail::sparse::ScopedSwitches scoped(sw);
@@ -736,7 +741,11 @@ BENCHMARK(TransitionStudy)
     ->Args({400, 3, 100, 29, 0, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
     // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {29}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
+    // decisions 037 and 038 together: before both (0), 037 alone (29), 038 alone (32), both (61)
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
+    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
+    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
