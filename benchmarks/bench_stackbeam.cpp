@@ -741,7 +741,7 @@ BENCHMARK(TransitionStudy)
     ->Args({400, 3, 100, 29, 0, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
     // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
     // decisions 037 and 038 together: before both (0), 037 alone (29), 038 alone (32), both (61)
     ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
     ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
