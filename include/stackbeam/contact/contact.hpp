@@ -75,7 +75,9 @@ struct SolverOptions {
     double alpha = 0.0;               ///< paper / block_jacobi: alpha; 0 = alpha_fraction * 2 / lambda_max(E W)
     double alpha_fraction = 0.9;      ///< paper / block_jacobi: alpha as a fraction of the stability bound 2/lambda_max(E W)
     int max_active_set_iterations = 3;    ///< exact solver: active-set passes from the given modes before it
-                                          ///< turns to the Tresca fixed point (and again after it)
+                                          ///< turns to the Tresca fixed point (and again after it); on the
+                                          ///< sparse path's Newton route one pass precedes the Newton method
+                                          ///< and these passes confirm its answer (docs/contact-solvers.md)
     int tresca_anderson_depth = 8;        ///< exact solver (dense and sparse path): Anderson acceleration depth of
                                           ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
                                           ///< fixed point (decision 007: of 3, 5 and 8 only 8 settles the graduated
