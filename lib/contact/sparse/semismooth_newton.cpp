@@ -279,13 +279,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         }
         ++r.iterations;
         ++r.newton_iterations;
-        // the study (docs/decisions/036), Switches::study bits 8 / 16: pairs within a band of
-        // 0.1 / 0.01 x ||F||_inf of their kink keep their modes (hysteresis against flips)
-        const int study = path.switches.study;
-        const double band = (study & 8) != 0 ? 0.1 * F.lpNorm<Eigen::Infinity>()
-                            : (study & 16) != 0 ? 0.01 * F.lpNorm<Eigen::Infinity>()
-                                                : 0.0;
-        path.natural_residual(p, sk, F, true, band);
+        path.natural_residual(p, sk, F, true);
         NewtonIterationTrace* itr = nullptr;
         if (tr) {
             if (trace->first_n.empty()) {
@@ -326,17 +320,6 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
                 grid_theta = t1;
                 a = 1.0;
                 searched = nonmonotone_full = true;
-            }
-        }
-        if (!searched && (path.switches.study & 1) != 0) {
-            // the study (docs/decisions/036), Switches::study bit 1: the full step wherever it
-            // lowers theta (p is then the linear solution of its modes)
-            path.natural_residual(p1, s1, F1, false);
-            const double t1 = F1.squaredNorm();
-            if (t1 < theta) {
-                grid_theta = t1;
-                a = 1.0;
-                searched = true;
             }
         }
         if (!searched && path.switches.incremental) {

@@ -60,31 +60,23 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
         lin_tau_rule_ = laws.tau_rule;
         lin_ok_ = true;
     }
-    // the study (docs/decisions/038): the sets solved earlier in this step (the same load and
-    // offsets, so the same solution), recalled with Switches::study bit 64; the trace counts them
-    const bool recall = (switches.study & 64) != 0;
+    // the trace (docs/decisions/038) counts the solves of a set already solved in this step
+    // (the same load and offsets, so the same solution; measured: none recurs) and of a set
+    // seen in an earlier step
     StepTrace* const tr = switches.trace ? switches.trace->current : nullptr;
-    Solved* found = nullptr;
-    if ((recall || tr) && !solver.is_current(lin_key_)) {
-        for (auto& sv : recall_)
-            if (sv.key == lin_key_) found = &sv;
-        if (tr) {
-            if (found) ++tr->recallable;
-            else if (switches.trace->seen(lin_key_)) ++tr->seen_earlier;
-        }
-        if (found && recall) {
-            p = found->p;
-            z = found->z;
-            return 0;
-        }
+    bool found = false;
+    if (tr && !solver.is_current(lin_key_)) {
+        for (const auto& sv : recall_) found = found || sv.key == lin_key_;
+        if (found) ++tr->recallable;
+        else if (switches.trace->seen(lin_key_)) ++tr->seen_earlier;
     }
     const int f = solver.solve(lin_, lin_key_, step.b, step.d, p, z);
     modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
-    if ((recall || tr) && !found) {
+    if (tr && !found) {
         constexpr std::size_t kRecallSets = 64;
         if (recall_.size() >= kRecallSets) recall_.erase(recall_.begin());
-        recall_.push_back(Solved{lin_key_, p, z});
-        if (tr) switches.trace->remember(lin_key_);
+        recall_.push_back(Solved{lin_key_});
+        switches.trace->remember(lin_key_);
     }
     return f;
 }
@@ -118,7 +110,7 @@ bool passes_from_modes(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
 /// With w = W_kk (diag) both parts of each component are in metres, so the Newton step
 /// of the modes (the linear problem solve_modes solves) zeroes F for those modes.
 void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F,
-                                  bool set_modes, double band_m) {
+                                  bool set_modes) {
     const Eigen::VectorXd& diag = this->diag();
     F = s;
     const bool prev = laws.tau_rule == TauRule::previous_step;
@@ -130,8 +122,6 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
             const double a = pn - s[c.row_n] / w;
             F[c.row_n] = w * (pn - std::min(0.0, a));
             closed = a < 0.0;
-            if (set_modes && band_m > 0.0 && w * std::abs(a) < band_m && modes.nmode[k] != modes::NONE)
-                closed = modes.nmode[k] == modes::CLOSED;  // within the band: kept
             if (set_modes) modes.nmode[k] = closed ? modes::CLOSED : modes::OPEN;
         } else if (c.kind == PairKind::coulomb) {
             closed = false;  // no normal row: the unilateral pair has no normal force
@@ -154,10 +144,6 @@ void SparsePath::natural_residual(const Eigen::VectorXd& p, const Eigen::VectorX
         if (carries) {
             if (std::abs(a) < limit || a == 0.0) mode = modes::STICK;
             else mode = a > 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
-            const signed char old = modes.tmode[k];
-            if (band_m > 0.0 && mode != old && (old == modes::STICK || old == modes::SLIP_POS || old == modes::SLIP_NEG) &&
-                w * std::abs(std::abs(a) - limit) < band_m && (old == modes::STICK || (old == modes::SLIP_POS) == (a > 0.0)))
-                mode = old;  // within the band of the stick / slip kink: kept
         }
         modes.tmode[k] = mode;
         modes.make_consistent(laws, k);

@@ -71,10 +71,9 @@ struct SparsePath {
     const Eigen::VectorXd& diag() const { return solver.stiffness().diag; }
 
     /// Solves the linear problem of the current modes for `step` into p and z; returns 1
-    /// if it factorised. Throws SingularModes. With Switches::study bit 64 (docs/decisions/038)
-    /// a set of modes already solved in this step is recalled (its p and z copied), not solved.
+    /// if it factorised. Throws SingularModes.
     int solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z);
-    /// A new step (a new load and offsets): forgets the sets solve_modes solved.
+    /// A new step (a new load and offsets): forgets the sets solve_modes solved (the trace's count).
     void begin_step() { recall_.clear(); }
     /// Sets s = G z - d and returns the number of violated modes at (p, s) (threshold
     /// kAccept x tolerance, or the round-off of s if larger).
@@ -84,10 +83,7 @@ struct SparsePath {
     bool passes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, int max_passes, SolveResult& r);
     /// The natural map F(p, s) of the contact laws per component in metres, and with
     /// `set_modes` the modes of its generalised Jacobian at (p, s) (sparse_path.cpp).
-    /// With band_m > 0 (the study, docs/decisions/036: Switches::study bits 8 / 16) a pair
-    /// whose mode decision is within band_m [m] of its kink keeps its current mode.
-    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes,
-                          double band_m = 0.0);
+    void natural_residual(const Eigen::VectorXd& p, const Eigen::VectorXd& s, Eigen::VectorXd& F, bool set_modes);
 
 private:
     // the linearisation of the modes solve_modes last solved (kept while they stay)
@@ -95,10 +91,9 @@ private:
     bool lin_ok_ = false;
     std::vector<signed char> lin_nmode_, lin_tmode_, lin_key_;
     TauRule lin_tau_rule_ = TauRule::current;
-    // the sets of modes solved in this step and their solutions (most recent last)
+    // with a trace, the sets of modes solved in this step (most recent last)
     struct Solved {
         std::vector<signed char> key;
-        Eigen::VectorXd p, z;
     };
     std::vector<Solved> recall_;
 };

@@ -299,17 +299,13 @@ struct SparseContactSolver::Impl {
             // passes before keep the previous modes (modes read from the extrapolation cost
             // more: 27.7 iterations per step)
             const bool extrapolate = previous_p.size() == m && last_p.size() == m && p_start == last_p;
-            // the study (docs/decisions/036), Switches::study bit 2: from the one pass's answer
-            // (the previous modes' linear solution for this step)
-            const bool from_pass = (path.switches.study & 2) != 0 && !path.switches.newton_first && p_passes.size() == m;
             // without an extrapolation (the step after the first: one solve before) and not from
             // rest, the first pass's solution, the previous modes' answer to this step's load, not
             // the warm start, the last step's (Switches::first_pass_start; graduated 10 x 400,
             // 100 ms: the second step 92 -> 18 mode-set solves, docs/decisions/037)
             const bool from_first_pass = path.switches.first_pass_start && !extrapolate && p_first_pass.size() == m &&
                                          !p_start.isZero(0.0);
-            if (confirmed(semismooth_newton, from_pass         ? p_passes
-                                             : from_first_pass ? p_first_pass
+            if (confirmed(semismooth_newton, from_first_pass ? p_first_pass
                                              : extrapolate     ? Eigen::VectorXd(2.0 * last_p - previous_p)
                                                                : p_start))
                 return true;
@@ -444,13 +440,9 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         //    method follows, Switches::newton_passes of them (1: its start is not the passes'
         //    answer, and further passes switch every violated row and move away from the step's
         //    answer, docs/decisions/036 / 037), else max_active_set_iterations.
-        //    (the study, docs/decisions/036: Switches::study bit 2 one pass, bit 4 two)
-        const int study = path.switches.study;
         const bool newton_follows = path.switches.transition != TransitionMethod::tresca && m >= im.newton_min_rows;
-        const int max_passes = (study & 2) != 0                                      ? 1
-                               : (study & 4) != 0                                    ? 2
-                               : newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
-                                                                                     : path.options.max_active_set_iterations;
+        const int max_passes = newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
+                                                                                 : path.options.max_active_set_iterations;
         if (!path.switches.newton_first && max_passes > 4) {
             r.converged = path.passes(step, p, z, max_passes, r);
         } else if (!path.switches.newton_first) {

@@ -100,16 +100,6 @@ struct Switches {
     /// A study aid (docs/decisions/036): where not null, every solve records its transition's
     /// statistics there (trace.hpp). The caller owns it; nullptr (default): nothing recorded.
     TransitionTrace* trace = nullptr;
-    /// The study's changes of a transition step (docs/decisions/036), a bit mask, 0 none (the
-    /// default): 1 the semismooth Newton method takes the full step wherever it lowers
-    /// ||F||^2 (else the line search as before); 2 one active-set pass from the previous modes
-    /// (not max_active_set_iterations), the Newton method from its answer (not the
-    /// extrapolated forces); 4 two passes from the previous modes (without bit 2); 8 / 16
-    /// the semismooth Newton method's pairs within 0.1 / 0.01 x ||F||_inf of their kink keep
-    /// their modes (SparsePath::natural_residual's band). Bits 64 and above are decision 038's:
-    /// 64 a set of modes solved earlier in the same step is recalled (SparsePath::solve_modes
-    /// keeps this step's solutions), not solved again (measured: no set recurs; not landed).
-    int study = 0;
     /// The Schur way's fresh dense LU (a held set no low-rank update of the base reaches) only
     /// up to this many held rows; larger sets take the sparse LU (ModeSolverTuning::
     /// schur_fresh_max_rows; docs/decisions/038). -1: no limit, the way before.
