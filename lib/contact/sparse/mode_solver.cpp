@@ -43,6 +43,9 @@ constexpr double kColumnCacheDoubles = 1e7;
 // k base solves and a k x k LU, against the LU's ms^3 / 3; docs/decisions/020)
 constexpr int kMinUpdateRows = 24;
 constexpr int kUpdateRankFraction = 4;
+/// Whether a held set of ms rows, the update's rank k against a base of nb rows, is
+/// factorised afresh rather than updated (the update's cost against a fresh LU's).
+bool fresh_schur_lu(int ms, int nb, int k) { return ms < kMinUpdateRows || nb == 0 || kUpdateRankFraction * k > ms; }
 // the primal route takes a held set with at most this many held rigid rows (each one a
 // column of its Schur complement, solved with the factor at every new set)
 constexpr int kPrimalMaxRigidRows = 200;
@@ -674,7 +677,7 @@ int ModeSolver::factor_schur_update(const ModeLinearization& lin, bool may_facto
     if (!may_factorise) {  // (the rank test of the update below, before its work)
         const int na = static_cast<int>(added.size());
         const int k = static_cast<int>(removed.size()) + 2 * na + changed_kept;
-        if (ms < kMinUpdateRows || nb == 0 || kUpdateRankFraction * k > ms) return -1;
+        if (fresh_schur_lu(ms, nb, k)) return -1;
     }
     ensure_columns(needed);
     // g_a K^-1 g_b^T from whichever of the two columns is cached (every entry computed below
@@ -714,7 +717,7 @@ int ModeSolver::factor_schur_update(const ModeLinearization& lin, bool may_facto
         else base_schur = false;
         return 1;
     };
-    if (ms < kMinUpdateRows || nb == 0 || kUpdateRankFraction * k > ms) return factorise();
+    if (fresh_schur_lu(ms, nb, k)) return factorise();
     // the bordered embedding (see above)
     const int nu = nb + na;
     wb_nb = nb;

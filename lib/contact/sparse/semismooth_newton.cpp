@@ -361,15 +361,8 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
         // kink of F next to the iterate at every step) is left to the smoothing method, which
         // has no kinks (docs/decisions/037)
         creeping = a < kCreepStep ? creeping + 1 : 0;
-        if (path.switches.creep_limit > 0 && creeping >= path.switches.creep_limit) {
-            // the step is taken first (it lowered theta), so best_p is the latest iterate
-            p += a * (p1 - p);
-            z += a * (z1 - z);
-            sk += a * (s1 - sk);
-            path.natural_residual(p, sk, F, false);
-            if (F.squaredNorm() < best_theta) path.best_p = p;
-            return end(2, false);
-        }
+        // (the step is taken first: it lowered theta, so best_p may be its iterate)
+        const bool creep_stop = path.switches.creep_limit > 0 && creeping >= path.switches.creep_limit;
         full_step = a == 1.0;
         if (full_step) {
             p = p1;
@@ -394,6 +387,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             best_theta = theta;
             path.best_p = p;
         }
+        if (creep_stop) break;
     }
     return end(2, false);
 }

@@ -60,24 +60,10 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
         lin_tau_rule_ = laws.tau_rule;
         lin_ok_ = true;
     }
-    // the trace (docs/decisions/038) counts the solves of a set already solved in this step
-    // (the same load and offsets, so the same solution; measured: none recurs) and of a set
-    // seen in an earlier step
-    StepTrace* const tr = switches.trace ? switches.trace->current : nullptr;
-    bool found = false;
-    if (tr && !solver.is_current(lin_key_)) {
-        for (const auto& sv : recall_) found = found || sv.key == lin_key_;
-        if (found) ++tr->recallable;
-        else if (switches.trace->seen(lin_key_)) ++tr->seen_earlier;
-    }
+    // the trace counts the new-set solves of a set solved before (docs/decisions/038: none recurs)
+    if (switches.trace && switches.trace->current && !solver.is_current(lin_key_)) switches.trace->count_solve(lin_key_);
     const int f = solver.solve(lin_, lin_key_, step.b, step.d, p, z);
     modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
-    if (tr && !found) {
-        constexpr std::size_t kRecallSets = 64;
-        if (recall_.size() >= kRecallSets) recall_.erase(recall_.begin());
-        recall_.push_back(Solved{lin_key_});
-        switches.trace->remember(lin_key_);
-    }
     return f;
 }
 

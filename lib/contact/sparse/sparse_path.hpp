@@ -73,8 +73,6 @@ struct SparsePath {
     /// Solves the linear problem of the current modes for `step` into p and z; returns 1
     /// if it factorised. Throws SingularModes.
     int solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z);
-    /// A new step (a new load and offsets): forgets the sets solve_modes solved (the trace's count).
-    void begin_step() { recall_.clear(); }
     /// Sets s = G z - d and returns the number of violated modes at (p, s) (threshold
     /// kAccept x tolerance, or the round-off of s if larger).
     int count_violations(const Eigen::VectorXd& d, const Eigen::VectorXd& p, const Eigen::VectorXd& z);
@@ -91,11 +89,6 @@ private:
     bool lin_ok_ = false;
     std::vector<signed char> lin_nmode_, lin_tmode_, lin_key_;
     TauRule lin_tau_rule_ = TauRule::current;
-    // with a trace, the sets of modes solved in this step (most recent last)
-    struct Solved {
-        std::vector<signed char> key;
-    };
-    std::vector<Solved> recall_;
 };
 
 }  // namespace stackbeam::detail::sparse

@@ -410,7 +410,6 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     }
     SolveResult r;
     path.solver.reset_updates();
-    path.begin_step();
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};
@@ -419,8 +418,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     StepTrace* tr = nullptr;
     std::vector<signed char> start_n, start_t, pred_n, pred_t, passes_n, passes_t;
     if (trace) {
-        trace->steps.emplace_back();
-        tr = trace->current = &trace->steps.back();
+        tr = &trace->new_step();
         start_n = path.modes.nmode;
         start_t = path.modes.tmode;
         trace->begin(start_n, start_t);

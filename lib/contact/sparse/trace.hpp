@@ -112,12 +112,27 @@ struct TransitionTrace {
     std::vector<StepTrace> steps;
     StepTrace* current = nullptr;  ///< the step being recorded (the solver's)
     RouteStats routes;             ///< the mode solver's calls so far (ModeSolver::solve adds to it)
-    std::unordered_set<std::size_t> keys;  ///< hashes of the sets of modes solved so far (all steps)
+    std::unordered_set<std::size_t> keys;       ///< hashes of the sets of modes solved so far (all steps)
+    std::unordered_set<std::size_t> step_keys;  ///< those solved in the current step
     static std::size_t hash(const std::vector<signed char>& key) {
         return std::hash<std::string>()(std::string(key.begin(), key.end()));
     }
-    void remember(const std::vector<signed char>& key) { keys.insert(hash(key)); }
-    bool seen(const std::vector<signed char>& key) const { return keys.count(hash(key)) > 0; }
+    /// A new step's record (the solver's, at the start of each solve), made current.
+    StepTrace& new_step() {
+        steps.emplace_back();
+        current = &steps.back();
+        step_keys.clear();
+        return *current;
+    }
+    /// Counts a new-set solve of the set `key` into the current step (docs/decisions/038:
+    /// a set solved earlier in this step, else in an earlier one) and remembers it.
+    void count_solve(const std::vector<signed char>& key) {
+        const std::size_t h = hash(key);
+        if (step_keys.count(h) > 0) ++current->recallable;
+        else if (keys.count(h) > 0) ++current->seen_earlier;
+        step_keys.insert(h);
+        keys.insert(h);
+    }
     // the open phase's start: the routes and the CPU time then
     RouteStats mark;
     double mark_s = 0.0;
