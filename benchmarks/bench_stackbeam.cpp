@@ -579,9 +579,9 @@ BENCHMARK(ElasticRuns)
 /// ended; per phase and route the mode solver's calls and their CPU time (decision 038).
 /// args: elements per half leaf, stack, simulated ms, way, trace, schur (> 0:
 /// SparsePathTuning::schur_max_rows; 0 its default), fixed (Switches::fixed_pattern; -1 its
-/// default), path (the homotopy, docs/decisions/040: 0 off, Switches::path_following's
-/// default; > 0 on with a new base past that many changed rows, Switches::path_rebase_rows;
-/// -1 on without new bases). Each run's answer at its end (w, dissipated energy, |z|) goes to
+/// default), path (the homotopy, docs/decisions/040: 0 off, the way before; > 0 on with a
+/// new base past that many changed rows, Switches::path_rebase_rows, 48 the default; -1 on
+/// without new bases). Each run's answer at its end (w, dissipated energy, |z|) goes to
 /// stderr to 17 digits, with the trace the homotopy's counts.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
@@ -608,10 +608,8 @@ void TransitionStudy(benchmark::State& state) {
     if (state.range(4) == 1) sw.trace = &trace;
     if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const int path_arg = static_cast<int>(state.range(7));
-    if (path_arg != 0) {
-        sw.path_following = 1;
-        sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
-    }
+    sw.path_following = path_arg != 0 ? 1 : 0;
+    if (path_arg != 0) sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
@@ -800,11 +798,13 @@ BENCHMARK(TransitionStudy)
     ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
     ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
     ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}})
-    // decision 040: the homotopy (path) off / on (new base past 48 changed rows) / on without
-    // new bases, graduated and identical 10 x 400 and graduated 100 / 200, 100 ms, every
-    // default else (way 61); the bonded meshes
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {0, 24, 48, 96, -1}})
-    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0, 1}, {0}, {-1}, {0, 48}})
+    // decision 040: the homotopy (path) on, a new base past 24 / 48 (its default) / 96 changed
+    // rows or none (-1), against off (path 0: registered above without the trace), graduated
+    // and identical 10 x 400 and graduated 100 / 200, 100 ms, every default else (way 61)
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -56,10 +56,11 @@ BOOST_AUTO_TEST_CASE(homotopy_transitions_give_the_default_answers) {
     // elastic interfaces with the derived layer, 2 m/s from rest)
     const auto problems = sparse_step_problems(with_elastic_interfaces(graduated_stack(50, 6)), 60);
     const SolverOptions options;
-    const Replay def = replay(problems, options, sp::Switches{});
+    sp::Switches newton;  // the Newton methods after the pass from the previous modes, without the homotopy
+    newton.path_following = 0;
+    const Replay def = replay(problems, options, newton);
     sp::TransitionTrace trace;
-    sp::Switches sw;
-    sw.path_following = 1;  // the homotopy after the pass from the previous modes
+    sp::Switches sw;  // the default: the homotopy after the pass, then (where it fails) the Newton methods
     sw.trace = &trace;
     const Replay hom = replay(problems, options, sw);
     BOOST_TEST(def.unconverged == 0);

@@ -512,8 +512,9 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             passes_n = path.modes.nmode;
             passes_t = path.modes.tmode;
         }
-        // 1b. The homotopy from the last step's data and modes (Switches::path_following)
-        if (!r.converged && path.switches.path_following != 0 && !path.switches.newton_first) {
+        // 1b. The homotopy from the last step's data and modes (Switches::path_following),
+        //     where a Newton method would follow (the same problems, the same confirmation)
+        if (!r.converged && newton_follows && path.switches.path_following != 0 && !path.switches.newton_first) {
             r.converged = im.path_transition(step, p, z, r);
             if (tr) trace->close_phase(phase_path);
         }
