@@ -426,6 +426,7 @@ struct ElasticFigures {
     long steps = 0, failed = 0, by_passes = 0, by_semismooth = 0, by_smoothing = 0, by_tresca = 0;
     long transition_steps = 0;
     int components = 0;
+    double final_w_m = 0.0, dissipated_j = 0.0, z_norm = 0.0;  // the run's answer at its end
 
     void run(const ModelSpec& spec, const SimulationOptions& so) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -453,6 +454,9 @@ struct ElasticFigures {
         total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         components = s.num_components();
+        final_w_m = st.current().w_m;
+        dissipated_j = st.current().dissipated_energy_j;
+        z_norm = st.reduced_displacements().norm();
     }
 
     void put(benchmark::State& state, double t_sim) const {
@@ -575,7 +579,10 @@ BENCHMARK(ElasticRuns)
 /// ended; per phase and route the mode solver's calls and their CPU time (decision 038).
 /// args: elements per half leaf, stack, simulated ms, way, trace, schur (> 0:
 /// SparsePathTuning::schur_max_rows; 0 its default), fixed (Switches::fixed_pattern; -1 its
-/// default).
+/// default), path (the homotopy, docs/decisions/040: 0 off, the way before; > 0 on with a
+/// new base past that many changed rows, Switches::path_rebase_rows, 48 the default; -1 on
+/// without new bases). Each run's answer at its end (w, dissipated energy, |z|) goes to
+/// stderr to 17 digits, with the trace the homotopy's counts.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
     const int stack = static_cast<int>(state.range(1));
@@ -600,6 +607,9 @@ void TransitionStudy(benchmark::State& state) {
     }
     if (state.range(4) == 1) sw.trace = &trace;
     if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
+    const int path_arg = static_cast<int>(state.range(7));
+    sw.path_following = path_arg != 0 ? 1 : 0;
+    if (path_arg != 0) sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
@@ -611,7 +621,49 @@ void TransitionStudy(benchmark::State& state) {
         fig.run(spec, so);
     }
     fig.put(state, t_sim);
+    std::fprintf(stderr, "# TransitionStudy el:%d stack:%d ms:%d way:%d path:%d answer: w %.17g m, dissipated %.17g J, |z| %.17g\n",
+                 elements, stack, static_cast<int>(state.range(2)), way, path_arg, fig.final_w_m, fig.dissipated_j,
+                 fig.z_norm);
     if (state.range(4) != 1) return;
+    // the homotopy (Switches::path_following, docs/decisions/040): the steps it ran on, those
+    // it settled (its modes confirmed), its breakpoints, columns (and the multi-column solves
+    // that made them), base factorisations, pairs evaluated exactly per pair test, the
+    // confirming passes' solves, and the fallbacks by reason
+    {
+        double runs = 0, settled = 0, bp = 0, cols = 0, blocks = 0, fact = 0, conf = 0, rebases = 0, evals = 0, tests = 0;
+        double col_s = 0, base_s = 0, all_s = 0;
+        std::map<int, int> path_ends;
+        for (const auto& t : trace.steps) {
+            if (t.path_end == 0) continue;
+            ++runs;
+            settled += t.path_confirmed;
+            bp += t.path_breakpoints;
+            cols += t.path_columns;
+            blocks += t.path_column_blocks;
+            fact += t.path_factorizations;
+            rebases += t.path_rebases;
+            conf += t.path_confirm_solves;
+            evals += static_cast<double>(t.path_evaluations);
+            tests += static_cast<double>(t.path_pair_tests);
+            col_s += t.path_column_s;
+            base_s += t.path_base_s;
+            all_s += t.path_s;
+            ++path_ends[t.path_end * 10 + (t.path_confirmed ? 0 : 1)];
+        }
+        state.counters["path_runs"] = runs;
+        state.counters["path_fallbacks"] = runs - settled;
+        state.counters["breakpoints_per_path"] = runs > 0 ? bp / runs : 0.0;
+        state.counters["columns_per_path"] = runs > 0 ? cols / runs : 0.0;
+        if (runs > 0) {
+            std::fprintf(stderr, "# path: %g runs, %g settled; per run %.2f breakpoints, %.2f columns in %.2f solves, %.2f factorisations (%.2f new bases), %.2f confirming solves; pairs evaluated %.3f of tested; ends (10 x end + unconfirmed):",
+                         runs, settled, bp / runs, cols / runs, blocks / runs, fact / runs, rebases / runs, conf / runs,
+                         tests > 0 ? evals / tests : 0.0);
+            std::fprintf(stderr, " CPU ms per run: %.2f (columns %.2f, bases %.2f);", 1e3 * all_s / runs,
+                         1e3 * col_s / runs, 1e3 * base_s / runs);
+            for (const auto& e : path_ends) std::fprintf(stderr, " [%d]=%d", e.first, e.second);
+            std::fprintf(stderr, " (1 reached, 2 n/a, 3 singular, 4 rows, 5 breakpoints, 6 stalled, 7 folded, 8 cycled, 9 singular modes)\n");
+        }
+    }
     // the statistics over the steps with a Newton method (and over those the passes settled)
     const auto& steps = trace.steps;
     std::fprintf(stderr, "\n# TransitionStudy el:%d stack:%d ms:%d way:%d: %zu solves\n", elements, stack,
@@ -731,21 +783,28 @@ void TransitionStudy(benchmark::State& state) {
     routes_table("all steps", 0, steps.size());
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed"})
+    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed", "path"})
     // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
-    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}})
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}, {0}})
     // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
     // meshes bonded (the targets' reference)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}})
-    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}})
-    ->Args({400, 3, 100, 29, 0, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}, {0}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}, {0}})
+    ->Args({400, 3, 100, 29, 0, 0, -1, 0})->Args({400, 4, 100, 29, 0, 0, -1, 0})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
     // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}, {0}})
     // decisions 037 and 038 together: before both (0), 037 alone (29), 038 alone (32), both (61)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
-    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}})
-    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
+    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
+    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}})
+    // decision 040: the homotopy (path) on, a new base past 24 / 48 (its default) / 96 changed
+    // rows or none (-1), against off (path 0: registered above without the trace), graduated
+    // and identical 10 x 400 and graduated 100 / 200, 100 ms, every default else (way 61)
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

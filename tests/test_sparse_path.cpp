@@ -411,16 +411,9 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
                          TransitionMethod method = TransitionMethod::newton) {
     const bool smoothing = method == TransitionMethod::smoothing;
     const bool tresca = method == TransitionMethod::tresca;  // with the interior-point method on every box QP
-    const System sys(Model::build(spec));
     SimulationOptions so;
     so.solver.tolerance_m = kTol;
-    so.contact_path = ContactPath::sparse;
-    ClosedFormStepper st(sys, so);
-    std::vector<SparseContactProblem> problems;
-    for (int i = 0; i < steps; ++i) {
-        st.advance();
-        problems.push_back(st.last_sparse_problem());
-    }
+    const std::vector<SparseContactProblem> problems = testing::sparse_step_problems(spec, steps, so);
     detail::sparse::Switches switches;
     switches.newton_first = true;
     switches.transition = method;

@@ -8,6 +8,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
 
 namespace stackbeam::testing {
@@ -174,6 +175,21 @@ std::string input_error_field(F&& f) {
         return e.field();
     }
     return "";
+}
+
+/// The sparse contact problems of the first `steps` closed-form steps of `spec` on the sparse
+/// path (so.contact_path is set to sparse), in order: to replay them with other solvers.
+inline std::vector<SparseContactProblem> sparse_step_problems(const ModelSpec& spec, int steps,
+                                                              SimulationOptions so = {}) {
+    const System sys(Model::build(spec));
+    so.contact_path = ContactPath::sparse;
+    ClosedFormStepper st(sys, so);
+    std::vector<SparseContactProblem> problems;
+    for (int i = 0; i < steps; ++i) {
+        st.advance();
+        problems.push_back(st.last_sparse_problem());
+    }
+    return problems;
 }
 
 }  // namespace stackbeam::testing

@@ -427,17 +427,19 @@ Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
     return gather(x);
 }
 
-Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R) {
+Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {
     if (held_system_) {
         Eigen::MatrixXd X = R;
-        if (!lu_->refined_solve(As_, X)) throw SingularModes{};
+        if (!refine) lu_->solve_in_place(X);
+        else if (!lu_->refined_solve(As_, X)) throw SingularModes{};
         return X;
     }
     const int n = st_->dofs(), m = st_->rows();
     Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n + m, R.cols());
     X.topRows(n) = R.topRows(n);
     for (std::size_t i = 0; i < held_.size(); ++i) X.row(n + held_[i]) = R.row(n + static_cast<Eigen::Index>(i));
-    if (!lu_->refined_solve(A_, X)) throw SingularModes{};
+    if (!refine) lu_->solve_in_place(X);
+    else if (!lu_->refined_solve(A_, X)) throw SingularModes{};
     Eigen::MatrixXd out(n + static_cast<Eigen::Index>(held_.size()), R.cols());
     out.topRows(n) = X.topRows(n);
     for (std::size_t i = 0; i < held_.size(); ++i) out.row(n + static_cast<Eigen::Index>(i)) = X.row(n + held_[i]);

@@ -124,8 +124,10 @@ public:
     /// x = A_S^-1 r for the variable system's layout (n DOFs, then the held rows in lin.S's
     /// order), with one step of iterative refinement against the fixed-pattern matrix.
     Eigen::VectorXd solve(const Eigen::VectorXd& r);
-    /// The same for each column of R (one multi-column solve).
-    Eigen::MatrixXd solve(const Eigen::MatrixXd& R);
+    /// The same for each column of R (one multi-column solve); refine false: without the
+    /// refinement step (and without the backward-error check of an unchecked refactorisation:
+    /// for a factor a refined solve has already checked; docs/decisions/040).
+    Eigen::MatrixXd solve(const Eigen::MatrixXd& R, bool refine = true);
     /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
     /// Orderings and symbolic analyses made since reset() (tests, benchmark).

@@ -387,6 +387,57 @@ void ModeSolver::direct_solve(const ModeLinearization& lin, const Eigen::VectorX
     pS = row_scale.cwiseProduct(x.tail(ms));
 }
 
+bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int>& rows, bool refine, Eigen::MatrixXd& P,
+                             Eigen::MatrixXd& Z) {
+    if (border_active || lu_primal || !lu_ok) return false;
+    const int n = st_.dofs(), m = st_.rows(), ms = static_cast<int>(lin.S.size()), k = static_cast<int>(rows.size());
+    pos.assign(m, -1);
+    for (int i = 0; i < ms; ++i) pos[lin.S[static_cast<std::size_t>(i)]] = i;
+    Z.resize(n, k);
+    Eigen::MatrixXd PS(ms, k);
+    if (lu_schur) {
+        // the loads g_r^T of the force columns through K's factor together, then each
+        // column's held forces by the (dense, refined) Schur solve
+        Eigen::MatrixXd Z0 = Eigen::MatrixXd::Zero(n, k);
+        for (int j = 0; j < k; ++j)
+            if (pos[rows[static_cast<std::size_t>(j)]] < 0)
+                for (SpMat::InnerIterator it(st_.Gt, rows[static_cast<std::size_t>(j)]); it; ++it)
+                    Z0(it.row(), j) = it.value();
+        Z0 = st_.k_llt.solve(Z0).eval();
+        Eigen::VectorXd target(ms), pS, zf;
+        for (int j = 0; j < k; ++j) {
+            const int i = pos[rows[static_cast<std::size_t>(j)]];
+            target.setZero();
+            if (i >= 0) target[i] = 1.0;
+            schur_solve(lin, Z0.col(j), target, pS, zf);
+            Z.col(j) = zf;
+            PS.col(j) = pS;
+        }
+    } else {
+        Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n + ms, k);
+        for (int j = 0; j < k; ++j) {
+            const int r = rows[static_cast<std::size_t>(j)], i = pos[r];
+            if (i >= 0) {
+                R(n + i, j) = row_scale[i];
+            } else {
+                for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) R(it.row(), j) = st_.dz[it.row()] * it.value();
+            }
+        }
+        const Eigen::MatrixXd X = lu_fixed ? fixed_->solve(R, refine) : refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
+        Z = st_.dz.asDiagonal() * X.topRows(n);
+        PS = row_scale.asDiagonal() * X.bottomRows(ms);
+    }
+    P.setZero(m, k);
+    for (int j = 0; j < k; ++j) {
+        const int r = rows[static_cast<std::size_t>(j)];
+        if (pos[r] < 0) P(r, j) = 1.0;
+        for (int i = 0; i < ms; ++i) P(lin.S[static_cast<std::size_t>(i)], j) = PS(i, j);
+        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
+            P(lin.coupled[a].first, j) += lin.coef[a] * P(lin.coupled[a].second, j);
+    }
+    return true;
+}
+
 /// Low-rank updates of the sparse saddle-point LU (the "base", held set S0, no slip
 /// coupling) for a held set S near S0, without refactorising: the system of S is the
 /// base system bordered by one row and column per changed row,

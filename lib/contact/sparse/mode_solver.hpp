@@ -122,6 +122,15 @@ public:
     /// Throws SingularModes if the held rows are dependent.
     int solve(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
               const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// For the current factorisation (lin's, made current by a solve() with its key): lin's
+    /// problem for one unit right-hand side per row of `rows`, all in one multi-column solve,
+    /// with b = 0 and e = 0 but a unit offset d_r (a held row of lin) or a unit fixed force e_r
+    /// (a row not held): the forces P (m x k) and displacements Z (n x k). refine false: no
+    /// iterative refinement (the homotopy's columns, docs/decisions/040: its end modes are
+    /// solved again with refinement by the passes). False (nothing solved) where the current
+    /// factorisation is a bordered update or the primal route's: then solve() per column.
+    bool unit_solves(const modes::ModeLinearization& lin, const std::vector<int>& rows, bool refine, Eigen::MatrixXd& P,
+                     Eigen::MatrixXd& Z);
     /// The current set of modes is the caller's accepted answer: on the Schur way, its
     /// Schur complement is factorised densely (if it was solved by an update) and becomes
     /// the base of the next updates, so updates never chain (no drift).

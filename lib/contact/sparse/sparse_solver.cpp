@@ -93,6 +93,9 @@
 //    to the Tresca fixed point (thousands of factorisations) in ~20 iterations; at 10
 //    identical leaves x 400 elements it stalls too (a near-singular Jacobian from the
 //    slip coupling), so that size still does not run with friction.
+//    Behind Switches::path_following (off by default, docs/decisions/040): between the
+//    passes and the Newton method, the homotopy from the last step's data and modes
+//    (path_following.cpp, Impl::path_transition), its modes confirmed by the passes.
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
 //    the dense exact solver on to_dense() (reported as fell_back); larger ones fail
 //    with a message.
@@ -247,8 +250,13 @@ struct SparseContactSolver::Impl {
 
     bool layer_structure(const SparseContactProblem& pr) { return detail::sparse::layer_structure(pr, layered); }
 
+    // the homotopy's start (Switches::path_following): the last converged solve's data and modes
+    Eigen::VectorXd path_b, path_d;
+    std::vector<signed char> path_n, path_t;
+
     void reset_structure(const SparseContactProblem& pr) {
         path.reset(pr);
+        path_d.resize(0);
         previous_p.resize(0);
         last_p.resize(0);
     }
@@ -319,6 +327,51 @@ struct SparseContactSolver::Impl {
             if (!smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         }
         p = p_passes;  // the Tresca fixed point starts where the passes ended
+        path.modes.nmode = nmode_passes;
+        path.modes.tmode = tmode_passes;
+        return false;
+    }
+
+    /// Step 1b, the homotopy (Switches::path_following, docs/decisions/040): from the last
+    /// converged solve's data and modes to this step's (path_following), its modes confirmed
+    /// by the passes. True when settled; otherwise p, z and the modes are those on entry (the
+    /// passes' end), and the caller goes on as without it.
+    bool path_transition(const detail::sparse::Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
+        using namespace detail::sparse;
+        if (path_d.size() != step.d.size() || path_b.size() != step.b.size()) return false;
+        const Eigen::VectorXd p_passes = p, z_passes = z;
+        const std::vector<signed char> nmode_passes = path.modes.nmode, tmode_passes = path.modes.tmode;
+        PathStats ps;
+        bool settled = false;
+        int confirm = 0;
+        if (path_following(path, step, PathStart{path_b, path_d, path_n, path_t}, p, z, r, ps,
+                           path.switches.path_rebase_rows)) {
+            const int it0 = r.iterations;
+            try {
+                settled = passes_from_modes(path, step, p, z, r);
+            } catch (const SingularModes&) {
+                path.solver.forget();  // the Newton methods from the passes' end, as without the homotopy
+            }
+            confirm = r.iterations - it0;
+        }
+        if (StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr) {
+            tr->path_end = static_cast<int>(ps.end);
+            tr->path_confirmed = settled;
+            tr->path_breakpoints = ps.breakpoints;
+            tr->path_columns = ps.columns;
+            tr->path_column_blocks = ps.column_blocks;
+            tr->path_factorizations = ps.factorizations;
+            tr->path_rebases = ps.rebases;
+            tr->path_evaluations = ps.evaluations;
+            tr->path_pair_tests = ps.pair_tests;
+            tr->path_confirm_solves = confirm;
+            tr->path_column_s = ps.column_s;
+            tr->path_base_s = ps.base_s;
+            tr->path_s = ps.total_s;
+        }
+        if (settled) return true;
+        p = p_passes;
+        z = z_passes;
         path.modes.nmode = nmode_passes;
         path.modes.tmode = tmode_passes;
         return false;
@@ -459,6 +512,12 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
             passes_n = path.modes.nmode;
             passes_t = path.modes.tmode;
         }
+        // 1b. The homotopy from the last step's data and modes (Switches::path_following),
+        //     where a Newton method would follow (the same problems, the same confirmation)
+        if (!r.converged && newton_follows && path.switches.path_following != 0 && !path.switches.newton_first) {
+            r.converged = im.path_transition(step, p, z, r);
+            if (tr) trace->close_phase(phase_path);
+        }
         // 2a. A transition the passes do not settle: the semismooth Newton method on the
         //     natural map from the previous step's forces, extrapolated (for the first
         //     step: the stepper's start), then the active-set passes from its modes
@@ -512,6 +571,16 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +
                     " m above the tolerance " + format_value(path.options.tolerance_m) + " m (natural-map residual " +
                     format_value(r.natural_residual_m) + " m)";
+    }
+    if (path.switches.path_following != 0) {  // the homotopy's next start
+        if (r.converged) {
+            im.path_b = problem.b;
+            im.path_d = problem.d;
+            im.path_n = path.modes.nmode;
+            im.path_t = path.modes.tmode;
+        } else {
+            im.path_d.resize(0);
+        }
     }
     if (r.converged) {
         path.solver.accept();  // the accepted modes: the base of the next step's updates

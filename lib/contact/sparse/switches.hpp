@@ -104,6 +104,19 @@ struct Switches {
     /// up to this many held rows; larger sets take the sparse LU (ModeSolverTuning::
     /// schur_fresh_max_rows; docs/decisions/038). -1: no limit, the way before.
     int schur_fresh_max_rows = 200;
+    /// The parametric (homotopy) active-set transition (path_following.cpp, docs/decisions/040):
+    /// where the passes from the previous modes do not settle a step, the solution is followed
+    /// from the last converged solve's data and modes to this step's along the straight line
+    /// between them, one mode switch per breakpoint, its end modes confirmed by the passes;
+    /// where it does not reach its end (a fold, a cycle, no progress, too many breakpoints or
+    /// changed rows, a singular system) or the passes do not confirm it, the Newton methods
+    /// follow as without it. 1: on (default; graduated 10 x 400 0.82x CPU, identical 0.97x,
+    /// docs/decisions/040); 0: off, the way before.
+    int path_following = 1;
+    /// Its new base: when more than this many contact rows' equations differ from the base
+    /// modes' (the modes whose factorisation the path's sets are low-rank changes of), the
+    /// current modes are factorised and become the base (0: never; up to 400 changed rows).
+    int path_rebase_rows = 48;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,

@@ -62,12 +62,13 @@ struct RouteStats {
     }
 };
 
-/// The phases of a solve: the passes from the previous modes, the semismooth Newton method,
+/// The phases of a solve: the passes from the previous modes, the homotopy (with its
+/// confirming passes; Switches::path_following), the semismooth Newton method,
 /// the passes that confirm a Newton method's answer, the smoothing Newton method, the Tresca
 /// fixed point (its box QPs and the passes after it).
-enum Phase : int { phase_passes, phase_semismooth, phase_confirm, phase_smoothing, phase_tresca, phase_count };
+enum Phase : int { phase_passes, phase_path, phase_semismooth, phase_confirm, phase_smoothing, phase_tresca, phase_count };
 inline const char* phase_name(int p) {
-    static const char* const names[phase_count] = {"passes", "semismooth", "confirm", "smoothing", "tresca"};
+    static const char* const names[phase_count] = {"passes", "path", "semismooth", "confirm", "smoothing", "tresca"};
     return names[p];
 }
 
@@ -106,6 +107,15 @@ struct StepTrace {
     int seen_earlier = 0;  ///< new-set solves of a set solved in an earlier step, not this one
     RouteStats phase[phase_count];     ///< the mode solver's calls per phase (docs/decisions/038)
     double phase_s[phase_count] = {};  ///< CPU time per phase [s] (its solves and everything else)
+    // the homotopy (Switches::path_following, path_following.cpp; docs/decisions/040)
+    int path_end = 0;               ///< PathStats::End (0 not run)
+    bool path_confirmed = false;    ///< it reached t = 1 and the passes from its modes settled
+    int path_breakpoints = 0, path_columns = 0, path_factorizations = 0, path_rebases = 0;
+    int path_column_blocks = 0;     ///< multi-column solves that made its columns
+    long path_evaluations = 0;      ///< pairs whose conditions were evaluated exactly (the rest bounded)
+    long path_pair_tests = 0;       ///< pairs tested (pairs x ratio tests)
+    int path_confirm_solves = 0;    ///< mode-set solves of the passes after it
+    double path_column_s = 0.0, path_base_s = 0.0, path_s = 0.0;  ///< its CPU time [s]: columns, bases, all
 };
 
 struct TransitionTrace {

@@ -5,6 +5,7 @@
 // (path.modes) those of its answer; the caller confirms them by the active-set passes
 // (passes_from_modes) where the method is not itself exact for its modes.
 #include <Eigen/Dense>
+#include <vector>
 
 #include "contact/sparse/sparse_path.hpp"
 
@@ -33,5 +34,43 @@ bool smoothing_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, Ei
 /// path.switches.box_qp chooses the box-QP methods); on success its working set gives
 /// the modes. It starts from the current modes and p.
 bool tresca_fixed_point(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r);
+
+/// Where the path of path_following starts: the previous solve's data (b0, d0) on the same
+/// K, G and pairs, and its final modes (valid there).
+struct PathStart {
+    const Eigen::VectorXd& b;
+    const Eigen::VectorXd& d;
+    const std::vector<signed char>& nmode;
+    const std::vector<signed char>& tmode;
+};
+
+/// What one path_following did (the trace's counts, docs/decisions/040).
+struct PathStats {
+    enum End { not_run, reached, not_applicable, singular, too_many_rows, too_many_breakpoints, stalled, folded, cycled,
+               singular_modes };
+    End end = not_run;
+    int breakpoints = 0;     ///< mode switches along the path (hits within kGroupT of each other count once)
+    int columns = 0;         ///< columns A0^-1 u_r solved with the base modes' factorisation (one per changed row)
+    int column_blocks = 0;   ///< multi-column solves that made them
+    int factorizations = 0;  ///< factorisations of the base modes (0 when still current)
+    int updates = 0;         ///< the mode solver's bordered updates for them
+    int rebases = 0;         ///< new bases (rebase_rows)
+    long evaluations = 0;    ///< pairs whose conditions were evaluated exactly at a ratio test
+    long pair_tests = 0;     ///< pairs x ratio tests (the rest were bounded away from their kinks)
+    // CPU time [s] (thread): the columns' solves, the base factorisations and solves, the rest
+    double column_s = 0.0, base_s = 0.0, total_s = 0.0;
+};
+
+/// The parametric active-set transition (Switches::path_following; path_following.cpp):
+/// follows the solution from `start` (the previous step's data and final modes) to `step`
+/// along the straight line between their data, switching the pairs whose mode condition
+/// fails first at each breakpoint; each set of modes on the way solved as a low-rank change
+/// of the base modes' (one factorisation). True when it reached t = 1: the current modes
+/// (path.modes) are then the path's end and p its forces (the caller confirms them by the
+/// passes). TauRule::current only (else false, end not_applicable). rebase_rows > 0: when
+/// more rows than that differ from the base modes, the current modes become the base (one
+/// factorisation); 0: the start modes stay the base (up to 400 changed rows).
+bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows = 0);
 
 }  // namespace stackbeam::detail::sparse

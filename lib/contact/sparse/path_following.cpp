@@ -1,0 +1,445 @@
+// The parametric (homotopy) active-set transition of the sparse path (transitions.hpp,
+// path_following; Switches::path_following, docs/decisions/040).
+//
+// The previous step's problem (b0, d0) was solved with modes M0; this step's is (b1, d1) on
+// the same K, G and pairs. Along data(t) = data0 + t (data1 - data0), t in [0, 1], the
+// solution of one set of modes is affine in t. Starting from M0 (valid at t = 0), a ratio
+// test over the pairs' mode conditions finds the first t* where a mode stops being valid,
+// that pair switches, and the path goes on from t*; at t = 1 the modes are this step's
+// (Murty, Linear Complementarity, ch. 5: parametric principal pivoting).
+//
+// Every set of modes on the path is solved as a low-rank change of the base modes' linear
+// problem (M0's, or the current modes' after a new base), whose factorisation (the mode
+// solver's, one key) is made once: the full system in x = (z, p) is
+//     K z - G^T p = b,   per contact row r one equation a_r x = f_r:
+//       held (closed normal, stick)   g_r z = d_r
+//       zero force (open, free)       p_r = 0
+//       slip (p_t = e_t + c p_n)      p_t - c p_n = e_t
+// and a set M differs from the base in the equations of a few rows C. With y_r = A0^-1 u_r
+// (u_r the unit right-hand side of row r's base equation, scaled to about a metre of
+// motion: one column per row that ever changes, solved with the base's factorisation,
+// several in one multi-column solve where they are known together, without refinement)
+// and x^(t) = A0^-1 f0(t) (the base's solution along the path),
+//     x(t) = x^(t) + Y lambda(t),   H lambda = f^M_C(t) - a^M_C x^(t),   H = a^M_C Y,
+// i.e. the base's equations hold on the rows outside C and M's on C (Woodbury / bordering;
+// slip couplings are ordinary rows here). H is |C| x |C|, dense.
+//
+// The ratio test needs every pair's conditions at t = 1, but one breakpoint moves lambda
+// only: a pair's condition at t = 1 moves by at most kappa_k ||d lambda_1|| (Cauchy-Schwarz
+// on the rows of Y its condition reads), so a pair is evaluated exactly (its few entries of
+// x^ + Y lambda, O(|C|) each) only where the accumulated bound reaches its slack to the
+// acceptance; the others cannot switch.
+//
+// The answer at t = 1 is confirmed by the caller's active-set passes (so it is the exact
+// solver's, solved with refinement); on any failure (a pair switching back at the same t,
+// a pair switching too often, no progress in t, too many breakpoints or changed rows, a
+// singular H) the caller falls back to the Newton methods.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "contact/sparse/common.hpp"
+#include "contact/sparse/trace.hpp"
+#include "contact/sparse/transitions.hpp"
+
+namespace stackbeam::detail::sparse {
+
+namespace {
+
+constexpr int kMaxBreakpoints = 400;   // then the caller's fallback
+constexpr int kMaxChangedRows = 400;   // |C|: the dense H's size (and the columns' memory)
+constexpr int kMaxSwitchesPerPair = 6; // a pair switching more often: cycling
+constexpr int kMaxStalls = 20;         // breakpoints in a row that do not advance t
+constexpr double kSameT = 1e-12;       // hits within this of the first are simultaneous (and a pair back
+                                       // in the mode it left within this of t: a fold)
+
+/// One contact row's equation under a set of modes.
+struct Eq {
+    enum Kind : signed char { held, zero, slip } kind = zero;
+    int other = -1;      ///< slip: the coupled normal row (or -1)
+    double coef = 0.0;   ///< slip: p_t - coef p_n = e
+    double e = 0.0;      ///< slip: its right-hand side [N]
+    bool operator==(const Eq& o) const { return kind == o.kind && other == o.other && coef == o.coef && e == o.e; }
+    bool operator!=(const Eq& o) const { return !(*this == o); }
+    /// a_r x for x given by an accessor of its force (row) and G z (m + row) entries.
+    template <class F>
+    double apply(int r, int m, const F& x) const {
+        if (kind == held) return x(m + r);
+        if (kind == zero) return x(r);
+        return x(r) - (other >= 0 ? coef * x(other) : 0.0);
+    }
+    double rhs(int r, const Eigen::VectorXd& d) const { return kind == held ? d[r] : kind == slip ? e : 0.0; }
+};
+
+/// The equations of pair k's rows under (nmode, tmode), as ModeSet::linearize writes them
+/// (TauRule::current only).
+void pair_equations(const ContactPair& c, signed char nm, signed char tm, Eq& en, Eq& et) {
+    en = Eq{};
+    et = Eq{};
+    if (c.row_n >= 0 && nm == modes::CLOSED) en.kind = Eq::held;
+    if (c.row_t < 0) return;
+    if (tm == modes::STICK) {
+        et.kind = Eq::held;
+    } else if (tm == modes::SLIP_POS || tm == modes::SLIP_NEG) {
+        const double sigma = tm == modes::SLIP_POS ? 1.0 : -1.0, mu = c.friction_coefficient;
+        et.kind = Eq::slip;
+        if (c.kind == PairKind::clamp) {
+            et.e = sigma * mu * c.preload_n;
+            if (c.row_n >= 0) {
+                et.other = c.row_n;
+                et.coef = -sigma * mu;
+            }
+        } else {
+            et.other = c.row_n;
+            et.coef = -sigma * mu;
+        }
+    }
+}
+
+/// A pair whose mode condition fails on the rest of the path, its new mode (normal or
+/// tangential) and where. A condition g [m] is affine along the path (within one set of
+/// modes) and valid while g <= the passes' acceptance (kAccept x tolerance_m).
+struct Hit {
+    int k;
+    bool normal;
+    signed char to;
+    double t;
+};
+
+}  // namespace
+
+bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows) {
+    struct Clock {  // the whole run's CPU time, whatever the return
+        double& total;
+        double t0;
+        ~Clock() { total += thread_cpu_s() - t0; }
+    } clock{stats.total_s, thread_cpu_s()};
+    const ContactProblem& laws = path.laws;
+    if (laws.tau_rule != TauRule::current) {
+        stats.end = PathStats::not_applicable;
+        return false;
+    }
+    const SparseStiffness& st = path.stiffness();
+    const int m = laws.size();
+    const int np = static_cast<int>(laws.pairs.size());
+    const Eigen::VectorXd& W = path.diag();
+    const double ts = kAccept * path.options.tolerance_m;
+
+    // the base's linear problem and key (as SparsePath::solve_modes names it, so a
+    // factorisation of M0 still current is reused)
+    modes::ModeSet cur;
+    cur.nmode = start.nmode;
+    cur.tmode = start.tmode;
+    modes::ModeLinearization lin0;
+    std::vector<signed char> key0;
+    std::vector<Eq> base(m);
+    auto set_base_equations = [&]() {
+        for (int k = 0; k < np; ++k) {
+            const auto& c = laws.pairs[k];
+            Eq en, et;
+            pair_equations(c, cur.nmode[k], cur.tmode[k], en, et);
+            if (c.row_n >= 0) base[c.row_n] = en;
+            if (c.row_t >= 0) base[c.row_t] = et;
+        }
+    };
+    const int upd0 = path.solver.updates();
+    // x^ at t = 0 and t = 1: [forces; G z] (2m entries each)
+    Eigen::VectorXd X0h(2 * m), X1h(2 * m);
+    auto solve0 = [&](const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
+                      Eigen::VectorXd& X) {
+        Eigen::VectorXd zz, P;
+        const int f = path.solver.solve(lin, key0, b, d, P, zz);
+        r.factorizations += f;
+        stats.factorizations += f;
+        X.head(m) = P;
+        X.tail(m) = st.Grow * zz;
+        return zz;
+    };
+    auto make_base = [&]() {
+        const double c0 = thread_cpu_s();
+        cur.linearize(laws, lin0);
+        key0 = cur.key();
+        key0.push_back(static_cast<signed char>(laws.tau_rule));
+        set_base_equations();
+        solve0(lin0, start.b, start.d, X0h);
+        z = solve0(lin0, step.b, step.d, X1h);
+        stats.base_s += thread_cpu_s() - c0;
+    };
+    try {
+        make_base();
+    } catch (const SingularModes&) {
+        stats.end = PathStats::singular_modes;
+        return false;
+    }
+    ++r.iterations;
+
+    // the columns y_r, row-major (a pair's entries over all columns contiguous), each scaled
+    // to about a metre of motion: a held base row's for a unit offset [m], another's for a
+    // unit force times 1 / W_rr [N]; rn2 the squared norms of Y's rows (the bound's)
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    RowMajor Y(2 * m, 0);
+    int ncol = 0;
+    std::vector<int> col(m, -1);
+    Eigen::VectorXd rn2 = Eigen::VectorXd::Zero(2 * m);
+    const Eigen::VectorXd zero_b = Eigen::VectorXd::Zero(st.K.rows()), zero_d = Eigen::VectorXd::Zero(m);
+    auto add_columns = [&](std::vector<int> rows) {
+        std::sort(rows.begin(), rows.end());
+        rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+        rows.erase(std::remove_if(rows.begin(), rows.end(), [&](int row) { return col[row] >= 0; }), rows.end());
+        if (rows.empty()) return;
+        const double c0 = thread_cpu_s();
+        const int k = static_cast<int>(rows.size());
+        Eigen::MatrixXd P, Z;
+        if (path.solver.unit_solves(lin0, rows, false, P, Z)) {
+            ++stats.column_blocks;
+        } else {  // a bordered or primal factorisation: one solve() per column
+            P.resize(m, k);
+            Z.resize(st.K.rows(), k);
+            for (int j = 0; j < k; ++j) {
+                modes::ModeLinearization lin = lin0;
+                lin.e.setZero();
+                Eigen::VectorXd d = zero_d, Pj, zj;
+                if (base[rows[j]].kind == Eq::held) d[rows[j]] = 1.0;
+                else lin.e[rows[j]] = 1.0;
+                const int f = path.solver.solve(lin, key0, zero_b, d, Pj, zj);
+                r.factorizations += f;
+                stats.factorizations += f;
+                P.col(j) = Pj;
+                Z.col(j) = zj;
+            }
+        }
+        Eigen::MatrixXd B(2 * m, k);  // the scaled columns, then into Y's rows
+        B.topRows(m) = P;
+        B.bottomRows(m).noalias() = st.G * Z;
+        for (int j = 0; j < k; ++j) B.col(j) *= base[rows[j]].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
+        rn2 += B.rowwise().squaredNorm();
+        if (ncol + k > Y.cols()) Y.conservativeResize(2 * m, std::max(16, 2 * (ncol + k)));
+        Y.middleCols(ncol, k) = B;
+        for (int j = 0; j < k; ++j) col[rows[j]] = ncol++;
+        stats.columns += k;
+        stats.column_s += thread_cpu_s() - c0;
+    };
+
+    std::vector<Eq> eq = base;  // the current set's equations
+    std::vector<int> switches(np, 0);
+    std::vector<double> last_switch_t(np, -1.0);
+    std::vector<signed char> left_n(np, modes::NONE), left_t(np, modes::NONE);  // the modes a pair left last
+    // the bound: A1 the sum of ||d lambda_1|| over the breakpoints; per pair the sum at its
+    // last exact evaluation and its slack then (ts minus its largest condition at t = 1)
+    double A1 = 0.0;
+    std::vector<double> A1_at(np, 0.0), slack(np, 0.0);
+    std::vector<char> dirty(np, 1);
+    Eigen::VectorXd L0, L1, L1_prev;  // lambda at t = 0 and 1 per column (0 outside C)
+    double t = 0.0;
+    int stalls = 0;
+    std::vector<Hit> hits;
+    std::vector<int> C;
+    // x's entry q (a force: q < m; G z: m + q) at t = 0 and t = 1 under the current set
+    auto x0 = [&](int q) { return X0h[q] + (ncol > 0 ? Y.row(q).head(ncol).dot(L0) : 0.0); };
+    auto x1 = [&](int q) { return X1h[q] + (ncol > 0 ? Y.row(q).head(ncol).dot(L1) : 0.0); };
+    auto rn = [&](int q) { return std::sqrt(rn2[q]); };
+    try {
+        for (;;) {
+            C.clear();
+            for (int row = 0; row < m; ++row)
+                if (eq[row] != base[row]) C.push_back(row);
+            if (rebase_rows > 0 && static_cast<int>(C.size()) > rebase_rows) {
+                // a new base: the current modes factorised (the columns and the bound start again)
+                make_base();
+                eq = base;
+                std::fill(col.begin(), col.end(), -1);
+                ncol = 0;
+                rn2.setZero();
+                A1 = 0.0;
+                std::fill(dirty.begin(), dirty.end(), 1);
+                L1_prev.resize(0);
+                C.clear();
+                ++stats.rebases;
+            }
+            const int nc = static_cast<int>(C.size());
+            if (nc > kMaxChangedRows) {
+                stats.end = PathStats::too_many_rows;
+                return false;
+            }
+            add_columns(C);
+            L0.setZero(ncol);
+            L1.setZero(ncol);
+            if (nc > 0) {
+                // H (metres both ways: a force equation's row by W_rr; the columns are scaled)
+                Eigen::MatrixXd H(nc, nc);
+                Eigen::VectorXd F0(nc), F1(nc);
+                for (int i = 0; i < nc; ++i) {
+                    const int ri = C[i];
+                    const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
+                    for (int j = 0; j < nc; ++j) {
+                        const int cj = col[C[j]];
+                        H(i, j) = sr * eq[ri].apply(ri, m, [&](int q) { return Y(q, cj); });
+                    }
+                    F0[i] = sr * (eq[ri].rhs(ri, start.d) - eq[ri].apply(ri, m, [&](int q) { return X0h[q]; }));
+                    F1[i] = sr * (eq[ri].rhs(ri, step.d) - eq[ri].apply(ri, m, [&](int q) { return X1h[q]; }));
+                }
+                const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
+                if (!(lu.rcond() > 1e-14)) {
+                    stats.end = PathStats::singular;
+                    return false;
+                }
+                const Eigen::VectorXd l0 = lu.solve(F0), l1 = lu.solve(F1);
+                for (int j = 0; j < nc; ++j) {
+                    L0[col[C[j]]] = l0[j];
+                    L1[col[C[j]]] = l1[j];
+                }
+            }
+            {  // the bound's step: lambda_1's change since the last breakpoint
+                Eigen::VectorXd prev = Eigen::VectorXd::Zero(ncol);
+                prev.head(std::min<Eigen::Index>(L1_prev.size(), ncol)) = L1_prev.head(std::min<Eigen::Index>(L1_prev.size(), ncol));
+                A1 += (L1 - prev).norm();
+                L1_prev = L1;
+            }
+            // the ratio test: the first t' >= t where a condition passes the acceptance
+            double tmin = 2.0;
+            hits.clear();
+            double gmin = 0.0;  // the pair's slack (ts minus its largest condition at t = 1)
+            auto test = [&](int k, bool normal, signed char to, double g0, double g1) {
+                gmin = std::min(gmin, ts - g1);
+                const double gc = g0 + t * (g1 - g0);
+                if (!(g1 > ts) || !(g1 > gc)) return;  // valid at t = 1 and not rising
+                const double th = gc >= ts ? t : t + (1.0 - t) * (ts - gc) / (g1 - gc);
+                tmin = std::min(tmin, th);
+                hits.push_back({k, normal, to, th});
+            };
+            for (int k = 0; k < np; ++k) {
+                const auto& c = laws.pairs[k];
+                const bool nrow = c.row_n >= 0 && modes::ModeSet::unilateral(c);
+                const bool trow = !(c.row_t < 0 || c.kind == PairKind::bonded || c.friction_coefficient == 0.0 ||
+                                    (modes::ModeSet::unilateral(c) && cur.tmode[k] == modes::FREE));
+                if (!nrow && !trow) continue;
+                ++stats.pair_tests;
+                const int rn_ = c.row_n, rt = c.row_t;
+                const bool clamp = c.kind == PairKind::clamp;
+                const double mu = c.friction_coefficient;
+                if (!dirty[k]) {
+                    // the largest move of its conditions at t = 1 per unit of ||d lambda_1||
+                    double kappa = 0.0;
+                    if (nrow) kappa = cur.nmode[k] == modes::CLOSED ? W[rn_] * rn(rn_) : rn(m + rn_);
+                    if (trow) {
+                        const double Wt = W[rt], pn = rn_ >= 0 ? rn(rn_) : 0.0;
+                        double kt = clamp ? mu * Wt * pn : 0.0;
+                        if (cur.tmode[k] == modes::STICK) kt = std::max(kt, Wt * (rn(rt) + mu * pn));
+                        else if (cur.tmode[k] == modes::SLIP_POS || cur.tmode[k] == modes::SLIP_NEG) kt = std::max(kt, rn(m + rt));
+                        kappa = std::max(kappa, kt);
+                    }
+                    if (kappa * (A1 - A1_at[k]) < slack[k]) continue;
+                }
+                ++stats.evaluations;
+                dirty[k] = 0;
+                A1_at[k] = A1;
+                gmin = std::numeric_limits<double>::infinity();
+                if (nrow) {
+                    if (cur.nmode[k] == modes::CLOSED)
+                        test(k, true, modes::OPEN, x0(rn_) * W[rn_], x1(rn_) * W[rn_]);
+                    else if (cur.nmode[k] == modes::OPEN)
+                        test(k, true, modes::CLOSED, x0(m + rn_) - start.d[rn_], x1(m + rn_) - step.d[rn_]);
+                }
+                if (trow) {
+                    const double Wt = W[rt];
+                    const double pn0 = rn_ >= 0 ? x0(rn_) : 0.0, pn1 = rn_ >= 0 ? x1(rn_) : 0.0;
+                    // friction lost past the clamp's preload; the friction limit, affine in p_n
+                    const double rel0 = mu * (pn0 - c.preload_n) * Wt, rel1 = mu * (pn1 - c.preload_n) * Wt;
+                    const double lim0 = mu * (clamp ? c.preload_n - pn0 : -pn0), lim1 = mu * (clamp ? c.preload_n - pn1 : -pn1);
+                    switch (cur.tmode[k]) {
+                        case modes::STICK: {
+                            const double pt0 = x0(rt), pt1 = x1(rt);
+                            if (clamp) test(k, false, modes::FREE, rel0, rel1);
+                            test(k, false, modes::SLIP_POS, (pt0 - lim0) * Wt, (pt1 - lim1) * Wt);
+                            test(k, false, modes::SLIP_NEG, (-pt0 - lim0) * Wt, (-pt1 - lim1) * Wt);
+                            break;
+                        }
+                        case modes::SLIP_POS:
+                        case modes::SLIP_NEG: {
+                            const double sigma = cur.tmode[k] == modes::SLIP_POS ? 1.0 : -1.0;
+                            if (clamp) test(k, false, modes::FREE, rel0, rel1);
+                            test(k, false, modes::STICK, sigma * (x0(m + rt) - start.d[rt]),
+                                 sigma * (x1(m + rt) - step.d[rt]));
+                            break;
+                        }
+                        case modes::FREE:
+                            if (clamp) test(k, false, modes::STICK, -rel0, -rel1);
+                            break;
+                        default: break;
+                    }
+                }
+                slack[k] = gmin;
+            }
+            if (hits.empty()) break;  // the modes hold up to t = 1
+            // switch the pairs that hit within kSameT of t* (a pair's normal switch before its
+            // tangential)
+            if (++stats.breakpoints > kMaxBreakpoints) {
+                stats.end = PathStats::too_many_breakpoints;
+                return false;
+            }
+            stalls = tmin - t <= kSameT ? stalls + 1 : 0;
+            if (stalls > kMaxStalls) {
+                stats.end = PathStats::stalled;
+                return false;
+            }
+            hits.erase(std::remove_if(hits.begin(), hits.end(), [&](const Hit& h) { return h.t > tmin + kSameT; }),
+                       hits.end());
+            std::stable_sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.normal > b.normal; });
+            std::vector<char> done(np, 0);
+            for (const Hit& h : hits) {
+                if (done[h.k]) continue;
+                done[h.k] = 1;
+                dirty[h.k] = 1;
+                // back to the modes it left at the same t: the path folds (or a degenerate
+                // vertex): give up
+                const signed char to_n = h.normal ? h.to : cur.nmode[h.k], to_t = h.normal ? cur.tmode[h.k] : h.to;
+                if (last_switch_t[h.k] >= 0.0 && tmin - last_switch_t[h.k] <= kSameT &&
+                    (h.normal ? to_n == left_n[h.k] : to_t == left_t[h.k])) {
+                    stats.end = PathStats::folded;
+                    return false;
+                }
+                if (++switches[h.k] > kMaxSwitchesPerPair) {
+                    stats.end = PathStats::cycled;
+                    return false;
+                }
+                last_switch_t[h.k] = tmin;
+                left_n[h.k] = cur.nmode[h.k];
+                left_t[h.k] = cur.tmode[h.k];
+                const auto& pc = laws.pairs[h.k];
+                if (h.normal) {
+                    cur.nmode[h.k] = h.to;
+                    // a pair closes with no normal force, so no friction limit: it sticks only
+                    // where its tangential position is at this step's anchor (s_t = 0), else
+                    // it slips against s_t (the natural map's decision at p_t = 0): the path
+                    // stays continuous, and sticks where s_t comes back to 0
+                    if (h.to == modes::CLOSED && pc.row_t >= 0) {
+                        const int rt = pc.row_t;
+                        const double stc = (1.0 - tmin) * (x0(m + rt) - start.d[rt]) + tmin * (x1(m + rt) - step.d[rt]);
+                        cur.tmode[h.k] = std::abs(stc) <= ts ? modes::STICK : stc < 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
+                    }
+                } else {
+                    cur.tmode[h.k] = h.to;
+                }
+                cur.make_consistent(laws, h.k);
+                Eq en, et;
+                pair_equations(pc, cur.nmode[h.k], cur.tmode[h.k], en, et);
+                if (pc.row_n >= 0) eq[pc.row_n] = en;
+                if (pc.row_t >= 0) eq[pc.row_t] = et;
+            }
+            t = tmin;
+        }
+    } catch (const SingularModes&) {
+        stats.end = PathStats::singular_modes;
+        return false;
+    }
+    stats.updates += path.solver.updates() - upd0;
+    stats.end = PathStats::reached;
+    path.modes.nmode = cur.nmode;
+    path.modes.tmode = cur.tmode;
+    p = X1h.head(m);
+    if (ncol > 0) p.noalias() += Y.topRows(m).leftCols(ncol) * L1;
+    return true;
+}
+
+}  // namespace stackbeam::detail::sparse
