@@ -345,7 +345,7 @@ struct SparseContactSolver::Impl {
         bool settled = false;
         int confirm = 0;
         if (path_following(path, step, PathStart{path_b, path_d, path_n, path_t}, p, z, r, ps,
-                           path.switches.path_rebase_rows)) {
+                           path.switches.path_rebase_rows, path.switches.path_max_start_hits)) {
             const int it0 = r.iterations;
             try {
                 settled = passes_from_modes(path, step, p, z, r);
@@ -360,6 +360,7 @@ struct SparseContactSolver::Impl {
             tr->path_breakpoints = ps.breakpoints;
             tr->path_columns = ps.columns;
             tr->path_column_blocks = ps.column_blocks;
+            tr->path_start_hits = ps.start_hits;
             tr->path_factorizations = ps.factorizations;
             tr->path_rebases = ps.rebases;
             tr->path_evaluations = ps.evaluations;

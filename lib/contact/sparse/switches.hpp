@@ -117,6 +117,10 @@ struct Switches {
     /// modes' (the modes whose factorisation the path's sets are low-rank changes of), the
     /// current modes are factorised and become the base (0: never; up to 400 changed rows).
     int path_rebase_rows = 48;
+    /// It is not followed (the Newton methods instead) where more than this many conditions of
+    /// the start modes fail before its end (its first ratio test's hits: a broad change,
+    /// hundreds of breakpoints and columns; docs/decisions/040). 0: no limit.
+    int path_max_start_hits = 500;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
