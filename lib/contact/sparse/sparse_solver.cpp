@@ -93,7 +93,7 @@
 //    to the Tresca fixed point (thousands of factorisations) in ~20 iterations; at 10
 //    identical leaves x 400 elements it stalls too (a near-singular Jacobian from the
 //    slip coupling), so that size still does not run with friction.
-//    Behind Switches::path_following (off by default, docs/decisions/040): between the
+//    Switches::path_following (on by default, docs/decisions/040): between the
 //    passes and the Newton method, the homotopy from the last step's data and modes
 //    (path_following.cpp, Impl::path_transition), its modes confirmed by the passes.
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
