@@ -581,7 +581,8 @@ BENCHMARK(ElasticRuns)
 /// SparsePathTuning::schur_max_rows; 0 its default), fixed (Switches::fixed_pattern; -1 its
 /// default), path (the homotopy, docs/decisions/040: 0 off, the way before; > 0 on with a
 /// new base past that many changed rows, Switches::path_rebase_rows, 48 the default; -1 on
-/// without new bases). Each run's answer at its end (w, dissipated energy, |z|) goes to
+/// without new bases), hits (Switches::path_max_start_hits; -1 its default 500, 0 no
+/// limit). Each run's answer at its end (w, dissipated energy, |z|) goes to
 /// stderr to 17 digits, with the trace the homotopy's counts.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
@@ -610,6 +611,7 @@ void TransitionStudy(benchmark::State& state) {
     const int path_arg = static_cast<int>(state.range(7));
     sw.path_following = path_arg != 0 ? 1 : 0;
     if (path_arg != 0) sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
+    if (state.range(8) >= 0) sw.path_max_start_hits = static_cast<int>(state.range(8));
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
@@ -661,7 +663,15 @@ void TransitionStudy(benchmark::State& state) {
             std::fprintf(stderr, " CPU ms per run: %.2f (columns %.2f, bases %.2f);", 1e3 * all_s / runs,
                          1e3 * col_s / runs, 1e3 * base_s / runs);
             for (const auto& e : path_ends) std::fprintf(stderr, " [%d]=%d", e.first, e.second);
-            std::fprintf(stderr, " (1 reached, 2 n/a, 3 singular, 4 rows, 5 breakpoints, 6 stalled, 7 folded, 8 cycled, 9 singular modes)\n");
+            std::fprintf(stderr, " (1 reached, 2 n/a, 3 singular, 4 rows, 5 breakpoints, 6 stalled, 7 folded, 8 cycled, 9 singular modes, 10 start hits)\n");
+            // per run: the start modes' failing conditions (the first ratio test's hits), its
+            // breakpoints, columns, CPU ms, settled
+            std::fprintf(stderr, "# path runs: start hits / breakpoints / columns / CPU ms / settled:");
+            for (const auto& t : trace.steps)
+                if (t.path_end != 0)
+                    std::fprintf(stderr, " %d/%d/%d/%.1f/%d", t.path_start_hits, t.path_breakpoints, t.path_columns,
+                                 1e3 * t.path_s, t.path_confirmed ? 1 : 0);
+            std::fprintf(stderr, "\n");
         }
     }
     // the statistics over the steps with a Newton method (and over those the passes settled)
@@ -783,28 +793,30 @@ void TransitionStudy(benchmark::State& state) {
     routes_table("all steps", 0, steps.size());
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed", "path"})
+    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed", "path", "hits"})
     // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
-    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}, {0}})
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}, {0}, {-1}})
     // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
     // meshes bonded (the targets' reference)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}, {0}})
-    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}, {0}})
-    ->Args({400, 3, 100, 29, 0, 0, -1, 0})->Args({400, 4, 100, 29, 0, 0, -1, 0})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}, {0}, {-1}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}, {0}, {-1}})
+    ->Args({400, 3, 100, 29, 0, 0, -1, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1, 0, -1})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
     // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}, {0}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}, {0}, {-1}})
     // decisions 037 and 038 together: before both (0), 037 alone (29), 038 alone (32), both (61)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
-    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}})
-    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}})
+    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}})
+    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}, {-1}})
     // decision 040: the homotopy (path) on, a new base past 24 / 48 (its default) / 96 changed
     // rows or none (-1), against off (path 0: registered above without the trace), graduated
     // and identical 10 x 400 and graduated 100 / 200, 100 ms, every default else (way 61)
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}})
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}})
-    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}})
-    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}, {-1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}, {-1}})
+    // the limit on the start modes' failing conditions: none (0), 300, 500 (the default, -1)
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {0, 300}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}, {-1}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}, {-1}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -33,7 +33,8 @@
 // The answer at t = 1 is confirmed by the caller's active-set passes (so it is the exact
 // solver's, solved with refinement); on any failure (a pair switching back at the same t,
 // a pair switching too often, no progress in t, too many breakpoints or changed rows, a
-// singular H) the caller falls back to the Newton methods.
+// singular H, or too many of the start modes' conditions failing at the first ratio test:
+// a broad change, cheaper by the Newton methods) the caller falls back to the Newton methods.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -109,7 +110,7 @@ struct Hit {
 }  // namespace
 
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
-                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows) {
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows, int max_start_hits) {
     struct Clock {  // the whole run's CPU time, whatever the return
         double& total;
         double t0;
@@ -370,6 +371,13 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                     }
                 }
                 slack[k] = gmin;
+            }
+            if (stats.breakpoints == 0 && stats.rebases == 0) {
+                stats.start_hits = static_cast<int>(hits.size());
+                if (max_start_hits > 0 && stats.start_hits > max_start_hits) {
+                    stats.end = PathStats::too_many_start_hits;
+                    return false;
+                }
             }
             if (hits.empty()) break;  // the modes hold up to t = 1
             // switch the pairs that hit within kSameT of t* (a pair's normal switch before its

@@ -93,7 +93,7 @@
 //    to the Tresca fixed point (thousands of factorisations) in ~20 iterations; at 10
 //    identical leaves x 400 elements it stalls too (a near-singular Jacobian from the
 //    slip coupling), so that size still does not run with friction.
-//    Behind Switches::path_following (off by default, docs/decisions/040): between the
+//    Switches::path_following (on by default, docs/decisions/040): between the
 //    passes and the Newton method, the homotopy from the last step's data and modes
 //    (path_following.cpp, Impl::path_transition), its modes confirmed by the passes.
 //    If all that fails, problems of at most kDenseFallbackMaxRows rows are finished by
@@ -345,7 +345,7 @@ struct SparseContactSolver::Impl {
         bool settled = false;
         int confirm = 0;
         if (path_following(path, step, PathStart{path_b, path_d, path_n, path_t}, p, z, r, ps,
-                           path.switches.path_rebase_rows)) {
+                           path.switches.path_rebase_rows, path.switches.path_max_start_hits)) {
             const int it0 = r.iterations;
             try {
                 settled = passes_from_modes(path, step, p, z, r);
@@ -360,6 +360,7 @@ struct SparseContactSolver::Impl {
             tr->path_breakpoints = ps.breakpoints;
             tr->path_columns = ps.columns;
             tr->path_column_blocks = ps.column_blocks;
+            tr->path_start_hits = ps.start_hits;
             tr->path_factorizations = ps.factorizations;
             tr->path_rebases = ps.rebases;
             tr->path_evaluations = ps.evaluations;

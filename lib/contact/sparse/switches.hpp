@@ -110,13 +110,17 @@ struct Switches {
     /// between them, one mode switch per breakpoint, its end modes confirmed by the passes;
     /// where it does not reach its end (a fold, a cycle, no progress, too many breakpoints or
     /// changed rows, a singular system) or the passes do not confirm it, the Newton methods
-    /// follow as without it. 1: on (default; graduated 10 x 400 0.82x CPU, identical 0.97x,
-    /// docs/decisions/040); 0: off, the way before.
+    /// follow as without it. 1: on (default; graduated 10 x 400 about 0.9x CPU, identical
+    /// 0.76-0.85x, docs/decisions/040); 0: off, the way before.
     int path_following = 1;
     /// Its new base: when more than this many contact rows' equations differ from the base
     /// modes' (the modes whose factorisation the path's sets are low-rank changes of), the
     /// current modes are factorised and become the base (0: never; up to 400 changed rows).
     int path_rebase_rows = 48;
+    /// It is not followed (the Newton methods instead) where more than this many conditions of
+    /// the start modes fail before its end (its first ratio test's hits: a broad change,
+    /// hundreds of breakpoints and columns; docs/decisions/040). 0: no limit.
+    int path_max_start_hits = 500;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,

@@ -112,6 +112,7 @@ struct StepTrace {
     bool path_confirmed = false;    ///< it reached t = 1 and the passes from its modes settled
     int path_breakpoints = 0, path_columns = 0, path_factorizations = 0, path_rebases = 0;
     int path_column_blocks = 0;     ///< multi-column solves that made its columns
+    int path_start_hits = 0;        ///< the start modes' conditions failing before t = 1
     long path_evaluations = 0;      ///< pairs whose conditions were evaluated exactly (the rest bounded)
     long path_pair_tests = 0;       ///< pairs tested (pairs x ratio tests)
     int path_confirm_solves = 0;    ///< mode-set solves of the passes after it

@@ -47,7 +47,7 @@ struct PathStart {
 /// What one path_following did (the trace's counts, docs/decisions/040).
 struct PathStats {
     enum End { not_run, reached, not_applicable, singular, too_many_rows, too_many_breakpoints, stalled, folded, cycled,
-               singular_modes };
+               singular_modes, too_many_start_hits };
     End end = not_run;
     int breakpoints = 0;     ///< mode switches along the path (hits within kGroupT of each other count once)
     int columns = 0;         ///< columns A0^-1 u_r solved with the base modes' factorisation (one per changed row)
@@ -55,6 +55,7 @@ struct PathStats {
     int factorizations = 0;  ///< factorisations of the base modes (0 when still current)
     int updates = 0;         ///< the mode solver's bordered updates for them
     int rebases = 0;         ///< new bases (rebase_rows)
+    int start_hits = 0;      ///< conditions of the start modes that fail before t = 1 (the first ratio test's)
     long evaluations = 0;    ///< pairs whose conditions were evaluated exactly at a ratio test
     long pair_tests = 0;     ///< pairs x ratio tests (the rest were bounded away from their kinks)
     // CPU time [s] (thread): the columns' solves, the base factorisations and solves, the rest
@@ -69,8 +70,10 @@ struct PathStats {
 /// (path.modes) are then the path's end and p its forces (the caller confirms them by the
 /// passes). TauRule::current only (else false, end not_applicable). rebase_rows > 0: when
 /// more rows than that differ from the base modes, the current modes become the base (one
-/// factorisation); 0: the start modes stay the base (up to 400 changed rows).
+/// factorisation); 0: the start modes stay the base (up to 400 changed rows). max_start_hits
+/// > 0: false (end too_many_start_hits) where more of the start modes' conditions than that
+/// fail before t = 1.
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
-                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows = 0);
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows = 0, int max_start_hits = 0);
 
 }  // namespace stackbeam::detail::sparse
