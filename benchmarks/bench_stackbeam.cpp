@@ -636,21 +636,21 @@ void TransitionStudy(benchmark::State& state) {
         double col_s = 0, base_s = 0, all_s = 0;
         std::map<int, int> path_ends;
         for (const auto& t : trace.steps) {
-            if (t.path_end == 0) continue;
+            if (t.path.end == 0) continue;
             ++runs;
             settled += t.path_confirmed;
-            bp += t.path_breakpoints;
-            cols += t.path_columns;
-            blocks += t.path_column_blocks;
-            fact += t.path_factorizations;
-            rebases += t.path_rebases;
+            bp += t.path.breakpoints;
+            cols += t.path.columns;
+            blocks += t.path.column_blocks;
+            fact += t.path.factorizations;
+            rebases += t.path.rebases;
             conf += t.path_confirm_solves;
-            evals += static_cast<double>(t.path_evaluations);
-            tests += static_cast<double>(t.path_pair_tests);
-            col_s += t.path_column_s;
-            base_s += t.path_base_s;
-            all_s += t.path_s;
-            ++path_ends[t.path_end * 10 + (t.path_confirmed ? 0 : 1)];
+            evals += static_cast<double>(t.path.evaluations);
+            tests += static_cast<double>(t.path.pair_tests);
+            col_s += t.path.column_s;
+            base_s += t.path.base_s;
+            all_s += t.path.total_s;
+            ++path_ends[static_cast<int>(t.path.end) * 10 + (t.path_confirmed ? 0 : 1)];
         }
         state.counters["path_runs"] = runs;
         state.counters["path_fallbacks"] = runs - settled;
@@ -668,9 +668,9 @@ void TransitionStudy(benchmark::State& state) {
             // breakpoints, columns, CPU ms, settled
             std::fprintf(stderr, "# path runs: start hits / breakpoints / columns / CPU ms / settled:");
             for (const auto& t : trace.steps)
-                if (t.path_end != 0)
-                    std::fprintf(stderr, " %d/%d/%d/%.1f/%d", t.path_start_hits, t.path_breakpoints, t.path_columns,
-                                 1e3 * t.path_s, t.path_confirmed ? 1 : 0);
+                if (t.path.end != 0)
+                    std::fprintf(stderr, " %d/%d/%d/%.1f/%d", t.path.start_hits, t.path.breakpoints, t.path.columns,
+                                 1e3 * t.path.total_s, t.path_confirmed ? 1 : 0);
             std::fprintf(stderr, "\n");
         }
     }

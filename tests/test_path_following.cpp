@@ -67,9 +67,9 @@ BOOST_AUTO_TEST_CASE(homotopy_transitions_give_the_default_answers) {
     BOOST_TEST(hom.unconverged == 0);
     int runs = 0, settled = 0, breakpoints = 0;
     for (const auto& t : trace.steps) {
-        runs += t.path_end != 0;
+        runs += t.path.end != 0;
         settled += t.path_confirmed;
-        breakpoints += t.path_breakpoints;
+        breakpoints += t.path.breakpoints;
     }
     // At most steps both methods end with the same modes, and their answers agree to the
     // solve's round-off (direct solves with refinement: ~1e-12 relative measured, bound 1e-9

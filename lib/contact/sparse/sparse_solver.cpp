@@ -355,20 +355,9 @@ struct SparseContactSolver::Impl {
             confirm = r.iterations - it0;
         }
         if (StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr) {
-            tr->path_end = static_cast<int>(ps.end);
+            tr->path = ps;
             tr->path_confirmed = settled;
-            tr->path_breakpoints = ps.breakpoints;
-            tr->path_columns = ps.columns;
-            tr->path_column_blocks = ps.column_blocks;
-            tr->path_start_hits = ps.start_hits;
-            tr->path_factorizations = ps.factorizations;
-            tr->path_rebases = ps.rebases;
-            tr->path_evaluations = ps.evaluations;
-            tr->path_pair_tests = ps.pair_tests;
             tr->path_confirm_solves = confirm;
-            tr->path_column_s = ps.column_s;
-            tr->path_base_s = ps.base_s;
-            tr->path_s = ps.total_s;
         }
         if (settled) return true;
         p = p_passes;

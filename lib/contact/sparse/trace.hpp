@@ -62,6 +62,24 @@ struct RouteStats {
     }
 };
 
+/// What one path_following did (the trace's counts, docs/decisions/040).
+struct PathStats {
+    enum End { not_run, reached, not_applicable, singular, too_many_rows, too_many_breakpoints, stalled, folded, cycled,
+               singular_modes, too_many_start_hits };
+    End end = not_run;
+    int breakpoints = 0;     ///< mode switches along the path (hits within kGroupT of each other count once)
+    int columns = 0;         ///< columns A0^-1 u_r solved with the base modes' factorisation (one per changed row)
+    int column_blocks = 0;   ///< multi-column solves that made them
+    int factorizations = 0;  ///< factorisations of the base modes (0 when still current)
+    int updates = 0;         ///< the mode solver's bordered updates for them
+    int rebases = 0;         ///< new bases (rebase_rows)
+    int start_hits = 0;      ///< conditions of the start modes that fail before t = 1 (the first ratio test's)
+    long evaluations = 0;    ///< pairs whose conditions were evaluated exactly at a ratio test
+    long pair_tests = 0;     ///< pairs x ratio tests (the rest were bounded away from their kinks)
+    // CPU time [s] (thread): the columns' solves, the base factorisations and solves, the rest
+    double column_s = 0.0, base_s = 0.0, total_s = 0.0;
+};
+
 /// The phases of a solve: the passes from the previous modes, the homotopy (with its
 /// confirming passes; Switches::path_following), the semismooth Newton method,
 /// the passes that confirm a Newton method's answer, the smoothing Newton method, the Tresca
@@ -108,15 +126,9 @@ struct StepTrace {
     RouteStats phase[phase_count];     ///< the mode solver's calls per phase (docs/decisions/038)
     double phase_s[phase_count] = {};  ///< CPU time per phase [s] (its solves and everything else)
     // the homotopy (Switches::path_following, path_following.cpp; docs/decisions/040)
-    int path_end = 0;               ///< PathStats::End (0 not run)
+    PathStats path;                 ///< what it did (path.end not_run: not run)
     bool path_confirmed = false;    ///< it reached t = 1 and the passes from its modes settled
-    int path_breakpoints = 0, path_columns = 0, path_factorizations = 0, path_rebases = 0;
-    int path_column_blocks = 0;     ///< multi-column solves that made its columns
-    int path_start_hits = 0;        ///< the start modes' conditions failing before t = 1
-    long path_evaluations = 0;      ///< pairs whose conditions were evaluated exactly (the rest bounded)
-    long path_pair_tests = 0;       ///< pairs tested (pairs x ratio tests)
     int path_confirm_solves = 0;    ///< mode-set solves of the passes after it
-    double path_column_s = 0.0, path_base_s = 0.0, path_s = 0.0;  ///< its CPU time [s]: columns, bases, all
 };
 
 struct TransitionTrace {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "contact/sparse/sparse_path.hpp"
+#include "contact/sparse/trace.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -42,24 +43,6 @@ struct PathStart {
     const Eigen::VectorXd& d;
     const std::vector<signed char>& nmode;
     const std::vector<signed char>& tmode;
-};
-
-/// What one path_following did (the trace's counts, docs/decisions/040).
-struct PathStats {
-    enum End { not_run, reached, not_applicable, singular, too_many_rows, too_many_breakpoints, stalled, folded, cycled,
-               singular_modes, too_many_start_hits };
-    End end = not_run;
-    int breakpoints = 0;     ///< mode switches along the path (hits within kGroupT of each other count once)
-    int columns = 0;         ///< columns A0^-1 u_r solved with the base modes' factorisation (one per changed row)
-    int column_blocks = 0;   ///< multi-column solves that made them
-    int factorizations = 0;  ///< factorisations of the base modes (0 when still current)
-    int updates = 0;         ///< the mode solver's bordered updates for them
-    int rebases = 0;         ///< new bases (rebase_rows)
-    int start_hits = 0;      ///< conditions of the start modes that fail before t = 1 (the first ratio test's)
-    long evaluations = 0;    ///< pairs whose conditions were evaluated exactly at a ratio test
-    long pair_tests = 0;     ///< pairs x ratio tests (the rest were bounded away from their kinks)
-    // CPU time [s] (thread): the columns' solves, the base factorisations and solves, the rest
-    double column_s = 0.0, base_s = 0.0, total_s = 0.0;
 };
 
 /// The parametric active-set transition (Switches::path_following; path_following.cpp):
