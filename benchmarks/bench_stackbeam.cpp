@@ -572,7 +572,9 @@ BENCHMARK(ElasticRuns)
 /// bit the Switches field at its default, else the way before: 1 newton_passes, 2
 /// smoothing_from_rest, 4 first_pass_start, 8 creep_limit, 16 nonmonotone_memory; 29 the
 /// default (smoothing_from_rest is off), 0 the way before; bit 32 decision 038's routes,
-/// Switches::fixed_pattern 4 and schur_fresh_max_rows 200, else 2 and none; 61 every default) and, with trace 1, the statistics of
+/// Switches::fixed_pattern 4 and schur_fresh_max_rows 200, else 2 and none; 61 every default;
+/// bit 64 decision 041's homotopy from rest off, Switches::rest_path_violations 0, so 125 is
+/// 61 the way before 041) and, with trace 1, the statistics of
 /// every transition step (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton
 /// iteration, pairs back in a mode they had left, the distances of the start, a predicted start
 /// and the Newton method's first modes to the step's final modes, how the semismooth method
@@ -612,6 +614,7 @@ void TransitionStudy(benchmark::State& state) {
     sw.path_following = path_arg != 0 ? 1 : 0;
     if (path_arg != 0) sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
     if (state.range(8) >= 0) sw.path_max_start_hits = static_cast<int>(state.range(8));
+    if ((way & 64) != 0) sw.rest_path_violations = 0;  // decision 041's homotopy from rest off
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
@@ -740,7 +743,7 @@ void TransitionStudy(benchmark::State& state) {
                  newton_steps, solves.mean(), pass_solves.mean(), newton_its.mean(), confirm.mean());
     std::fprintf(stderr, "#   semismooth ends:");
     for (const auto& e : ends) std::fprintf(stderr, " [%d]=%d", e.first, e.second);
-    std::fprintf(stderr, " (1 converged, 2 iteration limit, 3 no decrease, 4 singular); smoothing in %d steps (%d settled), %.1f iterations each\n",
+    std::fprintf(stderr, " (1 converged, 2 iteration limit, 3 no decrease, 4 singular, 5 handed to the homotopy from rest); smoothing in %d steps (%d settled), %.1f iterations each\n",
                  smoothing_steps, smoothing_ok, smooth.mean());
     std::fprintf(stderr, "#   distance to the final modes (pairs, normal / tangential): start %.1f / %.1f, predicted %.1f / %.1f, Newton's first %.1f / %.1f, after the passes %.1f / %.1f\n",
                  start_n.mean(), start_t.mean(), pred_n.mean(), pred_t.mean(), first_n.mean(), first_t.mean(), passes_n.mean(), passes_t.mean());
@@ -788,6 +791,7 @@ void TransitionStudy(benchmark::State& state) {
                          ph < detail::sparse::phase_count ? phase_s[ph] : all_s, rs.fixed_pivoted);
         }
     };
+    routes_table("step 1", 0, 1);
     routes_table("steps 1-2", 0, 2);
     routes_table("steps 3-", 2, steps.size());
     routes_table("all steps", 0, steps.size());
@@ -817,6 +821,11 @@ BENCHMARK(TransitionStudy)
     ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {0, 300}})
     ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}, {-1}})
     ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}, {-1}})
+    // decision 041: the homotopy from rest off (way 125) against on (61, registered above for
+    // graduated 100 / 200 / 400 and identical 400), with and without the trace; identical 100 / 200
+    ->ArgsProduct({{100, 200, 400}, {1}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}})
+    ->ArgsProduct({{400}, {2}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}})
+    ->ArgsProduct({{100, 200}, {2}, {100}, {61, 125}, {0, 1}, {0}, {-1}, {48}, {-1}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

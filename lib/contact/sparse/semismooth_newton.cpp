@@ -230,20 +230,25 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
 /// change per iteration without the ping-pong of full switches. Stops when every
 /// component of F is within `accept` [m] (half the active-set threshold, so the passes
 /// that follow see no violated mode); returns false after kNewtonIterations or on a
-/// singular set of modes (p and z are then the last iterate). On entry z must be
+/// singular set of modes (p and z are then the last iterate). From rest with
+/// Switches::rest_path_violations > 0 it also returns false (p, z the linear solution of
+/// the current modes) after a full step that leaves 1 to that many components of F above
+/// `accept`: the caller's homotopy finishes (docs/decisions/041). On entry z must be
 /// K^-1 (b + G^T p).
 bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
     const SparseStiffness& st = path.stiffness();
     const Eigen::VectorXd& d = step.d;
     const int m = static_cast<int>(d.size());
     path.best_p.resize(0);
+    path.handed_over = false;
     TransitionTrace* const trace = path.switches.trace;
     StepTrace* const tr = trace ? trace->current : nullptr;
     auto end = [&](int how, bool result) {
         if (tr) tr->newton_end = how;
         return result;
     };
-    if (m > 0 && p.isZero(0.0)) {
+    const bool from_rest = m > 0 && p.isZero(0.0);
+    if (from_rest) {
         // a start from rest (no force anywhere, the first step of a run): the linear problem
         // of the open modes (set_open_modes) instead of the natural map's modes at p = 0, where
         // every closed pair sits on the kink of its friction limit (tau = 0)
@@ -268,6 +273,8 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     int creeping = 0;                 // consecutive steps below kCreepStep (Switches::creep_limit)
     const int memory = path.switches.nonmonotone_memory;
     std::vector<double> recent{theta};  // the last iterates' theta, at most `memory` (the nonmonotone search)
+    // from rest, the hand-over to the homotopy (Switches::rest_path_violations)
+    const int handover = from_rest ? path.switches.rest_path_violations : 0;
     for (int it = 0; it < kNewtonIterations; ++it) {
         const double roundoff = st.roundoff(d, z);
         const double accept = std::max(0.5 * kAccept * path.options.tolerance_m, roundoff);
@@ -388,6 +395,15 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             path.best_p = p;
         }
         if (creep_stop) break;
+        if (handover > 0 && full_step) {
+            const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
+            int v = 0;
+            for (int i = 0; i < m; ++i) v += std::abs(F[i]) > acc;
+            if (v > 0 && v <= handover) {
+                path.handed_over = true;
+                return end(5, false);
+            }
+        }
     }
     return end(2, false);
 }

@@ -51,6 +51,7 @@ struct SparsePath {
     modes::ModeSet modes;    ///< the current modes
     Eigen::VectorXd s;       ///< s = G z - d [m] where the last unit left it (the solver's answer's at the end)
     Eigen::VectorXd best_p;  ///< the semismooth Newton method's iterate of smallest ||F|| (its last run)
+    bool handed_over = false;  ///< its last run stopped for the homotopy (Switches::rest_path_violations)
     // workspaces made once per (K, G): the interior-point method's LDL^T of K + G^T Sigma^-1 G
     // (its ordering) and the smoothing Newton method's Jacobian and LU (its ordering)
     Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ipm_ldlt;

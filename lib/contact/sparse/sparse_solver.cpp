@@ -317,6 +317,17 @@ struct SparseContactSolver::Impl {
                                              : extrapolate     ? Eigen::VectorXd(2.0 * last_p - previous_p)
                                                                : p_start))
                 return true;
+            // from rest: the homotopy from a covering start at the semismooth method's last
+            // iterate (Switches::rest_path_violations, docs/decisions/041); where it fails after
+            // the hand-over, the semismooth method goes on from that iterate
+            if (path.switches.rest_path_violations > 0 && p_start.isZero(0.0) && p.size() == m) {
+                const bool handed_over = path.handed_over;
+                const Eigen::VectorXd p_newton = p;
+                const bool ok = rest_transition(step, p, z, r);
+                if (tr) path.switches.trace->close_phase(phase_path);
+                if (ok) return true;
+                if (handed_over && confirmed(semismooth_newton, p_newton)) return true;
+            }
         }
         // the smoothing method from the semismooth method's best iterate (measured on the
         // graduated 10-leaf spring, 10 x 100, 100 steps: 3.2 s instead of 10.2 s from the
@@ -365,6 +376,44 @@ struct SparseContactSolver::Impl {
         path.modes.nmode = nmode_passes;
         path.modes.tmode = tmode_passes;
         return false;
+    }
+
+    /// Step 2a', from rest (Switches::rest_path_violations, docs/decisions/041): the homotopy
+    /// from a covering start at p (the semismooth method's last iterate, z = K^-1 (b + G^T p)):
+    /// the modes of the natural map's Jacobian there (the Newton method's next set) and their
+    /// linear solution x1 (one solve), this step's data moved so that those modes hold at t = 0
+    /// (covering_start), path_following to this step's data, its end modes confirmed by the
+    /// passes. True when settled; otherwise p, z and the modes are where it stopped.
+    bool rest_transition(const detail::sparse::Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z,
+                         SolveResult& r) {
+        using namespace detail::sparse;
+        if (path.laws.tau_rule != TauRule::current) return false;  // path_following's rule
+        PathStats ps;
+        bool settled = false;
+        int confirm = 0;
+        try {
+            Eigen::VectorXd F;
+            path.natural_residual(p, path.stiffness().Grow * z - step.d, F, true);
+            ++r.iterations;
+            r.factorizations += path.solve_modes(step, p, z);
+            Eigen::VectorXd b0, d0;
+            covering_start(path, step, p, z, b0, d0);
+            const std::vector<signed char> n0 = path.modes.nmode, t0 = path.modes.tmode;
+            if (path_following(path, step, PathStart{b0, d0, n0, t0}, p, z, r, ps, path.switches.path_rebase_rows,
+                               path.switches.path_max_start_hits)) {
+                const int it0 = r.iterations;
+                settled = passes_from_modes(path, step, p, z, r);
+                confirm = r.iterations - it0;
+            }
+        } catch (const SingularModes&) {
+            path.solver.forget();
+        }
+        if (StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr) {
+            tr->path = ps;
+            tr->path_confirmed = settled;
+            tr->path_confirm_solves = confirm;
+        }
+        return settled;
     }
 
     /// Step 2b, the Tresca fixed point, then the coupled Coulomb problem from its modes; if

@@ -106,7 +106,8 @@ struct StepTrace {
     bool passes_settled = false;
     std::vector<NewtonIterationTrace> iterations;
     /// how the semismooth method ended: 0 not run, 1 converged, 2 iteration limit,
-    /// 3 no decrease (nonmonotone limit), 4 singular modes
+    /// 3 no decrease (nonmonotone limit), 4 singular modes, 5 handed to the homotopy from rest
+    /// (Switches::rest_path_violations; its run is then `path`)
     int newton_end = 0;
     bool newton_confirmed = false;  ///< the passes after it found no violation
     int confirm_solves = 0;         ///< mode-set solves of the passes after the Newton method
