@@ -75,13 +75,16 @@
 //    linear problem (one factorisation, update or cached Schur solve, as a pass) and
 //    searches along the step on ||F||^2 (s is affine in p: O(m) per trial). From rest it
 //    starts from the open modes (set_open_modes). Its final modes are confirmed by the
-//    passes, so its answer is the exact solver's. Where the Newton method follows, one
+//    passes, so its answer is the exact solver's. From rest (Switches::rest_path_violations,
+//    docs/decisions/041) it hands its iterate over once at most 25 laws are violated, and
+//    the homotopy below finishes the step from a covering start (covering_start: the
+//    iterate's modes made valid by moving the step's data). Where the Newton method follows, one
 //    pass from the previous modes comes first (not max_active_set_iterations), the line
 //    search takes the full step where it stays below the last 10 iterates' worst, and a
 //    creeping search goes to the smoothing method early (Switches, decision 037: graduated
 //    10 x 400 14.4 -> 9.3 mode-set solves per transition step). At 10 leaves x 100 elements it took the
 //    friction run from 50-53 to 2.4 factorisations per step; at 10 x 400 its first step
-//    still does not converge (docs/decisions/003-semismooth-newton-transitions.md).
+//    alone still does not converge (docs/decisions/003-semismooth-newton-transitions.md).
 //    Where the semismooth method stalls (60 iterations, or no decrease of ||F||): the
 //    smoothing Newton method (smoothing_newton) from its best iterate: the natural map
 //    with every max(0, .) replaced by (y + sqrt(y^2 + 4 e^2)) / 2, so ||F_eps||^2 is

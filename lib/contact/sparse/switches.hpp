@@ -128,7 +128,7 @@ struct Switches {
     /// (its tail there: tens of iterations flipping the same pairs), and wherever it fails from
     /// rest; the path's end modes confirmed by the passes. Where the path fails, the semismooth
     /// method goes on from the iterate, then the smoothing method, as before (docs/decisions/
-    /// 041: graduated 10 x 400 the first step 1.15 -> ~0.4 CPU s). 0: off, the way before.
+    /// 041: graduated 10 x 400 the first step 1.15 -> 0.4-0.5 CPU s). 0: off, the way before.
     int rest_path_violations = 25;
 };
 

@@ -126,7 +126,8 @@ struct StepTrace {
     int seen_earlier = 0;  ///< new-set solves of a set solved in an earlier step, not this one
     RouteStats phase[phase_count];     ///< the mode solver's calls per phase (docs/decisions/038)
     double phase_s[phase_count] = {};  ///< CPU time per phase [s] (its solves and everything else)
-    // the homotopy (Switches::path_following, path_following.cpp; docs/decisions/040)
+    // the homotopy (Switches::path_following, path_following.cpp; docs/decisions/040), or from
+    // rest its run from a covering start (Switches::rest_path_violations, docs/decisions/041)
     PathStats path;                 ///< what it did (path.end not_run: not run)
     bool path_confirmed = false;    ///< it reached t = 1 and the passes from its modes settled
     int path_confirm_solves = 0;    ///< mode-set solves of the passes after it

@@ -59,7 +59,7 @@ struct PathStart {
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
                     Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows = 0, int max_start_hits = 0);
 
-/// The covering start of the homotopy (covering_start.cpp; Switches::rest_path): for the
+/// The covering start of the homotopy (covering_start.cpp; Switches::rest_path_violations): for the
 /// current modes M0 (path.modes) and their linear solution (p, z) at `step`'s data, the data
 /// (b0, d0) at which M0 holds, its solution there the projection of (p, s) onto M0's
 /// conditions; PathStart{b0, d0, M0} then starts path_following toward `step`.
