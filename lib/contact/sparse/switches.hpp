@@ -121,6 +121,27 @@ struct Switches {
     /// the start modes fail before its end (its first ratio test's hits: a broad change,
     /// hundreds of breakpoints and columns; docs/decisions/040). 0: no limit.
     int path_max_start_hits = 500;
+    /// Its continuity where a clamp takes friction again (its normal force back below the
+    /// preload: free -> carrying friction; docs/decisions/042): true (default) the clamp enters
+    /// slip against its tangential motion s_t (its friction force 0 there, continuous) and sticks
+    /// only where s_t is at its anchor, as a closing pair does; false: it sticks at once, the way
+    /// before (s_t jumps to the anchor: the path is not continuous there, other pairs' modes go
+    /// wrong without a breakpoint; graduated 10 x 400, 100 ms: 4 of the 5 runs that fell back to
+    /// the Newton methods, 3 ends not confirmed and 1 fold).
+    bool path_clamp_slip = true;
+    /// Its limit on one pair's mode switches in one run (a cycle, then the Newton methods): 0 none
+    /// (default, docs/decisions/042: a pair may open and close again as t advances, graduated 10 x
+    /// 400 one run of 82 with 7 switches of one pair; a cycle at one t still ends at the limit of
+    /// 20 breakpoints without progress, or as a fold, and every run at 400 breakpoints); 6 the way
+    /// before.
+    int path_max_pair_switches = 0;
+    /// Its end at a fold, a pair switching back to the mode it left at the same t: false
+    /// (default, docs/decisions/042) it goes on: where several pairs reach their kinks at one t (a
+    /// degenerate vertex) a pair switching back is how the pivots resolve it (graduated 10 x 50 and
+    /// 10 x 100, 6 x 50 and 6 x 100, 100 ms: the 3 runs of 263 that ended at a fold settle with it),
+    /// and a real fold or cycle at one t ends at the limit of 20 breakpoints without progress; true:
+    /// the Newton methods at once, the way before.
+    bool path_fold_ends = false;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
