@@ -5,7 +5,9 @@
 // the default method's: both are the exact solver's solution of the same problem (the passes
 // accept a set of modes only when no mode is violated by more than 1e-3 x tolerance_m), so
 // they agree to the solve's round-off, except where the problem has more than one solution
-// (then each answer must be one: see below).
+// (then each answer must be one: see below). Decision 042's repairs (a clamp taking friction
+// again slips first, no per-pair switch limit, folds at degenerate vertices pivot on) must
+// settle the runs that fell back before them, with answers of the same standard.
 #define BOOST_TEST_MODULE path_following
 #include <boost/test/unit_test.hpp>
 

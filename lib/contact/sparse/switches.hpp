@@ -108,8 +108,9 @@ struct Switches {
     /// where the passes from the previous modes do not settle a step, the solution is followed
     /// from the last converged solve's data and modes to this step's along the straight line
     /// between them, one mode switch per breakpoint, its end modes confirmed by the passes;
-    /// where it does not reach its end (a fold, a cycle, no progress, too many breakpoints or
-    /// changed rows, a singular system) or the passes do not confirm it, the Newton methods
+    /// where it does not reach its end (no progress, too many breakpoints or changed rows, a
+    /// singular system; a fold or a cycle where path_fold_ends / path_max_pair_switches say so)
+    /// or the passes do not confirm it, the Newton methods
     /// follow as without it. 1: on (default; graduated 10 x 400 about 0.9x CPU, identical
     /// 0.76-0.85x, docs/decisions/040); 0: off, the way before.
     int path_following = 1;
