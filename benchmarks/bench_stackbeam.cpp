@@ -584,7 +584,9 @@ BENCHMARK(ElasticRuns)
 /// default), path (the homotopy, docs/decisions/040: 0 off, the way before; > 0 on with a
 /// new base past that many changed rows, Switches::path_rebase_rows, 48 the default; -1 on
 /// without new bases), hits (Switches::path_max_start_hits; -1 its default 500, 0 no
-/// limit). Each run's answer at its end (w, dissipated energy, |z|) goes to
+/// limit), repair (docs/decisions/042; -1 the defaults, else a bit mask of its changes, each bit
+/// the Switches field at its default, else the way before: 1 path_clamp_slip, 2
+/// path_max_pair_switches, 4 path_fold_ends; 0 the way before 042). Each run's answer at its end (w, dissipated energy, |z|) goes to
 /// stderr to 17 digits, with the trace the homotopy's counts.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
@@ -615,6 +617,11 @@ void TransitionStudy(benchmark::State& state) {
     if (path_arg != 0) sw.path_rebase_rows = path_arg > 0 ? path_arg : 0;
     if (state.range(8) >= 0) sw.path_max_start_hits = static_cast<int>(state.range(8));
     if ((way & 64) != 0) sw.rest_path_violations = 0;  // decision 041's homotopy from rest off
+    if (state.range(9) >= 0) {  // decision 042's repairs of the homotopy, else the way before
+        sw.path_clamp_slip = (state.range(9) & 1) != 0;
+        sw.path_max_pair_switches = (state.range(9) & 2) != 0 ? now.path_max_pair_switches : 6;
+        sw.path_fold_ends = (state.range(9) & 4) != 0 ? now.path_fold_ends : true;
+    }
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
     so.t_end_s = t_sim;
@@ -797,35 +804,38 @@ void TransitionStudy(benchmark::State& state) {
     routes_table("all steps", 0, steps.size());
 }
 BENCHMARK(TransitionStudy)
-    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed", "path", "hits"})
+    ->ArgNames({"el", "stack", "ms", "way", "trace", "schur", "fixed", "path", "hits", "repair"})
     // decision 037: the changes one by one on the graduated 10 x 400, 30 / 100 ms, with the trace
-    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}, {0}, {-1}})
+    ->ArgsProduct({{400}, {1}, {30, 100}, {0, 1, 3, 7, 15, 23, 29, 31}, {1}, {0}, {-1}, {0}, {-1}, {-1}})
     // before / after: graduated 50 / 100 / 200 / 400 and identical 400, 30 / 100 ms; the same
     // meshes bonded (the targets' reference)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}, {0}, {-1}})
-    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}, {0}, {-1}})
-    ->Args({400, 3, 100, 29, 0, 0, -1, 0, -1})->Args({400, 4, 100, 29, 0, 0, -1, 0, -1})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 31}, {0}, {0}, {-1}, {0}, {-1}, {-1}})
+    ->ArgsProduct({{400}, {2}, {30, 100}, {0, 29, 31}, {0, 1}, {0}, {-1}, {0}, {-1}, {-1}})
+    ->Args({400, 3, 100, 29, 0, 0, -1, 0, -1, -1})->Args({400, 4, 100, 29, 0, 0, -1, 0, -1, -1})
     // decision 038: the identical (and graduated) 10 x 400 stack's routes: the held sets' own KLU
     // systems (fixed 2 the fixed pattern, 3, 4 the default), the Schur way's limit
-    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}, {0}, {-1}})
+    ->ArgsProduct({{400}, {1, 2}, {30, 100}, {0, 32, 61}, {0, 1}, {0, 1, 200, 1000}, {2, 3, 4}, {0}, {-1}, {-1}})
     // decisions 037 and 038 together: before both (0), 037 alone (29), 038 alone (32), both (61)
-    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}})
-    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}})
-    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}, {-1}})
+    ->ArgsProduct({{50, 100, 200, 400}, {1}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}, {-1}})
+    ->ArgsProduct({{400}, {2}, {100}, {0, 29, 32, 61}, {0}, {0}, {-1}, {0}, {-1}, {-1}})
+    ->ArgsProduct({{100, 200, 400}, {3, 4}, {100}, {61}, {0}, {0}, {-1}, {0}, {-1}, {-1}})
     // decision 040: the homotopy (path) on, a new base past 24 / 48 (its default) / 96 changed
     // rows or none (-1), against off (path 0: registered above without the trace), graduated
     // and identical 10 x 400 and graduated 100 / 200, 100 ms, every default else (way 61)
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}, {-1}})
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}, {-1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {1}, {0}, {-1}, {0, 24, 48, 96, -1}, {-1}, {-1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0}, {0}, {-1}, {24, 48, 96, -1}, {-1}, {-1}})
     // the limit on the start modes' failing conditions: none (0), 300, 500 (the default, -1)
-    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {0, 300}})
-    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}, {-1}})
-    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}, {-1}})
+    ->ArgsProduct({{400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {0, 300}, {-1}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {1}, {0}, {-1}, {0, 48}, {-1}, {-1}})
+    ->ArgsProduct({{100, 200}, {1}, {100}, {61}, {0}, {0}, {-1}, {48}, {-1}, {-1}})
     // decision 041: the homotopy from rest off (way 125) against on (61, registered above for
     // graduated 100 / 200 / 400 and identical 400), with and without the trace; identical 100 / 200
-    ->ArgsProduct({{100, 200, 400}, {1}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}})
-    ->ArgsProduct({{400}, {2}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}})
-    ->ArgsProduct({{100, 200}, {2}, {100}, {61, 125}, {0, 1}, {0}, {-1}, {48}, {-1}})
+    ->ArgsProduct({{100, 200, 400}, {1}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}, {-1}})
+    ->ArgsProduct({{400}, {2}, {100}, {125}, {0, 1}, {0}, {-1}, {48}, {-1}, {-1}})
+    ->ArgsProduct({{100, 200}, {2}, {100}, {61, 125}, {0, 1}, {0}, {-1}, {48}, {-1}, {-1}})
+    // decision 042: the homotopy's repairs off (0, the way before), the clamp's slip entry alone
+    // (1), both (-1, the defaults), graduated and identical 100 / 200 / 400, 100 ms
+    ->ArgsProduct({{100, 200, 400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {-1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

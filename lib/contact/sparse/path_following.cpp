@@ -31,10 +31,15 @@
 // acceptance; the others cannot switch.
 //
 // The answer at t = 1 is confirmed by the caller's active-set passes (so it is the exact
-// solver's, solved with refinement); on any failure (a pair switching back at the same t,
-// a pair switching too often, no progress in t, too many breakpoints or changed rows, a
-// singular H, or too many of the start modes' conditions failing at the first ratio test:
-// a broad change, cheaper by the Newton methods) the caller falls back to the Newton methods.
+// solver's, solved with refinement); on any failure (no progress in t, too many breakpoints
+// or changed rows, a singular H, or too many of the start modes' conditions failing at the
+// first ratio test: a broad change, cheaper by the Newton methods; and where the switches say
+// so, a pair switching back at the same t or switching too often: Switches::path_fold_ends,
+// path_max_pair_switches) the caller falls back to the Newton methods.
+//
+// The path stays continuous where a pair takes friction with a friction limit of 0 (a pair
+// that closes, a clamp back below its preload: Switches::path_clamp_slip): it slips against
+// its tangential motion there, and sticks where that comes back to 0 (docs/decisions/042).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -49,7 +54,6 @@ namespace {
 
 constexpr int kMaxBreakpoints = 400;   // then the caller's fallback
 constexpr int kMaxChangedRows = 400;   // |C|: the dense H's size (and the columns' memory)
-constexpr int kMaxSwitchesPerPair = 6; // a pair switching more often: cycling
 constexpr int kMaxStalls = 20;         // breakpoints in a row that do not advance t
 constexpr double kSameT = 1e-12;       // hits within this of the first are simultaneous (and a pair back
                                        // in the mode it left within this of t: a fold)
@@ -126,6 +130,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     const int np = static_cast<int>(laws.pairs.size());
     const Eigen::VectorXd& W = path.diag();
     const double ts = kAccept * path.options.tolerance_m;
+    const int max_pair_switches = path.switches.path_max_pair_switches;  // a pair switching more often: cycling
 
     // the base's linear problem and key (as SparsePath::solve_modes names it, so a
     // factorisation of M0 still current is reused)
@@ -399,15 +404,16 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 if (done[h.k]) continue;
                 done[h.k] = 1;
                 dirty[h.k] = 1;
-                // back to the modes it left at the same t: the path folds (or a degenerate
-                // vertex): give up
+                // back to the modes it left at the same t: the path folds, or a degenerate
+                // vertex (several pairs at their kinks at one t) resolves by switching a pair
+                // back (Switches::path_fold_ends false: it goes on, the stalls' limit bounds it)
                 const signed char to_n = h.normal ? h.to : cur.nmode[h.k], to_t = h.normal ? cur.tmode[h.k] : h.to;
-                if (last_switch_t[h.k] >= 0.0 && tmin - last_switch_t[h.k] <= kSameT &&
+                if (path.switches.path_fold_ends && last_switch_t[h.k] >= 0.0 && tmin - last_switch_t[h.k] <= kSameT &&
                     (h.normal ? to_n == left_n[h.k] : to_t == left_t[h.k])) {
                     stats.end = PathStats::folded;
                     return false;
                 }
-                if (++switches[h.k] > kMaxSwitchesPerPair) {
+                if (++switches[h.k] > max_pair_switches && max_pair_switches > 0) {
                     stats.end = PathStats::cycled;
                     return false;
                 }
@@ -415,17 +421,21 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 left_n[h.k] = cur.nmode[h.k];
                 left_t[h.k] = cur.tmode[h.k];
                 const auto& pc = laws.pairs[h.k];
+                // a pair that takes friction with a friction limit of 0 (one that closes, a
+                // clamp back below its preload, Switches::path_clamp_slip) sticks only where its
+                // tangential position is at this step's anchor (s_t = 0), else it slips against
+                // s_t (the natural map's decision at p_t = 0): the path stays continuous, and
+                // sticks where s_t comes back to 0 (sticking at once would jump s_t to the anchor)
+                auto friction_from_zero = [&]() {
+                    const int rt = pc.row_t;
+                    const double stc = (1.0 - tmin) * (x0(m + rt) - start.d[rt]) + tmin * (x1(m + rt) - step.d[rt]);
+                    return std::abs(stc) <= ts ? modes::STICK : stc < 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
+                };
                 if (h.normal) {
                     cur.nmode[h.k] = h.to;
-                    // a pair closes with no normal force, so no friction limit: it sticks only
-                    // where its tangential position is at this step's anchor (s_t = 0), else
-                    // it slips against s_t (the natural map's decision at p_t = 0): the path
-                    // stays continuous, and sticks where s_t comes back to 0
-                    if (h.to == modes::CLOSED && pc.row_t >= 0) {
-                        const int rt = pc.row_t;
-                        const double stc = (1.0 - tmin) * (x0(m + rt) - start.d[rt]) + tmin * (x1(m + rt) - step.d[rt]);
-                        cur.tmode[h.k] = std::abs(stc) <= ts ? modes::STICK : stc < 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
-                    }
+                    if (h.to == modes::CLOSED && pc.row_t >= 0) cur.tmode[h.k] = friction_from_zero();
+                } else if (h.to == modes::STICK && cur.tmode[h.k] == modes::FREE && path.switches.path_clamp_slip) {
+                    cur.tmode[h.k] = friction_from_zero();
                 } else {
                     cur.tmode[h.k] = h.to;
                 }

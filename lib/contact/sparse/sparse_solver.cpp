@@ -264,16 +264,30 @@ struct SparseContactSolver::Impl {
         last_p.resize(0);
     }
 
+    /// Where a transition method starts (the passes' end: p, z and the modes), put back where
+    /// it does not settle, so the next method starts there as without it.
+    struct TransitionStart {
+        Eigen::VectorXd p, z;
+        std::vector<signed char> nmode, tmode;
+        TransitionStart(const Eigen::VectorXd& p_, const Eigen::VectorXd& z_, const modes::ModeSet& modes)
+            : p(p_), z(z_), nmode(modes.nmode), tmode(modes.tmode) {}
+        void restore(Eigen::VectorXd& p_, Eigen::VectorXd& z_, modes::ModeSet& modes) const {
+            p_ = p;
+            z_ = z;
+            modes.nmode = nmode;
+            modes.tmode = tmode;
+        }
+    };
+
     /// Step 2a, the Newton methods (SparseContactSolver::solve): each
     /// from its start, its answer confirmed by the active-set passes from its modes. True
-    /// when one settled; otherwise p and the modes are those on entry (the passes' end).
+    /// when one settled; otherwise p, z and the modes are those on entry (the passes' end).
     bool newton_transition(const detail::sparse::Step& step, const Eigen::VectorXd& p_start, Eigen::VectorXd& p,
                            Eigen::VectorXd& z, SolveResult& r) {
         using namespace detail::sparse;
         const int m = static_cast<int>(step.d.size());
         const TransitionMethod tm = path.switches.transition;
-        const Eigen::VectorXd p_passes = p;
-        const std::vector<signed char> nmode_passes = path.modes.nmode, tmode_passes = path.modes.tmode;
+        const TransitionStart passes_end(p, z, path.modes);  // the Tresca fixed point starts there
         StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr;
         auto confirmed = [&](TransitionFn method, const Eigen::VectorXd& start) {
             p = start;
@@ -340,9 +354,7 @@ struct SparseContactSolver::Impl {
                 return true;
             if (!smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
         }
-        p = p_passes;  // the Tresca fixed point starts where the passes ended
-        path.modes.nmode = nmode_passes;
-        path.modes.tmode = tmode_passes;
+        passes_end.restore(p, z, path.modes);
         return false;
     }
 
@@ -353,8 +365,7 @@ struct SparseContactSolver::Impl {
     bool path_transition(const detail::sparse::Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
         using namespace detail::sparse;
         if (path_d.size() != step.d.size() || path_b.size() != step.b.size()) return false;
-        const Eigen::VectorXd p_passes = p, z_passes = z;
-        const std::vector<signed char> nmode_passes = path.modes.nmode, tmode_passes = path.modes.tmode;
+        const TransitionStart passes_end(p, z, path.modes);
         PathStats ps;
         bool settled = false;
         int confirm = 0;
@@ -374,10 +385,7 @@ struct SparseContactSolver::Impl {
             tr->path_confirm_solves = confirm;
         }
         if (settled) return true;
-        p = p_passes;
-        z = z_passes;
-        path.modes.nmode = nmode_passes;
-        path.modes.tmode = tmode_passes;
+        passes_end.restore(p, z, path.modes);
         return false;
     }
 

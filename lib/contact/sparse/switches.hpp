@@ -108,8 +108,9 @@ struct Switches {
     /// where the passes from the previous modes do not settle a step, the solution is followed
     /// from the last converged solve's data and modes to this step's along the straight line
     /// between them, one mode switch per breakpoint, its end modes confirmed by the passes;
-    /// where it does not reach its end (a fold, a cycle, no progress, too many breakpoints or
-    /// changed rows, a singular system) or the passes do not confirm it, the Newton methods
+    /// where it does not reach its end (no progress, too many breakpoints or changed rows, a
+    /// singular system; a fold or a cycle where path_fold_ends / path_max_pair_switches say so)
+    /// or the passes do not confirm it, the Newton methods
     /// follow as without it. 1: on (default; graduated 10 x 400 about 0.9x CPU, identical
     /// 0.76-0.85x, docs/decisions/040); 0: off, the way before.
     int path_following = 1;
@@ -130,6 +131,27 @@ struct Switches {
     /// method goes on from the iterate, then the smoothing method, as before (docs/decisions/
     /// 041: graduated 10 x 400 the first step 1.15 -> 0.4-0.5 CPU s). 0: off, the way before.
     int rest_path_violations = 25;
+    /// Its continuity where a clamp takes friction again (its normal force back below the
+    /// preload: free -> carrying friction; docs/decisions/042): true (default) the clamp enters
+    /// slip against its tangential motion s_t (its friction force 0 there, continuous) and sticks
+    /// only where s_t is at its anchor, as a closing pair does; false: it sticks at once, the way
+    /// before (s_t jumps to the anchor: the path is not continuous there, other pairs' modes go
+    /// wrong without a breakpoint; graduated 10 x 400, 100 ms: 4 of the 5 runs that fell back to
+    /// the Newton methods, 3 ends not confirmed and 1 fold).
+    bool path_clamp_slip = true;
+    /// Its limit on one pair's mode switches in one run (a cycle, then the Newton methods): 0 none
+    /// (default, docs/decisions/042: a pair may open and close again as t advances, graduated 10 x
+    /// 400 one run of 82 with 7 switches of one pair; a cycle at one t still ends at the limit of
+    /// 20 breakpoints without progress, or as a fold, and every run at 400 breakpoints); 6 the way
+    /// before.
+    int path_max_pair_switches = 0;
+    /// Its end at a fold, a pair switching back to the mode it left at the same t: false
+    /// (default, docs/decisions/042) it goes on: where several pairs reach their kinks at one t (a
+    /// degenerate vertex) a pair switching back is how the pivots resolve it (graduated 10 x 50 and
+    /// 10 x 100, 6 x 50 and 6 x 100, 100 ms: the 3 runs of 263 that ended at a fold settle with it),
+    /// and a real fold or cycle at one t ends at the limit of 20 breakpoints without progress; true:
+    /// the Newton methods at once, the way before.
+    bool path_fold_ends = false;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
