@@ -461,14 +461,27 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
     Z.resize(n, k);
     Eigen::MatrixXd PS(ms, k);
     if (lu_schur) {
-        // the loads g_r^T of the force columns through K's factor together, then each
-        // column's held forces by the (dense, refined) Schur solve
+        // the force columns' K^-1 g_r^T: the cached columns where there are (ensure_columns'
+        // cache), the others through K's factor together; then each column's held forces by
+        // the (dense, refined) Schur solve
         Eigen::MatrixXd Z0 = Eigen::MatrixXd::Zero(n, k);
-        for (int j = 0; j < k; ++j)
-            if (pos[rows[static_cast<std::size_t>(j)]] < 0)
-                for (SpMat::InnerIterator it(st_.Gt, rows[static_cast<std::size_t>(j)]); it; ++it)
-                    Z0(it.row(), j) = it.value();
-        Z0 = st_.k_llt.solve(Z0).eval();
+        std::vector<int> solved;
+        for (int j = 0; j < k; ++j) {
+            const int r = rows[static_cast<std::size_t>(j)];
+            if (pos[r] >= 0) continue;
+            if (xcol[static_cast<std::size_t>(r)].size() != 0) {
+                Z0.col(j) = xcol[static_cast<std::size_t>(r)];
+                continue;
+            }
+            for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) Z0(it.row(), j) = it.value();
+            solved.push_back(j);
+        }
+        if (!solved.empty()) {
+            Eigen::MatrixXd Y(n, static_cast<Eigen::Index>(solved.size()));
+            for (std::size_t c = 0; c < solved.size(); ++c) Y.col(static_cast<Eigen::Index>(c)) = Z0.col(solved[c]);
+            Y = st_.k_llt.solve(Y).eval();
+            for (std::size_t c = 0; c < solved.size(); ++c) Z0.col(solved[c]) = Y.col(static_cast<Eigen::Index>(c));
+        }
         Eigen::VectorXd target(ms), pS, zf;
         for (int j = 0; j < k; ++j) {
             const int i = pos[rows[static_cast<std::size_t>(j)]];
