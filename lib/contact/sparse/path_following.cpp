@@ -122,6 +122,22 @@ public:
         }
         return sum;
     }
+    /// dot(q, L0) and dot(q, L1) in one pass over the row (the same sums)
+    void dot2(int q, const Eigen::VectorXd& L0, const Eigen::VectorXd& L1, double& a, double& b) const {
+        a = b = 0.0;
+        const double* l0 = L0.data();
+        const double* l1 = L1.data();
+        for (int p = 0; p < used_; ++p, l0 += kWidth, l1 += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].data() + static_cast<std::size_t>(q) * kWidth;
+            double s0 = 0.0, s1 = 0.0;
+            for (int i = 0; i < kWidth; ++i) {
+                s0 += y[i] * l0[i];
+                s1 += y[i] * l1[i];
+            }
+            a += s0;
+            b += s1;
+        }
+    }
     /// A new column, its entries from `value(q)` for q < rows; returns its index.
     template <class F>
     int add(const F& value) {
@@ -287,8 +303,16 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     std::vector<Hit> hits;
     std::vector<int> C;
     // x's entry q (a force: q < m; G z: m + q) at t = 0 and t = 1 under the current set
-    auto x0 = [&](int q) { return X0h[q] + (Y.size() > 0 ? Y.dot(q, L0) : 0.0); };
-    auto x1 = [&](int q) { return X1h[q] + (Y.size() > 0 ? Y.dot(q, L1) : 0.0); };
+    // (both ends at once: one pass over the row of Y)
+    auto x01 = [&](int q, double& a, double& b) {
+        a = X0h[q];
+        b = X1h[q];
+        if (Y.size() == 0) return;
+        double ya, yb;
+        Y.dot2(q, L0, L1, ya, yb);
+        a += ya;
+        b += yb;
+    };
     auto rn = [&](int q) { return std::sqrt(rn2[q]); };
     try {
         for (;;) {
@@ -386,21 +410,27 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 dirty[k] = 0;
                 A1_at[k] = A1;
                 gmin = std::numeric_limits<double>::infinity();
+                // the pair's normal force at both ends (its normal test, its friction limit)
+                double pn0 = 0.0, pn1 = 0.0;
+                if (rn_ >= 0 && (trow || (nrow && cur.nmode[k] == modes::CLOSED))) x01(rn_, pn0, pn1);
                 if (nrow) {
-                    if (cur.nmode[k] == modes::CLOSED)
-                        test(k, true, modes::OPEN, x0(rn_) * W[rn_], x1(rn_) * W[rn_]);
-                    else if (cur.nmode[k] == modes::OPEN)
-                        test(k, true, modes::CLOSED, x0(m + rn_) - start.d[rn_], x1(m + rn_) - step.d[rn_]);
+                    if (cur.nmode[k] == modes::CLOSED) {
+                        test(k, true, modes::OPEN, pn0 * W[rn_], pn1 * W[rn_]);
+                    } else if (cur.nmode[k] == modes::OPEN) {
+                        double g0, g1;
+                        x01(m + rn_, g0, g1);
+                        test(k, true, modes::CLOSED, g0 - start.d[rn_], g1 - step.d[rn_]);
+                    }
                 }
                 if (trow) {
                     const double Wt = W[rt];
-                    const double pn0 = rn_ >= 0 ? x0(rn_) : 0.0, pn1 = rn_ >= 0 ? x1(rn_) : 0.0;
                     // friction lost past the clamp's preload; the friction limit, affine in p_n
                     const double rel0 = mu * (pn0 - c.preload_n) * Wt, rel1 = mu * (pn1 - c.preload_n) * Wt;
                     const double lim0 = mu * (clamp ? c.preload_n - pn0 : -pn0), lim1 = mu * (clamp ? c.preload_n - pn1 : -pn1);
                     switch (cur.tmode[k]) {
                         case modes::STICK: {
-                            const double pt0 = x0(rt), pt1 = x1(rt);
+                            double pt0, pt1;
+                            x01(rt, pt0, pt1);
                             if (clamp) test(k, false, modes::FREE, rel0, rel1);
                             test(k, false, modes::SLIP_POS, (pt0 - lim0) * Wt, (pt1 - lim1) * Wt);
                             test(k, false, modes::SLIP_NEG, (-pt0 - lim0) * Wt, (-pt1 - lim1) * Wt);
@@ -409,9 +439,10 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                         case modes::SLIP_POS:
                         case modes::SLIP_NEG: {
                             const double sigma = cur.tmode[k] == modes::SLIP_POS ? 1.0 : -1.0;
+                            double s0, s1;
+                            x01(m + rt, s0, s1);
                             if (clamp) test(k, false, modes::FREE, rel0, rel1);
-                            test(k, false, modes::STICK, sigma * (x0(m + rt) - start.d[rt]),
-                                 sigma * (x1(m + rt) - step.d[rt]));
+                            test(k, false, modes::STICK, sigma * (s0 - start.d[rt]), sigma * (s1 - step.d[rt]));
                             break;
                         }
                         case modes::FREE:
@@ -473,7 +504,9 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                     // stays continuous, and sticks where s_t comes back to 0
                     if (h.to == modes::CLOSED && pc.row_t >= 0) {
                         const int rt = pc.row_t;
-                        const double stc = (1.0 - tmin) * (x0(m + rt) - start.d[rt]) + tmin * (x1(m + rt) - step.d[rt]);
+                        double s0, s1;
+                        x01(m + rt, s0, s1);
+                        const double stc = (1.0 - tmin) * (s0 - start.d[rt]) + tmin * (s1 - step.d[rt]);
                         cur.tmode[h.k] = std::abs(stc) <= ts ? modes::STICK : stc < 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
                     }
                 } else {
