@@ -235,3 +235,57 @@ BOOST_AUTO_TEST_CASE(refactorisation_kept_by_the_backward_error_of_its_solves) {
         BOOST_TEST((x - X_exact.col(1)).norm() / X_exact.col(1).norm() < 1e-13);
     }
 }
+
+BOOST_AUTO_TEST_CASE(sparse_right_hand_sides_solved_as_klu_solves_them) {
+    // PatternLu::solve_sparse_in_place on KLU (docs/decisions/043: the homotopy's unrefined
+    // column solves): klu_solve's arithmetic on the extracted factor, skipping the columns
+    // of L and U whose multiplier is zero. Subtracting a zero multiple changes nothing, so the
+    // result is klu_solve's: bound 1e-14 of the largest entry (the same operations in the same
+    // order; a compiler contracting a multiply-add may round the last bit differently).
+    // Checked on unit right-hand sides (a DOF, a multiplier, a contact row's column) and a
+    // dense one, and again after a second factorisation with other values (the extracted
+    // factor follows it). The matrix: a saddle-point system [K -G^T; G 0] of the kind the
+    // mode solver factorises (K tridiagonal and positive definite, G 20 rows of two entries),
+    // which KLU must pivot (zero diagonal) and fill.
+    if (!sp::klu_built()) return;
+    const int n = 150, r = 20;
+    auto saddle = [&](double k_scale) {
+        std::vector<Eigen::Triplet<double>> t;
+        for (int i = 0; i < n; ++i) {
+            t.emplace_back(i, i, k_scale * (4.0 + 0.01 * i));
+            if (i > 0) t.emplace_back(i, i - 1, -k_scale);
+            if (i + 1 < n) t.emplace_back(i, i + 1, -k_scale);
+        }
+        for (int j = 0; j < r; ++j) {
+            const int a = 7 * j, b = (7 * j + 61) % n;
+            for (const auto& [dof, g] : {std::pair<int, double>{a, 1.0}, std::pair<int, double>{b, -0.5 - 0.01 * j}}) {
+                t.emplace_back(n + j, dof, g);
+                t.emplace_back(dof, n + j, -g);
+            }
+        }
+        sp::SpMat A(n + r, n + r);
+        A.setFromTriplets(t.begin(), t.end());
+        A.makeCompressed();
+        return A;
+    };
+    auto lu = sp::make_pattern_lu(sp::FixedPatternLu::klu_held_amd);
+    for (const double k_scale : {1.0, 2.5}) {
+        const sp::SpMat A = saddle(k_scale);
+        lu->analyze_given(A, {});
+        BOOST_TEST_REQUIRE(lu->factorize(A));
+        Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n + r, 5);
+        B(3, 0) = 1.0;            // a unit load on a DOF
+        B(n + 4, 1) = 1.0;        // a unit offset of a multiplier's row
+        B(28, 2) = 1.0;           // a contact row's column (G_4^T: DOFs 28 and 89)
+        B(89, 2) = -0.54;
+        B(n - 1, 3) = 2.0;        // the last unknowns in the ordering's sense need not be last
+        for (int i = 0; i < n + r; ++i) B(i, 4) = std::sin(0.3 * i) + 0.1;  // dense
+        Eigen::MatrixXd X_klu = B, X_sparse = B;
+        lu->solve_in_place(X_klu);
+        lu->solve_sparse_in_place(X_sparse);
+        const double scale = X_klu.cwiseAbs().maxCoeff();
+        BOOST_TEST((X_sparse - X_klu).cwiseAbs().maxCoeff() <= 1e-14 * scale);
+        // and it solves the system: residual at round-off (cond of this system ~1e3)
+        BOOST_TEST((A * X_sparse - B).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + scale));
+    }
+}

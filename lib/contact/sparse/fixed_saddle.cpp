@@ -76,9 +76,58 @@ private:
     double fresh_rgrowth_ = 0.0, fresh_rcond_ = 0.0;  // of the last klu_factor
     bool residual_check_ = true;
     bool unchecked_ = false;  // the current factor: a refactorisation kept on klu_rcond alone
+    // the current factor in compressed columns (klu_extract), for solve_sparse_in_place: made
+    // at its first use after each factorisation
+    bool extracted_ = false;
+    std::vector<int> lp_, li_, up_, ui_, p_, q_;
+    std::vector<double> lx_, ux_, udiag_, rs_, y_;
     void release() {
+        extracted_ = false;
         if (numeric_) klu_free_numeric(&numeric_, &common_);
         if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
+    }
+    /// The factor as L (unit diagonal first in each column), U (diagonal last), P, Q and the
+    /// row scaling, one block only (false: a block triangular form, left to klu_solve).
+    bool extract() {
+        if (extracted_) return true;
+        if (!numeric_ || symbolic_->nblocks != 1 || numeric_->nzoff != 0) return false;
+        const int n = symbolic_->n;
+        lp_.resize(static_cast<std::size_t>(n) + 1);
+        up_.resize(static_cast<std::size_t>(n) + 1);
+        li_.resize(static_cast<std::size_t>(numeric_->lnz));
+        lx_.resize(static_cast<std::size_t>(numeric_->lnz));
+        ui_.resize(static_cast<std::size_t>(numeric_->unz));
+        ux_.resize(static_cast<std::size_t>(numeric_->unz));
+        p_.resize(static_cast<std::size_t>(n));
+        q_.resize(static_cast<std::size_t>(n));
+        rs_.resize(static_cast<std::size_t>(n));
+        y_.resize(static_cast<std::size_t>(n));
+        if (klu_extract(numeric_, symbolic_, lp_.data(), li_.data(), lx_.data(), up_.data(), ui_.data(), ux_.data(),
+                        nullptr, nullptr, nullptr, p_.data(), q_.data(), rs_.data(), nullptr, &common_) == 0)
+            return false;
+        // the diagonals out of the columns (L's unit first, U's last): strictly triangular
+        // parts in place, U's diagonal apart
+        udiag_.resize(static_cast<std::size_t>(n));
+        int wl = 0, wu = 0;
+        for (int k = 0; k < n; ++k) {
+            const int l0 = lp_[static_cast<std::size_t>(k)] + 1, l1 = lp_[static_cast<std::size_t>(k) + 1];
+            const int u0 = up_[static_cast<std::size_t>(k)], u1 = up_[static_cast<std::size_t>(k) + 1] - 1;
+            lp_[static_cast<std::size_t>(k)] = wl;
+            for (int q = l0; q < l1; ++q, ++wl) {
+                li_[static_cast<std::size_t>(wl)] = li_[static_cast<std::size_t>(q)];
+                lx_[static_cast<std::size_t>(wl)] = lx_[static_cast<std::size_t>(q)];
+            }
+            up_[static_cast<std::size_t>(k)] = wu;
+            udiag_[static_cast<std::size_t>(k)] = ux_[static_cast<std::size_t>(u1)];
+            for (int q = u0; q < u1; ++q, ++wu) {
+                ui_[static_cast<std::size_t>(wu)] = ui_[static_cast<std::size_t>(q)];
+                ux_[static_cast<std::size_t>(wu)] = ux_[static_cast<std::size_t>(q)];
+            }
+        }
+        lp_[static_cast<std::size_t>(n)] = wl;
+        up_[static_cast<std::size_t>(n)] = wu;
+        extracted_ = true;
+        return true;
     }
     // (SpMat's outer and inner indices are int, as KLU's int version takes them; KLU does
     // not write through its non-const pointers)
@@ -99,6 +148,7 @@ private:
     }
     bool pivot(const SpMat& A) {
         double rgrowth = 0.0, rcond = 0.0;
+        extracted_ = false;
         if (numeric_) klu_free_numeric(&numeric_, &common_);
         numeric_ = klu_factor(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_, &common_);
         if (numeric_ == nullptr || common_.status != KLU_OK || !quality(A, rgrowth, rcond)) {
@@ -120,6 +170,7 @@ public:
         if (!symbolic_) return false;
         norm_valid_ = false;
         unchecked_ = false;
+        extracted_ = false;
         double rgrowth = 0.0, rcond = 0.0;
         if (numeric_ && klu_refactor(ip(A.outerIndexPtr()), ip(A.innerIndexPtr()), vp(A.valuePtr()), symbolic_,
                                      numeric_, &common_) &&
@@ -168,6 +219,46 @@ public:
     void solve_in_place(Eigen::MatrixXd& X) override {
         if (X.cols() == 0) return;
         klu_solve(symbolic_, numeric_, static_cast<int>(X.rows()), static_cast<int>(X.cols()), X.data(), &common_);
+    }
+    /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), column by column) on the extracted
+    /// factor, skipping each column of L and U whose multiplier is zero: a unit right-hand
+    /// side's forward solve touches only the factor's columns it reaches (docs/decisions/043).
+    void solve_sparse_in_place(Eigen::MatrixXd& X) override {
+        if (X.cols() == 0) return;
+        if (!extract()) {
+            solve_in_place(X);
+            return;
+        }
+        const int n = symbolic_->n;
+        const int* lp = lp_.data();
+        const int* li = li_.data();
+        const double* lx = lx_.data();
+        const int* up = up_.data();
+        const int* ui = ui_.data();
+        const double* ux = ux_.data();
+        const double* ud = udiag_.data();
+        double* y = y_.data();
+        const int* perm = p_.data();
+        const double* rs = rs_.data();
+        for (Eigen::Index c = 0; c < X.cols(); ++c) {
+            double* b = X.col(c).data();
+            for (int k = 0; k < n; ++k) {
+                const double v = b[perm[k]];
+                y[k] = v == 0.0 ? 0.0 : v / rs[k];
+            }
+            for (int k = 0; k < n; ++k) {  // L (unit diagonal)
+                const double x = y[k];
+                if (x == 0.0) continue;
+                for (int q = lp[k]; q < lp[k + 1]; ++q) y[li[q]] -= lx[q] * x;
+            }
+            for (int k = n - 1; k >= 0; --k) {  // U
+                if (y[k] == 0.0) continue;
+                const double x = y[k] / ud[k];
+                y[k] = x;
+                for (int q = up[k]; q < up[k + 1]; ++q) y[ui[q]] -= ux[q] * x;
+            }
+            for (int k = 0; k < n; ++k) b[q_[static_cast<std::size_t>(k)]] = y[k];
+        }
     }
 };
 #endif
@@ -430,7 +521,7 @@ Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
 Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {
     if (held_system_) {
         Eigen::MatrixXd X = R;
-        if (!refine) lu_->solve_in_place(X);
+        if (!refine) lu_->solve_sparse_in_place(X);
         else if (!lu_->refined_solve(As_, X)) throw SingularModes{};
         return X;
     }
@@ -438,7 +529,7 @@ Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {
     Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n + m, R.cols());
     X.topRows(n) = R.topRows(n);
     for (std::size_t i = 0; i < held_.size(); ++i) X.row(n + held_[i]) = R.row(n + static_cast<Eigen::Index>(i));
-    if (!refine) lu_->solve_in_place(X);
+    if (!refine) lu_->solve_sparse_in_place(X);
     else if (!lu_->refined_solve(A_, X)) throw SingularModes{};
     Eigen::MatrixXd out(n + static_cast<Eigen::Index>(held_.size()), R.cols());
     out.topRows(n) = X.topRows(n);

@@ -62,6 +62,10 @@ public:
     virtual void solve_in_place(Eigen::VectorXd& x) = 0;
     /// X = A^-1 X, every column (one pass over the factor for several columns where the LU can).
     virtual void solve_in_place(Eigen::MatrixXd& X) = 0;
+    /// The same for columns with few nonzeros (unit right-hand sides): where the LU can, its
+    /// triangular solves skip the columns of the factors that a zero entry would apply (the
+    /// same arithmetic otherwise, so the same result). Default: solve_in_place.
+    virtual void solve_sparse_in_place(Eigen::MatrixXd& X) { solve_in_place(X); }
     /// Whether the current factor is a refactorisation on an old pivot sequence whose pivots
     /// were not checked (Switches::residual_refactor_check): its solves' backward error is.
     virtual bool unchecked() const { return false; }
@@ -126,7 +130,8 @@ public:
     Eigen::VectorXd solve(const Eigen::VectorXd& r);
     /// The same for each column of R (one multi-column solve); refine false: without the
     /// refinement step (and without the backward-error check of an unchecked refactorisation:
-    /// for a factor a refined solve has already checked; docs/decisions/040).
+    /// for a factor a refined solve has already checked; docs/decisions/040), for columns with
+    /// few nonzeros (PatternLu::solve_sparse_in_place; docs/decisions/043).
     Eigen::MatrixXd solve(const Eigen::MatrixXd& R, bool refine = true);
     /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;

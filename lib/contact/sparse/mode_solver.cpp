@@ -66,6 +66,19 @@ bool column_couplings(const ModeLinearization& lin, const std::vector<int>& pos,
     }
     return true;
 }
+
+/// Each slipping row's force from its pair's normal force (held or fixed): p_t += coef p_n.
+void add_slip_couplings(const ModeLinearization& lin, Eigen::Ref<Eigen::VectorXd> p) {
+    for (std::size_t a = 0; a < lin.coupled.size(); ++a) p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+}
+
+/// Every contact row's force [N] from the held rows' pS: the fixed forces e, pS on the held
+/// rows, the slip couplings.
+void all_forces(const ModeLinearization& lin, const Eigen::VectorXd& pS, Eigen::VectorXd& p) {
+    p = lin.e;
+    for (std::size_t i = 0; i < lin.S.size(); ++i) p[lin.S[i]] = pS[static_cast<Eigen::Index>(i)];
+    add_slip_couplings(lin, p);
+}
 }  // namespace
 
 std::vector<int> layer_dofs(const SpMat& K, const SpMat& G) {
@@ -208,7 +221,64 @@ int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed cha
 
 int ModeSolver::solve_key(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-    const int n = static_cast<int>(st_.K.rows()), m = static_cast<int>(d.size());
+    const int n = static_cast<int>(st_.K.rows());
+    const auto& S = lin.S;
+    const int ms = static_cast<int>(S.size());
+    const int factorised = make_current(lin, key);
+    Eigen::VectorXd dS(ms);
+    for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
+    Eigen::VectorXd pS;
+    if (border_active) {
+        border_solve(lin, b, d, p, z);
+        return factorised;
+    }
+    if (++key_uses == 1) {
+        // first use of a factorisation (most active-set passes use it once): one solve
+        // with the whole load; the affine caches are made if it is used again
+        direct_solve(lin, b + st_.G.transpose() * lin.e, dS, pS, z);
+        all_forces(lin, pS, p);
+        return factorised;
+    }
+    if (!const_ok || const_e != lin.e || const_dS != dS) {
+        direct_solve(lin, st_.G.transpose() * lin.e, dS, pc, zc);
+        const_e = lin.e;
+        const_dS = dS;
+        const_ok = true;
+    }
+    // b: one nonzero entry (the closed-form stepper's load on the rigid body) is a
+    // multiple of a cached unit solve; anything else is solved directly.
+    int nz = -1, count = 0;
+    for (int i = 0; i < n; ++i)
+        if (b[i] != 0.0) {
+            nz = i;
+            ++count;
+        }
+    if (count == 0) {
+        z = zc;
+        pS = pc;
+    } else if (count == 1) {
+        if (unit_dof != nz) {
+            load_solve(lin, Eigen::VectorXd::Unit(n, nz), pu, zu);
+            unit_dof = nz;
+        }
+        z = zc + b[nz] * zu;
+        pS = pc + b[nz] * pu;
+    } else {
+        Eigen::VectorXd pb, zb;
+        load_solve(lin, b, pb, zb);
+        z = zc + zb;
+        pS = pc + pb;
+    }
+    all_forces(lin, pS, p);
+    return factorised;
+}
+
+
+/// Makes lin's factorisation (named by key) current: reused, a bordered update of the
+/// last sparse LU (counted in updates()), or factorised (returns 1). Throws SingularModes
+/// if the held rows are dependent.
+int ModeSolver::make_current(const ModeLinearization& lin, const std::vector<signed char>& key) {
+    const int m = st_.rows();
     const auto& S = lin.S;
     const int ms = static_cast<int>(S.size());
     pos.assign(m, -1);
@@ -266,57 +336,52 @@ int ModeSolver::solve_key(const ModeLinearization& lin, const std::vector<signed
         unit_dof = -1;
     }
     if (!lu_ok) throw SingularModes{};
-    Eigen::VectorXd dS(ms);
-    for (int i = 0; i < ms; ++i) dS[i] = d[S[i]];
-    Eigen::VectorXd pS;
-    if (border_active) {
-        border_solve(lin, b, d, p, z);
-        return factorised;
-    }
-    if (++key_uses == 1) {
-        // first use of a factorisation (most active-set passes use it once): one solve
-        // with the whole load; the affine caches are made if it is used again
-        direct_solve(lin, b + st_.G.transpose() * lin.e, dS, pS, z);
-        p = lin.e;
-        for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
-        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
-            p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
-        return factorised;
-    }
-    if (!const_ok || const_e != lin.e || const_dS != dS) {
-        direct_solve(lin, st_.G.transpose() * lin.e, dS, pc, zc);
-        const_e = lin.e;
-        const_dS = dS;
-        const_ok = true;
-    }
-    // b: one nonzero entry (the closed-form stepper's load on the rigid body) is a
-    // multiple of a cached unit solve; anything else is solved directly.
-    int nz = -1, count = 0;
-    for (int i = 0; i < n; ++i)
-        if (b[i] != 0.0) {
-            nz = i;
-            ++count;
+    return factorised;
+}
+
+int ModeSolver::solve_block(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::MatrixXd& B,
+                            const Eigen::MatrixXd& D, Eigen::MatrixXd& P, Eigen::MatrixXd& Z) {
+    const double t0 = routes_ ? thread_cpu_s() : 0.0;
+    const long pivoted0 = fixed_ ? fixed_->lu().pivoted : 0;
+    route_ = route_cached;
+    const int factorised = make_current(lin, key);
+    const int n = st_.dofs(), m = st_.rows(), ms = static_cast<int>(lin.S.size()), k = static_cast<int>(B.cols());
+    P.resize(m, k);
+    Z.resize(n, k);
+    Eigen::MatrixXd F = B;  // the loads b + G^T e
+    F.colwise() += st_.Gt * lin.e;
+    Eigen::MatrixXd DS(ms, k);
+    for (int i = 0; i < ms; ++i) DS.row(i) = D.row(lin.S[static_cast<std::size_t>(i)]);
+    Eigen::VectorXd pS, p, z;
+    if (border_active || lu_schur || lu_primal) {  // one solve per column
+        for (int j = 0; j < k; ++j) {
+            if (border_active) {
+                border_solve(lin, B.col(j), D.col(j), p, z);
+            } else {
+                direct_solve(lin, F.col(j), DS.col(j), pS, z);
+                all_forces(lin, pS, p);
+            }
+            P.col(j) = p;
+            Z.col(j) = z;
         }
-    if (count == 0) {
-        z = zc;
-        pS = pc;
-    } else if (count == 1) {
-        if (unit_dof != nz) {
-            load_solve(lin, Eigen::VectorXd::Unit(n, nz), pu, zu);
-            unit_dof = nz;
+    } else {  // the sparse LU: one multi-column solve, refined
+        Eigen::MatrixXd R(n + ms, k);
+        R.topRows(n) = st_.dz.asDiagonal() * F;
+        R.bottomRows(ms) = row_scale.asDiagonal() * DS;
+        const Eigen::MatrixXd X = refined_solve(R);
+        Z = st_.dz.asDiagonal() * X.topRows(n);
+        for (int j = 0; j < k; ++j) {
+            pS = row_scale.cwiseProduct(X.col(j).tail(ms));
+            all_forces(lin, pS, p);
+            P.col(j) = p;
         }
-        z = zc + b[nz] * zu;
-        pS = pc + b[nz] * pu;
-    } else {
-        Eigen::VectorXd pb, zb;
-        load_solve(lin, b, pb, zb);
-        z = zc + zb;
-        pS = pc + pb;
     }
-    p = lin.e;
-    for (int i = 0; i < ms; ++i) p[S[i]] = pS[i];
-    for (std::size_t a = 0; a < lin.coupled.size(); ++a)
-        p[lin.coupled[a].first] += lin.coef[a] * p[lin.coupled[a].second];
+    if (routes_) {
+        routes_->count[route_] += 1;
+        routes_->seconds[route_] += thread_cpu_s() - t0;
+        routes_->held[route_] += static_cast<double>(ms);
+        if (fixed_) routes_->fixed_pivoted += fixed_->lu().pivoted - pivoted0;
+    }
     return factorised;
 }
 
@@ -396,14 +461,27 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
     Z.resize(n, k);
     Eigen::MatrixXd PS(ms, k);
     if (lu_schur) {
-        // the loads g_r^T of the force columns through K's factor together, then each
-        // column's held forces by the (dense, refined) Schur solve
+        // the force columns' K^-1 g_r^T: the cached columns where there are (ensure_columns'
+        // cache), the others through K's factor together; then each column's held forces by
+        // the (dense, refined) Schur solve
         Eigen::MatrixXd Z0 = Eigen::MatrixXd::Zero(n, k);
-        for (int j = 0; j < k; ++j)
-            if (pos[rows[static_cast<std::size_t>(j)]] < 0)
-                for (SpMat::InnerIterator it(st_.Gt, rows[static_cast<std::size_t>(j)]); it; ++it)
-                    Z0(it.row(), j) = it.value();
-        Z0 = st_.k_llt.solve(Z0).eval();
+        std::vector<int> solved;
+        for (int j = 0; j < k; ++j) {
+            const int r = rows[static_cast<std::size_t>(j)];
+            if (pos[r] >= 0) continue;
+            if (xcol[static_cast<std::size_t>(r)].size() != 0) {
+                Z0.col(j) = xcol[static_cast<std::size_t>(r)];
+                continue;
+            }
+            for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) Z0(it.row(), j) = it.value();
+            solved.push_back(j);
+        }
+        if (!solved.empty()) {
+            Eigen::MatrixXd Y(n, static_cast<Eigen::Index>(solved.size()));
+            for (std::size_t c = 0; c < solved.size(); ++c) Y.col(static_cast<Eigen::Index>(c)) = Z0.col(solved[c]);
+            Y = st_.k_llt.solve(Y).eval();
+            for (std::size_t c = 0; c < solved.size(); ++c) Z0.col(solved[c]) = Y.col(static_cast<Eigen::Index>(c));
+        }
         Eigen::VectorXd target(ms), pS, zf;
         for (int j = 0; j < k; ++j) {
             const int i = pos[rows[static_cast<std::size_t>(j)]];
@@ -432,8 +510,7 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
         const int r = rows[static_cast<std::size_t>(j)];
         if (pos[r] < 0) P(r, j) = 1.0;
         for (int i = 0; i < ms; ++i) P(lin.S[static_cast<std::size_t>(i)], j) = PS(i, j);
-        for (std::size_t a = 0; a < lin.coupled.size(); ++a)
-            P(lin.coupled[a].first, j) += lin.coef[a] * P(lin.coupled[a].second, j);
+        add_slip_couplings(lin, P.col(j));
     }
     return true;
 }

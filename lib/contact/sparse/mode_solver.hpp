@@ -122,6 +122,12 @@ public:
     /// Throws SingularModes if the held rows are dependent.
     int solve(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
               const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    /// solve() for the columns of B (loads, n x k) and D (offsets, m x k), all with lin's fixed
+    /// forces e: the forces P (m x k) and displacements Z (n x k). On the sparse LU one
+    /// multi-column solve, refined (one pass over the factor for every column); the affine
+    /// caches of solve() are neither used nor changed. Returns 1 if it factorised.
+    int solve_block(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::MatrixXd& B,
+                    const Eigen::MatrixXd& D, Eigen::MatrixXd& P, Eigen::MatrixXd& Z);
     /// For the current factorisation (lin's, made current by a solve() with its key): lin's
     /// problem for one unit right-hand side per row of `rows`, all in one multi-column solve,
     /// with b = 0 and e = 0 but a unit offset d_r (a held row of lin) or a unit fixed force e_r
@@ -158,6 +164,7 @@ public:
 private:
     int solve_key(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    int make_current(const modes::ModeLinearization& lin, const std::vector<signed char>& key);
     bool try_border(const modes::ModeLinearization& lin);
     void border_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
                       Eigen::VectorXd& p, Eigen::VectorXd& z);

@@ -101,6 +101,72 @@ void pair_equations(const ContactPair& c, signed char nm, signed char tm, Eq& en
     }
 }
 
+/// The columns y_r of the path (2m rows: the forces, then G z), stored in panels of kWidth
+/// columns, each panel row-major: one row's entries of a panel share a cache line. A row's
+/// dot product with lambda (the ratio test's x0 / x1) reads ncol / kWidth lines, and adding
+/// a column writes along its panel in memory order; a row-major matrix of all the columns
+/// (the way before) put every row of a new column on its own cache line (decision 043).
+class ColumnStore {
+public:
+    static constexpr int kWidth = 8;
+    explicit ColumnStore(int rows) : rows_(rows) {}
+    int size() const { return ncol_; }
+    /// the columns rounded up to whole panels (lambda's padded length)
+    int padded() const { return used_ * kWidth; }
+    double operator()(int q, int c) const { return panels_[static_cast<std::size_t>(c / kWidth)][slot(q, c)]; }
+    /// sum_c Y(q, c) L[c] over the columns (L: padded() entries, zero past size())
+    double dot(int q, const Eigen::VectorXd& L) const {
+        double sum = 0.0;
+        const double* l = L.data();
+        for (int p = 0; p < used_; ++p, l += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].data() + static_cast<std::size_t>(q) * kWidth;
+            double s = 0.0;
+            for (int i = 0; i < kWidth; ++i) s += y[i] * l[i];
+            sum += s;
+        }
+        return sum;
+    }
+    /// dot(q, L0) and dot(q, L1) in one pass over the row (the same sums)
+    void dot2(int q, const Eigen::VectorXd& L0, const Eigen::VectorXd& L1, double& a, double& b) const {
+        a = b = 0.0;
+        const double* l0 = L0.data();
+        const double* l1 = L1.data();
+        for (int p = 0; p < used_; ++p, l0 += kWidth, l1 += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].data() + static_cast<std::size_t>(q) * kWidth;
+            double s0 = 0.0, s1 = 0.0;
+            for (int i = 0; i < kWidth; ++i) {
+                s0 += y[i] * l0[i];
+                s1 += y[i] * l1[i];
+            }
+            a += s0;
+            b += s1;
+        }
+    }
+    /// A new column, its entries from `value(q)` for q < rows; returns its index.
+    template <class F>
+    int add(const F& value) {
+        const int c = ncol_++;
+        if (c % kWidth == 0) {  // a new panel (one left by clear() is zeroed for its new columns)
+            if (used_ < static_cast<int>(panels_.size()))
+                std::fill(panels_[static_cast<std::size_t>(used_)].begin(), panels_[static_cast<std::size_t>(used_)].end(), 0.0);
+            else
+                panels_.emplace_back(static_cast<std::size_t>(rows_) * kWidth, 0.0);
+            ++used_;
+        }
+        double* y = panels_[static_cast<std::size_t>(used_ - 1)].data() + c % kWidth;
+        for (int q = 0; q < rows_; ++q) y[static_cast<std::size_t>(q) * kWidth] = value(q);
+        return c;
+    }
+    /// Forgets every column (a new base; the panels' memory is kept for the next ones).
+    void clear() { ncol_ = used_ = 0; }
+
+private:
+    static std::size_t slot(int q, int c) { return static_cast<std::size_t>(q) * kWidth + static_cast<std::size_t>(c % kWidth); }
+    int rows_;
+    int ncol_ = 0, used_ = 0;
+    std::vector<std::vector<double>> panels_;
+};
+
 /// A pair whose mode condition fails on the rest of the path, its new mode (normal or
 /// tangential) and where. A condition g [m] is affine along the path (within one set of
 /// modes) and valid while g <= the passes' acceptance (kAccept x tolerance_m).
@@ -150,26 +216,25 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         }
     };
     const int upd0 = path.solver.updates();
-    // x^ at t = 0 and t = 1: [forces; G z] (2m entries each)
+    // x^ at t = 0 and t = 1: [forces; G z] (2m entries each), both in one (multi-column,
+    // refined) solve with the base's factorisation
     Eigen::VectorXd X0h(2 * m), X1h(2 * m);
-    auto solve0 = [&](const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
-                      Eigen::VectorXd& X) {
-        Eigen::VectorXd zz, P;
-        const int f = path.solver.solve(lin, key0, b, d, P, zz);
-        r.factorizations += f;
-        stats.factorizations += f;
-        X.head(m) = P;
-        X.tail(m) = st.Grow * zz;
-        return zz;
-    };
     auto make_base = [&]() {
         const double c0 = thread_cpu_s();
         cur.linearize(laws, lin0);
         key0 = cur.key();
         key0.push_back(static_cast<signed char>(laws.tau_rule));
         set_base_equations();
-        solve0(lin0, start.b, start.d, X0h);
-        z = solve0(lin0, step.b, step.d, X1h);
+        Eigen::MatrixXd B(st.K.rows(), 2), D(m, 2), P, Z;
+        B << start.b, step.b;
+        D << start.d, step.d;
+        const int f = path.solver.solve_block(lin0, key0, B, D, P, Z);
+        r.factorizations += f;
+        stats.factorizations += f;
+        const Eigen::MatrixXd GZ = st.Grow * Z;
+        X0h << P.col(0), GZ.col(0);
+        X1h << P.col(1), GZ.col(1);
+        z = Z.col(1);
         stats.base_s += thread_cpu_s() - c0;
     };
     try {
@@ -180,12 +245,10 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     }
     ++r.iterations;
 
-    // the columns y_r, row-major (a pair's entries over all columns contiguous), each scaled
-    // to about a metre of motion: a held base row's for a unit offset [m], another's for a
-    // unit force times 1 / W_rr [N]; rn2 the squared norms of Y's rows (the bound's)
-    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-    RowMajor Y(2 * m, 0);
-    int ncol = 0;
+    // the columns y_r (ColumnStore: in panels), each scaled to about a metre of motion: a
+    // held base row's for a unit offset [m], another's for a unit force times 1 / W_rr [N];
+    // rn2 the squared norms of Y's rows (the bound's)
+    ColumnStore Y(2 * m);
     std::vector<int> col(m, -1);
     Eigen::VectorXd rn2 = Eigen::VectorXd::Zero(2 * m);
     const Eigen::VectorXd zero_b = Eigen::VectorXd::Zero(st.K.rows()), zero_d = Eigen::VectorXd::Zero(m);
@@ -215,14 +278,17 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 Z.col(j) = zj;
             }
         }
-        Eigen::MatrixXd B(2 * m, k);  // the scaled columns, then into Y's rows
-        B.topRows(m) = P;
-        B.bottomRows(m).noalias() = st.G * Z;
-        for (int j = 0; j < k; ++j) B.col(j) *= base[rows[j]].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
-        rn2 += B.rowwise().squaredNorm();
-        if (ncol + k > Y.cols()) Y.conservativeResize(2 * m, std::max(16, 2 * (ncol + k)));
-        Y.middleCols(ncol, k) = B;
-        for (int j = 0; j < k; ++j) col[rows[j]] = ncol++;
+        const Eigen::MatrixXd GZ = st.Grow * Z;  // (row-major G: a gather per row)
+        for (int j = 0; j < k; ++j) {
+            const double s = base[rows[j]].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
+            const double* pj = P.col(j).data();
+            const double* gj = GZ.col(j).data();
+            col[rows[j]] = Y.add([&](int q) {
+                const double v = s * (q < m ? pj[q] : gj[q - m]);
+                rn2[q] += v * v;
+                return v;
+            });
+        }
         stats.columns += k;
         stats.column_s += thread_cpu_s() - c0;
     };
@@ -242,8 +308,16 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     std::vector<Hit> hits;
     std::vector<int> C;
     // x's entry q (a force: q < m; G z: m + q) at t = 0 and t = 1 under the current set
-    auto x0 = [&](int q) { return X0h[q] + (ncol > 0 ? Y.row(q).head(ncol).dot(L0) : 0.0); };
-    auto x1 = [&](int q) { return X1h[q] + (ncol > 0 ? Y.row(q).head(ncol).dot(L1) : 0.0); };
+    // (both ends at once: one pass over the row of Y)
+    auto x01 = [&](int q, double& a, double& b) {
+        a = X0h[q];
+        b = X1h[q];
+        if (Y.size() == 0) return;
+        double ya, yb;
+        Y.dot2(q, L0, L1, ya, yb);
+        a += ya;
+        b += yb;
+    };
     auto rn = [&](int q) { return std::sqrt(rn2[q]); };
     try {
         for (;;) {
@@ -255,7 +329,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 make_base();
                 eq = base;
                 std::fill(col.begin(), col.end(), -1);
-                ncol = 0;
+                Y.clear();
                 rn2.setZero();
                 A1 = 0.0;
                 std::fill(dirty.begin(), dirty.end(), 1);
@@ -269,8 +343,8 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 return false;
             }
             add_columns(C);
-            L0.setZero(ncol);
-            L1.setZero(ncol);
+            L0.setZero(Y.padded());
+            L1.setZero(Y.padded());
             if (nc > 0) {
                 // H (metres both ways: a force equation's row by W_rr; the columns are scaled)
                 Eigen::MatrixXd H(nc, nc);
@@ -297,8 +371,8 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 }
             }
             {  // the bound's step: lambda_1's change since the last breakpoint
-                Eigen::VectorXd prev = Eigen::VectorXd::Zero(ncol);
-                prev.head(std::min<Eigen::Index>(L1_prev.size(), ncol)) = L1_prev.head(std::min<Eigen::Index>(L1_prev.size(), ncol));
+                Eigen::VectorXd prev = Eigen::VectorXd::Zero(L1.size());
+                prev.head(std::min(L1_prev.size(), L1.size())) = L1_prev.head(std::min(L1_prev.size(), L1.size()));
                 A1 += (L1 - prev).norm();
                 L1_prev = L1;
             }
@@ -341,21 +415,27 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 dirty[k] = 0;
                 A1_at[k] = A1;
                 gmin = std::numeric_limits<double>::infinity();
+                // the pair's normal force at both ends (its normal test, its friction limit)
+                double pn0 = 0.0, pn1 = 0.0;
+                if (rn_ >= 0 && (trow || (nrow && cur.nmode[k] == modes::CLOSED))) x01(rn_, pn0, pn1);
                 if (nrow) {
-                    if (cur.nmode[k] == modes::CLOSED)
-                        test(k, true, modes::OPEN, x0(rn_) * W[rn_], x1(rn_) * W[rn_]);
-                    else if (cur.nmode[k] == modes::OPEN)
-                        test(k, true, modes::CLOSED, x0(m + rn_) - start.d[rn_], x1(m + rn_) - step.d[rn_]);
+                    if (cur.nmode[k] == modes::CLOSED) {
+                        test(k, true, modes::OPEN, pn0 * W[rn_], pn1 * W[rn_]);
+                    } else if (cur.nmode[k] == modes::OPEN) {
+                        double g0, g1;
+                        x01(m + rn_, g0, g1);
+                        test(k, true, modes::CLOSED, g0 - start.d[rn_], g1 - step.d[rn_]);
+                    }
                 }
                 if (trow) {
                     const double Wt = W[rt];
-                    const double pn0 = rn_ >= 0 ? x0(rn_) : 0.0, pn1 = rn_ >= 0 ? x1(rn_) : 0.0;
                     // friction lost past the clamp's preload; the friction limit, affine in p_n
                     const double rel0 = mu * (pn0 - c.preload_n) * Wt, rel1 = mu * (pn1 - c.preload_n) * Wt;
                     const double lim0 = mu * (clamp ? c.preload_n - pn0 : -pn0), lim1 = mu * (clamp ? c.preload_n - pn1 : -pn1);
                     switch (cur.tmode[k]) {
                         case modes::STICK: {
-                            const double pt0 = x0(rt), pt1 = x1(rt);
+                            double pt0, pt1;
+                            x01(rt, pt0, pt1);
                             if (clamp) test(k, false, modes::FREE, rel0, rel1);
                             test(k, false, modes::SLIP_POS, (pt0 - lim0) * Wt, (pt1 - lim1) * Wt);
                             test(k, false, modes::SLIP_NEG, (-pt0 - lim0) * Wt, (-pt1 - lim1) * Wt);
@@ -364,9 +444,10 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                         case modes::SLIP_POS:
                         case modes::SLIP_NEG: {
                             const double sigma = cur.tmode[k] == modes::SLIP_POS ? 1.0 : -1.0;
+                            double s0, s1;
+                            x01(m + rt, s0, s1);
                             if (clamp) test(k, false, modes::FREE, rel0, rel1);
-                            test(k, false, modes::STICK, sigma * (x0(m + rt) - start.d[rt]),
-                                 sigma * (x1(m + rt) - step.d[rt]));
+                            test(k, false, modes::STICK, sigma * (s0 - start.d[rt]), sigma * (s1 - step.d[rt]));
                             break;
                         }
                         case modes::FREE:
@@ -428,7 +509,9 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 // sticks where s_t comes back to 0 (sticking at once would jump s_t to the anchor)
                 auto friction_from_zero = [&]() {
                     const int rt = pc.row_t;
-                    const double stc = (1.0 - tmin) * (x0(m + rt) - start.d[rt]) + tmin * (x1(m + rt) - step.d[rt]);
+                    double s0, s1;
+                    x01(m + rt, s0, s1);
+                    const double stc = (1.0 - tmin) * (s0 - start.d[rt]) + tmin * (s1 - step.d[rt]);
                     return std::abs(stc) <= ts ? modes::STICK : stc < 0.0 ? modes::SLIP_POS : modes::SLIP_NEG;
                 };
                 if (h.normal) {
@@ -456,7 +539,8 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     path.modes.nmode = cur.nmode;
     path.modes.tmode = cur.tmode;
     p = X1h.head(m);
-    if (ncol > 0) p.noalias() += Y.topRows(m).leftCols(ncol) * L1;
+    if (Y.size() > 0)
+        for (int q = 0; q < m; ++q) p[q] += Y.dot(q, L1);
     return true;
 }
 
