@@ -366,16 +366,27 @@ struct SparseContactSolver::Impl {
         using namespace detail::sparse;
         if (path_d.size() != step.d.size() || path_b.size() != step.b.size()) return false;
         const TransitionStart passes_end(p, z, path.modes);
+        if (follow_path(step, PathStart{path_b, path_d, path_n, path_t}, p, z, r)) return true;
+        passes_end.restore(p, z, path.modes);
+        return false;
+    }
+
+    /// path_following from `start` to this step's data, its end modes confirmed by the passes
+    /// (a singular set of modes among them: not settled), the homotopy's statistics into the
+    /// trace. True when settled.
+    bool follow_path(const detail::sparse::Step& step, const detail::sparse::PathStart& start, Eigen::VectorXd& p,
+                     Eigen::VectorXd& z, SolveResult& r) {
+        using namespace detail::sparse;
         PathStats ps;
         bool settled = false;
         int confirm = 0;
-        if (path_following(path, step, PathStart{path_b, path_d, path_n, path_t}, p, z, r, ps,
-                           path.switches.path_rebase_rows, path.switches.path_max_start_hits)) {
+        if (path_following(path, step, start, p, z, r, ps, path.switches.path_rebase_rows,
+                           path.switches.path_max_start_hits)) {
             const int it0 = r.iterations;
             try {
                 settled = passes_from_modes(path, step, p, z, r);
             } catch (const SingularModes&) {
-                path.solver.forget();  // the Newton methods from the passes' end, as without the homotopy
+                path.solver.forget();  // the caller's next method, as without the homotopy
             }
             confirm = r.iterations - it0;
         }
@@ -384,9 +395,7 @@ struct SparseContactSolver::Impl {
             tr->path_confirmed = settled;
             tr->path_confirm_solves = confirm;
         }
-        if (settled) return true;
-        passes_end.restore(p, z, path.modes);
-        return false;
+        return settled;
     }
 
     /// Step 2a', from rest (Switches::rest_path_violations, docs/decisions/041): the homotopy
@@ -399,9 +408,6 @@ struct SparseContactSolver::Impl {
                          SolveResult& r) {
         using namespace detail::sparse;
         if (path.laws.tau_rule != TauRule::current) return false;  // path_following's rule
-        PathStats ps;
-        bool settled = false;
-        int confirm = 0;
         try {
             Eigen::VectorXd F;
             path.natural_residual(p, path.stiffness().Grow * z - step.d, F, true);
@@ -410,21 +416,11 @@ struct SparseContactSolver::Impl {
             Eigen::VectorXd b0, d0;
             covering_start(path, step, p, z, b0, d0);
             const std::vector<signed char> n0 = path.modes.nmode, t0 = path.modes.tmode;
-            if (path_following(path, step, PathStart{b0, d0, n0, t0}, p, z, r, ps, path.switches.path_rebase_rows,
-                               path.switches.path_max_start_hits)) {
-                const int it0 = r.iterations;
-                settled = passes_from_modes(path, step, p, z, r);
-                confirm = r.iterations - it0;
-            }
+            return follow_path(step, PathStart{b0, d0, n0, t0}, p, z, r);
         } catch (const SingularModes&) {
             path.solver.forget();
         }
-        if (StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr) {
-            tr->path = ps;
-            tr->path_confirmed = settled;
-            tr->path_confirm_solves = confirm;
-        }
-        return settled;
+        return false;
     }
 
     /// Step 2b, the Tresca fixed point, then the coupled Coulomb problem from its modes; if
