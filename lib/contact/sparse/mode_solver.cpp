@@ -207,14 +207,20 @@ void ModeSolver::accept() {
 /// Both cache the affine map of the load: (z, p_S) = (zc, pc) + b_w (zu, pu).
 int ModeSolver::solve(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
                       const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-    if (!routes_) return solve_key(lin, key, b, d, p, z);
+    return counted(lin.S.size(), [&]() { return solve_key(lin, key, b, d, p, z); });
+}
+
+/// One call of the solver (solve_key, solve_block) under the trace's route statistics
+/// (set_route_stats): its route, CPU time, held rows and KLU pivotings; without them just the call.
+int ModeSolver::counted(std::size_t held_rows, const std::function<int()>& call) {
+    if (!routes_) return call();
     const double t0 = thread_cpu_s();
     const long pivoted0 = fixed_ ? fixed_->lu().pivoted : 0;
     route_ = route_cached;
-    const int f = solve_key(lin, key, b, d, p, z);
+    const int f = call();
     routes_->count[route_] += 1;
     routes_->seconds[route_] += thread_cpu_s() - t0;
-    routes_->held[route_] += static_cast<double>(lin.S.size());
+    routes_->held[route_] += static_cast<double>(held_rows);
     if (fixed_) routes_->fixed_pivoted += fixed_->lu().pivoted - pivoted0;
     return f;
 }
@@ -272,7 +278,6 @@ int ModeSolver::solve_key(const ModeLinearization& lin, const std::vector<signed
     all_forces(lin, pS, p);
     return factorised;
 }
-
 
 /// Makes lin's factorisation (named by key) current: reused, a bordered update of the
 /// last sparse LU (counted in updates()), or factorised (returns 1). Throws SingularModes
@@ -341,9 +346,12 @@ int ModeSolver::make_current(const ModeLinearization& lin, const std::vector<sig
 
 int ModeSolver::solve_block(const ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::MatrixXd& B,
                             const Eigen::MatrixXd& D, Eigen::MatrixXd& P, Eigen::MatrixXd& Z) {
-    const double t0 = routes_ ? thread_cpu_s() : 0.0;
-    const long pivoted0 = fixed_ ? fixed_->lu().pivoted : 0;
-    route_ = route_cached;
+    return counted(lin.S.size(), [&]() { return solve_block_key(lin, key, B, D, P, Z); });
+}
+
+int ModeSolver::solve_block_key(const ModeLinearization& lin, const std::vector<signed char>& key,
+                                const Eigen::MatrixXd& B, const Eigen::MatrixXd& D, Eigen::MatrixXd& P,
+                                Eigen::MatrixXd& Z) {
     const int factorised = make_current(lin, key);
     const int n = st_.dofs(), m = st_.rows(), ms = static_cast<int>(lin.S.size()), k = static_cast<int>(B.cols());
     P.resize(m, k);
@@ -375,12 +383,6 @@ int ModeSolver::solve_block(const ModeLinearization& lin, const std::vector<sign
             all_forces(lin, pS, p);
             P.col(j) = p;
         }
-    }
-    if (routes_) {
-        routes_->count[route_] += 1;
-        routes_->seconds[route_] += thread_cpu_s() - t0;
-        routes_->held[route_] += static_cast<double>(ms);
-        if (fixed_) routes_->fixed_pivoted += fixed_->lu().pivoted - pivoted0;
     }
     return factorised;
 }

@@ -25,6 +25,7 @@
 // the back-solves of that map are cached.
 #include <Eigen/Dense>
 #include <Eigen/SparseLU>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -164,7 +165,10 @@ public:
 private:
     int solve_key(const modes::ModeLinearization& lin, const std::vector<signed char>& key, const Eigen::VectorXd& b,
                   const Eigen::VectorXd& d, Eigen::VectorXd& p, Eigen::VectorXd& z);
+    int solve_block_key(const modes::ModeLinearization& lin, const std::vector<signed char>& key,
+                        const Eigen::MatrixXd& B, const Eigen::MatrixXd& D, Eigen::MatrixXd& P, Eigen::MatrixXd& Z);
     int make_current(const modes::ModeLinearization& lin, const std::vector<signed char>& key);
+    int counted(std::size_t held_rows, const std::function<int()>& call);
     bool try_border(const modes::ModeLinearization& lin);
     void border_solve(const modes::ModeLinearization& lin, const Eigen::VectorXd& b, const Eigen::VectorXd& d,
                       Eigen::VectorXd& p, Eigen::VectorXd& z);

@@ -180,7 +180,7 @@ struct Hit {
 }  // namespace
 
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
-                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows, int max_start_hits) {
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats) {
     struct Clock {  // the whole run's CPU time, whatever the return
         double& total;
         double t0;
@@ -197,6 +197,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     const Eigen::VectorXd& W = path.diag();
     const double ts = kAccept * path.options.tolerance_m;
     const int max_pair_switches = path.switches.path_max_pair_switches;  // a pair switching more often: cycling
+    const int rebase_rows = path.switches.path_rebase_rows, max_start_hits = path.switches.path_max_start_hits;
 
     // the base's linear problem and key (as SparsePath::solve_modes names it, so a
     // factorisation of M0 still current is reused)

@@ -386,23 +386,23 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             recent.push_back(theta);
             if (recent.size() > static_cast<std::size_t>(memory)) recent.erase(recent.begin());
         }
-        if (itr) {
+        // the components of F above the acceptance after the step (the trace's count and the
+        // hand-over's test)
+        const bool handover_test = handover > 0 && full_step;
+        int violated = 0;
+        if (itr || handover_test) {
             const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
-            for (int i = 0; i < m; ++i) itr->violations += std::abs(F[i]) > acc;
+            for (int i = 0; i < m; ++i) violated += std::abs(F[i]) > acc;
         }
+        if (itr) itr->violations += violated;
         if (theta < best_theta) {
             best_theta = theta;
             path.best_p = p;
         }
         if (creep_stop) break;
-        if (handover > 0 && full_step) {
-            const double acc = std::max(0.5 * kAccept * path.options.tolerance_m, st.roundoff(d, z));
-            int v = 0;
-            for (int i = 0; i < m; ++i) v += std::abs(F[i]) > acc;
-            if (v > 0 && v <= handover) {
-                path.handed_over = true;
-                return end(5, false);
-            }
+        if (handover_test && violated > 0 && violated <= handover) {
+            path.handed_over = true;
+            return end(5, false);
         }
     }
     return end(2, false);

@@ -380,8 +380,7 @@ struct SparseContactSolver::Impl {
         PathStats ps;
         bool settled = false;
         int confirm = 0;
-        if (path_following(path, step, start, p, z, r, ps, path.switches.path_rebase_rows,
-                           path.switches.path_max_start_hits)) {
+        if (path_following(path, step, start, p, z, r, ps)) {
             const int it0 = r.iterations;
             try {
                 settled = passes_from_modes(path, step, p, z, r);

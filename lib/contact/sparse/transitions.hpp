@@ -51,13 +51,13 @@ struct PathStart {
 /// fails first at each breakpoint; each set of modes on the way solved as a low-rank change
 /// of the base modes' (one factorisation). True when it reached t = 1: the current modes
 /// (path.modes) are then the path's end and p its forces (the caller confirms them by the
-/// passes). TauRule::current only (else false, end not_applicable). rebase_rows > 0: when
-/// more rows than that differ from the base modes, the current modes become the base (one
-/// factorisation); 0: the start modes stay the base (up to 400 changed rows). max_start_hits
-/// > 0: false (end too_many_start_hits) where more of the start modes' conditions than that
-/// fail before t = 1.
+/// passes). TauRule::current only (else false, end not_applicable). Its limits and repairs
+/// are path.switches' path_* fields: path_rebase_rows > 0: when more rows than that differ
+/// from the base modes, the current modes become the base (one factorisation); 0: the start
+/// modes stay the base (up to 400 changed rows). path_max_start_hits > 0: false (end
+/// too_many_start_hits) where more of the start modes' conditions than that fail before t = 1.
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
-                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats, int rebase_rows = 0, int max_start_hits = 0);
+                    Eigen::VectorXd& z, SolveResult& r, PathStats& stats);
 
 /// The covering start of the homotopy (covering_start.cpp; Switches::rest_path_violations): for the
 /// current modes M0 (path.modes) and their linear solution (p, z) at `step`'s data, the data
