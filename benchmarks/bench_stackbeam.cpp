@@ -836,6 +836,9 @@ BENCHMARK(TransitionStudy)
     // decision 042: the homotopy's repairs off (0, the way before), the clamp's slip entry alone
     // (1), both (-1, the defaults), graduated and identical 100 / 200 / 400, 100 ms
     ->ArgsProduct({{100, 200, 400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {-1}, {0, 1}})
+    // issue 27's per-doubling target from 50 elements per half leaf: graduated 10 x 50 with every
+    // default and bonded (benchmarks/transition_targets.sh)
+    ->Args({50, 1, 100, 61, 0, 0, -1, 48, -1, -1})->Args({50, 3, 100, 61, 0, 0, -1, 0, -1, -1})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Benchmark (not a test): issue 27's friction-at-scale targets in one invocation, whole processes,
-# CPU time (`cpu_s_per_sim_s`: CPU s per simulated second). The graduated 10-leaf spring at 100,
+# CPU time (`cpu_s_per_sim_s`: CPU s per simulated second). The graduated 10-leaf spring at 50, 100,
 # 200 and 400 elements per half leaf and the identical 10 x 400, 100 ms, elastic interfaces,
 # every default (TransitionStudy way 61, path 48, repair -1), each run once per repetition as its
 # own process, interleaved with the same runs of a second build (the code before a change, or
@@ -21,12 +21,12 @@ flt() {  # flt EL STACK PATH [repair]: one TransitionStudy registration
 }
 echo "# rep run cpu_s_per_sim_s"
 for rep in $(seq 1 "$reps"); do
-    for run in "400 1" "400 2" "200 1" "100 1"; do
+    for run in "400 1" "400 2" "200 1" "100 1" "50 1"; do
         read -r el st <<<"$run"
         [ -n "$old" ] && echo "$rep old_el${el}_stack$st $(cpu "$old" "$(flt "$el" "$st" 48)iter")"
         echo "$rep new_el${el}_stack$st $(cpu "$new" "$(flt "$el" "$st" 48 repair:-1/)")"
     done
-    for run in "400 3" "400 4" "200 3" "100 3"; do
+    for run in "400 3" "400 4" "200 3" "100 3" "50 3"; do
         read -r el st <<<"$run"
         echo "$rep bonded_el${el}_stack$st $(cpu "$new" "$(flt "$el" "$st" 0 repair:-1/)")"
     done
