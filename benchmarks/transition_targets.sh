@@ -8,7 +8,8 @@
 # docs/performance.md, "Decisions 040-043 together".
 #   benchmarks/transition_targets.sh NEW_BENCH [OLD_BENCH] [REPETITIONS (default 5)]
 # NEW_BENCH / OLD_BENCH: bench_stackbeam binaries (OLD_BENCH built before the `repair` argument
-# existed is run with the filter without it). Prints one line per run: rep, run, CPU s per sim. s.
+# existed is run with the filter without it, one with it at repair:-1). Prints one line per run:
+# rep, run, CPU s per sim. s.
 set -euo pipefail
 new=$1
 old=${2:-}
@@ -19,11 +20,15 @@ cpu() {  # cpu BINARY FILTER: the run's CPU s per simulated second
 flt() {  # flt EL STACK PATH [repair]: one TransitionStudy registration
     echo "TransitionStudy/el:$1/stack:$2/ms:100/way:61/trace:0/schur:0/fixed:-1/path:$3/hits:-1/${4:-}"
 }
+# the old build's registrations end with `repair:` where it has that argument (main since decision
+# 042), else right after `hits:`; `iter` keeps the filter to the one registration either way
+old_tail=""
+if [ -n "$old" ] && "$old" --benchmark_list_tests 2>/dev/null | grep '/repair:' >/dev/null; then old_tail="repair:-1/"; fi
 echo "# rep run cpu_s_per_sim_s"
 for rep in $(seq 1 "$reps"); do
     for run in "400 1" "400 2" "200 1" "100 1" "50 1"; do
         read -r el st <<<"$run"
-        [ -n "$old" ] && echo "$rep old_el${el}_stack$st $(cpu "$old" "$(flt "$el" "$st" 48)iter")"
+        [ -n "$old" ] && echo "$rep old_el${el}_stack$st $(cpu "$old" "$(flt "$el" "$st" 48 "$old_tail")iter")"
         echo "$rep new_el${el}_stack$st $(cpu "$new" "$(flt "$el" "$st" 48 repair:-1/)")"
     done
     for run in "400 3" "400 4" "200 3" "100 3" "50 3"; do

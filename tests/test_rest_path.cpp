@@ -146,3 +146,54 @@ BOOST_AUTO_TEST_CASE(a_step_from_rest_gives_the_answer_of_the_way_before) {
         }
     }
 }
+
+BOOST_AUTO_TEST_CASE(the_first_solve_from_rest_takes_no_pass_from_the_rest_modes) {
+    // Switches::rest_first_pass (docs/decisions/046): the run's first solve from rest goes to the
+    // Newton methods without the active-set pass from the rest modes (every pair closed and
+    // sticking, every contact row held: the run's largest factorisation), whose solution no
+    // Newton method starts from (from rest the semismooth method starts from the open modes'
+    // solution). On the first step of a graduated 10 x 100 elastic spring: the same answer as
+    // with the pass, one mode-set solve fewer, both confirmed by the passes (converged: every law
+    // within the passes' acceptance). The same sequence of mode sets is solved either way, by
+    // factorisations of those sets alone (the skipped pass's factorisation is reused by no later
+    // set), so the answers agree to the solves' round-off: bound 1e-12 of the largest force
+    // (measured: equal to the last digit, as the graduated and identical 10 x 100 to 10 x 400
+    // runs' answer lines). A later solve from p = 0 on the same solver (a converged solve
+    // before it) still takes the pass.
+    const auto problems = sparse_step_problems(with_elastic_interfaces(graduated_stack(100, 10)), 1);
+    const SparseContactProblem& pr = problems.front();
+    const SolverOptions options;
+    auto solve = [&](bool first_pass, sp::TransitionTrace& trace, SolveResult& r, SolveResult* again) {
+        sp::Switches sw;
+        sw.rest_first_pass = first_pass;
+        sw.trace = &trace;
+        const sp::ScopedSwitches scoped(sw);
+        SparseContactSolver solver(options);
+        Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
+        r = solver.solve(pr, p, z);
+        if (again) {
+            Eigen::VectorXd p2 = Eigen::VectorXd::Zero(pr.size()), z2;
+            *again = solver.solve(pr, p2, z2);
+        }
+        return p;
+    };
+    sp::TransitionTrace with_trace, without_trace;
+    SolveResult with, without, again;
+    const Eigen::VectorXd p_with = solve(true, with_trace, with, nullptr);
+    const Eigen::VectorXd p_without = solve(false, without_trace, without, &again);
+    BOOST_TEST(with.converged);
+    BOOST_TEST(without.converged);
+    BOOST_TEST(again.converged);
+    BOOST_REQUIRE(with_trace.steps.size() == 1u);
+    BOOST_REQUIRE(without_trace.steps.size() == 2u);
+    BOOST_TEST(with_trace.steps[0].pass_solves == 1);
+    BOOST_TEST(without_trace.steps[0].pass_solves == 0);
+    BOOST_TEST(without_trace.steps[1].pass_solves >= 1);  // not the run's first solve: the pass
+    BOOST_TEST(with.iterations - without.iterations == 1);
+    BOOST_TEST(with.factorizations - without.factorizations == 1);
+    BOOST_TEST(with.newton_iterations == without.newton_iterations);
+    BOOST_TEST(without_trace.steps[0].newton_end == with_trace.steps[0].newton_end);
+    const double scale = p_with.lpNorm<Eigen::Infinity>();
+    BOOST_TEST(scale > 0.0);
+    BOOST_CHECK_SMALL((p_without - p_with).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+}

@@ -539,7 +539,14 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
         const bool newton_follows = path.switches.transition != TransitionMethod::tresca && m >= im.newton_min_rows;
         const int max_passes = newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
                                                                                  : path.options.max_active_set_iterations;
-        if (!path.switches.newton_first && max_passes > 4) {
+        //    From rest in the run's first solve (no converged solve before on this structure), none
+        //    (Switches::rest_first_pass, docs/decisions/046): the Newton methods start from p = 0,
+        //    not from the pass's solution; z = K^-1 b and s as the passes would leave them.
+        const bool rest_pass = path.switches.rest_first_pass || !newton_follows || !p_start.isZero(0.0) ||
+                               im.last_p.size() == static_cast<Eigen::Index>(m);
+        if (!rest_pass && !path.switches.newton_first) {
+            path.s = st.positions(problem.b, problem.d, p, z);
+        } else if (!path.switches.newton_first && max_passes > 4) {
             r.converged = path.passes(step, p, z, max_passes, r);
         } else if (!path.switches.newton_first) {
             // the first pass alone, then the rest: the same sequence (the passes' budget before

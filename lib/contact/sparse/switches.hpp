@@ -131,6 +131,15 @@ struct Switches {
     /// method goes on from the iterate, then the smoothing method, as before (docs/decisions/
     /// 041: graduated 10 x 400 the first step 1.15 -> 0.4-0.5 CPU s). 0: off, the way before.
     int rest_path_violations = 25;
+    /// A solve from rest (p = 0) that is the first of its run (no converged solve before it on
+    /// the same structure) and that a Newton method follows: false (default, docs/decisions/
+    /// 046) no active-set pass from the rest modes first: from rest the Newton methods start from
+    /// p = 0 (the semismooth method from the open modes' solution), so that pass's solution (every
+    /// pair closed and sticking, all contact rows held: the run's largest factorisation) was used
+    /// only where it settled the step, which no measured run's did (graduated and identical 10 x
+    /// 100 to 10 x 400: one solve fewer, the same answers to the last digit). true: the pass, the
+    /// way before.
+    bool rest_first_pass = false;
     /// Its continuity where a clamp takes friction again (its normal force back below the
     /// preload: free -> carrying friction; docs/decisions/042): true (default) the clamp enters
     /// slip against its tangential motion s_t (its friction force 0 there, continuous) and sticks
