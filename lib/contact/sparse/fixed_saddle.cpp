@@ -101,7 +101,6 @@ private:
         p_.resize(static_cast<std::size_t>(n));
         q_.resize(static_cast<std::size_t>(n));
         rs_.resize(static_cast<std::size_t>(n));
-        y_.resize(static_cast<std::size_t>(n));
         if (klu_extract(numeric_, symbolic_, lp_.data(), li_.data(), lx_.data(), up_.data(), ui_.data(), ux_.data(),
                         nullptr, nullptr, nullptr, p_.data(), q_.data(), rs_.data(), nullptr, &common_) == 0)
             return false;
@@ -221,14 +220,29 @@ public:
         klu_solve(symbolic_, numeric_, static_cast<int>(X.rows()), static_cast<int>(X.cols()), X.data(), &common_);
     }
     /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), column by column) on the extracted
-    /// factor, skipping each column of L and U whose multiplier is zero: a unit right-hand
+    /// factor, skipping each column of L and U whose multipliers are all zero: a unit right-hand
     /// side's forward solve touches only the factor's columns it reaches (docs/decisions/043).
+    /// Up to four columns go through the factor together, their entries side by side (y:
+    /// row k's entries at NB k .. NB k + NB - 1): the backward solve is a chain of dependent
+    /// rows (a row's division waits for the update of the row before), and independent
+    /// columns fill that chain's latency (docs/decisions/047). A column's arithmetic stays its
+    /// own: where its multiplier is zero and another's is not, it subtracts zero products,
+    /// which change no value (only, at most, the sign of a zero).
     void solve_sparse_in_place(Eigen::MatrixXd& X) override {
         if (X.cols() == 0) return;
         if (!extract()) {
             solve_in_place(X);
             return;
         }
+        Eigen::Index c = 0;
+        for (; c + 4 <= X.cols(); c += 4) sparse_columns<4>(X, c);
+        for (; c + 2 <= X.cols(); c += 2) sparse_columns<2>(X, c);
+        if (c < X.cols()) sparse_columns<1>(X, c);
+    }
+
+private:
+    template <int NB>
+    void sparse_columns(Eigen::MatrixXd& X, Eigen::Index c0) {
         const int n = symbolic_->n;
         const int* lp = lp_.data();
         const int* li = li_.data();
@@ -237,28 +251,51 @@ public:
         const int* ui = ui_.data();
         const double* ux = ux_.data();
         const double* ud = udiag_.data();
-        double* y = y_.data();
         const int* perm = p_.data();
+        const int* qperm = q_.data();
         const double* rs = rs_.data();
-        for (Eigen::Index c = 0; c < X.cols(); ++c) {
-            double* b = X.col(c).data();
-            for (int k = 0; k < n; ++k) {
-                const double v = b[perm[k]];
-                y[k] = v == 0.0 ? 0.0 : v / rs[k];
+        y_.resize(static_cast<std::size_t>(NB) * static_cast<std::size_t>(n));
+        double* y = y_.data();
+        double* b[NB];
+        for (int c = 0; c < NB; ++c) b[c] = X.col(c0 + c).data();
+        for (int k = 0; k < n; ++k) {
+            const int i = perm[k];
+            for (int c = 0; c < NB; ++c) {
+                const double v = b[c][i];
+                y[NB * k + c] = v == 0.0 ? 0.0 : v / rs[k];
             }
-            for (int k = 0; k < n; ++k) {  // L (unit diagonal)
-                const double x = y[k];
-                if (x == 0.0) continue;
-                for (int q = lp[k]; q < lp[k + 1]; ++q) y[li[q]] -= lx[q] * x;
-            }
-            for (int k = n - 1; k >= 0; --k) {  // U
-                if (y[k] == 0.0) continue;
-                const double x = y[k] / ud[k];
-                y[k] = x;
-                for (int q = up[k]; q < up[k + 1]; ++q) y[ui[q]] -= ux[q] * x;
-            }
-            for (int k = 0; k < n; ++k) b[q_[static_cast<std::size_t>(k)]] = y[k];
         }
+        for (int k = 0; k < n; ++k) {  // L (unit diagonal)
+            double x[NB];
+            bool any = false;
+            for (int c = 0; c < NB; ++c) {
+                x[c] = y[NB * k + c];
+                any = any || x[c] != 0.0;
+            }
+            if (!any) continue;
+            for (int q = lp[k]; q < lp[k + 1]; ++q) {
+                const double l = lx[q];
+                double* t = y + NB * li[q];
+                for (int c = 0; c < NB; ++c) t[c] -= l * x[c];
+            }
+        }
+        for (int k = n - 1; k >= 0; --k) {  // U
+            bool any = false;
+            for (int c = 0; c < NB; ++c) any = any || y[NB * k + c] != 0.0;
+            if (!any) continue;
+            double x[NB];
+            for (int c = 0; c < NB; ++c) {
+                x[c] = y[NB * k + c] / ud[k];
+                y[NB * k + c] = x[c];
+            }
+            for (int q = up[k]; q < up[k + 1]; ++q) {
+                const double u = ux[q];
+                double* t = y + NB * ui[q];
+                for (int c = 0; c < NB; ++c) t[c] -= u * x[c];
+            }
+        }
+        for (int k = 0; k < n; ++k)
+            for (int c = 0; c < NB; ++c) b[c][qperm[k]] = y[NB * k + c];
     }
 };
 #endif
