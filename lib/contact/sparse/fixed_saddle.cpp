@@ -370,8 +370,8 @@ void FixedSaddle::reset(const SparseStiffness& st, const std::vector<std::pair<i
 }
 
 /// The pattern: Dz K Dz; per contact row i its column -Dz g_i^T and row g_i Dz at n + i and
-/// its diagonal; per coupling (t, n_r) g_t's entries in column n + n_r. Then the slot of
-/// each entry in A_'s value array, so that each set fills the values in O(nnz).
+/// its diagonal; per coupling (t, n_r) g_t's entries in column n + n_r. K's values once, then
+/// the slot of each contact entry in A_'s value array, so that each set fills its values in O(nnz(G)).
 void FixedSaddle::build_pattern() {
     const SparseStiffness& st = *st_;
     const int n = st.dofs(), m = st.rows();
@@ -394,13 +394,10 @@ void FixedSaddle::build_pattern() {
     A_.resize(n + m, n + m);
     A_.setFromTriplets(t.begin(), t.end());
     A_.makeCompressed();
-    k_slot_.clear();
-    k_scaled_.clear();
-    for (int j = 0; j < st.K.outerSize(); ++j)
-        for (SpMat::InnerIterator it(st.K, j); it; ++it) {
-            k_slot_.push_back(slot(A_, static_cast<int>(it.row()), j));
-            k_scaled_.push_back(it.value() * st.dz[it.row()] * st.dz[j]);
-        }
+    std::fill(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), 0.0);
+    for (int j = 0; j < st.K.outerSize(); ++j)  // Dz K Dz: the same for every set
+        for (SpMat::InnerIterator it(st.K, j); it; ++it)
+            A_.valuePtr()[slot(A_, static_cast<int>(it.row()), j)] = it.value() * st.dz[it.row()] * st.dz[j];
     gcol_slot_.clear();
     grow_slot_.clear();
     diag_slot_.assign(static_cast<std::size_t>(m), 0);
@@ -435,15 +432,16 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
     }
     if (extend) build_pattern();
     double* v = A_.valuePtr();
-    std::fill(v, v + A_.nonZeros(), 0.0);
-    for (std::size_t k = 0; k < k_slot_.size(); ++k) v[k_slot_[k]] += k_scaled_[k];
+    // K's values stay from build_pattern; the contact rows' columns (n..) are cleared and
+    // their rows' entries in the DOF columns (one slot per entry of G) overwritten
+    std::fill(v + A_.outerIndexPtr()[st.dofs()], v + A_.nonZeros(), 0.0);
     std::size_t j = 0;
     for (int i = 0; i < m; ++i) {
         const int at = pos[static_cast<std::size_t>(i)];
         const double s = at >= 0 ? row_scale[at] : 0.0;
         for (SpMat::InnerIterator it(st.Gt_scaled, i); it; ++it, ++j) {
             v[gcol_slot_[j]] += -it.value() * s;
-            v[grow_slot_[j]] += it.value() * s;
+            v[grow_slot_[j]] = it.value() * s;
         }
         v[diag_slot_[static_cast<std::size_t>(i)]] = at >= 0 ? 0.0 : 1.0;
     }
@@ -484,7 +482,10 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
 }
 
 /// As_: the rows and columns of A_ of the DOFs and the held rows (in held_'s order), its
-/// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left out.
+/// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left
+/// out. Written straight into As_'s arrays, whose storage the next set reuses (no allocation
+/// per set once As_ has held the largest set; docs/decisions/047). A column's rows come out
+/// sorted as A_'s are where held_ is ascending (the modes' pair order); else they are sorted.
 void FixedSaddle::extract_held(const std::vector<int>& pos) {
     const int n = st_->dofs(), m = st_->rows();
     const int ms = static_cast<int>(held_.size());
@@ -495,30 +496,40 @@ void FixedSaddle::extract_held(const std::vector<int>& pos) {
         sub_of_[static_cast<std::size_t>(n + r)] = at >= 0 ? n + at : -1;
     }
     const int ns = n + ms;
-    std::vector<int> outer(static_cast<std::size_t>(ns) + 1, 0), inner;
-    std::vector<double> values;
-    inner.reserve(static_cast<std::size_t>(A_.nonZeros()));
-    values.reserve(static_cast<std::size_t>(A_.nonZeros()));
-    std::vector<std::pair<int, double>> col;
+    As_.resize(ns, ns);
+    As_.resizeNonZeros(A_.nonZeros());  // (a bound: the set's entries are among A_'s)
+    int* outer = As_.outerIndexPtr();
+    int* inner = As_.innerIndexPtr();
+    double* values = As_.valuePtr();
+    const int* a_outer = A_.outerIndexPtr();
+    const int* a_inner = A_.innerIndexPtr();
+    const double* a_values = A_.valuePtr();
+    int w = 0;
+    outer[0] = 0;
     for (int c = 0; c < ns; ++c) {
         const int full = c < n ? c : n + held_[static_cast<std::size_t>(c - n)];
-        col.clear();
+        const int start = w;
         bool sorted = true;
-        for (SpMat::InnerIterator it(A_, full); it; ++it) {
-            const int r = sub_of_[static_cast<std::size_t>(it.row())];
-            if (r < 0 || it.value() == 0.0) continue;
-            if (!col.empty() && r < col.back().first) sorted = false;
-            col.emplace_back(r, it.value());
+        for (int q = a_outer[full]; q < a_outer[full + 1]; ++q) {
+            const int r = sub_of_[static_cast<std::size_t>(a_inner[q])];
+            if (r < 0 || a_values[q] == 0.0) continue;
+            if (w > start && r < inner[w - 1]) sorted = false;
+            inner[w] = r;
+            values[w] = a_values[q];
+            ++w;
         }
-        if (!sorted) std::sort(col.begin(), col.end());
-        for (const auto& e : col) {
-            inner.push_back(e.first);
-            values.push_back(e.second);
+        if (!sorted) {
+            col_.clear();
+            for (int q = start; q < w; ++q) col_.emplace_back(inner[q], values[q]);
+            std::sort(col_.begin(), col_.end());
+            for (int q = start; q < w; ++q) {
+                inner[q] = col_[static_cast<std::size_t>(q - start)].first;
+                values[q] = col_[static_cast<std::size_t>(q - start)].second;
+            }
         }
-        outer[static_cast<std::size_t>(c) + 1] = static_cast<int>(inner.size());
+        outer[c + 1] = w;
     }
-    As_ = Eigen::Map<const SpMat>(ns, ns, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(),
-                                  values.data());
+    As_.resizeNonZeros(w);
 }
 
 /// The variable system's layout (n DOFs, then the held rows in lin.S's order) to the fixed
@@ -555,11 +566,19 @@ Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
     return gather(x);
 }
 
+void FixedSaddle::solve_in_place(Eigen::MatrixXd& R, bool refine) {
+    if (!held_system_) {
+        R = solve(R, refine);
+        return;
+    }
+    if (!refine) lu_->solve_sparse_in_place(R);
+    else if (!lu_->refined_solve(As_, R)) throw SingularModes{};
+}
+
 Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {
     if (held_system_) {
         Eigen::MatrixXd X = R;
-        if (!refine) lu_->solve_sparse_in_place(X);
-        else if (!lu_->refined_solve(As_, X)) throw SingularModes{};
+        solve_in_place(X, refine);
         return X;
     }
     const int n = st_->dofs(), m = st_->rows();
