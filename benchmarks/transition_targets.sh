@@ -8,7 +8,8 @@
 # docs/performance.md, "Decisions 040-043 together".
 #   benchmarks/transition_targets.sh NEW_BENCH [OLD_BENCH] [REPETITIONS (default 5)]
 # NEW_BENCH / OLD_BENCH: bench_stackbeam binaries (OLD_BENCH built before the `repair` argument
-# existed is run with the filter without it). Prints one line per run: rep, run, CPU s per sim. s.
+# existed, where the filter with it matches nothing, is run with the filter without it). Prints
+# one line per run: rep, run, CPU s per sim. s.
 set -euo pipefail
 new=$1
 old=${2:-}
@@ -23,7 +24,11 @@ echo "# rep run cpu_s_per_sim_s"
 for rep in $(seq 1 "$reps"); do
     for run in "400 1" "400 2" "200 1" "100 1"; do
         read -r el st <<<"$run"
-        [ -n "$old" ] && echo "$rep old_el${el}_stack$st $(cpu "$old" "$(flt "$el" "$st" 48)iter")"
+        if [ -n "$old" ]; then  # (an old build with the repair argument takes the new filter)
+            v=$(cpu "$old" "$(flt "$el" "$st" 48 repair:-1/)")
+            [ -n "$v" ] || v=$(cpu "$old" "$(flt "$el" "$st" 48)iter")
+            echo "$rep old_el${el}_stack$st $v"
+        fi
         echo "$rep new_el${el}_stack$st $(cpu "$new" "$(flt "$el" "$st" 48 repair:-1/)")"
     done
     for run in "400 3" "400 4" "200 3" "100 3"; do

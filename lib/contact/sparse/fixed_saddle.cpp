@@ -219,15 +219,15 @@ public:
         if (X.cols() == 0) return;
         klu_solve(symbolic_, numeric_, static_cast<int>(X.rows()), static_cast<int>(X.cols()), X.data(), &common_);
     }
-    /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), column by column) on the extracted
+    /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), each column's own) on the extracted
     /// factor, skipping each column of L and U whose multipliers are all zero: a unit right-hand
     /// side's forward solve touches only the factor's columns it reaches (docs/decisions/043).
     /// Up to four columns go through the factor together, their entries side by side (y:
     /// row k's entries at NB k .. NB k + NB - 1): the backward solve is a chain of dependent
-    /// rows (a row's division waits for the update of the row before), and independent
-    /// columns fill that chain's latency (docs/decisions/047). A column's arithmetic stays its
-    /// own: where its multiplier is zero and another's is not, it subtracts zero products,
-    /// which change no value (only, at most, the sign of a zero).
+    /// rows (a row's division waits for the update from the row solved just before it), and
+    /// independent columns fill that chain's latency (docs/decisions/047). A column's
+    /// arithmetic stays its own: where its multiplier is zero and another's is not, it
+    /// subtracts zero products, which change no value (only, at most, the sign of a zero).
     void solve_sparse_in_place(Eigen::MatrixXd& X) override {
         if (X.cols() == 0) return;
         if (!extract()) {
