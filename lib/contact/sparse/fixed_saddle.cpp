@@ -485,7 +485,7 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
 /// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left
 /// out. Written straight into As_'s arrays, whose storage the next set reuses (no allocation
 /// per set once As_ has held the largest set; docs/decisions/047). A column's rows come out
-/// sorted as A_'s are where held_ is ascending (the modes' pair order); else they are sorted.
+/// sorted as A_'s are where held_ is ascending; else that column is sorted.
 void FixedSaddle::extract_held(const std::vector<int>& pos) {
     const int n = st_->dofs(), m = st_->rows();
     const int ms = static_cast<int>(held_.size());
