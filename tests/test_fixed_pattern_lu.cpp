@@ -287,5 +287,19 @@ BOOST_AUTO_TEST_CASE(sparse_right_hand_sides_solved_as_klu_solves_them) {
         BOOST_TEST((X_sparse - X_klu).cwiseAbs().maxCoeff() <= 1e-14 * scale);
         // and it solves the system: residual at round-off (cond of this system ~1e3)
         BOOST_TEST((A * X_sparse - B).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + scale));
+        // columns go through the factor four, two or one at a time (docs/decisions/047):
+        // each column's arithmetic is its own, a zero multiplier of one column beside a
+        // nonzero one of another only subtracting zero products, so every block size gives
+        // each column exactly the result of its solve alone (== : equal values, a zero's sign
+        // aside); 5 columns take the blocks 4 + 1, their first 2 and 3 the blocks 2 and 2 + 1
+        for (const int k : {2, 3, 5}) {
+            Eigen::MatrixXd X_block = B.leftCols(k);
+            lu->solve_sparse_in_place(X_block);
+            for (int c = 0; c < k; ++c) {
+                Eigen::MatrixXd X_one = B.col(c);
+                lu->solve_sparse_in_place(X_one);
+                BOOST_TEST((X_block.col(c).array() == X_one.col(0).array()).all());
+            }
+        }
     }
 }

@@ -101,7 +101,6 @@ private:
         p_.resize(static_cast<std::size_t>(n));
         q_.resize(static_cast<std::size_t>(n));
         rs_.resize(static_cast<std::size_t>(n));
-        y_.resize(static_cast<std::size_t>(n));
         if (klu_extract(numeric_, symbolic_, lp_.data(), li_.data(), lx_.data(), up_.data(), ui_.data(), ux_.data(),
                         nullptr, nullptr, nullptr, p_.data(), q_.data(), rs_.data(), nullptr, &common_) == 0)
             return false;
@@ -220,15 +219,30 @@ public:
         if (X.cols() == 0) return;
         klu_solve(symbolic_, numeric_, static_cast<int>(X.rows()), static_cast<int>(X.cols()), X.data(), &common_);
     }
-    /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), column by column) on the extracted
-    /// factor, skipping each column of L and U whose multiplier is zero: a unit right-hand
+    /// klu_solve's arithmetic (X = Q U^-1 L^-1 P (R \ X), each column's own) on the extracted
+    /// factor, skipping each column of L and U whose multipliers are all zero: a unit right-hand
     /// side's forward solve touches only the factor's columns it reaches (docs/decisions/043).
+    /// Up to four columns go through the factor together, their entries side by side (y:
+    /// row k's entries at NB k .. NB k + NB - 1): the backward solve is a chain of dependent
+    /// rows (a row's division waits for the update from the row solved just before it), and
+    /// independent columns fill that chain's latency (docs/decisions/047). A column's
+    /// arithmetic stays its own: where its multiplier is zero and another's is not, it
+    /// subtracts zero products, which change no value (only, at most, the sign of a zero).
     void solve_sparse_in_place(Eigen::MatrixXd& X) override {
         if (X.cols() == 0) return;
         if (!extract()) {
             solve_in_place(X);
             return;
         }
+        Eigen::Index c = 0;
+        for (; c + 4 <= X.cols(); c += 4) sparse_columns<4>(X, c);
+        for (; c + 2 <= X.cols(); c += 2) sparse_columns<2>(X, c);
+        if (c < X.cols()) sparse_columns<1>(X, c);
+    }
+
+private:
+    template <int NB>
+    void sparse_columns(Eigen::MatrixXd& X, Eigen::Index c0) {
         const int n = symbolic_->n;
         const int* lp = lp_.data();
         const int* li = li_.data();
@@ -237,28 +251,51 @@ public:
         const int* ui = ui_.data();
         const double* ux = ux_.data();
         const double* ud = udiag_.data();
-        double* y = y_.data();
         const int* perm = p_.data();
+        const int* qperm = q_.data();
         const double* rs = rs_.data();
-        for (Eigen::Index c = 0; c < X.cols(); ++c) {
-            double* b = X.col(c).data();
-            for (int k = 0; k < n; ++k) {
-                const double v = b[perm[k]];
-                y[k] = v == 0.0 ? 0.0 : v / rs[k];
+        y_.resize(static_cast<std::size_t>(NB) * static_cast<std::size_t>(n));
+        double* y = y_.data();
+        double* b[NB];
+        for (int c = 0; c < NB; ++c) b[c] = X.col(c0 + c).data();
+        for (int k = 0; k < n; ++k) {
+            const int i = perm[k];
+            for (int c = 0; c < NB; ++c) {
+                const double v = b[c][i];
+                y[NB * k + c] = v == 0.0 ? 0.0 : v / rs[k];
             }
-            for (int k = 0; k < n; ++k) {  // L (unit diagonal)
-                const double x = y[k];
-                if (x == 0.0) continue;
-                for (int q = lp[k]; q < lp[k + 1]; ++q) y[li[q]] -= lx[q] * x;
-            }
-            for (int k = n - 1; k >= 0; --k) {  // U
-                if (y[k] == 0.0) continue;
-                const double x = y[k] / ud[k];
-                y[k] = x;
-                for (int q = up[k]; q < up[k + 1]; ++q) y[ui[q]] -= ux[q] * x;
-            }
-            for (int k = 0; k < n; ++k) b[q_[static_cast<std::size_t>(k)]] = y[k];
         }
+        for (int k = 0; k < n; ++k) {  // L (unit diagonal)
+            double x[NB];
+            bool any = false;
+            for (int c = 0; c < NB; ++c) {
+                x[c] = y[NB * k + c];
+                any = any || x[c] != 0.0;
+            }
+            if (!any) continue;
+            for (int q = lp[k]; q < lp[k + 1]; ++q) {
+                const double l = lx[q];
+                double* t = y + NB * li[q];
+                for (int c = 0; c < NB; ++c) t[c] -= l * x[c];
+            }
+        }
+        for (int k = n - 1; k >= 0; --k) {  // U
+            bool any = false;
+            for (int c = 0; c < NB; ++c) any = any || y[NB * k + c] != 0.0;
+            if (!any) continue;
+            double x[NB];
+            for (int c = 0; c < NB; ++c) {
+                x[c] = y[NB * k + c] / ud[k];
+                y[NB * k + c] = x[c];
+            }
+            for (int q = up[k]; q < up[k + 1]; ++q) {
+                const double u = ux[q];
+                double* t = y + NB * ui[q];
+                for (int c = 0; c < NB; ++c) t[c] -= u * x[c];
+            }
+        }
+        for (int k = 0; k < n; ++k)
+            for (int c = 0; c < NB; ++c) b[c][qperm[k]] = y[NB * k + c];
     }
 };
 #endif
@@ -333,8 +370,8 @@ void FixedSaddle::reset(const SparseStiffness& st, const std::vector<std::pair<i
 }
 
 /// The pattern: Dz K Dz; per contact row i its column -Dz g_i^T and row g_i Dz at n + i and
-/// its diagonal; per coupling (t, n_r) g_t's entries in column n + n_r. Then the slot of
-/// each entry in A_'s value array, so that each set fills the values in O(nnz).
+/// its diagonal; per coupling (t, n_r) g_t's entries in column n + n_r. K's values once, then
+/// the slot of each contact entry in A_'s value array, so that each set fills its values in O(nnz(G)).
 void FixedSaddle::build_pattern() {
     const SparseStiffness& st = *st_;
     const int n = st.dofs(), m = st.rows();
@@ -357,13 +394,10 @@ void FixedSaddle::build_pattern() {
     A_.resize(n + m, n + m);
     A_.setFromTriplets(t.begin(), t.end());
     A_.makeCompressed();
-    k_slot_.clear();
-    k_scaled_.clear();
-    for (int j = 0; j < st.K.outerSize(); ++j)
-        for (SpMat::InnerIterator it(st.K, j); it; ++it) {
-            k_slot_.push_back(slot(A_, static_cast<int>(it.row()), j));
-            k_scaled_.push_back(it.value() * st.dz[it.row()] * st.dz[j]);
-        }
+    std::fill(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), 0.0);
+    for (int j = 0; j < st.K.outerSize(); ++j)  // Dz K Dz: the same for every set
+        for (SpMat::InnerIterator it(st.K, j); it; ++it)
+            A_.valuePtr()[slot(A_, static_cast<int>(it.row()), j)] = it.value() * st.dz[it.row()] * st.dz[j];
     gcol_slot_.clear();
     grow_slot_.clear();
     diag_slot_.assign(static_cast<std::size_t>(m), 0);
@@ -398,15 +432,16 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
     }
     if (extend) build_pattern();
     double* v = A_.valuePtr();
-    std::fill(v, v + A_.nonZeros(), 0.0);
-    for (std::size_t k = 0; k < k_slot_.size(); ++k) v[k_slot_[k]] += k_scaled_[k];
+    // K's values stay from build_pattern; the contact rows' columns (n..) are cleared and
+    // their rows' entries in the DOF columns (one slot per entry of G) overwritten
+    std::fill(v + A_.outerIndexPtr()[st.dofs()], v + A_.nonZeros(), 0.0);
     std::size_t j = 0;
     for (int i = 0; i < m; ++i) {
         const int at = pos[static_cast<std::size_t>(i)];
         const double s = at >= 0 ? row_scale[at] : 0.0;
         for (SpMat::InnerIterator it(st.Gt_scaled, i); it; ++it, ++j) {
             v[gcol_slot_[j]] += -it.value() * s;
-            v[grow_slot_[j]] += it.value() * s;
+            v[grow_slot_[j]] = it.value() * s;
         }
         v[diag_slot_[static_cast<std::size_t>(i)]] = at >= 0 ? 0.0 : 1.0;
     }
@@ -447,7 +482,10 @@ bool FixedSaddle::factor(const modes::ModeLinearization& lin, const std::vector<
 }
 
 /// As_: the rows and columns of A_ of the DOFs and the held rows (in held_'s order), its
-/// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left out.
+/// explicit zeros (the rows not held, the couplings not slipping, the held rows' diagonal) left
+/// out. Written straight into As_'s arrays, whose storage the next set reuses (no allocation
+/// per set once As_ has held the largest set; docs/decisions/047). A column's rows come out
+/// sorted as A_'s are where held_ is ascending; else that column is sorted.
 void FixedSaddle::extract_held(const std::vector<int>& pos) {
     const int n = st_->dofs(), m = st_->rows();
     const int ms = static_cast<int>(held_.size());
@@ -458,30 +496,40 @@ void FixedSaddle::extract_held(const std::vector<int>& pos) {
         sub_of_[static_cast<std::size_t>(n + r)] = at >= 0 ? n + at : -1;
     }
     const int ns = n + ms;
-    std::vector<int> outer(static_cast<std::size_t>(ns) + 1, 0), inner;
-    std::vector<double> values;
-    inner.reserve(static_cast<std::size_t>(A_.nonZeros()));
-    values.reserve(static_cast<std::size_t>(A_.nonZeros()));
-    std::vector<std::pair<int, double>> col;
+    As_.resize(ns, ns);
+    As_.resizeNonZeros(A_.nonZeros());  // (a bound: the set's entries are among A_'s)
+    int* outer = As_.outerIndexPtr();
+    int* inner = As_.innerIndexPtr();
+    double* values = As_.valuePtr();
+    const int* a_outer = A_.outerIndexPtr();
+    const int* a_inner = A_.innerIndexPtr();
+    const double* a_values = A_.valuePtr();
+    int w = 0;
+    outer[0] = 0;
     for (int c = 0; c < ns; ++c) {
         const int full = c < n ? c : n + held_[static_cast<std::size_t>(c - n)];
-        col.clear();
+        const int start = w;
         bool sorted = true;
-        for (SpMat::InnerIterator it(A_, full); it; ++it) {
-            const int r = sub_of_[static_cast<std::size_t>(it.row())];
-            if (r < 0 || it.value() == 0.0) continue;
-            if (!col.empty() && r < col.back().first) sorted = false;
-            col.emplace_back(r, it.value());
+        for (int q = a_outer[full]; q < a_outer[full + 1]; ++q) {
+            const int r = sub_of_[static_cast<std::size_t>(a_inner[q])];
+            if (r < 0 || a_values[q] == 0.0) continue;
+            if (w > start && r < inner[w - 1]) sorted = false;
+            inner[w] = r;
+            values[w] = a_values[q];
+            ++w;
         }
-        if (!sorted) std::sort(col.begin(), col.end());
-        for (const auto& e : col) {
-            inner.push_back(e.first);
-            values.push_back(e.second);
+        if (!sorted) {
+            col_.clear();
+            for (int q = start; q < w; ++q) col_.emplace_back(inner[q], values[q]);
+            std::sort(col_.begin(), col_.end());
+            for (int q = start; q < w; ++q) {
+                inner[q] = col_[static_cast<std::size_t>(q - start)].first;
+                values[q] = col_[static_cast<std::size_t>(q - start)].second;
+            }
         }
-        outer[static_cast<std::size_t>(c) + 1] = static_cast<int>(inner.size());
+        outer[c + 1] = w;
     }
-    As_ = Eigen::Map<const SpMat>(ns, ns, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(),
-                                  values.data());
+    As_.resizeNonZeros(w);
 }
 
 /// The variable system's layout (n DOFs, then the held rows in lin.S's order) to the fixed
@@ -518,11 +566,19 @@ Eigen::VectorXd FixedSaddle::solve(const Eigen::VectorXd& r) {
     return gather(x);
 }
 
+void FixedSaddle::solve_in_place(Eigen::MatrixXd& R, bool refine) {
+    if (!held_system_) {
+        R = solve(R, refine);
+        return;
+    }
+    if (!refine) lu_->solve_sparse_in_place(R);
+    else if (!lu_->refined_solve(As_, R)) throw SingularModes{};
+}
+
 Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {
     if (held_system_) {
         Eigen::MatrixXd X = R;
-        if (!refine) lu_->solve_sparse_in_place(X);
-        else if (!lu_->refined_solve(As_, X)) throw SingularModes{};
+        solve_in_place(X, refine);
         return X;
     }
     const int n = st_->dofs(), m = st_->rows();

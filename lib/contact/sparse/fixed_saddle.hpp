@@ -133,6 +133,8 @@ public:
     /// for a factor a refined solve has already checked; docs/decisions/040), for columns with
     /// few nonzeros (PatternLu::solve_sparse_in_place; docs/decisions/043).
     Eigen::MatrixXd solve(const Eigen::MatrixXd& R, bool refine = true);
+    /// The same, R overwritten by the result (the held system's: in place, no copy).
+    void solve_in_place(Eigen::MatrixXd& R, bool refine = true);
     /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
     /// Orderings and symbolic analyses made since reset() (tests, benchmark).
@@ -149,8 +151,6 @@ private:
     std::vector<std::pair<int, int>> couplings_;  // (tangential row, normal row) in the pattern
     std::vector<int> coupling_of_t_;              // tangential row -> its index in couplings_, or -1
     SpMat A_;                                     // the pattern and the current values
-    std::vector<int> k_slot_;                     // per nonzero of K: its slot in A_
-    std::vector<double> k_scaled_;                //   and its value in Dz K Dz
     std::vector<int> gcol_slot_, grow_slot_;      // per nonzero of Gt_scaled: slots (dof, n + i), (n + i, dof)
     std::vector<int> diag_slot_;                  // per contact row: the slot (n + i, n + i)
     std::vector<std::vector<int>> cpl_slot_;      // per coupling: slots (dof, n + normal) for g_t's nonzeros
@@ -164,6 +164,7 @@ private:
     SpMat As_;
     std::vector<int> order_;                      // the fixed pattern's elimination order
     std::vector<int> sub_of_;                     // per unknown of A_: its index in As_, or -1
+    std::vector<std::pair<int, double>> col_;     // extract_held's scratch (a column to sort)
     void extract_held(const std::vector<int>& pos);
 };
 

@@ -503,9 +503,10 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
                 for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) R(it.row(), j) = st_.dz[it.row()] * it.value();
             }
         }
-        const Eigen::MatrixXd X = lu_fixed ? fixed_->solve(R, refine) : refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
-        Z = st_.dz.asDiagonal() * X.topRows(n);
-        PS = row_scale.asDiagonal() * X.bottomRows(ms);
+        if (lu_fixed) fixed_->solve_in_place(R, refine);  // (no copy of the n + ms rows per column)
+        else R = refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
+        Z = st_.dz.asDiagonal() * R.topRows(n);
+        PS = row_scale.asDiagonal() * R.bottomRows(ms);
     }
     P.setZero(m, k);
     for (int j = 0; j < k; ++j) {
