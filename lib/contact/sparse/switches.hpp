@@ -152,6 +152,16 @@ struct Switches {
     /// and a real fold or cycle at one t ends at the limit of 20 breakpoints without progress; true:
     /// the Newton methods at once, the way before.
     bool path_fold_ends = false;
+    /// Its base kept (docs/decisions/045): at the path's end its modes are the base's plus the
+    /// changed rows C (at most path_rebase_rows), whose columns it holds; the confirming passes
+    /// solve such a set of modes on the base's factorisation and those columns (the bordered,
+    /// Woodbury form, refined against the set's own system until its held rows' residual is at
+    /// round-off; a singular or ill-conditioned bordered system, a refinement that does not reach
+    /// that, or more changed rows: a fresh factorisation as before), and so does the next step's
+    /// first pass; the next path starts on the same base with its columns. true (default): no
+    /// factorisation of the path's end modes; false: the way before (the confirming passes
+    /// factorise the end modes, the next path's base).
+    bool path_keep_base = true;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
