@@ -192,13 +192,15 @@ void mode_equations(const ContactProblem& laws, const std::vector<signed char>& 
 }
 
 // the kept base's refinement (solve_on_kept_base): at most this many corrections, while each
-// at least halves the held rows' residual, until it is at most the round-off of s = G z - d
-// (SparseStiffness::roundoff, 1e-13 of its terms: the passes' own floor); where it stops
-// decreasing first, the answer is taken if the residual is at most kKeptStall x that (measured,
-// graduated 10 x 400, 100 ms: the first residual 0.04 to 1e5 x it, after the corrections
-// 0.02-4 x it: the floor of z = K^-1 (b + G^T p)), else the caller factorises
+// at least halves the held rows' residual |G z - d|, until it is at most kKeptResidual x the
+// round-off of s = G z - d (SparseStiffness::roundoff, 1e-13 of its terms: the passes' own
+// floor), 1e-16 relative, what a direct solve of the whole system reaches (measured, graduated
+// 10 x 400, 100 ms: KLU's and Eigen's refined solves 4e-18 to 2e-17 m, the kept solves 1e-18 to
+// 6e-17 m after 0 or 1 correction); where it stops decreasing first, taken at most kKeptStall x
+// the round-off, else the caller factorises
 constexpr int kKeptCorrections = 4;
-constexpr double kKeptStall = 8.0;
+constexpr double kKeptResidual = 1e-3;
+constexpr double kKeptStall = 1e-2;
 constexpr double kKeptRcond = 1e-12;  // the bordered system's (H's) reciprocal condition: below, a factorisation
 
 }  // namespace
@@ -216,14 +218,16 @@ struct KeptBase {
     std::vector<signed char> key;  ///< its key (the mode solver's)
     std::vector<Eq> eqs;           ///< per contact row its base equation
     ColumnStore Y;                 ///< the columns y_r (2m rows: forces, then G z)
+    std::vector<Eigen::VectorXd> zc;  ///< their displacement parts, scaled alike (with path_keep_base)
     std::vector<int> col;          ///< per contact row its column in Y, or -1
     Eigen::VectorXd rn2;           ///< the squared norms of Y's rows (the ratio test's bound)
     struct Solution {
         Eigen::VectorXd b, d, X;   ///< x^ = [forces; G z] for the data (b, d); X empty: none
+        Eigen::VectorXd z;         ///< its displacements
     };
     Solution sol[2];
     int next_sol = 0;
-    std::shared_ptr<ModeSolver> check;  ///< TransitionTrace::check_kept's own mode solver (tests)
+    std::shared_ptr<ModeSolver> check[2];  ///< TransitionTrace::check_kept's own mode solvers (tests)
     /// whether the base's factorisation is the mode solver's current one
     bool current(const SparsePath& path) const {
         return !key.empty() && static_cast<int>(col.size()) == path.laws.size() && path.solver.is_current(key) &&
@@ -236,30 +240,36 @@ struct KeptBase {
         key.push_back(static_cast<signed char>(laws.tau_rule));
         mode_equations(laws, modes.nmode, modes.tmode, eqs);
         Y.clear();
+        zc.clear();
         std::fill(col.begin(), col.end(), -1);
         rn2.setZero();
         for (auto& s : sol) s.X.resize(0);
     }
-    const Eigen::VectorXd* solution(const Eigen::VectorXd& b, const Eigen::VectorXd& d) const {
+    const Solution* solution(const Eigen::VectorXd& b, const Eigen::VectorXd& d) const {
         for (const auto& s : sol)
-            if (s.X.size() > 0 && s.b.size() == b.size() && s.d.size() == d.size() && s.b == b && s.d == d) return &s.X;
+            if (s.X.size() > 0 && s.b.size() == b.size() && s.d.size() == d.size() && s.b == b && s.d == d) return &s;
         return nullptr;
     }
 };
 
 namespace {
 
-/// x^ of the base for the data (b_j, d_j), j < k (k <= 2): the kept ones reused, the others in one
-/// multi-column refined solve with the base's factorisation (ModeSolver::solve_block) and kept.
-/// Returns the factorisations (0 where the base is current). Throws SingularModes.
+/// x^ of the base for the data (b_j, d_j), j < k (k <= 2), and its displacements into zx[j] where
+/// zx is not null: the kept ones reused, the others in one multi-column refined solve with the
+/// base's factorisation (ModeSolver::solve_block) and kept. Returns the factorisations (0 where
+/// the base is current). Throws SingularModes.
 int base_solutions(SparsePath& path, KeptBase& kb, int k, const Eigen::VectorXd* const* b, const Eigen::VectorXd* const* d,
-                   Eigen::VectorXd* const* X) {
+                   Eigen::VectorXd* const* X, Eigen::VectorXd* const* zx = nullptr) {
     const int m = path.laws.size(), n = path.stiffness().dofs();
     std::vector<int> missing;
     for (int j = 0; j < k; ++j) {
-        const Eigen::VectorXd* s = kb.solution(*b[j], *d[j]);
-        if (s) *X[j] = *s;
-        else missing.push_back(j);
+        const KeptBase::Solution* s = kb.solution(*b[j], *d[j]);
+        if (!s) {
+            missing.push_back(j);
+            continue;
+        }
+        *X[j] = s->X;
+        if (zx) *zx[j] = s->z;
     }
     if (missing.empty()) return 0;
     const int nm = static_cast<int>(missing.size());
@@ -280,6 +290,8 @@ int base_solutions(SparsePath& path, KeptBase& kb, int k, const Eigen::VectorXd*
         s.b = *b[j];
         s.d = *d[j];
         s.X = x;
+        s.z = Z.col(c);
+        if (zx) *zx[j] = s.z;
     }
     return f;
 }
@@ -330,6 +342,7 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             kb.rn2[q] += v * v;
             return v;
         });
+        if (path.switches.path_keep_base) kb.zc.push_back(s * Z.col(j));
     }
     stats.columns += k;
     stats.column_s += thread_cpu_s() - c0;
@@ -351,6 +364,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         return false;
     }
     static_cast<void>(z);  // (not set: the passes after it solve the end modes again)
+    path.solves_since_path = 0;
     const int m = laws.size();
     const int np = static_cast<int>(laws.pairs.size());
     const Eigen::VectorXd& W = path.diag();
@@ -659,31 +673,51 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
 
 namespace {
 /// The trace's check of a kept-base solve (TransitionTrace::check_kept; tests): the same modes
-/// solved from scratch by a mode solver of its own (its own factorisation, Eigen's SparseLU or the
-/// dense Schur complement), the largest differences of p and z relative to their largest entries.
+/// solved from scratch by mode solvers of its own on the whole saddle-point system, refined: Eigen's
+/// SparseLU (the reference) and, in builds with KLU, KLU on the held set's system (the default
+/// route's); the largest differences of p and z (kept against the reference, and KLU's against it:
+/// the round-off of two direct solves of the same system) relative to their largest entries.
 void check_kept_solve(SparsePath& path, const Step& step, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
     TransitionTrace& tr = *path.switches.trace;
-    if (!path.kept->check) {
-        path.kept->check = std::make_shared<ModeSolver>();
-        path.kept->check->reset(path.stiffness().K, path.stiffness().G);
+    KeptBase& kb = *path.kept;
+    if (!kb.check[0]) {
+        ModeSolverTuning own;  // the whole saddle-point system (not the Schur way, whose z = K^-1 (...)
+        own.schur_max_rows = 0;  // after p_S stops at K's round-off), no bordered updates
+        own.max_border_rows = 0;
+        kb.check[0] = std::make_shared<ModeSolver>(own);
+        if (klu_built()) {
+            own.fixed_pattern = FixedPatternLu::klu_held_amd;
+            kb.check[1] = std::make_shared<ModeSolver>(own);
+        }
+        for (auto& c : kb.check)
+            if (c) c->reset(path.stiffness().K, path.stiffness().G);
     }
     modes::ModeLinearization lin;
     path.modes.linearize(path.laws, lin);
     std::vector<signed char> key = path.modes.key();
     key.push_back(static_cast<signed char>(path.laws.tau_rule));
-    Eigen::VectorXd pf, zf;
-    path.kept->check->solve(lin, key, step.b, step.d, pf, zf);
+    auto rel = [](const Eigen::VectorXd& a, const Eigen::VectorXd& ref) {
+        return (a - ref).lpNorm<Eigen::Infinity>() / std::max(ref.lpNorm<Eigen::Infinity>(), 1e-300);
+    };
+    Eigen::VectorXd pf, zf, pk = p;
+    kb.check[0]->solve(lin, key, step.b, step.d, pf, zf);
     path.modes.put_slip_forces(path.laws, pf);
-    Eigen::VectorXd pk = p;
     path.modes.put_slip_forces(path.laws, pk);
     ++tr.kept_checked;
-    tr.kept_p_diff = std::max(tr.kept_p_diff, (pk - pf).lpNorm<Eigen::Infinity>() / std::max(pf.lpNorm<Eigen::Infinity>(), 1e-300));
-    tr.kept_z_diff = std::max(tr.kept_z_diff, (z - zf).lpNorm<Eigen::Infinity>() / std::max(zf.lpNorm<Eigen::Infinity>(), 1e-300));
+    tr.kept_p_diff = std::max(tr.kept_p_diff, rel(pk, pf));
+    tr.kept_z_diff = std::max(tr.kept_z_diff, rel(z, zf));
+    if (kb.check[1]) {
+        Eigen::VectorXd p2, z2;
+        kb.check[1]->solve(lin, key, step.b, step.d, p2, z2);
+        path.modes.put_slip_forces(path.laws, p2);
+        tr.fresh_p_diff = std::max(tr.fresh_p_diff, rel(p2, pf));
+        tr.fresh_z_diff = std::max(tr.fresh_z_diff, rel(z2, zf));
+    }
 }
 }  // namespace
 
 bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-    if (!path.switches.path_keep_base || !path.kept || !path.kept->current(path)) return false;
+    if (!path.switches.path_keep_base || !path.kept || path.solves_since_path > 1 || !path.kept->current(path)) return false;
     RouteStats* const rs = path.switches.trace ? &path.switches.trace->routes : nullptr;
     const double c0 = thread_cpu_s(), cached0 = rs ? rs->seconds[route_cached] : 0.0;
     KeptBase& kb = *path.kept;
@@ -701,17 +735,19 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
     const int nc = static_cast<int>(C.size());
     if (nc > limit) return false;
     PathStats unused;
-    Eigen::VectorXd X;
+    Eigen::VectorXd X, zh;
     try {
         if (add_columns(path, kb, C, false, unused) < 0) return false;
         const Eigen::VectorXd* b[1] = {&step.b};
         const Eigen::VectorXd* d[1] = {&step.d};
         Eigen::VectorXd* Xp[1] = {&X};
-        base_solutions(path, kb, 1, b, d, Xp);
+        Eigen::VectorXd* zp[1] = {&zh};
+        base_solutions(path, kb, 1, b, d, Xp, zp);
     } catch (const SingularModes&) {
         return false;
     }
     const ColumnStore& Y = kb.Y;
+    if (static_cast<int>(kb.zc.size()) != Y.size()) return false;  // (columns made with the switch off)
     // the bordered system on C: H lambda = F (metres both ways, as the path's)
     Eigen::MatrixXd H(nc, nc);
     for (int i = 0; i < nc; ++i) {
@@ -724,10 +760,12 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
     }
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
     if (nc > 0 && !(H.allFinite() && lu.rcond() > kKeptRcond)) return false;
-    // x = Xb + Y lambda with the modes' equations on C (rhs: the modes' right-hand sides on C,
-    // `target(i)`), its forces into p (the force equations then put exactly: p = 0, slip p_t = e + c p_n)
-    auto correct = [&](const Eigen::VectorXd& Xb, const std::function<double(int)>& target, Eigen::VectorXd& pf) {
+    // x = xb + Y lambda with the modes' equations on C (right-hand sides there `target(row)`):
+    // its forces pf and displacements zf
+    auto bordered = [&](const Eigen::VectorXd& Xb, const Eigen::VectorXd& zb, const std::function<double(int)>& target,
+                        Eigen::VectorXd& pf, Eigen::VectorXd& zf) {
         pf = Xb.head(m);
+        zf = zb;
         if (nc == 0) return;
         Eigen::VectorXd F(nc);
         for (int i = 0; i < nc; ++i) {
@@ -737,28 +775,33 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
         }
         const Eigen::VectorXd l = lu.solve(F);
         Eigen::VectorXd L = Eigen::VectorXd::Zero(Y.padded());
-        for (int j = 0; j < nc; ++j) L[kb.col[C[j]]] = l[j];
+        for (int j = 0; j < nc; ++j) {
+            const int cj = kb.col[C[j]];
+            L[cj] = l[j];
+            zf += l[j] * kb.zc[static_cast<std::size_t>(cj)];
+        }
         for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L);
     };
+    // the force equations put exactly (p = 0; slip p_t = e + c p_n: a slip row's normal row is
+    // held or zero, never slip)
     auto put_force_equations = [&](Eigen::VectorXd& pf) {
         for (int row = 0; row < m; ++row)
             if (eq[row].kind == Eq::zero) pf[row] = 0.0;
-        for (int row = 0; row < m; ++row)  // (a slip row's normal row is held or zero, never slip)
+        for (int row = 0; row < m; ++row)
             if (eq[row].kind == Eq::slip) pf[row] = eq[row].e + (eq[row].other >= 0 ? eq[row].coef * pf[eq[row].other] : 0.0);
     };
-    Eigen::VectorXd pn;
-    correct(X, [&](int r) { return eq[r].rhs(r, step.d); }, pn);
+    Eigen::VectorXd pn, zn;
+    bordered(X, zh, [&](int r) { return eq[r].rhs(r, step.d); }, pn, zn);
     put_force_equations(pn);
-    // refinement against the modes' own system: z = K^-1 (b + G^T p) and the force equations hold
-    // to round-off, so the residual is the held rows' s = G z - d; each correction is the same
-    // bordered solve of it (the base's factorisation, unrefined columns: a contraction)
+    // iterative refinement against the modes' own system (K z - G^T p = b, the held rows' G z = d,
+    // the force equations exact): each correction the same bordered solve of the residual (the
+    // base's factorisation, unrefined columns: a contraction), until the held rows' residual is at
+    // the round-off a direct solve of the whole system reaches
     modes::ModeLinearization lin0 = kb.lin;
     lin0.e.setZero();
-    const Eigen::MatrixXd B0 = Eigen::MatrixXd::Zero(st.K.rows(), 1);
-    Eigen::VectorXd zn, res(m);
+    Eigen::VectorXd res(m);
     double last = std::numeric_limits<double>::infinity();
     for (int it = 0;; ++it) {
-        zn = st.k_llt.solve(step.b + st.Gt * pn);
         const Eigen::VectorXd s = st.Grow * zn - step.d;
         double err = 0.0;
         for (int row = 0; row < m; ++row) {
@@ -766,26 +809,28 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
             err = std::max(err, std::abs(res[row]));
         }
         const double roundoff = st.roundoff(step.d, zn);
-        if (err <= roundoff) break;
+        if (err <= kKeptResidual * roundoff) break;
         if (it == kKeptCorrections || !(err < 0.5 * last)) {  // no longer decreasing
             if (err <= kKeptStall * roundoff) break;
             return false;  // not at round-off: the caller factorises
         }
         last = err;
-        // the correction: the base's solve of the residual on the rows outside C (the same equations)
-        Eigen::MatrixXd D(m, 1), P, Z;
-        for (int row = 0; row < m; ++row) D(row, 0) = res[row];
+        // the correction: the base's solve of the residual (the load's; the held rows' outside C,
+        // whose equations are the base's), bordered on C
+        Eigen::MatrixXd B(st.K.rows(), 1), D(m, 1), P, Z;
+        B.col(0) = step.b + st.Gt * pn - st.K * zn;
+        D.col(0) = res;
         for (int row : C) D(row, 0) = 0.0;
         try {
-            path.solver.solve_block(lin0, kb.key, B0, D, P, Z);
+            path.solver.solve_block(lin0, kb.key, B, D, P, Z);
         } catch (const SingularModes&) {
             return false;
         }
-        Eigen::VectorXd dX(2 * m);
+        Eigen::VectorXd dX(2 * m), dp, dz;
         dX << P.col(0), st.Grow * Z.col(0);
-        Eigen::VectorXd dp;
-        correct(dX, [&](int r) { return res[r]; }, dp);
+        bordered(dX, Z.col(0), [&](int r) { return res[r]; }, dp, dz);
         pn += dp;
+        zn += dz;
         put_force_equations(pn);
     }
     p = pn;

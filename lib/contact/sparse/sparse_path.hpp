@@ -65,6 +65,10 @@ struct SparsePath {
     /// the homotopy's base, its columns and solutions, kept while the mode solver's current
     /// factorisation is the base's (Switches::path_keep_base, docs/decisions/045)
     std::shared_ptr<KeptBase> kept;
+    /// solves (steps) begun since the homotopy last ran: the kept base serves the step of the path
+    /// and the next one only (a set of modes that stays is then factorised once, so the steps after
+    /// it are the cached affine solves, not a kept-base solve each)
+    int solves_since_path = 0;
 
     SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
         : options(o), switches(sw), solver(with_switches(tuning, sw)) {

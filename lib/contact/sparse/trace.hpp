@@ -145,11 +145,12 @@ struct TransitionTrace {
     StepTrace* current = nullptr;  ///< the step being recorded (the solver's)
     RouteStats routes;             ///< the mode solver's calls so far (ModeSolver::solve adds to it)
     /// tests (docs/decisions/045): every solve on the homotopy's kept base checked against the same
-    /// modes solved from scratch by a mode solver of its own: how many, the largest differences of
-    /// p and z relative to their largest entries
+    /// modes solved from scratch by a mode solver of its own (Eigen's SparseLU of the whole system):
+    /// how many, the largest differences of p and z relative to their largest entries; and the same
+    /// for a second from-scratch solve (KLU of the held set's system, where built) against it
     bool check_kept = false;
     int kept_checked = 0;
-    double kept_p_diff = 0.0, kept_z_diff = 0.0;
+    double kept_p_diff = 0.0, kept_z_diff = 0.0, fresh_p_diff = 0.0, fresh_z_diff = 0.0;
     std::unordered_set<std::size_t> keys;       ///< hashes of the sets of modes solved so far (all steps)
     std::unordered_set<std::size_t> step_keys;  ///< those solved in the current step
     static std::size_t hash(const std::vector<signed char>& key) {
