@@ -622,7 +622,7 @@ void TransitionStudy(benchmark::State& state) {
         sw.path_clamp_slip = (state.range(9) & 1) != 0;
         sw.path_max_pair_switches = (state.range(9) & 2) != 0 ? now.path_max_pair_switches : 6;
         sw.path_fold_ends = (state.range(9) & 4) != 0 ? now.path_fold_ends : true;
-        sw.path_keep_base = (state.range(9) & 8) != 0 ? now.path_keep_base : false;  // decision 045
+        sw.path_keep_base = (state.range(9) & 8) != 0 ? now.path_keep_base : 0;  // decision 045
     }
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;

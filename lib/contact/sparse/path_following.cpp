@@ -254,6 +254,11 @@ struct KeptBase {
 
 namespace {
 
+/// Whether the homotopy keeps its base here (Switches::path_keep_base: on, and enough unknowns).
+bool keeps_base(const SparsePath& path) {
+    return path.switches.path_keep_base > 0 && path.stiffness().dofs() >= path.switches.path_keep_base;
+}
+
 /// x^ of the base for the data (b_j, d_j), j < k (k <= 2), and its displacements into zx[j] where
 /// zx is not null: the kept ones reused, the others in one multi-column refined solve with the
 /// base's factorisation (ModeSolver::solve_block) and kept. Returns the factorisations (0 where
@@ -342,7 +347,7 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             kb.rn2[q] += v * v;
             return v;
         });
-        if (path.switches.path_keep_base) kb.zc.push_back(s * Z.col(j));
+        if (keeps_base(path)) kb.zc.push_back(s * Z.col(j));
     }
     stats.columns += k;
     stats.column_s += thread_cpu_s() - c0;
@@ -400,7 +405,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         stats.base_s += thread_cpu_s() - c0;
     };
     try {
-        if (path.switches.path_keep_base && kb.current(path)) {
+        if (keeps_base(path) && kb.current(path)) {
             const double c0 = thread_cpu_s();
             base_data();
             stats.base_s += thread_cpu_s() - c0;
@@ -717,7 +722,7 @@ void check_kept_solve(SparsePath& path, const Step& step, const Eigen::VectorXd&
 }  // namespace
 
 bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z) {
-    if (!path.switches.path_keep_base || !path.kept || path.solves_since_path > 1 || !path.kept->current(path)) return false;
+    if (!keeps_base(path) || !path.kept || path.solves_since_path > 1 || !path.kept->current(path)) return false;
     RouteStats* const rs = path.switches.trace ? &path.switches.trace->routes : nullptr;
     const double c0 = thread_cpu_s(), cached0 = rs ? rs->seconds[route_cached] : 0.0;
     KeptBase& kb = *path.kept;
