@@ -586,7 +586,8 @@ BENCHMARK(ElasticRuns)
 /// without new bases), hits (Switches::path_max_start_hits; -1 its default 500, 0 no
 /// limit), repair (docs/decisions/042; -1 the defaults, else a bit mask of its changes, each bit
 /// the Switches field at its default, else the way before: 1 path_clamp_slip, 2
-/// path_max_pair_switches, 4 path_fold_ends; 0 the way before 042). Each run's answer at its end (w, dissipated energy, |z|) goes to
+/// path_max_pair_switches, 4 path_fold_ends, 8 path_keep_base (decision 045); 0 the way before
+/// 042, 7 the way before 045). Each run's answer at its end (w, dissipated energy, |z|) goes to
 /// stderr to 17 digits, with the trace the homotopy's counts.
 void TransitionStudy(benchmark::State& state) {
     const int elements = static_cast<int>(state.range(0));
@@ -621,6 +622,7 @@ void TransitionStudy(benchmark::State& state) {
         sw.path_clamp_slip = (state.range(9) & 1) != 0;
         sw.path_max_pair_switches = (state.range(9) & 2) != 0 ? now.path_max_pair_switches : 6;
         sw.path_fold_ends = (state.range(9) & 4) != 0 ? now.path_fold_ends : true;
+        sw.path_keep_base = (state.range(9) & 8) != 0 ? now.path_keep_base : 0;  // decision 045
     }
     const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
@@ -643,7 +645,8 @@ void TransitionStudy(benchmark::State& state) {
     // confirming passes' solves, and the fallbacks by reason
     {
         double runs = 0, settled = 0, bp = 0, cols = 0, blocks = 0, fact = 0, conf = 0, rebases = 0, evals = 0, tests = 0;
-        double col_s = 0, base_s = 0, all_s = 0;
+        double col_s = 0, base_s = 0, all_s = 0, kept = 0, start_rows = 0, end_rows = 0;
+        std::map<int, int> start_hist, end_hist;  // rows by bins of 8
         std::map<int, int> path_ends;
         for (const auto& t : trace.steps) {
             if (t.path.end == 0) continue;
@@ -660,6 +663,13 @@ void TransitionStudy(benchmark::State& state) {
             col_s += t.path.column_s;
             base_s += t.path.base_s;
             all_s += t.path.total_s;
+            end_rows += t.path.end_rows;
+            ++end_hist[t.path.end_rows / 8 * 8];
+            if (t.path.kept_base) {
+                ++kept;
+                start_rows += t.path.start_rows;
+                ++start_hist[t.path.start_rows / 8 * 8];
+            }
             ++path_ends[static_cast<int>(t.path.end) * 10 + (t.path_confirmed ? 0 : 1)];
         }
         state.counters["path_runs"] = runs;
@@ -673,6 +683,13 @@ void TransitionStudy(benchmark::State& state) {
             std::fprintf(stderr, " CPU ms per run: %.2f (columns %.2f, bases %.2f);", 1e3 * all_s / runs,
                          1e3 * col_s / runs, 1e3 * base_s / runs);
             for (const auto& e : path_ends) std::fprintf(stderr, " [%d]=%d", e.first, e.second);
+            // decision 045: the base kept from the run before, the rows the start modes differ from
+            // it, the rows the end modes differ from the last base (by bins of 8 rows: first row)
+            std::fprintf(stderr, " kept base %g runs, start rows %.1f, end rows %.1f; start rows hist:", kept,
+                         kept > 0 ? start_rows / kept : 0.0, end_rows / runs);
+            for (const auto& e : start_hist) std::fprintf(stderr, " %d:%d", e.first, e.second);
+            std::fprintf(stderr, "; end rows hist:");
+            for (const auto& e : end_hist) std::fprintf(stderr, " %d:%d", e.first, e.second);
             std::fprintf(stderr, " (1 reached, 2 n/a, 3 singular, 4 rows, 5 breakpoints, 6 stalled, 7 folded, 8 cycled, 9 singular modes, 10 start hits)\n");
             // per run: the start modes' failing conditions (the first ratio test's hits), its
             // breakpoints, columns, CPU ms, settled
@@ -839,6 +856,9 @@ BENCHMARK(TransitionStudy)
     // issue 27's per-doubling target from 50 elements per half leaf: graduated 10 x 50 with every
     // default and bonded (benchmarks/transition_targets.sh)
     ->Args({50, 1, 100, 61, 0, 0, -1, 48, -1, -1})->Args({50, 3, 100, 61, 0, 0, -1, 0, -1, -1})
+    // decision 045: the homotopy's base kept across steps off (repair 7, the way before) against
+    // on (-1, the defaults), graduated and identical 100 / 200 / 400, 100 ms
+    ->ArgsProduct({{100, 200, 400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {-1}, {7}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

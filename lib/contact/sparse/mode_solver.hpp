@@ -152,6 +152,8 @@ public:
     /// Solves by a bordered update since the last reset_updates().
     int updates() const { return updates_; }
     void reset_updates() { updates_ = 0; }
+    /// Counts a solve by a low-rank update made outside (the homotopy's kept base, docs/decisions/045).
+    void count_update() { ++updates_; }
     /// The primal route's solver (null when it is off or not built; tests, benchmark).
     PrimalSolver* primal() { return primal_.get(); }
     /// Whether the current factorisation is the primal route's.

@@ -42,6 +42,7 @@
 // its tangential motion there, and sticks where that comes back to 0 (docs/decisions/042).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "contact/sparse/common.hpp"
@@ -177,6 +178,182 @@ struct Hit {
     double t;
 };
 
+/// The equations of every contact row under the modes (n, t) into eq (m rows).
+void mode_equations(const ContactProblem& laws, const std::vector<signed char>& n, const std::vector<signed char>& t,
+                    std::vector<Eq>& eq) {
+    eq.assign(static_cast<std::size_t>(laws.size()), Eq{});
+    for (int k = 0; k < static_cast<int>(laws.pairs.size()); ++k) {
+        const auto& c = laws.pairs[k];
+        Eq en, et;
+        pair_equations(c, n[k], t[k], en, et);
+        if (c.row_n >= 0) eq[c.row_n] = en;
+        if (c.row_t >= 0) eq[c.row_t] = et;
+    }
+}
+
+// the kept base's refinement (solve_on_kept_base): at most this many corrections, while each
+// at least halves the held rows' residual |G z - d|, until it is at most kKeptResidual x the
+// round-off of s = G z - d (SparseStiffness::roundoff, 1e-13 of its terms: the passes' own
+// floor), 1e-16 relative, what a direct solve of the whole system reaches (measured, graduated
+// 10 x 400, 100 ms: KLU's and Eigen's refined solves 4e-18 to 2e-17 m, the kept solves 1e-18 to
+// 6e-17 m after 0 or 1 correction); where it stops decreasing first, taken at most kKeptStall x
+// the round-off, else the caller factorises
+constexpr int kKeptCorrections = 4;
+constexpr double kKeptResidual = 1e-3;
+constexpr double kKeptStall = 1e-2;
+constexpr double kKeptRcond = 1e-12;  // the bordered system's (H's) reciprocal condition: below, a factorisation
+
+}  // namespace
+
+/// The homotopy's base (Switches::path_keep_base, docs/decisions/045): the base modes' linear
+/// problem, key and equations, the columns y_r solved on its factorisation (ColumnStore, scaled
+/// to about a metre of motion) and its solutions x^ = [forces; G z] for the last two data. The
+/// columns depend on the base's system only (K, G, the base modes' equations: a slip row's
+/// coupling -sigma mu and a clamp's sigma mu F_c are the pair's data), not on a step's b and d, so
+/// they stay valid while the mode solver's current factorisation is the base's key (the same K
+/// and G: SparsePath::reset drops this).
+struct KeptBase {
+    explicit KeptBase(int m) : eqs(static_cast<std::size_t>(m)), Y(2 * m), col(static_cast<std::size_t>(m), -1), rn2(Eigen::VectorXd::Zero(2 * m)) {}
+    modes::ModeLinearization lin;  ///< the base modes' linear problem
+    std::vector<signed char> key;  ///< its key (the mode solver's)
+    std::vector<Eq> eqs;           ///< per contact row its base equation
+    ColumnStore Y;                 ///< the columns y_r (2m rows: forces, then G z)
+    std::vector<Eigen::VectorXd> zc;  ///< their displacement parts, scaled alike (with path_keep_base)
+    std::vector<int> col;          ///< per contact row its column in Y, or -1
+    Eigen::VectorXd rn2;           ///< the squared norms of Y's rows (the ratio test's bound)
+    struct Solution {
+        Eigen::VectorXd b, d, X;   ///< x^ = [forces; G z] for the data (b, d); X empty: none
+        Eigen::VectorXd z;         ///< its displacements
+    };
+    Solution sol[2];
+    int next_sol = 0;
+    std::shared_ptr<ModeSolver> check[2];  ///< TransitionTrace::check_kept's own mode solvers (tests)
+    /// whether the base's factorisation is the mode solver's current one
+    bool current(const SparsePath& path) const {
+        return !key.empty() && static_cast<int>(col.size()) == path.laws.size() && path.solver.is_current(key) &&
+               path.laws.tau_rule == TauRule::current;
+    }
+    /// the modes (n, t) as the base: their linear problem, key, equations; no columns, no solutions
+    void set(const ContactProblem& laws, const modes::ModeSet& modes) {
+        modes.linearize(laws, lin);
+        key = modes.key();
+        key.push_back(static_cast<signed char>(laws.tau_rule));
+        mode_equations(laws, modes.nmode, modes.tmode, eqs);
+        Y.clear();
+        zc.clear();
+        std::fill(col.begin(), col.end(), -1);
+        rn2.setZero();
+        for (auto& s : sol) s.X.resize(0);
+    }
+    const Solution* solution(const Eigen::VectorXd& b, const Eigen::VectorXd& d) const {
+        for (const auto& s : sol)
+            if (s.X.size() > 0 && s.b.size() == b.size() && s.d.size() == d.size() && s.b == b && s.d == d) return &s;
+        return nullptr;
+    }
+};
+
+namespace {
+
+/// Whether the homotopy keeps its base here (Switches::path_keep_base: on, and enough unknowns).
+bool keeps_base(const SparsePath& path) {
+    return path.switches.path_keep_base > 0 && path.stiffness().dofs() >= path.switches.path_keep_base;
+}
+
+/// x^ of the base for the data (b_j, d_j), j < k (k <= 2), and its displacements into zx[j] where
+/// zx is not null: the kept ones reused, the others in one multi-column refined solve with the
+/// base's factorisation (ModeSolver::solve_block) and kept. Returns the factorisations (0 where
+/// the base is current). Throws SingularModes.
+int base_solutions(SparsePath& path, KeptBase& kb, int k, const Eigen::VectorXd* const* b, const Eigen::VectorXd* const* d,
+                   Eigen::VectorXd* const* X, Eigen::VectorXd* const* zx = nullptr) {
+    const int m = path.laws.size(), n = path.stiffness().dofs();
+    std::vector<int> missing;
+    for (int j = 0; j < k; ++j) {
+        const KeptBase::Solution* s = kb.solution(*b[j], *d[j]);
+        if (!s) {
+            missing.push_back(j);
+            continue;
+        }
+        *X[j] = s->X;
+        if (zx) *zx[j] = s->z;
+    }
+    if (missing.empty()) return 0;
+    const int nm = static_cast<int>(missing.size());
+    Eigen::MatrixXd B(n, nm), D(m, nm), P, Z;
+    for (int c = 0; c < nm; ++c) {
+        B.col(c) = *b[missing[static_cast<std::size_t>(c)]];
+        D.col(c) = *d[missing[static_cast<std::size_t>(c)]];
+    }
+    const int f = path.solver.solve_block(kb.lin, kb.key, B, D, P, Z);
+    const Eigen::MatrixXd GZ = path.stiffness().Grow * Z;
+    for (int c = 0; c < nm; ++c) {
+        const int j = missing[static_cast<std::size_t>(c)];
+        Eigen::VectorXd& x = *X[j];
+        x.resize(2 * m);
+        x << P.col(c), GZ.col(c);
+        auto& s = kb.sol[kb.next_sol];
+        kb.next_sol = 1 - kb.next_sol;
+        s.b = *b[j];
+        s.d = *d[j];
+        s.X = x;
+        s.z = Z.col(c);
+        if (zx) *zx[j] = s.z;
+    }
+    return f;
+}
+
+/// The columns y_r of `rows` not in kb yet, solved on the base's factorisation (one multi-column
+/// solve without refinement, ModeSolver::unit_solves); where the factorisation is a bordered update
+/// or the primal route's, one solve() per column if `per_column`, else nothing (returns -1).
+/// Returns the factorisations (0 where the base is current); counts into stats.
+int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_column, PathStats& stats) {
+    const int m = path.laws.size();
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    rows.erase(std::remove_if(rows.begin(), rows.end(), [&](int row) { return kb.col[static_cast<std::size_t>(row)] >= 0; }),
+               rows.end());
+    if (rows.empty()) return 0;
+    const double c0 = thread_cpu_s();
+    const SparseStiffness& st = path.stiffness();
+    const Eigen::VectorXd& W = path.diag();
+    const int k = static_cast<int>(rows.size());
+    int f = 0;
+    Eigen::MatrixXd P, Z;
+    if (path.solver.unit_solves(kb.lin, rows, false, P, Z)) {
+        ++stats.column_blocks;
+    } else if (!per_column) {
+        return -1;
+    } else {  // a bordered or primal factorisation: one solve() per column
+        const Eigen::VectorXd zero_b = Eigen::VectorXd::Zero(st.K.rows()), zero_d = Eigen::VectorXd::Zero(m);
+        P.resize(m, k);
+        Z.resize(st.K.rows(), k);
+        for (int j = 0; j < k; ++j) {
+            modes::ModeLinearization lin = kb.lin;
+            lin.e.setZero();
+            Eigen::VectorXd d = zero_d, Pj, zj;
+            if (kb.eqs[static_cast<std::size_t>(rows[j])].kind == Eq::held) d[rows[j]] = 1.0;
+            else lin.e[rows[j]] = 1.0;
+            f += path.solver.solve(lin, kb.key, zero_b, d, Pj, zj);
+            P.col(j) = Pj;
+            Z.col(j) = zj;
+        }
+    }
+    const Eigen::MatrixXd GZ = st.Grow * Z;  // (row-major G: a gather per row)
+    for (int j = 0; j < k; ++j) {
+        const double s = kb.eqs[static_cast<std::size_t>(rows[j])].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
+        const double* pj = P.col(j).data();
+        const double* gj = GZ.col(j).data();
+        kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.add([&](int q) {
+            const double v = s * (q < m ? pj[q] : gj[q - m]);
+            kb.rn2[q] += v * v;
+            return v;
+        });
+        if (keeps_base(path)) kb.zc.push_back(s * Z.col(j));
+    }
+    stats.columns += k;
+    stats.column_s += thread_cpu_s() - c0;
+    return f;
+}
+
 }  // namespace
 
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
@@ -191,7 +368,8 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         stats.end = PathStats::not_applicable;
         return false;
     }
-    const SparseStiffness& st = path.stiffness();
+    static_cast<void>(z);  // (not set: the passes after it solve the end modes again)
+    path.solves_since_path = 0;
     const int m = laws.size();
     const int np = static_cast<int>(laws.pairs.size());
     const Eigen::VectorXd& W = path.diag();
@@ -199,102 +377,55 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     const int max_pair_switches = path.switches.path_max_pair_switches;  // a pair switching more often: cycling
     const int rebase_rows = path.switches.path_rebase_rows, max_start_hits = path.switches.path_max_start_hits;
 
-    // the base's linear problem and key (as SparsePath::solve_modes names it, so a
-    // factorisation of M0 still current is reused)
+    // the base (KeptBase, path.kept): the start modes, their linear problem and key (as
+    // SparsePath::solve_modes names them, so a factorisation of M0 still current is reused), or
+    // the base kept from the last run where it is still current (Switches::path_keep_base: its
+    // columns kept, the start modes differing from it in a few rows)
     modes::ModeSet cur;
     cur.nmode = start.nmode;
     cur.tmode = start.tmode;
-    modes::ModeLinearization lin0;
-    std::vector<signed char> key0;
-    std::vector<Eq> base(m);
-    auto set_base_equations = [&]() {
-        for (int k = 0; k < np; ++k) {
-            const auto& c = laws.pairs[k];
-            Eq en, et;
-            pair_equations(c, cur.nmode[k], cur.tmode[k], en, et);
-            if (c.row_n >= 0) base[c.row_n] = en;
-            if (c.row_t >= 0) base[c.row_t] = et;
-        }
-    };
+    if (!path.kept || static_cast<int>(path.kept->col.size()) != m) path.kept = std::make_shared<KeptBase>(m);
+    KeptBase& kb = *path.kept;
     const int upd0 = path.solver.updates();
     // x^ at t = 0 and t = 1: [forces; G z] (2m entries each), both in one (multi-column,
-    // refined) solve with the base's factorisation
+    // refined) solve with the base's factorisation (or kept from the solves before on this base)
     Eigen::VectorXd X0h(2 * m), X1h(2 * m);
-    auto make_base = [&]() {
-        const double c0 = thread_cpu_s();
-        cur.linearize(laws, lin0);
-        key0 = cur.key();
-        key0.push_back(static_cast<signed char>(laws.tau_rule));
-        set_base_equations();
-        Eigen::MatrixXd B(st.K.rows(), 2), D(m, 2), P, Z;
-        B << start.b, step.b;
-        D << start.d, step.d;
-        const int f = path.solver.solve_block(lin0, key0, B, D, P, Z);
+    auto base_data = [&]() {
+        const Eigen::VectorXd* b[2] = {&start.b, &step.b};
+        const Eigen::VectorXd* d[2] = {&start.d, &step.d};
+        Eigen::VectorXd* X[2] = {&X0h, &X1h};
+        const int f = base_solutions(path, kb, 2, b, d, X);
         r.factorizations += f;
         stats.factorizations += f;
-        const Eigen::MatrixXd GZ = st.Grow * Z;
-        X0h << P.col(0), GZ.col(0);
-        X1h << P.col(1), GZ.col(1);
-        z = Z.col(1);
+    };
+    auto make_base = [&]() {
+        const double c0 = thread_cpu_s();
+        kb.set(laws, cur);
+        base_data();
         stats.base_s += thread_cpu_s() - c0;
     };
     try {
-        make_base();
+        if (keeps_base(path) && kb.current(path)) {
+            const double c0 = thread_cpu_s();
+            base_data();
+            stats.base_s += thread_cpu_s() - c0;
+            stats.kept_base = true;
+        } else {
+            make_base();
+        }
     } catch (const SingularModes&) {
         stats.end = PathStats::singular_modes;
         return false;
     }
     ++r.iterations;
+    auto& Y = kb.Y;
+    auto& col = kb.col;
+    auto& rn2 = kb.rn2;
+    const std::vector<Eq>& base = kb.eqs;
+    auto rn = [&](int q) { return std::sqrt(rn2[q]); };
 
-    // the columns y_r (ColumnStore: in panels), each scaled to about a metre of motion: a
-    // held base row's for a unit offset [m], another's for a unit force times 1 / W_rr [N];
-    // rn2 the squared norms of Y's rows (the bound's)
-    ColumnStore Y(2 * m);
-    std::vector<int> col(m, -1);
-    Eigen::VectorXd rn2 = Eigen::VectorXd::Zero(2 * m);
-    const Eigen::VectorXd zero_b = Eigen::VectorXd::Zero(st.K.rows()), zero_d = Eigen::VectorXd::Zero(m);
-    auto add_columns = [&](std::vector<int> rows) {
-        std::sort(rows.begin(), rows.end());
-        rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-        rows.erase(std::remove_if(rows.begin(), rows.end(), [&](int row) { return col[row] >= 0; }), rows.end());
-        if (rows.empty()) return;
-        const double c0 = thread_cpu_s();
-        const int k = static_cast<int>(rows.size());
-        Eigen::MatrixXd P, Z;
-        if (path.solver.unit_solves(lin0, rows, false, P, Z)) {
-            ++stats.column_blocks;
-        } else {  // a bordered or primal factorisation: one solve() per column
-            P.resize(m, k);
-            Z.resize(st.K.rows(), k);
-            for (int j = 0; j < k; ++j) {
-                modes::ModeLinearization lin = lin0;
-                lin.e.setZero();
-                Eigen::VectorXd d = zero_d, Pj, zj;
-                if (base[rows[j]].kind == Eq::held) d[rows[j]] = 1.0;
-                else lin.e[rows[j]] = 1.0;
-                const int f = path.solver.solve(lin, key0, zero_b, d, Pj, zj);
-                r.factorizations += f;
-                stats.factorizations += f;
-                P.col(j) = Pj;
-                Z.col(j) = zj;
-            }
-        }
-        const Eigen::MatrixXd GZ = st.Grow * Z;  // (row-major G: a gather per row)
-        for (int j = 0; j < k; ++j) {
-            const double s = base[rows[j]].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
-            const double* pj = P.col(j).data();
-            const double* gj = GZ.col(j).data();
-            col[rows[j]] = Y.add([&](int q) {
-                const double v = s * (q < m ? pj[q] : gj[q - m]);
-                rn2[q] += v * v;
-                return v;
-            });
-        }
-        stats.columns += k;
-        stats.column_s += thread_cpu_s() - c0;
-    };
-
-    std::vector<Eq> eq = base;  // the current set's equations
+    std::vector<Eq> eq;  // the current set's equations
+    mode_equations(laws, cur.nmode, cur.tmode, eq);
     std::vector<int> switches(np, 0);
     std::vector<double> last_switch_t(np, -1.0);
     std::vector<signed char> left_n(np, modes::NONE), left_t(np, modes::NONE);  // the modes a pair left last
@@ -319,19 +450,16 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         a += ya;
         b += yb;
     };
-    auto rn = [&](int q) { return std::sqrt(rn2[q]); };
     try {
         for (;;) {
             C.clear();
             for (int row = 0; row < m; ++row)
                 if (eq[row] != base[row]) C.push_back(row);
+            if (stats.start_rows < 0 && stats.kept_base) stats.start_rows = static_cast<int>(C.size());
             if (rebase_rows > 0 && static_cast<int>(C.size()) > rebase_rows) {
                 // a new base: the current modes factorised (the columns and the bound start again)
                 make_base();
                 eq = base;
-                std::fill(col.begin(), col.end(), -1);
-                Y.clear();
-                rn2.setZero();
                 A1 = 0.0;
                 std::fill(dirty.begin(), dirty.end(), 1);
                 L1_prev.resize(0);
@@ -339,11 +467,14 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                 ++stats.rebases;
             }
             const int nc = static_cast<int>(C.size());
+            stats.end_rows = nc;
             if (nc > kMaxChangedRows) {
                 stats.end = PathStats::too_many_rows;
                 return false;
             }
-            add_columns(C);
+            const int fc = add_columns(path, kb, C, true, stats);
+            r.factorizations += fc;
+            stats.factorizations += fc;
             L0.setZero(Y.padded());
             L1.setZero(Y.padded());
             if (nc > 0) {
@@ -542,6 +673,180 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     p = X1h.head(m);
     if (Y.size() > 0)
         for (int q = 0; q < m; ++q) p[q] += Y.dot(q, L1);
+    return true;
+}
+
+namespace {
+/// The trace's check of a kept-base solve (TransitionTrace::check_kept; tests): the same modes
+/// solved from scratch by mode solvers of its own on the whole saddle-point system, refined: Eigen's
+/// SparseLU (the reference) and, in builds with KLU, KLU on the held set's system (the default
+/// route's); the largest differences of p and z (kept against the reference, and KLU's against it:
+/// the round-off of two direct solves of the same system) relative to their largest entries.
+void check_kept_solve(SparsePath& path, const Step& step, const Eigen::VectorXd& p, const Eigen::VectorXd& z) {
+    TransitionTrace& tr = *path.switches.trace;
+    KeptBase& kb = *path.kept;
+    if (!kb.check[0]) {
+        ModeSolverTuning own;  // the whole saddle-point system (not the Schur way, whose z = K^-1 (...)
+        own.schur_max_rows = 0;  // after p_S stops at K's round-off), no bordered updates
+        own.max_border_rows = 0;
+        kb.check[0] = std::make_shared<ModeSolver>(own);
+        if (klu_built()) {
+            own.fixed_pattern = FixedPatternLu::klu_held_amd;
+            kb.check[1] = std::make_shared<ModeSolver>(own);
+        }
+        for (auto& c : kb.check)
+            if (c) c->reset(path.stiffness().K, path.stiffness().G);
+    }
+    modes::ModeLinearization lin;
+    path.modes.linearize(path.laws, lin);
+    std::vector<signed char> key = path.modes.key();
+    key.push_back(static_cast<signed char>(path.laws.tau_rule));
+    auto rel = [](const Eigen::VectorXd& a, const Eigen::VectorXd& ref) {
+        return (a - ref).lpNorm<Eigen::Infinity>() / std::max(ref.lpNorm<Eigen::Infinity>(), 1e-300);
+    };
+    Eigen::VectorXd pf, zf, pk = p;
+    kb.check[0]->solve(lin, key, step.b, step.d, pf, zf);
+    path.modes.put_slip_forces(path.laws, pf);
+    path.modes.put_slip_forces(path.laws, pk);
+    ++tr.kept_checked;
+    tr.kept_p_diff = std::max(tr.kept_p_diff, rel(pk, pf));
+    tr.kept_z_diff = std::max(tr.kept_z_diff, rel(z, zf));
+    if (kb.check[1]) {
+        Eigen::VectorXd p2, z2;
+        kb.check[1]->solve(lin, key, step.b, step.d, p2, z2);
+        path.modes.put_slip_forces(path.laws, p2);
+        tr.fresh_p_diff = std::max(tr.fresh_p_diff, rel(p2, pf));
+        tr.fresh_z_diff = std::max(tr.fresh_z_diff, rel(z2, zf));
+    }
+}
+}  // namespace
+
+bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    if (!keeps_base(path) || !path.kept || path.solves_since_path > 1 || !path.kept->current(path)) return false;
+    RouteStats* const rs = path.switches.trace ? &path.switches.trace->routes : nullptr;
+    const double c0 = thread_cpu_s(), cached0 = rs ? rs->seconds[route_cached] : 0.0;
+    KeptBase& kb = *path.kept;
+    const ContactProblem& laws = path.laws;
+    const SparseStiffness& st = path.stiffness();
+    const int m = laws.size();
+    const Eigen::VectorXd& W = path.diag();
+    const int limit = path.switches.path_rebase_rows > 0 ? path.switches.path_rebase_rows : kMaxChangedRows;
+    // the modes' equations and the rows C where they differ from the base's
+    std::vector<Eq> eq;
+    mode_equations(laws, path.modes.nmode, path.modes.tmode, eq);
+    std::vector<int> C;
+    for (int row = 0; row < m; ++row)
+        if (eq[row] != kb.eqs[row]) C.push_back(row);
+    const int nc = static_cast<int>(C.size());
+    if (nc > limit) return false;
+    PathStats unused;
+    Eigen::VectorXd X, zh;
+    try {
+        if (add_columns(path, kb, C, false, unused) < 0) return false;
+        const Eigen::VectorXd* b[1] = {&step.b};
+        const Eigen::VectorXd* d[1] = {&step.d};
+        Eigen::VectorXd* Xp[1] = {&X};
+        Eigen::VectorXd* zp[1] = {&zh};
+        base_solutions(path, kb, 1, b, d, Xp, zp);
+    } catch (const SingularModes&) {
+        return false;
+    }
+    const ColumnStore& Y = kb.Y;
+    if (static_cast<int>(kb.zc.size()) != Y.size()) return false;  // (columns made with the switch off)
+    // the bordered system on C: H lambda = F (metres both ways, as the path's)
+    Eigen::MatrixXd H(nc, nc);
+    for (int i = 0; i < nc; ++i) {
+        const int ri = C[i];
+        const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
+        for (int j = 0; j < nc; ++j) {
+            const int cj = kb.col[C[j]];
+            H(i, j) = sr * eq[ri].apply(ri, m, [&](int q) { return Y(q, cj); });
+        }
+    }
+    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
+    if (nc > 0 && !(H.allFinite() && lu.rcond() > kKeptRcond)) return false;
+    // x = xb + Y lambda with the modes' equations on C (right-hand sides there `target(row)`):
+    // its forces pf and displacements zf
+    auto bordered = [&](const Eigen::VectorXd& Xb, const Eigen::VectorXd& zb, const std::function<double(int)>& target,
+                        Eigen::VectorXd& pf, Eigen::VectorXd& zf) {
+        pf = Xb.head(m);
+        zf = zb;
+        if (nc == 0) return;
+        Eigen::VectorXd F(nc);
+        for (int i = 0; i < nc; ++i) {
+            const int ri = C[i];
+            const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
+            F[i] = sr * (target(ri) - eq[ri].apply(ri, m, [&](int q) { return Xb[q]; }));
+        }
+        const Eigen::VectorXd l = lu.solve(F);
+        Eigen::VectorXd L = Eigen::VectorXd::Zero(Y.padded());
+        for (int j = 0; j < nc; ++j) {
+            const int cj = kb.col[C[j]];
+            L[cj] = l[j];
+            zf += l[j] * kb.zc[static_cast<std::size_t>(cj)];
+        }
+        for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L);
+    };
+    // the force equations put exactly (p = 0; slip p_t = e + c p_n: a slip row's normal row is
+    // held or zero, never slip)
+    auto put_force_equations = [&](Eigen::VectorXd& pf) {
+        for (int row = 0; row < m; ++row)
+            if (eq[row].kind == Eq::zero) pf[row] = 0.0;
+        for (int row = 0; row < m; ++row)
+            if (eq[row].kind == Eq::slip) pf[row] = eq[row].e + (eq[row].other >= 0 ? eq[row].coef * pf[eq[row].other] : 0.0);
+    };
+    Eigen::VectorXd pn, zn;
+    bordered(X, zh, [&](int r) { return eq[r].rhs(r, step.d); }, pn, zn);
+    put_force_equations(pn);
+    // iterative refinement against the modes' own system (K z - G^T p = b, the held rows' G z = d,
+    // the force equations exact): each correction the same bordered solve of the residual (the
+    // base's factorisation, unrefined columns: a contraction), until the held rows' residual is at
+    // the round-off a direct solve of the whole system reaches
+    modes::ModeLinearization lin0 = kb.lin;
+    lin0.e.setZero();
+    Eigen::VectorXd res(m);
+    double last = std::numeric_limits<double>::infinity();
+    for (int it = 0;; ++it) {
+        const Eigen::VectorXd s = st.Grow * zn - step.d;
+        double err = 0.0;
+        for (int row = 0; row < m; ++row) {
+            res[row] = eq[row].kind == Eq::held ? -s[row] : 0.0;
+            err = std::max(err, std::abs(res[row]));
+        }
+        const double roundoff = st.roundoff(step.d, zn);
+        if (err <= kKeptResidual * roundoff) break;
+        if (it == kKeptCorrections || !(err < 0.5 * last)) {  // no longer decreasing
+            if (err <= kKeptStall * roundoff) break;
+            return false;  // not at round-off: the caller factorises
+        }
+        last = err;
+        // the correction: the base's solve of the residual (the load's; the held rows' outside C,
+        // whose equations are the base's), bordered on C
+        Eigen::MatrixXd B(st.K.rows(), 1), D(m, 1), P, Z;
+        B.col(0) = step.b + st.Gt * pn - st.K * zn;
+        D.col(0) = res;
+        for (int row : C) D(row, 0) = 0.0;
+        try {
+            path.solver.solve_block(lin0, kb.key, B, D, P, Z);
+        } catch (const SingularModes&) {
+            return false;
+        }
+        Eigen::VectorXd dX(2 * m), dp, dz;
+        dX << P.col(0), st.Grow * Z.col(0);
+        bordered(dX, Z.col(0), [&](int r) { return res[r]; }, dp, dz);
+        pn += dp;
+        zn += dz;
+        put_force_equations(pn);
+    }
+    p = pn;
+    z = zn;
+    path.solver.count_update();
+    if (path.switches.trace && path.switches.trace->check_kept) check_kept_solve(path, step, p, z);
+    if (rs) {  // (its base solves are counted as the base's cached calls: their time once)
+        rs->count[route_kept] += 1;
+        rs->seconds[route_kept] += thread_cpu_s() - c0 - (rs->seconds[route_cached] - cached0);
+        rs->held[route_kept] += static_cast<double>(kb.lin.S.size());
+    }
     return true;
 }
 

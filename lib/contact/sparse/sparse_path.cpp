@@ -24,6 +24,7 @@ void SparsePath::reset(const SparseContactProblem& pr) {
     solver.reset(pr.K, pr.G, couplings);
     ipm_analysed = false;
     js_analysed = false;
+    kept.reset();  // its columns are of the old (K, G)
     // KLU for the smoothing Newton method's Jacobian with few rigid rows (as the mode solver's
     // fixed_max_rigid_rows: a rigid row near its held mode has a zero diagonal there)
     const std::vector<int> layer = layer_dofs(pr.K, pr.G);
@@ -59,6 +60,11 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
         lin_tmode_ = modes.tmode;
         lin_tau_rule_ = laws.tau_rule;
         lin_ok_ = true;
+    }
+    // a set near the homotopy's kept base: on its factorisation and columns (docs/decisions/045)
+    if (kept && solve_on_kept_base(*this, step, p, z)) {
+        modes.put_slip_forces(laws, p);
+        return 0;
     }
     // the trace counts the new-set solves of a set solved before (docs/decisions/038: none recurs)
     if (switches.trace && switches.trace->current && !solver.is_current(lin_key_)) switches.trace->count_solve(lin_key_);

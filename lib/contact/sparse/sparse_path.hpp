@@ -43,6 +43,8 @@ inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& s
     return tuning;
 }
 
+struct KeptBase;  // the homotopy's base kept across steps (path_following.cpp, Switches::path_keep_base)
+
 struct SparsePath {
     SolverOptions options;   ///< tolerance_m, max_active_set_iterations, tresca_anderson_depth
     Switches switches;       ///< the test-only switches (switches.hpp)
@@ -60,6 +62,13 @@ struct SparsePath {
     SpMat Js;
     std::unique_ptr<PatternLu> js_lu;  ///< Eigen's SparseLU, or KLU with Switches::fixed_pattern >= 2
     bool js_analysed = false;
+    /// the homotopy's base, its columns and solutions, kept while the mode solver's current
+    /// factorisation is the base's (Switches::path_keep_base, docs/decisions/045)
+    std::shared_ptr<KeptBase> kept;
+    /// solves (steps) begun since the homotopy last ran: the kept base serves the step of the path
+    /// and the next one only (a set of modes that stays is then factorised once, so the steps after
+    /// it are the cached affine solves, not a kept-base solve each)
+    int solves_since_path = 0;
 
     SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
         : options(o), switches(sw), solver(with_switches(tuning, sw)) {

@@ -508,6 +508,7 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     }
     SolveResult r;
     path.solver.reset_updates();
+    ++path.solves_since_path;  // (the homotopy's kept base serves the path's step and the next)
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};

@@ -161,6 +161,18 @@ struct Switches {
     /// and a real fold or cycle at one t ends at the limit of 20 breakpoints without progress; true:
     /// the Newton methods at once, the way before.
     bool path_fold_ends = false;
+    /// Its base kept (docs/decisions/045): at the path's end its modes are the base's plus the
+    /// changed rows C (at most path_rebase_rows), whose columns it holds; the confirming passes
+    /// solve such a set of modes on the base's factorisation and those columns (the bordered,
+    /// Woodbury form, refined against the set's own system until its held rows' residual is a
+    /// direct solve's; a singular or ill-conditioned bordered system, a refinement that does not
+    /// reach that, or more changed rows: a fresh factorisation as before), and so does the next
+    /// step's first pass; the next path starts on the same base with its columns. > 0: on where the
+    /// stiffness has at least this many unknowns (K's rows, the elastic layer's included), where a
+    /// factorisation costs more than the kept base's solves (10,000, the default: graduated 10 x 400
+    /// (12,340) 0.89x CPU, identical 0.93x; 10 x 200 and 10 x 100 1.0-1.1x, so off there); 1 always;
+    /// 0 off, the way before (the confirming passes factorise the end modes, the next path's base).
+    int path_keep_base = 10000;
 };
 
 /// The switches a SparseContactSolver constructed now on this thread takes: the defaults,

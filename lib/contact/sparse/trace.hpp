@@ -21,7 +21,8 @@ inline double thread_cpu_s() {
 /// How ModeSolver::solve answered one call (docs/decisions/038): the current key's cached
 /// factorisation; the Schur way's dense LU, its low-rank (Woodbury) update of the base's LU,
 /// or the base's own set again; a sparse LU (KLU on the fixed pattern, or the held set's own
-/// system); the bordered update of the last sparse LU; the primal route.
+/// system); the bordered update of the last sparse LU; the primal route; the homotopy's kept
+/// base with its columns (docs/decisions/045: a set near the base solved without a factorisation).
 enum Route : int {
     route_cached,
     route_schur_lu,
@@ -31,11 +32,12 @@ enum Route : int {
     route_lu,
     route_border,
     route_primal,
+    route_kept,
     route_count
 };
 inline const char* route_name(int r) {
     static const char* const names[route_count] = {"cached", "schur-LU", "schur-update", "schur-base",
-                                                   "fixed-LU", "own-LU", "border", "primal"};
+                                                   "fixed-LU", "own-LU", "border", "primal", "kept-base"};
     return names[r];
 }
 
@@ -76,6 +78,11 @@ struct PathStats {
     int start_hits = 0;      ///< conditions of the start modes that fail before t = 1 (the first ratio test's)
     long evaluations = 0;    ///< pairs whose conditions were evaluated exactly at a ratio test
     long pair_tests = 0;     ///< pairs x ratio tests (the rest were bounded away from their kinks)
+    /// the base kept from the last path run (Switches::path_keep_base, docs/decisions/045): true when
+    /// this run started on it, its rows differing from the start modes then (-1 on a new base), and
+    /// the rows differing from the (last) base at the end
+    bool kept_base = false;
+    int start_rows = -1, end_rows = 0;
     // CPU time [s] (thread): the columns' solves, the base factorisations and solves, the rest
     double column_s = 0.0, base_s = 0.0, total_s = 0.0;
 };
@@ -137,6 +144,13 @@ struct TransitionTrace {
     std::vector<StepTrace> steps;
     StepTrace* current = nullptr;  ///< the step being recorded (the solver's)
     RouteStats routes;             ///< the mode solver's calls so far (ModeSolver::solve adds to it)
+    /// tests (docs/decisions/045): every solve on the homotopy's kept base checked against the same
+    /// modes solved from scratch by a mode solver of its own (Eigen's SparseLU of the whole system):
+    /// how many, the largest differences of p and z relative to their largest entries; and the same
+    /// for a second from-scratch solve (KLU of the held set's system, where built) against it
+    bool check_kept = false;
+    int kept_checked = 0;
+    double kept_p_diff = 0.0, kept_z_diff = 0.0, fresh_p_diff = 0.0, fresh_z_diff = 0.0;
     std::unordered_set<std::size_t> keys;       ///< hashes of the sets of modes solved so far (all steps)
     std::unordered_set<std::size_t> step_keys;  ///< those solved in the current step
     static std::size_t hash(const std::vector<signed char>& key) {

@@ -59,6 +59,18 @@ struct PathStart {
 bool path_following(SparsePath& path, const Step& step, const PathStart& start, Eigen::VectorXd& p,
                     Eigen::VectorXd& z, SolveResult& r, PathStats& stats);
 
+/// The linear problem of the current modes (path.modes) for `step` on the homotopy's kept base
+/// (Switches::path_keep_base, docs/decisions/045; path_following.cpp): where the base's
+/// factorisation is still current, the homotopy ran in this solve or the one before, and the modes
+/// differ from the base's in at most path_rebase_rows rows C, x = x^ + Y lambda from the base's
+/// solution x^ for this data and the columns of C (those missing solved on the base), then
+/// iterative refinement against the modes' own saddle-point system (each correction the same
+/// bordered solve of its residual) until the held rows' residual is a direct solve's (1e-16 of
+/// s's terms). False (nothing changed but the kept columns) where it does not apply, the bordered
+/// system is singular or ill-conditioned, or the refinement does not get there: the caller
+/// factorises, as without it. No factorisation (counted as an update).
+bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, Eigen::VectorXd& z);
+
 /// The covering start of the homotopy (covering_start.cpp; Switches::rest_path_violations): for the
 /// current modes M0 (path.modes) and their linear solution (p, z) at `step`'s data, the data
 /// (b0, d0) at which M0 holds, its solution there the projection of (p, s) onto M0's
