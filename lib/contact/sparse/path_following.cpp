@@ -191,6 +191,35 @@ void mode_equations(const ContactProblem& laws, const std::vector<signed char>& 
     }
 }
 
+/// The bordered system on the rows C that differ from the base (metres both ways: a force
+/// equation's row scaled by W_rr; the columns are scaled): H(i, j) = row C[i]'s equation applied to
+/// the column of C[j], and F[i] = its right-hand side target(C[i]) minus the equation applied to x.
+double bordered_row_scale(const Eq& e, int row, const Eigen::VectorXd& W) { return e.kind == Eq::held ? 1.0 : W[row]; }
+Eigen::MatrixXd bordered_matrix(const std::vector<Eq>& eq, const std::vector<int>& C, const ColumnStore& Y,
+                                const std::vector<int>& col, const Eigen::VectorXd& W, int m) {
+    const int nc = static_cast<int>(C.size());
+    Eigen::MatrixXd H(nc, nc);
+    for (int i = 0; i < nc; ++i) {
+        const int ri = C[i];
+        const double sr = bordered_row_scale(eq[ri], ri, W);
+        for (int j = 0; j < nc; ++j) {
+            const int cj = col[C[j]];
+            H(i, j) = sr * eq[ri].apply(ri, m, [&](int q) { return Y(q, cj); });
+        }
+    }
+    return H;
+}
+template <class Target>
+Eigen::VectorXd bordered_rhs(const std::vector<Eq>& eq, const std::vector<int>& C, const Eigen::VectorXd& W, int m,
+                             const Target& target, const Eigen::VectorXd& x) {
+    Eigen::VectorXd F(static_cast<int>(C.size()));
+    for (int i = 0; i < F.size(); ++i) {
+        const int ri = C[i];
+        F[i] = bordered_row_scale(eq[ri], ri, W) * (target(ri) - eq[ri].apply(ri, m, [&](int q) { return x[q]; }));
+    }
+    return F;
+}
+
 // the kept base's refinement (solve_on_kept_base): at most this many corrections, while each
 // at least halves the held rows' residual |G z - d|, until it is at most kKeptResidual x the
 // round-off of s = G z - d (SparseStiffness::roundoff, 1e-13 of its terms: the passes' own
@@ -236,8 +265,7 @@ struct KeptBase {
     /// the modes (n, t) as the base: their linear problem, key, equations; no columns, no solutions
     void set(const ContactProblem& laws, const modes::ModeSet& modes) {
         modes.linearize(laws, lin);
-        key = modes.key();
-        key.push_back(static_cast<signed char>(laws.tau_rule));
+        key = solver_key(laws, modes);
         mode_equations(laws, modes.nmode, modes.tmode, eqs);
         Y.clear();
         zc.clear();
@@ -478,19 +506,9 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
             L0.setZero(Y.padded());
             L1.setZero(Y.padded());
             if (nc > 0) {
-                // H (metres both ways: a force equation's row by W_rr; the columns are scaled)
-                Eigen::MatrixXd H(nc, nc);
-                Eigen::VectorXd F0(nc), F1(nc);
-                for (int i = 0; i < nc; ++i) {
-                    const int ri = C[i];
-                    const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
-                    for (int j = 0; j < nc; ++j) {
-                        const int cj = col[C[j]];
-                        H(i, j) = sr * eq[ri].apply(ri, m, [&](int q) { return Y(q, cj); });
-                    }
-                    F0[i] = sr * (eq[ri].rhs(ri, start.d) - eq[ri].apply(ri, m, [&](int q) { return X0h[q]; }));
-                    F1[i] = sr * (eq[ri].rhs(ri, step.d) - eq[ri].apply(ri, m, [&](int q) { return X1h[q]; }));
-                }
+                const Eigen::MatrixXd H = bordered_matrix(eq, C, Y, col, W, m);
+                const Eigen::VectorXd F0 = bordered_rhs(eq, C, W, m, [&](int r) { return eq[r].rhs(r, start.d); }, X0h);
+                const Eigen::VectorXd F1 = bordered_rhs(eq, C, W, m, [&](int r) { return eq[r].rhs(r, step.d); }, X1h);
                 const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
                 if (!(lu.rcond() > 1e-14)) {
                     stats.end = PathStats::singular;
@@ -699,8 +717,7 @@ void check_kept_solve(SparsePath& path, const Step& step, const Eigen::VectorXd&
     }
     modes::ModeLinearization lin;
     path.modes.linearize(path.laws, lin);
-    std::vector<signed char> key = path.modes.key();
-    key.push_back(static_cast<signed char>(path.laws.tau_rule));
+    const std::vector<signed char> key = solver_key(path.laws, path.modes);
     auto rel = [](const Eigen::VectorXd& a, const Eigen::VectorXd& ref) {
         return (a - ref).lpNorm<Eigen::Infinity>() / std::max(ref.lpNorm<Eigen::Infinity>(), 1e-300);
     };
@@ -754,15 +771,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
     const ColumnStore& Y = kb.Y;
     if (static_cast<int>(kb.zc.size()) != Y.size()) return false;  // (columns made with the switch off)
     // the bordered system on C: H lambda = F (metres both ways, as the path's)
-    Eigen::MatrixXd H(nc, nc);
-    for (int i = 0; i < nc; ++i) {
-        const int ri = C[i];
-        const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
-        for (int j = 0; j < nc; ++j) {
-            const int cj = kb.col[C[j]];
-            H(i, j) = sr * eq[ri].apply(ri, m, [&](int q) { return Y(q, cj); });
-        }
-    }
+    const Eigen::MatrixXd H = bordered_matrix(eq, C, Y, kb.col, W, m);
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
     if (nc > 0 && !(H.allFinite() && lu.rcond() > kKeptRcond)) return false;
     // x = xb + Y lambda with the modes' equations on C (right-hand sides there `target(row)`):
@@ -772,13 +781,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
         pf = Xb.head(m);
         zf = zb;
         if (nc == 0) return;
-        Eigen::VectorXd F(nc);
-        for (int i = 0; i < nc; ++i) {
-            const int ri = C[i];
-            const double sr = eq[ri].kind == Eq::held ? 1.0 : W[ri];
-            F[i] = sr * (target(ri) - eq[ri].apply(ri, m, [&](int q) { return Xb[q]; }));
-        }
-        const Eigen::VectorXd l = lu.solve(F);
+        const Eigen::VectorXd l = lu.solve(bordered_rhs(eq, C, W, m, target, Xb));
         Eigen::VectorXd L = Eigen::VectorXd::Zero(Y.padded());
         for (int j = 0; j < nc; ++j) {
             const int cj = kb.col[C[j]];

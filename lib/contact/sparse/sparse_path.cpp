@@ -54,8 +54,7 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
                       lin_nmode_ == modes.nmode && lin_tmode_ == modes.tmode;
     if (!same) {
         modes.linearize(laws, lin_);
-        lin_key_ = modes.key();
-        lin_key_.push_back(static_cast<signed char>(laws.tau_rule));  // the slip coupling depends on it
+        lin_key_ = solver_key(laws, modes);
         lin_nmode_ = modes.nmode;
         lin_tmode_ = modes.tmode;
         lin_tau_rule_ = laws.tau_rule;

@@ -43,6 +43,14 @@ inline ModeSolverTuning with_switches(ModeSolverTuning tuning, const Switches& s
     return tuning;
 }
 
+/// The mode solver's key of a set of modes: its modes and the tau rule (the slip coupling depends
+/// on it), as SparsePath::solve_modes and the homotopy's base name a set.
+inline std::vector<signed char> solver_key(const ContactProblem& laws, const modes::ModeSet& modes) {
+    std::vector<signed char> key = modes.key();
+    key.push_back(static_cast<signed char>(laws.tau_rule));
+    return key;
+}
+
 struct KeptBase;  // the homotopy's base kept across steps (path_following.cpp, Switches::path_keep_base)
 
 struct SparsePath {
