@@ -861,4 +861,47 @@ BENCHMARK(TransitionStudy)
     ->ArgsProduct({{100, 200, 400}, {1, 2}, {100}, {61}, {0, 1}, {0}, {-1}, {48}, {-1}, {7}})
     ->Unit(benchmark::kMillisecond)->Iterations(1);
 
+/// Decision 050: the automatic path's choice (resolve_contact_path) against both paths forced,
+/// every other default. args: elements per half leaf, stack (0 the paper example, friction; 5 the
+/// paper example bonded; 6 the paper example, friction, elastic interfaces; 1 / 2 graduated /
+/// identical 10 leaves, friction, elastic interfaces, as TransitionStudy; 3 / 4 the same bonded),
+/// simulated ms, path (0 automatic, 1 dense, 2 sparse). Counters as ElasticRuns (cpu_s_per_sim_s:
+/// CPU s per simulated second, set-up and stepping); the answer at the end to stderr (17 digits).
+void PathChoice(benchmark::State& state) {
+    const int elements = static_cast<int>(state.range(0));
+    const int stack = static_cast<int>(state.range(1));
+    ModelSpec spec = stack == 0 || stack == 6 ? paper_example(PaperCase::friction, PaperExampleOptions{elements})
+                     : stack == 5             ? paper_example(PaperCase::bonded, PaperExampleOptions{elements})
+                     : stack == 1 || stack == 3 ? graduated_stack(elements, 10)
+                                                : paper_stack(PaperCase::friction, elements, 10);
+    for (auto& f : spec.interfaces) {
+        if (stack == 1 || stack == 2 || stack == 6) f.contact = InterfaceContact::elastic;
+        if (stack == 3 || stack == 4) f.law = InterfaceLaw::bonded;
+    }
+    SimulationOptions so;
+    so.t_end_s = 1e-3 * static_cast<double>(state.range(2));
+    so.stop_on_nonconvergence = false;
+    const int path = static_cast<int>(state.range(3));
+    so.contact_path = path == 1 ? ContactPath::dense : path == 2 ? ContactPath::sparse : ContactPath::automatic;
+    ElasticFigures fig;
+    for (auto _ : state) fig.run(spec, so);
+    fig.put(state, so.t_end_s);
+    const int rows = fig.components;
+    state.counters["auto_sparse"] =
+        resolve_contact_path(ContactPath::automatic, rows, so.solver.kind) == ContactPath::sparse ? 1.0 : 0.0;
+    std::fprintf(stderr, "# PathChoice el:%d stack:%d path:%d rows %d answer: w %.17g m, dissipated %.17g J, |z| %.17g\n",
+                 elements, stack, path, rows, fig.final_w_m, fig.dissipated_j, fig.z_norm);
+}
+BENCHMARK(PathChoice)
+    ->ArgNames({"el", "stack", "ms", "path"})
+    // the graduated 10-leaf spring (about 10.8 rows per element per half leaf) and the paper
+    // example's 3 leaves on finer meshes (about 3.9), 100 ms; the crossover's neighbourhood
+    ->ArgsProduct({{8, 12, 14, 16, 18, 25, 50, 100}, {1, 3}, {100}, {0, 1, 2}})
+    ->ArgsProduct({{20, 30, 40, 50, 80, 160}, {0, 5, 6}, {100}, {0, 1, 2}})
+    // whole seconds: the paper example (friction, bonded) and the graduated 10 x 12 / 14 friction
+    ->ArgsProduct({{20}, {0, 5}, {1000}, {0, 1, 2}})->ArgsProduct({{12, 14}, {1}, {1000}, {0, 1, 2}})
+    // identical 10 leaves, friction and bonded
+    ->ArgsProduct({{8, 12, 25, 50}, {2, 4}, {100}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+
 BENCHMARK_MAIN();

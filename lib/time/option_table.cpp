@@ -14,7 +14,7 @@ namespace stackbeam {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-static_assert(kSparsePathMinComponents == 1000, "the --contact-path help below states the threshold: update it");
+static_assert(kSparsePathMinComponents == 150, "the --contact-path help below states the threshold: update it");
 using T = OptionSpec::Type;
 
 std::string number_text(double v) {
@@ -70,7 +70,7 @@ std::vector<OptionSpec> make_table() {
              false, "0: perfectly inelastic, 1: elastic", [](const O& o) { return o.restitution; },
              [](O& o, double v) { o.restitution = v; }),
         keyword("contact_path", "integrator.contact_path", "--contact-path",
-                "contact problem: auto (dense below kSparsePathMinComponents = 1000 contact components, else "
+                "contact problem: auto (dense below kSparsePathMinComponents = 150 contact components, else "
                 "sparse), dense, sparse (exact solver only; not in mode cvode)",
                 "auto | dense | sparse", [](const O& o) { return std::string(to_string(o.contact_path)); },
                 [](O& o, S t, S f) { o.contact_path = parse_contact_path(t, f); }),

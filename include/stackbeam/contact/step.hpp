@@ -36,11 +36,14 @@ ContactPath parse_contact_path(const std::string& text, const std::string& field
 
 /// ContactPath::automatic takes the sparse path from this many contact components
 /// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
-/// 002-sparse-contact-path.md, friction case, the costliest): at 636 rows both paths take the same time per step,
-/// at 1,596 (3 leaves) the dense one is 2x faster, at 1,782 (10 leaves) the sparse one
-/// 2.5x; bonded and frictionless runs are faster on the sparse path from a few hundred
-/// rows. Above it the dense W (8 m^2 bytes, twice with its LU) also grows past 16 MB.
-constexpr int kSparsePathMinComponents = 1000;
+/// 050-automatic-path-threshold.md; CPU s per simulated second, 100 ms friction runs): on the
+/// graduated 10-leaf spring the dense path is 1.13x faster at 144 rows, the sparse one 2.2x at
+/// 234 and 10x at 540; on the paper example's 3 leaves the two are equal at 116 rows and the
+/// sparse one 1.2x faster at 156. Bonded runs are faster on the sparse path at every size (1.7x
+/// on the paper example); below this the dense path keeps the paper example and the small
+/// stacks on the paper's form, at most 20 % slower for friction. (Decision 002's 1,000 was
+/// measured on the sparse path before decisions 003-047.)
+constexpr int kSparsePathMinComponents = 150;
 
 /// The path `requested` resolves to for a problem of `rows` contact rows solved by `kind`:
 /// automatic gives sparse when the solver is exact and rows >= kSparsePathMinComponents, dense
