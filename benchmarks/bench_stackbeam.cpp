@@ -402,7 +402,7 @@ BENCHMARK(FrictionMeshRatioRuns)
 /// interface rigid or elastic (layer derived from the leaves), default solver chain, dt = 1 ms.
 /// args: elements per half leaf, stack (0 the paper example, 1 graduated 10 leaves, 2 identical
 /// 10 leaves, 3 graduated 10 leaves bonded, 4 identical 10 leaves bonded), elastic (0/1),
-/// simulated ms, contact path (0 automatic: sparse from 1000 rows; 1 sparse), inc (1 the
+/// simulated ms, contact path (0 automatic: sparse from kSparsePathMinComponents rows; 1 sparse), inc (1 the
 /// incremental solve, the default; 0 the way before it: Switches::incremental), schur (> 0:
 /// SparsePathTuning::schur_max_rows; 0 its default), primal (SparsePathTuning::primal_min_rows:
 /// -1 its default (0: off), 0 off: the large held sets on the sparse LU; > 0 the primal
