@@ -196,6 +196,17 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
     BOOST_TEST(so.contact_path == ContactPath::automatic);
     BOOST_TEST(small.num_components() < kSparsePathMinComponents);
     BOOST_TEST(choose_contact_path(small, so) == ContactPath::dense);
+    // decision 050: the paper example (76 rows) and the graduated 10 x 12 (144) dense, the
+    // graduated 10 x 14 (234) and 10 x 50 (540) sparse, where each path is the faster
+    const System g12(Model::build(testing::graduated_stack(12, 10)));
+    const System g14(Model::build(testing::graduated_stack(14, 10)));
+    const System g50(Model::build(testing::graduated_stack(50, 10)));
+    BOOST_TEST(g12.num_components() == 144);
+    BOOST_TEST(g14.num_components() == 234);
+    BOOST_TEST(g50.num_components() == 540);
+    BOOST_TEST(choose_contact_path(g12, so) == ContactPath::dense);
+    BOOST_TEST(choose_contact_path(g14, so) == ContactPath::sparse);
+    BOOST_TEST(choose_contact_path(g50, so) == ContactPath::sparse);
     PaperExampleOptions o;
     o.elements_per_half_leaf = 300;  // 3 leaves: 2 interfaces x ~300 nodes x 2 rows > 1000
     const System large(Model::build(paper_example(PaperCase::friction, o)));
