@@ -37,7 +37,7 @@ ContactPath parse_contact_path(const std::string& text, const std::string& field
 /// ContactPath::automatic takes the sparse path from this many contact components
 /// (rows of the contact problem) on, with the exact solver. Measured (docs/decisions/
 /// 050-automatic-path-threshold.md; CPU s per simulated second, 100 ms friction runs): on the
-/// graduated 10-leaf spring the dense path is 1.13x faster at 144 rows, the sparse one 2.2x at
+/// graduated 10-leaf spring the dense path is 1.12x faster at 144 rows, the sparse one 2.2x at
 /// 234 and 10x at 540; on the paper example's 3 leaves the two are equal at 116 rows and the
 /// sparse one 1.2x faster at 156. Bonded runs are faster on the sparse path at every size (1.7x
 /// on the paper example); below this the dense path keeps the paper example and the small
