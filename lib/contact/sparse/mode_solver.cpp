@@ -494,7 +494,10 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
             PS.col(j) = pS;
         }
     } else {
-        Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n + ms, k);
+        // solved in Z itself (n + ms rows: the displacements on top, scaled in place; the held
+        // forces below, copied out): no second n x k matrix and copy per call
+        Eigen::MatrixXd& R = Z;
+        R.setZero(n + ms, k);
         for (int j = 0; j < k; ++j) {
             const int r = rows[static_cast<std::size_t>(j)], i = pos[r];
             if (i >= 0) {
@@ -505,8 +508,8 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
         }
         if (lu_fixed) fixed_->solve_in_place(R, refine);  // (no copy of the n + ms rows per column)
         else R = refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
-        Z = st_.dz.asDiagonal() * R.topRows(n);
         PS = row_scale.asDiagonal() * R.bottomRows(ms);
+        R.topRows(n).array().colwise() *= st_.dz.array();  // (the same products as dz.asDiagonal() * R)
     }
     P.setZero(m, k);
     for (int j = 0; j < k; ++j) {

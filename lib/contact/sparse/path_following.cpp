@@ -408,14 +408,16 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             Z.col(j) = zj;
         }
     }
-    const Eigen::MatrixXd GZ = st.Grow * Z;  // (row-major G: a gather per row)
     const bool keep = keeps_base(path);
+    const int n = static_cast<int>(st.K.rows());  // (Z may have more rows: unit_solves' scratch)
     double* const rn2 = kb.rn2.data();
     for (int j = 0; j < k; ++j) {
         const double s = kb.eqs[static_cast<std::size_t>(rows[j])].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
         const double* pj = P.col(j).data();
-        const double* gj = GZ.col(j).data();
-        // the column [s p; s G z] written in memory order, its squares into the rows' norms
+        const double* zj = Z.col(j).data();
+        // the column [s p; s G z] written in memory order, its squares into the rows' norms; G z
+        // row by row here (the arithmetic of Eigen's row-major sparse x dense product, whose
+        // result starts at 0: 0 + (sum in the row's order)), not as an m x k temporary first
         double* y = kb.Y.next();
         for (int q = 0; q < m; ++q) {
             const double v = s * pj[q];
@@ -423,12 +425,14 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             rn2[q] += v * v;
         }
         for (int q = 0; q < m; ++q) {
-            const double v = s * gj[q];
+            double g = 0.0;
+            for (RowMat::InnerIterator it(st.Grow, q); it; ++it) g += it.value() * zj[it.index()];
+            const double v = s * (0.0 + g);
             y[m + q] = v;
             rn2[m + q] += v * v;
         }
         kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.commit();
-        if (keep) kb.add_zc(s, Z.col(j));
+        if (keep) kb.add_zc(s, Z.col(j).head(n));
     }
     stats.columns += k;
     stats.column_s += thread_cpu_s() - c0;
