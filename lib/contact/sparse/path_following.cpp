@@ -125,76 +125,59 @@ public:
         if (c / kWidth < full_) return panels_[static_cast<std::size_t>(c / kWidth)][slot(q, c)];
         return stage_[static_cast<std::size_t>(c % kWidth) * static_cast<std::size_t>(rows_) + static_cast<std::size_t>(q)];
     }
-    /// The panels, in order, where L0 or L1 (or null) has a nonzero entry (L0, L1: padded()
-    /// entries, zero past size()). A panel whose entries of lambda are all zero adds
-    /// sum_i y_i 0 = +0 to the sums below, and a sum that starts at +0 is never -0 (x + y is -0
-    /// only for -0 + -0), so adding it changes nothing: the sums over these panels alone are
-    /// the same to the last bit, for finite columns (where a column is not, every panel).
-    /// lambda is nonzero on the changed rows' columns only, a few of the base's (decision 049).
-    void nonzero_panels(const Eigen::VectorXd& L0, const Eigen::VectorXd* L1, std::vector<int>& out) const {
-        out.clear();
-        const int np = padded() / kWidth;
-        for (int p = 0; p < np; ++p) {
-            bool any = !finite_;
-            for (int i = p * kWidth; i < (p + 1) * kWidth && !any; ++i) any = L0[i] != 0.0 || (L1 && (*L1)[i] != 0.0);
-            if (any) out.push_back(p);
-        }
-    }
-    /// sum_c Y(q, c) L[c] over the columns of the panels `act` (nonzero_panels(L))
-    double dot(int q, const Eigen::VectorXd& L, const std::vector<int>& act) const {
+    /// sum_c Y(q, c) L[c] over the columns (L: padded() entries, zero past size())
+    double dot(int q, const Eigen::VectorXd& L) const {
         double sum = 0.0;
-        for (const int p : act) {
-            const double* l = L.data() + static_cast<std::size_t>(p) * kWidth;
+        const double* l = L.data();
+        for (int p = 0; p < full_; ++p, l += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
             double s = 0.0;
-            if (p < full_) {
-                const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
-                for (int i = 0; i < kWidth; ++i) s += y[i] * l[i];
-            } else {
-                for (int i = 0; i < kWidth; ++i) s += staged(q, i) * l[i];
-            }
+            for (int i = 0; i < kWidth; ++i) s += y[i] * l[i];
+            sum += s;
+        }
+        if (staged_ > 0) {
+            double s = 0.0;
+            for (int i = 0; i < kWidth; ++i) s += staged(q, i) * l[i];
             sum += s;
         }
         return sum;
     }
-    /// dot(q, L0, act) and dot(q, L1, act) in one pass over the row (the same sums)
-    void dot2(int q, const Eigen::VectorXd& L0, const Eigen::VectorXd& L1, const std::vector<int>& act, double& a,
-              double& b) const {
+    /// dot(q, L0) and dot(q, L1) in one pass over the row (the same sums)
+    void dot2(int q, const Eigen::VectorXd& L0, const Eigen::VectorXd& L1, double& a, double& b) const {
         a = b = 0.0;
-        for (const int p : act) {
-            const double* l0 = L0.data() + static_cast<std::size_t>(p) * kWidth;
-            const double* l1 = L1.data() + static_cast<std::size_t>(p) * kWidth;
+        const double* l0 = L0.data();
+        const double* l1 = L1.data();
+        for (int p = 0; p < full_; ++p, l0 += kWidth, l1 += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
             double s0 = 0.0, s1 = 0.0;
-            if (p < full_) {
-                const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
-                for (int i = 0; i < kWidth; ++i) {
-                    s0 += y[i] * l0[i];
-                    s1 += y[i] * l1[i];
-                }
-            } else {
-                for (int i = 0; i < kWidth; ++i) {
-                    const double y = staged(q, i);
-                    s0 += y * l0[i];
-                    s1 += y * l1[i];
-                }
+            for (int i = 0; i < kWidth; ++i) {
+                s0 += y[i] * l0[i];
+                s1 += y[i] * l1[i];
+            }
+            a += s0;
+            b += s1;
+        }
+        if (staged_ > 0) {
+            double s0 = 0.0, s1 = 0.0;
+            for (int i = 0; i < kWidth; ++i) {
+                const double y = staged(q, i);
+                s0 += y * l0[i];
+                s1 += y * l1[i];
             }
             a += s0;
             b += s1;
         }
     }
     /// A new column: its `rows` entries to be written at the pointer returned, then commit()
-    /// (which returns its index; `finite`: whether every entry is).
+    /// (which returns its index).
     double* next() { return stage_.data() + static_cast<std::size_t>(staged_) * static_cast<std::size_t>(rows_); }
-    int commit(bool finite) {
-        finite_ = finite_ && finite;
+    int commit() {
         const int c = ncol_++;
         if (++staged_ == kWidth) flush();
         return c;
     }
     /// Forgets every column (a new base; the panels' memory is kept for the next ones).
-    void clear() {
-        ncol_ = full_ = staged_ = 0;
-        finite_ = true;
-    }
+    void clear() { ncol_ = full_ = staged_ = 0; }
 
 private:
     static std::size_t slot(int q, int c) { return static_cast<std::size_t>(q) * kWidth + static_cast<std::size_t>(c % kWidth); }
@@ -217,7 +200,6 @@ private:
     }
     int rows_;
     int ncol_ = 0, full_ = 0, staged_ = 0;  // columns; complete panels; columns in the stage
-    bool finite_ = true;                    // every column's entries finite
     std::vector<std::unique_ptr<double[]>> panels_;
     std::vector<double> stage_;  // kWidth columns of `rows_` entries each
 };
@@ -449,7 +431,7 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             y[m + q] = v;
             rn2[m + q] += v * v;
         }
-        kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.commit(Eigen::Map<const Eigen::VectorXd>(y, 2 * m).allFinite());
+        kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.commit();
         if (keep) kb.add_zc(s, Z.col(j).head(n));
     }
     stats.columns += k;
@@ -538,7 +520,6 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     std::vector<double> A1_at(np, 0.0), slack(np, 0.0);
     std::vector<char> dirty(np, 1);
     Eigen::VectorXd L0, L1, L1_prev;  // lambda at t = 0 and 1 per column (0 outside C)
-    std::vector<int> act;             // the panels of Y where L0 or L1 is not zero
     double t = 0.0;
     int stalls = 0;
     std::vector<Hit> hits;
@@ -550,7 +531,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
         b = X1h[q];
         if (Y.size() == 0) return;
         double ya, yb;
-        Y.dot2(q, L0, L1, act, ya, yb);
+        Y.dot2(q, L0, L1, ya, yb);
         a += ya;
         b += yb;
     };
@@ -596,7 +577,6 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
                     L1[col[C[j]]] = l1[j];
                 }
             }
-            Y.nonzero_panels(L0, &L1, act);
             {  // the bound's step: lambda_1's change since the last breakpoint
                 Eigen::VectorXd prev = Eigen::VectorXd::Zero(L1.size());
                 prev.head(std::min(L1_prev.size(), L1.size())) = L1_prev.head(std::min(L1_prev.size(), L1.size()));
@@ -767,7 +747,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     path.modes.tmode = cur.tmode;
     p = X1h.head(m);
     if (Y.size() > 0)
-        for (int q = 0; q < m; ++q) p[q] += Y.dot(q, L1, act);
+        for (int q = 0; q < m; ++q) p[q] += Y.dot(q, L1);
     return true;
 }
 
@@ -865,9 +845,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
             L[cj] = l[j];
             zf += l[j] * kb.zc[static_cast<std::size_t>(cj)];
         }
-        std::vector<int> act;
-        Y.nonzero_panels(L, nullptr, act);
-        for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L, act);
+        for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L);
     };
     // the force equations put exactly (p = 0; slip p_t = e + c p_n: a slip row's normal row is
     // held or zero, never slip)
