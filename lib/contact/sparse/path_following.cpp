@@ -283,13 +283,27 @@ struct KeptBase {
     std::vector<signed char> key;  ///< its key (the mode solver's)
     std::vector<Eq> eqs;           ///< per contact row its base equation
     ColumnStore Y;                 ///< the columns y_r (2m rows: forces, then G z)
-    /// their displacement parts, scaled alike (with path_keep_base): the first nzc of zc (the
-    /// vectors past it kept for the next base's columns: no allocation per column)
-    std::vector<Eigen::VectorXd> zc;
+    /// their displacement parts, scaled alike (with path_keep_base): the first n rows of the
+    /// first nzc of zc (one column each; the matrices past nzc kept for the next base's columns:
+    /// no allocation per column)
+    std::vector<Eigen::MatrixXd> zc;
     int nzc = 0;
-    void add_zc(double s, const Eigen::Ref<const Eigen::VectorXd>& z) {
+    /// column j of Z (at least n rows) times s as the next one; where Z is that one column, it
+    /// is scaled in place and swapped in (no copy: Z takes an old one's storage, which the
+    /// next unit_solves of the same size reuses)
+    void add_zc(double s, Eigen::MatrixXd& Z, int j, int n) {
         if (nzc == static_cast<int>(zc.size())) zc.emplace_back();
-        zc[static_cast<std::size_t>(nzc++)] = s * z;  // (same size: no reallocation)
+        Eigen::MatrixXd& out = zc[static_cast<std::size_t>(nzc++)];
+        if (Z.cols() == 1) {
+            Z.col(0) *= s;  // (the same products as s * Z)
+            out.swap(Z);
+        } else {
+            out = s * Z.col(j).head(n);  // (same size: no reallocation)
+        }
+    }
+    /// the kept displacement part of column c
+    Eigen::Map<const Eigen::VectorXd> z_of(int c, int n) const {
+        return Eigen::Map<const Eigen::VectorXd>(zc[static_cast<std::size_t>(c)].data(), n);
     }
     std::vector<int> col;          ///< per contact row its column in Y, or -1
     Eigen::VectorXd rn2;           ///< the squared norms of Y's rows (the ratio test's bound)
@@ -432,7 +446,7 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             rn2[m + q] += v * v;
         }
         kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.commit();
-        if (keep) kb.add_zc(s, Z.col(j).head(n));
+        if (keep) kb.add_zc(s, Z, j, n);  // (the last use of Z's column j)
     }
     stats.columns += k;
     stats.column_s += thread_cpu_s() - c0;
@@ -843,7 +857,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
         for (int j = 0; j < nc; ++j) {
             const int cj = kb.col[C[j]];
             L[cj] = l[j];
-            zf += l[j] * kb.zc[static_cast<std::size_t>(cj)];
+            zf += l[j] * kb.z_of(cj, static_cast<int>(zf.size()));
         }
         for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L);
     };
