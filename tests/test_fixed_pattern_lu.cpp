@@ -301,5 +301,17 @@ BOOST_AUTO_TEST_CASE(sparse_right_hand_sides_solved_as_klu_solves_them) {
                 BOOST_TEST((X_block.col(c).array() == X_one.col(0).array()).all());
             }
         }
+        // the right-hand sides given by their nonzeros (PatternLu::solve_sparse_columns,
+        // docs/decisions/049: the homotopy's columns without a zeroed dense B): the dense B's
+        // solve exactly, X's entries all overwritten (X starts as garbage)
+        sp::SparseColumns S;
+        for (int c = 0; c < B.cols(); ++c) {
+            for (int i = 0; i < n + r; ++i)
+                if (B(i, c) != 0.0) S.add(i, B(i, c));
+            S.end_column();
+        }
+        Eigen::MatrixXd X_cols = Eigen::MatrixXd::Constant(n + r, B.cols(), std::nan(""));
+        lu->solve_sparse_columns(S, n + r, X_cols);
+        BOOST_TEST((X_cols.array() == X_sparse.array()).all());
     }
 }

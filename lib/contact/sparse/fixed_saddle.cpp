@@ -79,7 +79,7 @@ private:
     // the current factor in compressed columns (klu_extract), for solve_sparse_in_place: made
     // at its first use after each factorisation
     bool extracted_ = false;
-    std::vector<int> lp_, li_, up_, ui_, p_, q_;
+    std::vector<int> lp_, li_, up_, ui_, p_, q_, pinv_;  // (pinv_: P's inverse, for sparse right-hand sides)
     std::vector<double> lx_, ux_, udiag_, rs_, y_;
     void release() {
         extracted_ = false;
@@ -125,6 +125,8 @@ private:
         }
         lp_[static_cast<std::size_t>(n)] = wl;
         up_[static_cast<std::size_t>(n)] = wu;
+        pinv_.resize(static_cast<std::size_t>(n));
+        for (int k = 0; k < n; ++k) pinv_[static_cast<std::size_t>(p_[static_cast<std::size_t>(k)])] = k;
         extracted_ = true;
         return true;
     }
@@ -239,10 +241,30 @@ public:
         for (; c + 2 <= X.cols(); c += 2) sparse_columns<2>(X, c);
         if (c < X.cols()) sparse_columns<1>(X, c);
     }
+    /// The same for B given by its nonzeros: the permuted, scaled right-hand side made from
+    /// them alone (the dense B's gather read n entries per column, nearly all zero, and the
+    /// caller zeroed them first: two O(n) passes per column, decision 049); X written whole by
+    /// the final permutation.
+    void solve_sparse_columns(const SparseColumns& B, int n, Eigen::MatrixXd& X) override {
+        if (B.cols() == 0) {
+            X.resize(n, 0);
+            return;
+        }
+        if (!extract() || symbolic_->n != n) {
+            PatternLu::solve_sparse_columns(B, n, X);
+            return;
+        }
+        X.resize(n, B.cols());
+        Eigen::Index c = 0;
+        for (; c + 4 <= X.cols(); c += 4) sparse_columns<4>(X, c, &B);
+        for (; c + 2 <= X.cols(); c += 2) sparse_columns<2>(X, c, &B);
+        if (c < X.cols()) sparse_columns<1>(X, c, &B);
+    }
 
 private:
+    /// Columns c0 .. c0 + NB - 1 of X = A^-1 X, or (B given) of X = A^-1 B.
     template <int NB>
-    void sparse_columns(Eigen::MatrixXd& X, Eigen::Index c0) {
+    void sparse_columns(Eigen::MatrixXd& X, Eigen::Index c0, const SparseColumns* B = nullptr) {
         const int n = symbolic_->n;
         const int* lp = lp_.data();
         const int* li = li_.data();
@@ -258,11 +280,24 @@ private:
         double* y = y_.data();
         double* b[NB];
         for (int c = 0; c < NB; ++c) b[c] = X.col(c0 + c).data();
-        for (int k = 0; k < n; ++k) {
-            const int i = perm[k];
+        if (B) {  // the same entries: 0.0 where B's is zero, else B's / rs at its permuted row
+            std::fill(y, y + static_cast<std::size_t>(NB) * static_cast<std::size_t>(n), 0.0);
+            const int* pinv = pinv_.data();
             for (int c = 0; c < NB; ++c) {
-                const double v = b[c][i];
-                y[NB * k + c] = v == 0.0 ? 0.0 : v / rs[k];
+                const std::size_t col = static_cast<std::size_t>(c0 + c);
+                for (int p = B->start[col]; p < B->start[col + 1]; ++p) {
+                    const int k = pinv[B->row[static_cast<std::size_t>(p)]];
+                    const double v = B->value[static_cast<std::size_t>(p)];
+                    y[NB * k + c] = v == 0.0 ? 0.0 : v / rs[k];
+                }
+            }
+        } else {
+            for (int k = 0; k < n; ++k) {
+                const int i = perm[k];
+                for (int c = 0; c < NB; ++c) {
+                    const double v = b[c][i];
+                    y[NB * k + c] = v == 0.0 ? 0.0 : v / rs[k];
+                }
             }
         }
         for (int k = 0; k < n; ++k) {  // L (unit diagonal)
@@ -573,6 +608,15 @@ void FixedSaddle::solve_in_place(Eigen::MatrixXd& R, bool refine) {
     }
     if (!refine) lu_->solve_sparse_in_place(R);
     else if (!lu_->refined_solve(As_, R)) throw SingularModes{};
+}
+
+void FixedSaddle::solve_unit_columns(const SparseColumns& B, Eigen::MatrixXd& X) {
+    if (held_system_) {
+        lu_->solve_sparse_columns(B, static_cast<int>(As_.rows()), X);
+        return;
+    }
+    X = B.dense(st_->dofs() + static_cast<int>(held_.size()));
+    solve_in_place(X, false);
 }
 
 Eigen::MatrixXd FixedSaddle::solve(const Eigen::MatrixXd& R, bool refine) {

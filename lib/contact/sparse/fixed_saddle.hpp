@@ -49,6 +49,27 @@ enum class FixedPatternLu {
 /// Whether this build has SuiteSparse's KLU (STACKBEAM_HAVE_KLU).
 bool klu_built();
 
+/// Right-hand sides given by their nonzeros, column c's at start[c] .. start[c + 1] - 1 of
+/// (row, value), no row twice in a column (unit right-hand sides: the homotopy's columns).
+struct SparseColumns {
+    std::vector<int> start{0}, row;
+    std::vector<double> value;
+    int cols() const { return static_cast<int>(start.size()) - 1; }
+    void add(int r, double v) {
+        row.push_back(r);
+        value.push_back(v);
+    }
+    void end_column() { start.push_back(static_cast<int>(row.size())); }
+    /// the dense n x cols() matrix
+    Eigen::MatrixXd dense(int n) const {
+        Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, cols());
+        for (int c = 0; c < cols(); ++c)
+            for (int p = start[static_cast<std::size_t>(c)]; p < start[static_cast<std::size_t>(c) + 1]; ++p)
+                X(row[static_cast<std::size_t>(p)], c) = value[static_cast<std::size_t>(p)];
+        return X;
+    }
+};
+
 /// A sparse LU with partial pivoting whose ordering and symbolic analysis are made once for
 /// a pattern and reused by every numeric factorisation of a matrix of that pattern.
 class PatternLu {
@@ -66,6 +87,13 @@ public:
     /// triangular solves skip the columns of the factors that a zero entry would apply (the
     /// same arithmetic otherwise, so the same result). Default: solve_in_place.
     virtual void solve_sparse_in_place(Eigen::MatrixXd& X) { solve_in_place(X); }
+    /// X = A^-1 B (n x B.cols(), X's entries all overwritten) for B given by its nonzeros:
+    /// solve_sparse_in_place's arithmetic on the dense B, without B's zeros written and read
+    /// where the LU can. Default: the dense B, solve_sparse_in_place.
+    virtual void solve_sparse_columns(const SparseColumns& B, int n, Eigen::MatrixXd& X) {
+        X = B.dense(n);
+        solve_sparse_in_place(X);
+    }
     /// Whether the current factor is a refactorisation on an old pivot sequence whose pivots
     /// were not checked (Switches::residual_refactor_check): its solves' backward error is.
     virtual bool unchecked() const { return false; }
@@ -135,6 +163,9 @@ public:
     Eigen::MatrixXd solve(const Eigen::MatrixXd& R, bool refine = true);
     /// The same, R overwritten by the result (the held system's: in place, no copy).
     void solve_in_place(Eigen::MatrixXd& R, bool refine = true);
+    /// solve_in_place(R, false) for R given by its nonzeros (SparseColumns; X: the solution,
+    /// its entries all overwritten, no zeroed R needed on the held system's route)
+    void solve_unit_columns(const SparseColumns& B, Eigen::MatrixXd& X);
     /// A_S x in the same layout (the rows outside S contribute nothing: their entries are zero).
     Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
     /// Orderings and symbolic analyses made since reset() (tests, benchmark).

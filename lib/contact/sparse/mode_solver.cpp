@@ -494,19 +494,30 @@ bool ModeSolver::unit_solves(const ModeLinearization& lin, const std::vector<int
             PS.col(j) = pS;
         }
     } else {
-        Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n + ms, k);
+        // solved in Z itself (n + ms rows: the displacements on top, scaled in place; the held
+        // forces below, copied out): no second n x k matrix and copy per call
+        // (on the fixed pattern without refinement: the right-hand sides by their nonzeros, no
+        // zeroed n + ms x k matrix)
+        Eigen::MatrixXd& R = Z;
+        SparseColumns B;
         for (int j = 0; j < k; ++j) {
             const int r = rows[static_cast<std::size_t>(j)], i = pos[r];
             if (i >= 0) {
-                R(n + i, j) = row_scale[i];
+                B.add(n + i, row_scale[i]);
             } else {
-                for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) R(it.row(), j) = st_.dz[it.row()] * it.value();
+                for (SpMat::InnerIterator it(st_.Gt, r); it; ++it) B.add(static_cast<int>(it.row()), st_.dz[it.row()] * it.value());
             }
+            B.end_column();
         }
-        if (lu_fixed) fixed_->solve_in_place(R, refine);  // (no copy of the n + ms rows per column)
-        else R = refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
-        Z = st_.dz.asDiagonal() * R.topRows(n);
+        if (lu_fixed && !refine) {
+            fixed_->solve_unit_columns(B, R);
+        } else {
+            R = B.dense(n + ms);
+            if (lu_fixed) fixed_->solve_in_place(R, refine);  // (no copy of the n + ms rows per column)
+            else R = refine ? refined_solve(R) : Eigen::MatrixXd(lu.solve(R));
+        }
         PS = row_scale.asDiagonal() * R.bottomRows(ms);
+        R.topRows(n).array().colwise() *= st_.dz.array();  // (the same products as dz.asDiagonal() * R)
     }
     P.setZero(m, k);
     for (int j = 0; j < k; ++j) {

@@ -132,7 +132,8 @@ public:
     /// For the current factorisation (lin's, made current by a solve() with its key): lin's
     /// problem for one unit right-hand side per row of `rows`, all in one multi-column solve,
     /// with b = 0 and e = 0 but a unit offset d_r (a held row of lin) or a unit fixed force e_r
-    /// (a row not held): the forces P (m x k) and displacements Z (n x k). refine false: no
+    /// (a row not held): the forces P (m x k) and displacements Z (the first n of its rows; it
+    /// may have more, scratch, so the sparse LU's solution needs no copy). refine false: no
     /// iterative refinement (the homotopy's columns, docs/decisions/040: its end modes are
     /// solved again with refinement by the passes). False (nothing solved) where the current
     /// factorisation is a bordered update or the primal route's: then solve() per column.

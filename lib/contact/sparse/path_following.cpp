@@ -44,6 +44,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 
 #include "contact/sparse/common.hpp"
 #include "contact/sparse/trace.hpp"
@@ -104,25 +105,39 @@ void pair_equations(const ContactPair& c, signed char nm, signed char tm, Eq& en
 
 /// The columns y_r of the path (2m rows: the forces, then G z), stored in panels of kWidth
 /// columns, each panel row-major: one row's entries of a panel share a cache line. A row's
-/// dot product with lambda (the ratio test's x0 / x1) reads ncol / kWidth lines, and adding
-/// a column writes along its panel in memory order; a row-major matrix of all the columns
-/// (the way before) put every row of a new column on its own cache line (decision 043).
+/// dot product with lambda (the ratio test's x0 / x1) reads ncol / kWidth lines (decision 043).
+/// The columns of the last, incomplete panel are kept apart, each contiguous (the stage), and
+/// go into their panel together when it is complete (one sequential pass): written into the
+/// panel one by one, each new column touched one cache line per row (2m lines, the panel's
+/// whole 0.55 MB at 10 x 400 for 69 KB of values, the lines mostly out of cache after the
+/// solves between two columns), and each new panel was zeroed first (decision 049). The sums
+/// are the same to the last bit: the stage's row is read in the panel's slot order, with the
+/// panel's 0.0 in the slots of columns not added yet.
 class ColumnStore {
 public:
     static constexpr int kWidth = 8;
-    explicit ColumnStore(int rows) : rows_(rows) {}
+    explicit ColumnStore(int rows)
+        : rows_(rows), stage_(static_cast<std::size_t>(rows) * kWidth) {}
     int size() const { return ncol_; }
     /// the columns rounded up to whole panels (lambda's padded length)
-    int padded() const { return used_ * kWidth; }
-    double operator()(int q, int c) const { return panels_[static_cast<std::size_t>(c / kWidth)][slot(q, c)]; }
+    int padded() const { return (ncol_ + kWidth - 1) / kWidth * kWidth; }
+    double operator()(int q, int c) const {
+        if (c / kWidth < full_) return panels_[static_cast<std::size_t>(c / kWidth)][slot(q, c)];
+        return stage_[static_cast<std::size_t>(c % kWidth) * static_cast<std::size_t>(rows_) + static_cast<std::size_t>(q)];
+    }
     /// sum_c Y(q, c) L[c] over the columns (L: padded() entries, zero past size())
     double dot(int q, const Eigen::VectorXd& L) const {
         double sum = 0.0;
         const double* l = L.data();
-        for (int p = 0; p < used_; ++p, l += kWidth) {
-            const double* y = panels_[static_cast<std::size_t>(p)].data() + static_cast<std::size_t>(q) * kWidth;
+        for (int p = 0; p < full_; ++p, l += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
             double s = 0.0;
             for (int i = 0; i < kWidth; ++i) s += y[i] * l[i];
+            sum += s;
+        }
+        if (staged_ > 0) {
+            double s = 0.0;
+            for (int i = 0; i < kWidth; ++i) s += staged(q, i) * l[i];
             sum += s;
         }
         return sum;
@@ -132,8 +147,8 @@ public:
         a = b = 0.0;
         const double* l0 = L0.data();
         const double* l1 = L1.data();
-        for (int p = 0; p < used_; ++p, l0 += kWidth, l1 += kWidth) {
-            const double* y = panels_[static_cast<std::size_t>(p)].data() + static_cast<std::size_t>(q) * kWidth;
+        for (int p = 0; p < full_; ++p, l0 += kWidth, l1 += kWidth) {
+            const double* y = panels_[static_cast<std::size_t>(p)].get() + static_cast<std::size_t>(q) * kWidth;
             double s0 = 0.0, s1 = 0.0;
             for (int i = 0; i < kWidth; ++i) {
                 s0 += y[i] * l0[i];
@@ -142,30 +157,51 @@ public:
             a += s0;
             b += s1;
         }
-    }
-    /// A new column, its entries from `value(q)` for q < rows; returns its index.
-    template <class F>
-    int add(const F& value) {
-        const int c = ncol_++;
-        if (c % kWidth == 0) {  // a new panel (one left by clear() is zeroed for its new columns)
-            if (used_ < static_cast<int>(panels_.size()))
-                std::fill(panels_[static_cast<std::size_t>(used_)].begin(), panels_[static_cast<std::size_t>(used_)].end(), 0.0);
-            else
-                panels_.emplace_back(static_cast<std::size_t>(rows_) * kWidth, 0.0);
-            ++used_;
+        if (staged_ > 0) {
+            double s0 = 0.0, s1 = 0.0;
+            for (int i = 0; i < kWidth; ++i) {
+                const double y = staged(q, i);
+                s0 += y * l0[i];
+                s1 += y * l1[i];
+            }
+            a += s0;
+            b += s1;
         }
-        double* y = panels_[static_cast<std::size_t>(used_ - 1)].data() + c % kWidth;
-        for (int q = 0; q < rows_; ++q) y[static_cast<std::size_t>(q) * kWidth] = value(q);
+    }
+    /// A new column: its `rows` entries to be written at the pointer returned, then commit()
+    /// (which returns its index).
+    double* next() { return stage_.data() + static_cast<std::size_t>(staged_) * static_cast<std::size_t>(rows_); }
+    int commit() {
+        const int c = ncol_++;
+        if (++staged_ == kWidth) flush();
         return c;
     }
     /// Forgets every column (a new base; the panels' memory is kept for the next ones).
-    void clear() { ncol_ = used_ = 0; }
+    void clear() { ncol_ = full_ = staged_ = 0; }
 
 private:
     static std::size_t slot(int q, int c) { return static_cast<std::size_t>(q) * kWidth + static_cast<std::size_t>(c % kWidth); }
+    /// the stage's entry (q, i), 0.0 where column i of the panel is not added yet
+    double staged(int q, int i) const {
+        return i < staged_ ? stage_[static_cast<std::size_t>(i) * static_cast<std::size_t>(rows_) + static_cast<std::size_t>(q)]
+                           : 0.0;
+    }
+    /// the complete stage into the next panel (every entry written: no zeroing), row by row
+    void flush() {
+        if (full_ == static_cast<int>(panels_.size()))
+            panels_.emplace_back(new double[static_cast<std::size_t>(rows_) * kWidth]);  // (uninitialised)
+        double* y = panels_[static_cast<std::size_t>(full_)].get();
+        const double* st = stage_.data();
+        const std::size_t n = static_cast<std::size_t>(rows_);
+        for (std::size_t q = 0; q < n; ++q, y += kWidth)
+            for (std::size_t i = 0; i < static_cast<std::size_t>(kWidth); ++i) y[i] = st[i * n + q];
+        ++full_;
+        staged_ = 0;
+    }
     int rows_;
-    int ncol_ = 0, used_ = 0;
-    std::vector<std::vector<double>> panels_;
+    int ncol_ = 0, full_ = 0, staged_ = 0;  // columns; complete panels; columns in the stage
+    std::vector<std::unique_ptr<double[]>> panels_;
+    std::vector<double> stage_;  // kWidth columns of `rows_` entries each
 };
 
 /// A pair whose mode condition fails on the rest of the path, its new mode (normal or
@@ -247,7 +283,28 @@ struct KeptBase {
     std::vector<signed char> key;  ///< its key (the mode solver's)
     std::vector<Eq> eqs;           ///< per contact row its base equation
     ColumnStore Y;                 ///< the columns y_r (2m rows: forces, then G z)
-    std::vector<Eigen::VectorXd> zc;  ///< their displacement parts, scaled alike (with path_keep_base)
+    /// their displacement parts, scaled alike (with path_keep_base): the first n rows of the
+    /// first nzc of zc (one column each; the matrices past nzc kept for the next base's columns:
+    /// no allocation per column)
+    std::vector<Eigen::MatrixXd> zc;
+    int nzc = 0;
+    /// column j of Z (at least n rows) times s as the next one; where Z is that one column, it
+    /// is scaled in place and swapped in (no copy: Z takes an old one's storage, which the
+    /// next unit_solves of the same size reuses)
+    void add_zc(double s, Eigen::MatrixXd& Z, int j, int n) {
+        if (nzc == static_cast<int>(zc.size())) zc.emplace_back();
+        Eigen::MatrixXd& out = zc[static_cast<std::size_t>(nzc++)];
+        if (Z.cols() == 1) {
+            Z.col(0) *= s;  // (the same products as s * Z)
+            out.swap(Z);
+        } else {
+            out = s * Z.col(j).head(n);  // (same size: no reallocation)
+        }
+    }
+    /// the kept displacement part of column c
+    Eigen::Map<const Eigen::VectorXd> z_of(int c, int n) const {
+        return Eigen::Map<const Eigen::VectorXd>(zc[static_cast<std::size_t>(c)].data(), n);
+    }
     std::vector<int> col;          ///< per contact row its column in Y, or -1
     Eigen::VectorXd rn2;           ///< the squared norms of Y's rows (the ratio test's bound)
     struct Solution {
@@ -268,7 +325,7 @@ struct KeptBase {
         key = solver_key(laws, modes);
         mode_equations(laws, modes.nmode, modes.tmode, eqs);
         Y.clear();
-        zc.clear();
+        nzc = 0;
         std::fill(col.begin(), col.end(), -1);
         rn2.setZero();
         for (auto& s : sol) s.X.resize(0);
@@ -365,17 +422,31 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             Z.col(j) = zj;
         }
     }
-    const Eigen::MatrixXd GZ = st.Grow * Z;  // (row-major G: a gather per row)
+    const bool keep = keeps_base(path);
+    const int n = static_cast<int>(st.K.rows());  // (Z may have more rows: unit_solves' scratch)
+    double* const rn2 = kb.rn2.data();
     for (int j = 0; j < k; ++j) {
         const double s = kb.eqs[static_cast<std::size_t>(rows[j])].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
         const double* pj = P.col(j).data();
-        const double* gj = GZ.col(j).data();
-        kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.add([&](int q) {
-            const double v = s * (q < m ? pj[q] : gj[q - m]);
-            kb.rn2[q] += v * v;
-            return v;
-        });
-        if (keeps_base(path)) kb.zc.push_back(s * Z.col(j));
+        const double* zj = Z.col(j).data();
+        // the column [s p; s G z] written in memory order, its squares into the rows' norms; G z
+        // row by row here (the arithmetic of Eigen's row-major sparse x dense product, whose
+        // result starts at 0: 0 + (sum in the row's order)), not as an m x k temporary first
+        double* y = kb.Y.next();
+        for (int q = 0; q < m; ++q) {
+            const double v = s * pj[q];
+            y[q] = v;
+            rn2[q] += v * v;
+        }
+        for (int q = 0; q < m; ++q) {
+            double g = 0.0;
+            for (RowMat::InnerIterator it(st.Grow, q); it; ++it) g += it.value() * zj[it.index()];
+            const double v = s * (0.0 + g);
+            y[m + q] = v;
+            rn2[m + q] += v * v;
+        }
+        kb.col[static_cast<std::size_t>(rows[j])] = kb.Y.commit();
+        if (keep) kb.add_zc(s, Z, j, n);  // (the last use of Z's column j)
     }
     stats.columns += k;
     stats.column_s += thread_cpu_s() - c0;
@@ -769,7 +840,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
         return false;
     }
     const ColumnStore& Y = kb.Y;
-    if (static_cast<int>(kb.zc.size()) != Y.size()) return false;  // (columns made with the switch off)
+    if (kb.nzc != Y.size()) return false;  // (columns made with the switch off)
     // the bordered system on C: H lambda = F (metres both ways, as the path's)
     const Eigen::MatrixXd H = bordered_matrix(eq, C, Y, kb.col, W, m);
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(H);
@@ -786,7 +857,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
         for (int j = 0; j < nc; ++j) {
             const int cj = kb.col[C[j]];
             L[cj] = l[j];
-            zf += l[j] * kb.zc[static_cast<std::size_t>(cj)];
+            zf += l[j] * kb.z_of(cj, static_cast<int>(zf.size()));
         }
         for (int q = 0; q < m; ++q) pf[q] += Y.dot(q, L);
     };
