@@ -77,7 +77,7 @@ build() {
 # scripts/fuzz.sh runs them from this build (STACKBEAM_FUZZ_BUILD=build-asan), so the
 # library is compiled under the sanitizers once for both (decision 032). The readers,
 # writers and the CLI at -O0 (half their compile time; they read and dispatch, the work the
-# tests run is the library's solvers and steppers, -O1).
+# tests run is the library's solvers and steppers, -O1). Without studies/ (no test runs them).
 build_sanitized() {
   # shellcheck disable=SC2046
   cmake -S . -B build-asan $(generator_args build-asan) -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
