@@ -1,8 +1,9 @@
 # Shared by run-demo.sh and run-tests.sh (sourced, not run): installs the Debian
 # packages the project needs, if missing, and configures and builds it in build/.
 
-# The packages every build needs (pkgconf: the test of the installed stackbeam.pc).
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+# The packages every build needs (pkgconf: the test of the installed stackbeam.pc; ninja-build:
+# the builds' generator, generator_args below).
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake ninja-build pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)
@@ -43,9 +44,23 @@ install_packages() {
   "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
 }
 
+# generator_args DIR: `-G Ninja` for a build directory not configured yet (or already
+# configured with Ninja), when ninja is installed; nothing for one configured with another
+# generator (CMake refuses to change it), which keeps that one. Ninja compiles the objects of
+# a target while the libraries it links are still being built (the Makefile generator waits
+# for the whole library first): both cores stay busy past each library's longest source
+# (docs/decisions/048-ci-build-time.md).
+generator_args() {
+  if command -v ninja >/dev/null 2>&1 && \
+     { [ ! -f "$1/CMakeCache.txt" ] || grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' "$1/CMakeCache.txt"; }; then
+    echo "-G Ninja"
+  fi
+}
+
 # build: configures and builds the project in build/ (Release).
 build() {
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+  # shellcheck disable=SC2046
+  cmake -S . -B build $(generator_args build) -DCMAKE_BUILD_TYPE=Release
   cmake --build build -j"$(nproc)"
 }
 
@@ -62,11 +77,12 @@ build() {
 # scripts/fuzz.sh runs them from this build (STACKBEAM_FUZZ_BUILD=build-asan), so the
 # library is compiled under the sanitizers once for both (decision 032). The readers,
 # writers and the CLI at -O0 (half their compile time; they read and dispatch, the work the
-# tests run is the library's solvers and steppers, -O1).
+# tests run is the library's solvers and steppers, -O1). Without studies/ (no test runs them).
 build_sanitized() {
-  cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
+  # shellcheck disable=SC2046
+  cmake -S . -B build-asan $(generator_args build-asan) -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DBUILD_SHARED_LIBS=ON \
     -DSTACKBEAM_BUILD_PYTHON=OFF -DSTACKBEAM_BUILD_FUZZERS=ON -DSTACKBEAM_FUZZ_PLAIN_REST=OFF \
-    -DSTACKBEAM_COLD_COMPILE_OPTIONS=-O0 \
+    -DSTACKBEAM_COLD_COMPILE_OPTIONS=-O0 -DSTACKBEAM_BUILD_STUDIES=OFF \
     -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   cmake --build build-asan -j"$(nproc)"
 }
@@ -76,7 +92,8 @@ build_sanitized() {
 # --jobs N`'s scheduler), not the whole project (a few minutes on 2 cores). Proves the
 # library keeps no mutable state shared between runs: a data race fails the test.
 build_tsan() {
-  cmake -S . -B build-tsan -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
+  # shellcheck disable=SC2046
+  cmake -S . -B build-tsan $(generator_args build-tsan) -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
     -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DSTACKBEAM_BUILD_DEMOS=OFF \
     -DSTACKBEAM_COLD_COMPILE_OPTIONS=-O0
   cmake --build build-tsan -j"$(nproc)" --target test_sweep
