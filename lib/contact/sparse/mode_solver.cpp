@@ -143,12 +143,6 @@ void SparseStiffness::append_scaled_K(std::vector<Eigen::Triplet<double>>& t) co
             t.emplace_back(it.row(), it.col(), it.value() * dz[it.row()] * dz[it.col()]);
 }
 
-double SparseStiffness::row_dot(int r, const Eigen::VectorXd& v) const {
-    double sum = 0.0;
-    for (RowMat::InnerIterator it(Grow, r); it; ++it) sum += it.value() * v[it.col()];
-    return sum;
-}
-
 void ModeSolver::reset(const SpMat& K, const SpMat& G, const std::vector<std::pair<int, int>>& couplings) {
     st_.build(K, G);
     const auto m = static_cast<std::size_t>(st_.rows());

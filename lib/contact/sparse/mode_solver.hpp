@@ -61,8 +61,13 @@ struct SparseStiffness {
     double roundoff(const Eigen::VectorXd& d, const Eigen::VectorXd& z) const;
     /// Appends Dz K Dz (the stiffness block of the scaled saddle-point systems) to t.
     void append_scaled_K(std::vector<Eigen::Triplet<double>>& t) const;
-    /// g_r . v for a contact row r and a vector v of n entries.
-    double row_dot(int r, const Eigen::VectorXd& v) const;
+    /// g_r . v for a contact row r and a vector v of n entries (inline: the homotopy calls it per
+    /// row of every column, decision 049).
+    double row_dot(int r, const Eigen::Ref<const Eigen::VectorXd>& v) const {
+        double sum = 0.0;
+        for (RowMat::InnerIterator it(Grow, r); it; ++it) sum += it.value() * v[it.col()];
+        return sum;
+    }
 };
 
 /// Per contact row: its elastic-interface layer DOF (decision 013: a column of K with its

@@ -227,6 +227,13 @@ void mode_equations(const ContactProblem& laws, const std::vector<signed char>& 
     }
 }
 
+/// The rows whose equation in eq differs from the base's, ascending, into C.
+void changed_rows(const std::vector<Eq>& eq, const std::vector<Eq>& base, std::vector<int>& C) {
+    C.clear();
+    for (int row = 0; row < static_cast<int>(eq.size()); ++row)
+        if (eq[static_cast<std::size_t>(row)] != base[static_cast<std::size_t>(row)]) C.push_back(row);
+}
+
 /// The bordered system on the rows C that differ from the base (metres both ways: a force
 /// equation's row scaled by W_rr; the columns are scaled): H(i, j) = row C[i]'s equation applied to
 /// the column of C[j], and F[i] = its right-hand side target(C[i]) minus the equation applied to x.
@@ -428,10 +435,10 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
     for (int j = 0; j < k; ++j) {
         const double s = kb.eqs[static_cast<std::size_t>(rows[j])].kind == Eq::held ? 1.0 : 1.0 / W[rows[j]];
         const double* pj = P.col(j).data();
-        const double* zj = Z.col(j).data();
+        const auto zj = Z.col(j).head(n);
         // the column [s p; s G z] written in memory order, its squares into the rows' norms; G z
-        // row by row here (the arithmetic of Eigen's row-major sparse x dense product, whose
-        // result starts at 0: 0 + (sum in the row's order)), not as an m x k temporary first
+        // row by row here (SparseStiffness::row_dot: the sums of Eigen's row-major sparse x dense
+        // product, in the row's order), not as an m x k temporary first
         double* y = kb.Y.next();
         for (int q = 0; q < m; ++q) {
             const double v = s * pj[q];
@@ -439,9 +446,7 @@ int add_columns(SparsePath& path, KeptBase& kb, std::vector<int> rows, bool per_
             rn2[q] += v * v;
         }
         for (int q = 0; q < m; ++q) {
-            double g = 0.0;
-            for (RowMat::InnerIterator it(st.Grow, q); it; ++it) g += it.value() * zj[it.index()];
-            const double v = s * (0.0 + g);
+            const double v = s * st.row_dot(q, zj);
             y[m + q] = v;
             rn2[m + q] += v * v;
         }
@@ -551,9 +556,7 @@ bool path_following(SparsePath& path, const Step& step, const PathStart& start, 
     };
     try {
         for (;;) {
-            C.clear();
-            for (int row = 0; row < m; ++row)
-                if (eq[row] != base[row]) C.push_back(row);
+            changed_rows(eq, base, C);
             if (stats.start_rows < 0 && stats.kept_base) stats.start_rows = static_cast<int>(C.size());
             if (rebase_rows > 0 && static_cast<int>(C.size()) > rebase_rows) {
                 // a new base: the current modes factorised (the columns and the bound start again)
@@ -823,8 +826,7 @@ bool solve_on_kept_base(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
     std::vector<Eq> eq;
     mode_equations(laws, path.modes.nmode, path.modes.tmode, eq);
     std::vector<int> C;
-    for (int row = 0; row < m; ++row)
-        if (eq[row] != kb.eqs[row]) C.push_back(row);
+    changed_rows(eq, kb.eqs, C);
     const int nc = static_cast<int>(C.size());
     if (nc > limit) return false;
     PathStats unused;
