@@ -1,9 +1,13 @@
 // `stackbeam simulate`'s arguments -> ModelSpec + SimulationOptions + output files.
 #include "options.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include "stackbeam/errors.hpp"
@@ -14,6 +18,25 @@
 namespace stackbeam::cli {
 
 namespace {
+
+/// Refuses an output file that cannot be written, before any run: a directory, or a file
+/// in a folder that does not exist or cannot be written (the system's reason). `name`: the
+/// flag, or the scenario key that gave the path.
+void check_output_file(const std::string& name, const std::string& path) {
+    if (path.empty()) return;
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+        throw ArgumentError(name + ": value '" + path + "' is a directory: give a file name");
+    const auto cut = path.find_last_of('/');
+    const std::string folder = cut == std::string::npos ? "." : cut == 0 ? "/" : path.substr(0, cut);
+    if (::stat(folder.c_str(), &st) != 0)
+        throw ArgumentError(name + ": value '" + path + "': its folder '" + folder + "' cannot be used: " +
+                            std::strerror(errno));
+    if (!S_ISDIR(st.st_mode))
+        throw ArgumentError(name + ": value '" + path + "': '" + folder + "' is not a directory");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw ArgumentError(name + ": value '" + path + "': cannot write in '" + folder + "': " + std::strerror(errno));
+}
 
 /// Parses all of `text` as a number for `spec` given as `flag`, or throws naming the flag,
 /// the text as written and what the option table allows.
@@ -234,6 +257,15 @@ RunRequest make_request(const SimulateArgs& a) {
                 throw ArgumentError(what + ": value '" + r.nodes + "' is also the " + other +
                                     " file: give the nodal displacements a file of their own");
     }
+    // every output checked before the run: a bad path is found in a moment, not after the simulation
+    auto name = [&](const std::string& flag, const std::string& given, const char* key) {
+        return given.empty() && !a.scenario.empty() ? std::string("outputs.") + key + " (file " + a.scenario + ")" : flag;
+    };
+    check_output_file(name("--out", a.out, "csv_path"), r.out);
+    check_output_file(name("--events", a.events, "events_path"), r.events);
+    check_output_file(name("--summary", a.summary, "summary_path"), r.summary);
+    check_output_file(name("--pairs", a.pairs, "pairs_path"), r.pairs);
+    check_output_file(name("--nodes", a.nodes, "nodes_path"), r.nodes);
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }

@@ -1,9 +1,13 @@
 // The run of `stackbeam simulate`: rows streamed to FILE.partial, progress, interruption.
 #include "run.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -30,8 +34,17 @@ class PartialFile {
 public:
     PartialFile(const std::string& path, const std::string& option) : path_(path), partial_(path + ".partial") {
         if (path_.empty()) return;
+        errno = 0;
         stream_.open(partial_, std::ios::out | std::ios::trunc);
-        if (!stream_) throw ArgumentError(option + ": cannot open '" + partial_ + "' for writing");
+        if (!stream_)
+            throw ArgumentError(option + ": cannot open '" + partial_ + "' for writing" +
+                                (errno != 0 ? std::string(": ") + std::strerror(errno) : std::string()));
+    }
+    /// Throws (the system's reason) when a write failed (a full disk), after cutting the file
+    /// back to its last whole row.
+    void check() {
+        if (!active() || stream_.good()) return;
+        fail();
     }
     bool active() const { return !path_.empty(); }
     std::ofstream& stream() { return stream_; }
@@ -41,13 +54,21 @@ public:
         if (!active()) return;
         close();
         if (std::rename(partial_.c_str(), path_.c_str()) != 0)
-            throw std::runtime_error("cannot rename '" + partial_ + "' to '" + path_ + "'");
+            throw std::runtime_error("cannot rename '" + partial_ + "' to '" + path_ + "': " + std::strerror(errno));
     }
     /// Closes and keeps FILE.partial (an interrupted or failed run); throws if writing failed.
     void close() {
         if (!active()) return;
+        if (!stream_.is_open()) return;
+        errno = 0;
         stream_.close();
-        if (stream_.fail()) throw std::runtime_error("writing '" + partial_ + "' failed");
+        if (stream_.fail()) fail();
+    }
+    /// Flushes and closes after a failure elsewhere, keeping whole rows only.
+    void keep_whole_rows() {
+        if (!active() || !stream_.is_open()) return;
+        stream_.close();
+        trim();
     }
     /// Removes the partial file (bad input found before any result).
     void discard() {
@@ -57,6 +78,36 @@ public:
     }
 
 private:
+    [[noreturn]] void fail() {
+        const std::string why = errno != 0 ? std::strerror(errno) : "the stream reported an error";
+        if (stream_.is_open()) stream_.close();
+        trim();
+        throw std::runtime_error("writing '" + partial_ + "' failed: " + why + " (it keeps the whole rows written before)");
+    }
+    /// Cuts FILE.partial after its last line break: a row half written (a full disk, the
+    /// buffer flushed in part) is removed, so the file ends on a whole row as documented.
+    void trim() {
+        const int fd = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
+        if (fd < 0) return;
+        struct stat st {};
+        off_t keep = 0;
+        if (::fstat(fd, &st) == 0) {
+            char buffer[4096];
+            for (off_t end = st.st_size; end > 0 && keep == 0;) {
+                const off_t begin = std::max<off_t>(0, end - static_cast<off_t>(sizeof buffer));
+                const ssize_t n = ::pread(fd, buffer, static_cast<std::size_t>(end - begin), begin);
+                if (n <= 0) break;
+                for (ssize_t i = n; i-- > 0;)
+                    if (buffer[i] == '\n') {
+                        keep = begin + i + 1;
+                        break;
+                    }
+                end = begin;
+            }
+            if (keep < st.st_size) (void)::ftruncate(fd, keep);
+        }
+        ::close(fd);
+    }
     std::string path_, partial_;
     std::ofstream stream_;
 };
@@ -162,6 +213,9 @@ RunResult run(const RunRequest& request, const System& system) {
     auto on_step = [&](const StepRecord& r) {
         if (g_stop_signal != 0) throw Interrupted{};
         write_csv_row(csv.stream(), r);
+        csv.check();  // a write error (a full disk) stops the run at once, with the system's reason
+        pairs_csv.check();
+        nodes_csv.check();
         marked.clear();
         if (snapshots) {
             if (result.stats.records == 0 || r.w_m > result.stats.w_max_m) marked.push_back(&result.stack_at_w_max);
@@ -206,9 +260,9 @@ RunResult run(const RunRequest& request, const System& system) {
         throw;
     } catch (...) {
         progress.finish();
-        csv.stream().flush();
-        pairs_csv.stream().flush();
-        nodes_csv.stream().flush();
+        csv.keep_whole_rows();
+        pairs_csv.keep_whole_rows();
+        nodes_csv.keep_whole_rows();
         std::cerr << "stackbeam: note: " << request.out << " was not written; the rows up to the failure are in "
                   << csv.partial() << "\n";
         throw;

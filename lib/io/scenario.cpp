@@ -5,7 +5,13 @@
 
 #include <toml.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -666,13 +672,50 @@ void rethrow_in_scenario(const Scenario& scenario, const InputError& e) {
     rethrow_in_file(Context(scenario.source, scenario.key_locations), e);
 }
 
+std::string detail::read_input_file(const std::string& path, const std::string& what, const std::string& field,
+                                   const std::string& location, long long max_bytes) {
+    auto refuse = [&](const std::string& why) -> InputError {
+        const std::string message = what + " '" + path + "' " + why;
+        return location.empty() ? InputError(field, message) : InputError(field, message, location);
+    };
+    // O_NONBLOCK: opening a FIFO with no writer would wait for one; the type is checked before any read
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) throw refuse(std::string("cannot be opened: ") + std::strerror(errno));
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) throw refuse(std::string("cannot be examined: ") + std::strerror(errno));
+    if (!S_ISREG(st.st_mode)) {
+        const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
+                           : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                           : S_ISCHR(st.st_mode)  ? "a character device"
+                           : S_ISBLK(st.st_mode)  ? "a block device"
+                           : S_ISSOCK(st.st_mode) ? "a socket"
+                                                  : "not a regular file";
+        throw refuse(std::string("is ") + kind + ": a regular file is required");
+    }
+    if (st.st_size > max_bytes)
+        throw refuse("has " + std::to_string(static_cast<long long>(st.st_size)) + " bytes: at most " +
+                     std::to_string(max_bytes) + " are read");
+    std::string text;
+    char buffer[65536];
+    for (;;) {  // read to the end (the file may grow meanwhile: the cap holds for what is read)
+        const ssize_t n = ::read(fd, buffer, sizeof buffer);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw refuse(std::string("cannot be read: ") + std::strerror(errno));
+        if (n == 0) break;
+        text.append(buffer, static_cast<std::size_t>(n));
+        if (static_cast<long long>(text.size()) > max_bytes)
+            throw refuse("has more than " + std::to_string(max_bytes) + " bytes: at most " + std::to_string(max_bytes) +
+                         " are read");
+    }
+    return text;
+}
+
 Scenario load_scenario(const std::string& path) {
-    std::ifstream in(path, std::ios::in | std::ios::binary);
-    if (!in) throw InputError(path, "cannot open the scenario file for reading");
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (in.bad()) throw InputError(path, "cannot read the scenario file");
-    return parse_scenario(text.str(), path);
+    return parse_scenario(detail::read_input_file(path, "the scenario file", path), path);
 }
 
 }  // namespace stackbeam

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -71,6 +72,9 @@ std::vector<PathPart> split_key(const std::string& key, const std::string& locat
                 if (inside.empty() || inside.find_first_not_of("0123456789") != std::string::npos)
                     bad("index '[" + inside + "]' is neither a number nor *");
                 p.index = PathPart::Index::one;
+                // no array in a scenario has a million elements: a longer index is refused by name
+                // here, before std::stoul would throw its bare "stoul" on 20 digits
+                if (inside.size() > 6) bad("index '[" + inside + "]' is too large (at most 999999)");
                 p.element = static_cast<std::size_t>(std::stoul(inside));
             }
             i = close + 1;
@@ -148,11 +152,7 @@ bool key_covers(const std::string& key, const std::string& field) {
 
 std::string read_file(const std::string& path, const std::string& field, const std::string& location,
                       const std::string& what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(field, "cannot read " + what + " '" + path + "'", location);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return detail::read_input_file(path, what, field, location);
 }
 
 std::string directory_of(const std::string& path) {
@@ -224,7 +224,13 @@ const char* to_string(PointStatus status) {
 }
 
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
-    return parse_sweep_spec(text, source_name, [](const std::string& path, const std::string& location) {
+    return parse_sweep_spec(text, source_name, [&](const std::string& path, const std::string& location) {
+        // the spec named as its own base scenario would be read as a scenario with unknown keys
+        std::error_code ec;
+        if (std::filesystem::equivalent(path, source_name, ec))
+            throw InputError("scenario", "value '" + path + "' is the sweep spec itself: the base scenario is another "
+                                         "file (a scenario, docs/model-and-scenarios.md)",
+                             location);
         return read_file(path, "scenario", location, "the base scenario file");
     });
 }
@@ -386,6 +392,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
 int point_count(const SweepSpec& spec) {
     if (spec.axes.empty()) throw InputError("axes", "at least one axis is required", spec.source);
     long long n = spec.combine == Combine::zip ? -1 : 1;
+    double product = 1.0;  // the product's size for the message (exact below 2^53)
     for (std::size_t a = 0; a < spec.axes.size(); ++a) {
         const SweepAxis& axis = spec.axes[a];
         const std::string field = "axes[" + std::to_string(a) + "]";
@@ -401,68 +408,104 @@ int point_count(const SweepSpec& spec) {
                                  where);
             n = len;
         } else {
+            product *= static_cast<double>(len);
             n *= len;
-            if (n > 10000000) throw InputError("axes", "more than 10 million points", spec.source);
+            if (n > max_sweep_points) n = max_sweep_points + 1;  // refused below; no overflow however many axes
         }
+    }
+    if (n > max_sweep_points) {
+        std::string sizes;
+        for (const SweepAxis& axis : spec.axes)
+            sizes += (sizes.empty() ? "" : spec.combine == Combine::zip ? ", " : " x ") + std::to_string(axis.values.size());
+        throw InputError("axes", "the spec has " +
+                                     (spec.combine == Combine::zip ? std::to_string(n) : format_value(product)) +
+                                     " points (" + to_string(spec.combine) + " of " + sizes +
+                                     " values): at most " + std::to_string(max_sweep_points) +
+                                     " points in one sweep; split it into several specs",
+                         spec.source);
     }
     return static_cast<int>(n);
 }
 
-std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
-    const int n = point_count(spec);
-    Document base;
+struct SweepPoints::Impl {
+    Document base;                          // the base scenario without [outputs]
+    std::vector<std::vector<PathPart>> paths;  // each axis' key, split
+};
+
+SweepPoints::SweepPoints(const SweepSpec& spec) : spec_(&spec), count_(point_count(spec)) {
+    auto impl = std::make_shared<Impl>();
     try {
         detail::check_toml_text(spec.scenario_text, spec.scenario_path);
         std::istringstream in(spec.scenario_text);
-        base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
+        impl->base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
     } catch (const std::exception& e) {
         throw InputError("scenario", "the base scenario '" + spec.scenario_path + "' is not a valid TOML file: " + e.what(),
                          spec.scenario_location.empty() ? spec.source : spec.scenario_location);
     }
-    if (base.is_table()) base.as_table().erase("outputs");  // the sweep writes its own
-    std::vector<std::vector<PathPart>> paths;
+    if (impl->base.is_table()) impl->base.as_table().erase("outputs");  // the sweep writes its own
     for (std::size_t a = 0; a < spec.axes.size(); ++a)
-        paths.push_back(split_key(spec.axes[a].key, spec.axes[a].location, "axes[" + std::to_string(a) + "].key"));
+        impl->paths.push_back(split_key(spec.axes[a].key, spec.axes[a].location, "axes[" + std::to_string(a) + "].key"));
+    impl_ = std::move(impl);
+}
 
-    std::vector<SweepPoint> points;
-    points.reserve(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        SweepPoint point;
-        point.index = i;
-        // product: the last axis varies fastest
-        int rest = i;
-        point.values.resize(spec.axes.size());
-        for (std::size_t a = spec.axes.size(); a-- > 0;) {
-            const auto& vals = spec.axes[a].values;
-            const int len = static_cast<int>(vals.size());
-            point.values[a] = spec.combine == Combine::zip ? vals[static_cast<std::size_t>(i)] : vals[static_cast<std::size_t>(rest % len)];
-            if (spec.combine == Combine::product) rest /= len;
-        }
-        const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
-        Document doc = base;
-        for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-            try {
-                set_at(doc, paths[a], 0, to_document(point.values[a]), "");
-            } catch (const std::invalid_argument& e) {
-                throw InputError(spec.axes[a].key, at_point + ": " + e.what() + " (axis " + std::to_string(a) + ")",
-                                 spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
-            }
-        }
-        point.scenario_text = toml::format(doc, 0, std::numeric_limits<double>::max_digits10);
-        const std::string name = spec.scenario_path + " at point " + std::to_string(i);
-        try {
-            point.scenario = parse_scenario(point.scenario_text, name);
-        } catch (const InputError& e) {
-            for (std::size_t a = 0; a < spec.axes.size(); ++a)
-                if (key_covers(spec.axes[a].key, e.field()))
-                    throw InputError(e.field(), at_point + ": " + bare_message(e) + " (axis " + spec.axes[a].key + ")",
-                                     spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
-            throw InputError(e.field(), at_point + ": " + bare_message(e) + " (a key of the base scenario " +
-                                            spec.scenario_path + ", with the point's values)",
-                             spec.scenario_location.empty() ? spec.source : spec.scenario_location);
-        }
-        points.push_back(std::move(point));
+std::vector<AxisValue> SweepPoints::values(int i) const {
+    const SweepSpec& spec = *spec_;
+    if (i < 0 || i >= count_) throw std::out_of_range("sweep point " + std::to_string(i) + " of " + std::to_string(count_));
+    std::vector<AxisValue> values(spec.axes.size());
+    // product: the last axis varies fastest
+    int rest = i;
+    for (std::size_t a = spec.axes.size(); a-- > 0;) {
+        const auto& vals = spec.axes[a].values;
+        const int len = static_cast<int>(vals.size());
+        values[a] = spec.combine == Combine::zip ? vals[static_cast<std::size_t>(i)] : vals[static_cast<std::size_t>(rest % len)];
+        if (spec.combine == Combine::product) rest /= len;
     }
+    return values;
+}
+
+SweepPoint SweepPoints::point(int i) const {
+    const SweepSpec& spec = *spec_;
+    SweepPoint point;
+    point.index = i;
+    point.values = values(i);
+    const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
+    Document doc = impl_->base;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+        try {
+            set_at(doc, impl_->paths[a], 0, to_document(point.values[a]), "");
+        } catch (const std::invalid_argument& e) {
+            throw InputError(spec.axes[a].key, at_point + ": " + e.what() + " (axis " + std::to_string(a) + ")",
+                             spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+        }
+    }
+    point.scenario_text = toml::format(doc, 0, std::numeric_limits<double>::max_digits10);
+    const std::string name = spec.scenario_path + " at point " + std::to_string(i);
+    try {
+        point.scenario = parse_scenario(point.scenario_text, name);
+    } catch (const InputError& e) {
+        for (std::size_t a = 0; a < spec.axes.size(); ++a)
+            if (key_covers(spec.axes[a].key, e.field()))
+                throw InputError(e.field(), at_point + ": " + bare_message(e) + " (axis " + spec.axes[a].key + ")",
+                                 spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+        throw InputError(e.field(), at_point + ": " + bare_message(e) + " (a key of the base scenario " +
+                                        spec.scenario_path + ", with the point's values)",
+                         spec.scenario_location.empty() ? spec.source : spec.scenario_location);
+    }
+    return point;
+}
+
+void SweepPoints::check_all(const std::function<void(int checked)>& progress) const {
+    for (int i = 0; i < count_; ++i) {
+        point(i);  // built, checked and dropped: memory does not grow with the count
+        if (progress) progress(i + 1);
+    }
+}
+
+std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
+    const SweepPoints generator(spec);
+    std::vector<SweepPoint> points;
+    points.reserve(static_cast<std::size_t>(generator.size()));
+    for (int i = 0; i < generator.size(); ++i) points.push_back(generator.point(i));
     return points;
 }
 
@@ -558,13 +601,20 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     result.wall_s = elapsed();
     if (with_records) {
         result.records = &records;
+        result.point = &point;
         with_records(result);
         result.records = nullptr;
+        result.point = nullptr;
     }
     return result;
 }
 
-int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+namespace {
+
+/// run_sweep over `count` points, point i given by point_at(i) (a stored point, or one made now).
+template <class PointAt>
+int run_sweep_with(std::size_t count, const PointAt& point_at, const SweepRunOptions& opts,
+                   const PointCallback& on_point_done) {
     int jobs = opts.jobs > 0 ? opts.jobs : static_cast<int>(std::thread::hardware_concurrency());
     if (jobs < 1) jobs = 1;
     std::mutex hand_out, report;
@@ -577,14 +627,14 @@ int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts
         std::lock_guard<std::mutex> lock(hand_out);
         if (stopped()) return -1;
         if (opts.next_point) return opts.next_point();
-        while (next < points.size() && next < opts.skip.size() && opts.skip[next]) ++next;
-        return next < points.size() ? static_cast<int>(next++) : -1;
+        while (next < count && next < opts.skip.size() && opts.skip[next]) ++next;
+        return next < count ? static_cast<int>(next++) : -1;
     };
     std::atomic<bool> abort{false};  // opts.stop, or a callback's exception
     auto worker = [&] {
         for (int i; (i = take()) >= 0;) {
             try {
-                run_point(points.at(static_cast<std::size_t>(i)), &abort, [&](const PointResult& r) {
+                run_point(point_at(i), &abort, [&](const PointResult& r) {
                     std::lock_guard<std::mutex> lock(report);
                     if (failed) return;
                     try {
@@ -623,6 +673,19 @@ int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts
     watcher.join();
     if (error) std::rethrow_exception(error);
     return run;
+}
+
+}  // namespace
+
+int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+    return run_sweep_with(
+        points.size(), [&](int i) -> const SweepPoint& { return points.at(static_cast<std::size_t>(i)); }, opts,
+        on_point_done);
+}
+
+int run_sweep(const SweepPoints& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+    return run_sweep_with(
+        static_cast<std::size_t>(points.size()), [&](int i) { return points.point(i); }, opts, on_point_done);
 }
 
 }  // namespace stackbeam
