@@ -99,9 +99,10 @@ struct SweepPoint {
 };
 
 /// The most points one sweep may have (docs/sweep.md, "Limits"). A sweep directory keeps
-/// one row per point in memory (~0.3 kB) and checking a point before the run takes ~40 us,
-/// so 100,000 points cost ~30 MB and ~4 s before the first run; a larger map is several
-/// specs. A spec with more points is refused by parse_sweep_spec / point_count, with its size.
+/// one row per point in memory (~0.3 kB) and checking a point before the run takes ~1 ms
+/// (the rig scenario, docs/decisions/051), so 100,000 points cost ~30 MB and ~2 min of
+/// checking (shown as progress) before the first run; a larger map is several specs. A
+/// spec with more points is refused by parse_sweep_spec / point_count, with its size.
 constexpr long long max_sweep_points = 100000;
 
 /// The points of a spec made one at a time, when asked for: memory does not grow with
