@@ -11,7 +11,10 @@
 #include <boost/test/unit_test.hpp>
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -352,41 +355,19 @@ BOOST_AUTO_TEST_CASE(leaf_summary_periodic_and_rainflow) {
 
 namespace {
 
-const std::string kBase = R"(
-[[leaves]]
-length_m = 1.0
-height_m = 0.01
-width_m = 0.05
-youngs_modulus_pa = 2.1e11
-left_support = "fixed"
+#ifndef STACKBEAM_SOURCE_DIR
+#error "STACKBEAM_SOURCE_DIR must be defined"
+#endif
 
-[[leaves]]
-length_m = 0.6
-height_m = 0.01
-width_m = 0.05
-youngs_modulus_pa = 2.1e11
-left_support = "fixed"
-
-[[interfaces]]
-law = "coulomb"
-friction_coefficient = 0.3
-
-[rigid_body]
-mass_kg = 5
-x_m = 1.0
-
-[loading]
-kind = "initial-conditions"
-initial_velocity_m_per_s = 0.5
-
-[mesh]
-element_length_m = 0.05
-
-[integrator]
-mode = "closed-form"
-dt_s = 1e-3
-t_end_s = 0.05
-)";
+/// The paper's bonded example (three leaves), the scenario the material keys are added to.
+std::string base_text() {
+    std::ifstream in(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/paper_bonded.toml");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (text.str().find("[[leaves]]") == std::string::npos) throw std::runtime_error("cannot read scenarios/paper_bonded.toml");
+    return text.str();
+}
+const std::string kBase = base_text();
 
 const std::string kShared = R"(
 [material]
@@ -397,17 +378,14 @@ fatigue_strength_coefficient_pa = 2e9
 fatigue_strength_exponent = -0.1
 )";
 
-/// kBase with `to` inserted after the first occurrence of `after` (which must occur).
-std::string with(const std::string& after, const std::string& to, std::string text = kBase) {
-    const auto pos = text.find(after);
-    BOOST_TEST_REQUIRE(pos != std::string::npos);
-    return text.insert(pos + after.size(), to);
-}
-
-/// The second leaf's table with `lines` added as its [leaves.material].
-std::string second_leaf_material(const std::string& lines, const std::string& text = kBase) {
-    return with("length_m = 0.6\nheight_m = 0.01\nwidth_m = 0.05\nyoungs_modulus_pa = 2.1e11\nleft_support = \"fixed\"\n",
-                "[leaves.material]\n" + lines, text);
+/// `text` with `lines` as leaves[1]'s [leaves.material]: before the third [[leaves]].
+std::string second_leaf_material(const std::string& lines, std::string text = kBase) {
+    std::size_t pos = 0;
+    for (int k = 0; k < 3; ++k) {
+        pos = text.find("\n[[leaves]]", pos + 1);
+        BOOST_TEST_REQUIRE(pos != std::string::npos);
+    }
+    return text.insert(pos + 1, "[leaves.material]\n" + lines + "\n");
 }
 
 bool same(const FatigueMaterial& a, const FatigueMaterial& b) {
