@@ -211,7 +211,7 @@ LeafFatigue leaf_fatigue(const FatigueMaterial& m, const LeafStressHistories& h,
                 if (!has_sn_curve(m) && !(sar <= m.endurance_limit_pa)) out.has_life = false;  // no curve above S_e
             }
             if (has_sn_curve(m)) damage = miner_damage(m, cycles);
-            if (out.life_spot.node < 0 || damage > out.damage_per_repetition) {
+            if ((k == 0 && fibre == Fibre::top) || damage > out.damage_per_repetition) {  // the first spot, or worse
                 out.damage_per_repetition = damage;
                 out.life_spot = spot;
             }
