@@ -275,12 +275,41 @@ void parse_profile_and_ends(const Table& t, LeafSpec& l) {
     }
 }
 
+/// A fatigue material table, [material] or [leaves.material] (model.hpp, FatigueMaterial;
+/// ranges: validate_fatigue_material). A strength given as 0 is refused here: 0 stands for
+/// "not given" in the spec, so the file says that by leaving the key out.
+FatigueMaterial parse_material(const Table& parent, const std::string& key) {
+    const Table t = parent.table(key, {"ultimate_strength_pa", "yield_strength_pa", "endurance_limit_pa",
+                                       "fatigue_strength_coefficient_pa", "fatigue_strength_exponent",
+                                       "mean_stress_correction"});
+    auto optional = [&](const char* k, const char* what) {
+        const double v = t.number_or(k, what, 0.0);
+        if (t.has(k) && v == 0.0)
+            t.context().fail(child(t.path(), k), std::string("value 0 is not allowed: ") + what + " (leave the key out when not given)");
+        return v;
+    };
+    FatigueMaterial m;
+    m.ultimate_strength_pa = t.number("ultimate_strength_pa", "the ultimate tensile strength S_u [Pa], > 0");
+    m.yield_strength_pa = optional("yield_strength_pa", "the yield strength S_y [Pa], > 0");
+    m.endurance_limit_pa = optional("endurance_limit_pa", "the endurance limit S_e [Pa], > 0");
+    m.fatigue_strength_coefficient_pa = optional("fatigue_strength_coefficient_pa", "Basquin's sigma_f' [Pa], > 0");
+    m.fatigue_strength_exponent = optional("fatigue_strength_exponent", "Basquin's exponent b [-], in (-1, 0)");
+    const MeanStressCorrection goodman = MeanStressCorrection::goodman;
+    m.mean_stress_correction = choice<MeanStressCorrection>(t, "mean_stress_correction",
+                                                            {{"goodman", MeanStressCorrection::goodman},
+                                                             {"gerber", MeanStressCorrection::gerber},
+                                                             {"soderberg", MeanStressCorrection::soderberg},
+                                                             {"morrow", MeanStressCorrection::morrow}},
+                                                            &goodman);
+    return m;
+}
+
 void parse_leaves(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
     const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
                                            "youngs_modulus_pa", "density_kg_per_m3", "poisson_ratio", "left_support",
                                            "right_support", "profile", "left_end", "right_end", "free_camber_m",
-                                           "free_radius_m"};
+                                           "free_radius_m", "material"};
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("leaves", i), keys);
         LeafSpec l;
@@ -299,8 +328,20 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
         l.right_support = choice(t, "right_support", kSupports, &free);
         l.free_camber_m = t.number_or("free_camber_m", "the free arc height [m], + ends up (0: flat)", 0.0);
         l.free_radius_m = t.number_or("free_radius_m", "the free radius [m], + ends up (0: flat)", 0.0);
+        if (t.has("material")) l.material = parse_material(t, "material");
         spec.leaves.push_back(l);
     }
+    // [material]: the leaves' shared fatigue strength, for every leaf without its own
+    // [leaves.material] (which replaces it whole); checked here, under the key path as written
+    if (!top.has("material")) return;
+    const FatigueMaterial shared = parse_material(top, "material");
+    try {
+        validate_fatigue_material(shared, "material");
+    } catch (const InputError& e) {
+        rethrow_in_file(top.context(), e);
+    }
+    for (LeafSpec& l : spec.leaves)
+        if (!l.material) l.material = shared;
 }
 
 void parse_interfaces(const Table& top, ModelSpec& spec) {
@@ -643,7 +684,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     s.source = source_name;
     const Table top(ctx, root, "",
                     {"description", "leaves", "interfaces", "clamps", "rigid_body", "loading", "mesh", "probe",
-                     "integrator", "outputs", "clips"});
+                     "integrator", "outputs", "clips", "material"});
     s.description = top.string_or("description", "free text", "");
     parse_leaves(top, s.model);
     parse_interfaces(top, s.model);
