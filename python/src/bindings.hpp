@@ -12,6 +12,8 @@
 #include <pybind11/stl_bind.h>
 
 #include <algorithm>
+#include <limits>
+#include <type_traits>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -129,6 +131,74 @@ E parse_word(const std::string& text, const std::string& field, const std::vecto
         allowed += (allowed.empty() ? "'" : ", '") + std::string(w) + "'";
     }
     throw InputError(field, "value '" + text + "' is not allowed: must be one of " + allowed);
+}
+
+// --- Python values checked (checks.cpp) ------------------------------------------------------
+//
+// Every value a user gives the module (an attribute set, an argument) goes through these: a
+// wrong type (None, a bool where a number is wanted, a string, another class) raises
+// InputTypeError (Python: stackbeam.InputTypeError, an InputError and a TypeError), a value no
+// C++ number holds (an int beyond a double's range, 10**400; beyond an int's) InputError; both
+// name the attribute or argument, the value and what is allowed.
+
+/// A value of the wrong type: stackbeam.InputTypeError, both InputError and TypeError.
+class InputTypeError : public InputError {
+public:
+    using InputError::InputError;
+};
+
+/// repr(value), cut to 60 characters (a huge int's digits).
+std::string value_repr(const py::handle& value);
+/// `value` as a real number: a float or an int (numpy's too), not a bool.
+double real_arg(const py::handle& value, const std::string& name);
+/// `value` as an integer in [lo, hi]: an int (numpy's too), not a bool, not a float.
+long long integer_arg(const py::handle& value, const std::string& name, long long lo, long long hi);
+/// `value` as a bool: True or False (numpy's too), not 0 / 1 / None.
+bool bool_arg(const py::handle& value, const std::string& name);
+/// `value` as a string: a str.
+std::string string_arg(const py::handle& value, const std::string& name);
+/// The scenario argument: a Scenario, not None.
+const ScenarioPtr& scenario_arg(const ScenarioPtr& scenario, const std::string& name);
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class E>
+struct is_vector<std::vector<E>> : std::true_type {};
+
+/// `value` as T (double, int, std::string, a std::vector of those, a bound class) for `name`.
+template <class T>
+T checked(const py::handle& value, const std::string& name) {
+    if constexpr (std::is_same_v<T, double>) {
+        return real_arg(value, name);
+    } else if constexpr (std::is_same_v<T, int>) {
+        return static_cast<int>(integer_arg(value, name, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+    } else if constexpr (std::is_same_v<T, std::string>) {
+        return string_arg(value, name);
+    } else if constexpr (is_vector<T>::value) {
+        if (py::isinstance<py::str>(value) || (!py::isinstance<py::sequence>(value) && !py::hasattr(value, "__array__")))
+            throw InputTypeError(name, "value " + value_repr(value) + " is not allowed: must be a list of values");
+        T out;
+        std::size_t i = 0;
+        for (const py::handle item : value)
+            out.push_back(checked<typename T::value_type>(item, name + "[" + std::to_string(i++) + "]"));
+        return out;
+    } else {
+        if (value.is_none() || !py::isinstance<T>(value))
+            throw InputTypeError(name, "value " + value_repr(value) + " is not allowed: must be a stackbeam." +
+                                           py::type::of<T>().attr("__name__").template cast<std::string>());
+        return value.template cast<T>();
+    }
+}
+
+/// The getter and the setter of a read-write attribute for `member` (def_property), the value
+/// set checked by `checked` as the field `label` (e.g. "Leaf.height_m").
+template <class C, class T>
+auto getter(T C::*member) {
+    return [member](const C& c) -> const T& { return c.*member; };
+}
+template <class C, class T>
+auto setter(T C::*member, std::string label) {
+    return [member, label](C& c, const py::object& value) { c.*member = checked<T>(value, label); };
 }
 
 // --- options by member name (scenario.cpp) --------------------------------------------------

@@ -30,7 +30,7 @@ void enum_property(Cls& cls, const char* name, E C::*member, const std::vector<s
                 if (e == c.*member) return std::string(w);
             return std::string("?");
         },
-        [member, words, name](C& c, const std::string& text) { c.*member = parse_word(text, name, words); });
+        [member, words, name](C& c, const py::object& text) { c.*member = parse_word(string_arg(text, name), name, words); });
 }
 
 }  // namespace
@@ -48,15 +48,23 @@ void set_option(SimulationOptions& o, const std::string& member, const py::handl
     }
     if (spec->type == OptionSpec::Type::keyword) {
         if (!py::isinstance<py::str>(value))
-            throw InputError(member, "value " + py::repr(value).cast<std::string>() + " is not allowed: must be " + spec->allowed());
+            throw InputTypeError(member, "value " + value_repr(value) + " is not allowed: must be " + spec->allowed());
         spec->set_word(o, value.cast<std::string>(), member);
         return;
     }
-    if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) ||
-                                             py::hasattr(value, "__float__")))
-        throw InputError(member, "value " + py::repr(value).cast<std::string>() + " is not allowed: must be " + spec->allowed());
-    const double v = value.cast<double>();
-    if (spec->type == OptionSpec::Type::integer && v != static_cast<double>(static_cast<long long>(v)))
+    if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bool_>(value))
+        throw InputTypeError(member, "value " + value_repr(value) + " is not allowed: must be " + spec->allowed());
+    double v = 0.0;
+    try {
+        v = real_arg(value, member);
+    } catch (const InputTypeError&) {
+        throw InputTypeError(member, "value " + value_repr(value) + " is not allowed: must be " + spec->allowed());
+    } catch (const InputError&) {  // an int beyond a double's range (10**400)
+        throw InputError(member, "value " + value_repr(value) + " is not allowed: beyond a double's range; must be " +
+                                     spec->allowed());
+    }
+    if (spec->type == OptionSpec::Type::integer &&
+        !(std::abs(v) < 9.0e18 && v == static_cast<double>(static_cast<long long>(v))))
         throw InputError(member, "value " + format_value(v) + " is not allowed: must be " + spec->allowed());
     check_option(*spec, v);
     spec->set(o, v);
@@ -104,7 +112,7 @@ Model build_checked(const PyScenario& ps, const SimulationOptions& options) {
 
 SimulationOptions options_with(const PyScenario& ps, const py::dict& overrides) {
     SimulationOptions o = ps.scenario.simulation;
-    for (const auto& [k, v] : overrides) set_option(o, k.cast<std::string>(), v);
+    for (const auto& [k, v] : overrides) set_option(o, string_arg(k, "option name"), v);
     return o;
 }
 ScenarioPtr make_scenario(Scenario s, std::string setup) { return std::make_shared<PyScenario>(std::move(s), std::move(setup)); }
@@ -117,30 +125,30 @@ void bind_scenario(py::module_& m) {
     // --- the model's entries: attributes named as the scenario file's keys
     py::class_<LeafProfile>(m, "LeafProfile", "[leaves.profile]: thickness / width along the leaf (assign whole lists)")
         .def(py::init<>())
-        .def_readwrite("x_m", &LeafProfile::x_m)
-        .def_readwrite("thickness_m", &LeafProfile::thickness_m)
-        .def_readwrite("width_m", &LeafProfile::width_m);
+        .def_property("x_m", getter(&LeafProfile::x_m), setter(&LeafProfile::x_m, "LeafProfile.x_m"))
+        .def_property("thickness_m", getter(&LeafProfile::thickness_m), setter(&LeafProfile::thickness_m, "LeafProfile.thickness_m"))
+        .def_property("width_m", getter(&LeafProfile::width_m), setter(&LeafProfile::width_m, "LeafProfile.width_m"));
     py::class_<LeafEndSpec>(m, "LeafEnd", "[leaves.left_end] / [leaves.right_end]: eye, shackle, bushings")
         .def(py::init<>())
-        .def_readwrite("eye_offset_m", &LeafEndSpec::eye_offset_m)
-        .def_readwrite("shackle_angle_rad", &LeafEndSpec::shackle_angle_rad)
-        .def_readwrite("bushing_x_n_per_m", &LeafEndSpec::bushing_x_n_per_m)
-        .def_readwrite("bushing_y_n_per_m", &LeafEndSpec::bushing_y_n_per_m)
-        .def_readwrite("bushing_rotation_n_m_per_rad", &LeafEndSpec::bushing_rotation_n_m_per_rad);
+        .def_property("eye_offset_m", getter(&LeafEndSpec::eye_offset_m), setter(&LeafEndSpec::eye_offset_m, "LeafEnd.eye_offset_m"))
+        .def_property("shackle_angle_rad", getter(&LeafEndSpec::shackle_angle_rad), setter(&LeafEndSpec::shackle_angle_rad, "LeafEnd.shackle_angle_rad"))
+        .def_property("bushing_x_n_per_m", getter(&LeafEndSpec::bushing_x_n_per_m), setter(&LeafEndSpec::bushing_x_n_per_m, "LeafEnd.bushing_x_n_per_m"))
+        .def_property("bushing_y_n_per_m", getter(&LeafEndSpec::bushing_y_n_per_m), setter(&LeafEndSpec::bushing_y_n_per_m, "LeafEnd.bushing_y_n_per_m"))
+        .def_property("bushing_rotation_n_m_per_rad", getter(&LeafEndSpec::bushing_rotation_n_m_per_rad), setter(&LeafEndSpec::bushing_rotation_n_m_per_rad, "LeafEnd.bushing_rotation_n_m_per_rad"));
     py::class_<LeafSpec, std::shared_ptr<LeafSpec>> leaf(m, "Leaf", "[[leaves]]: one leaf, from the top of the stack down");
     leaf.def(py::init<>())
-        .def_readwrite("length_m", &LeafSpec::length_m)
-        .def_readwrite("x_start_m", &LeafSpec::x_start_m)
-        .def_readwrite("height_m", &LeafSpec::height_m)
-        .def_readwrite("width_m", &LeafSpec::width_m)
-        .def_readwrite("youngs_modulus_pa", &LeafSpec::youngs_modulus_pa)
-        .def_readwrite("density_kg_per_m3", &LeafSpec::density_kg_per_m3)
-        .def_readwrite("poisson_ratio", &LeafSpec::poisson_ratio)
-        .def_readwrite("profile", &LeafSpec::profile)
-        .def_readwrite("left_end", &LeafSpec::left_end)
-        .def_readwrite("right_end", &LeafSpec::right_end)
-        .def_readwrite("free_camber_m", &LeafSpec::free_camber_m)
-        .def_readwrite("free_radius_m", &LeafSpec::free_radius_m);
+        .def_property("length_m", getter(&LeafSpec::length_m), setter(&LeafSpec::length_m, "Leaf.length_m"))
+        .def_property("x_start_m", getter(&LeafSpec::x_start_m), setter(&LeafSpec::x_start_m, "Leaf.x_start_m"))
+        .def_property("height_m", getter(&LeafSpec::height_m), setter(&LeafSpec::height_m, "Leaf.height_m"))
+        .def_property("width_m", getter(&LeafSpec::width_m), setter(&LeafSpec::width_m, "Leaf.width_m"))
+        .def_property("youngs_modulus_pa", getter(&LeafSpec::youngs_modulus_pa), setter(&LeafSpec::youngs_modulus_pa, "Leaf.youngs_modulus_pa"))
+        .def_property("density_kg_per_m3", getter(&LeafSpec::density_kg_per_m3), setter(&LeafSpec::density_kg_per_m3, "Leaf.density_kg_per_m3"))
+        .def_property("poisson_ratio", getter(&LeafSpec::poisson_ratio), setter(&LeafSpec::poisson_ratio, "Leaf.poisson_ratio"))
+        .def_property("profile", getter(&LeafSpec::profile), setter(&LeafSpec::profile, "Leaf.profile"))
+        .def_property("left_end", getter(&LeafSpec::left_end), setter(&LeafSpec::left_end, "Leaf.left_end"))
+        .def_property("right_end", getter(&LeafSpec::right_end), setter(&LeafSpec::right_end, "Leaf.right_end"))
+        .def_property("free_camber_m", getter(&LeafSpec::free_camber_m), setter(&LeafSpec::free_camber_m, "Leaf.free_camber_m"))
+        .def_property("free_radius_m", getter(&LeafSpec::free_radius_m), setter(&LeafSpec::free_radius_m, "Leaf.free_radius_m"));
     enum_property(leaf, "left_support", &LeafSpec::left_support, kSupports);
     enum_property(leaf, "right_support", &LeafSpec::right_support, kSupports);
 
@@ -148,48 +156,53 @@ void bind_scenario(py::module_& m) {
     interface.def(py::init<>())
         .def_property(
             "law", [](const InterfaceSpec& f) { return std::string(f.law == InterfaceLaw::bonded ? "bonded" : "coulomb"); },
-            [](InterfaceSpec& f, const std::string& text) {
+            [](InterfaceSpec& f, const py::object& text) {
                 // 'frictionless' as in the file: coulomb with mu = 0
-                const int law = parse_word<int>(text, "law", {{"coulomb", 0}, {"frictionless", 1}, {"bonded", 2}});
+                const int law = parse_word<int>(string_arg(text, "Interface.law"), "law", {{"coulomb", 0}, {"frictionless", 1}, {"bonded", 2}});
                 f.law = law == 2 ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
                 if (law != 0) f.friction_coefficient = 0.0;
             })
-        .def_readwrite("friction_coefficient", &InterfaceSpec::friction_coefficient)
-        .def_readwrite("initial_gap_m", &InterfaceSpec::initial_gap_m)
+        .def_property("friction_coefficient", getter(&InterfaceSpec::friction_coefficient), setter(&InterfaceSpec::friction_coefficient, "Interface.friction_coefficient"))
+        .def_property("initial_gap_m", getter(&InterfaceSpec::initial_gap_m), setter(&InterfaceSpec::initial_gap_m, "Interface.initial_gap_m"))
         .def_property(
             "contact", [](const InterfaceSpec& f) { return std::string(to_string(f.contact)); },
-            [](InterfaceSpec& f, const std::string& text) { f.contact = parse_interface_contact(text, "contact"); })
-        .def_readwrite("normal_stiffness_pa_per_m", &InterfaceSpec::normal_stiffness_pa_per_m)
-        .def_readwrite("tangential_stiffness_pa_per_m", &InterfaceSpec::tangential_stiffness_pa_per_m);
+            [](InterfaceSpec& f, const py::object& text) {
+                f.contact = parse_interface_contact(string_arg(text, "Interface.contact"), "contact");
+            })
+        .def_property("normal_stiffness_pa_per_m", getter(&InterfaceSpec::normal_stiffness_pa_per_m), setter(&InterfaceSpec::normal_stiffness_pa_per_m, "Interface.normal_stiffness_pa_per_m"))
+        .def_property("tangential_stiffness_pa_per_m", getter(&InterfaceSpec::tangential_stiffness_pa_per_m), setter(&InterfaceSpec::tangential_stiffness_pa_per_m, "Interface.tangential_stiffness_pa_per_m"));
     py::class_<ClampSpec, std::shared_ptr<ClampSpec>>(m, "Clamp", "[[clamps]]: a clamp (band, U-bolt)")
         .def(py::init<>())
-        .def_readwrite("x_m", &ClampSpec::x_m)
-        .def_readwrite("preload_n", &ClampSpec::preload_n)
-        .def_readwrite("length_m", &ClampSpec::length_m);
+        .def_property("x_m", getter(&ClampSpec::x_m), setter(&ClampSpec::x_m, "Clamp.x_m"))
+        .def_property("preload_n", getter(&ClampSpec::preload_n), setter(&ClampSpec::preload_n, "Clamp.preload_n"))
+        .def_property("length_m", getter(&ClampSpec::length_m), setter(&ClampSpec::length_m, "Clamp.length_m"));
     py::class_<ClipSpec, std::shared_ptr<ClipSpec>>(m, "Clip", "[[clips]]: a rebound clip")
         .def(py::init<>())
-        .def_readwrite("x_m", &ClipSpec::x_m)
-        .def_readwrite("first_leaf", &ClipSpec::first_leaf)
-        .def_readwrite("last_leaf", &ClipSpec::last_leaf)
-        .def_readwrite("clearance_m", &ClipSpec::clearance_m)
-        .def_readwrite("stiffness_n_per_m", &ClipSpec::stiffness_n_per_m);
+        .def_property("x_m", getter(&ClipSpec::x_m), setter(&ClipSpec::x_m, "Clip.x_m"))
+        .def_property("first_leaf", getter(&ClipSpec::first_leaf), setter(&ClipSpec::first_leaf, "Clip.first_leaf"))
+        .def_property("last_leaf", getter(&ClipSpec::last_leaf), setter(&ClipSpec::last_leaf, "Clip.last_leaf"))
+        .def_property("clearance_m", getter(&ClipSpec::clearance_m), setter(&ClipSpec::clearance_m, "Clip.clearance_m"))
+        .def_property("stiffness_n_per_m", getter(&ClipSpec::stiffness_n_per_m), setter(&ClipSpec::stiffness_n_per_m, "Clip.stiffness_n_per_m"));
     py::class_<RigidBodySpec>(m, "RigidBody", "[rigid_body]: the axle seat R (its initial conditions: model.loading)")
-        .def_readwrite("mass_kg", &RigidBodySpec::mass_kg)
-        .def_readwrite("x_m", &RigidBodySpec::x_m)
-        .def_readwrite("tied_leaves", &RigidBodySpec::tied_leaves);
+        .def_property("mass_kg", getter(&RigidBodySpec::mass_kg), setter(&RigidBodySpec::mass_kg, "rigid_body.mass_kg"))
+        .def_property("x_m", getter(&RigidBodySpec::x_m), setter(&RigidBodySpec::x_m, "rigid_body.x_m"))
+        .def_property("tied_leaves", getter(&RigidBodySpec::tied_leaves), setter(&RigidBodySpec::tied_leaves, "rigid_body.tied_leaves"));
     py::class_<ProbeSpec, std::shared_ptr<ProbeSpec>>(m, "Probe", "[probe]: where the probe friction force is read")
         .def(py::init<>())
-        .def(py::init([](int i, double x) { return ProbeSpec{i, x}; }), "interface_index"_a, "x_m"_a)
-        .def_readwrite("interface_index", &ProbeSpec::interface_index)
-        .def_readwrite("x_m", &ProbeSpec::x_m);
+        .def(py::init([](const py::object& i, const py::object& x) {
+                 return ProbeSpec{checked<int>(i, "interface_index"), real_arg(x, "x_m")};
+             }),
+             "interface_index"_a, "x_m"_a)
+        .def_property("interface_index", getter(&ProbeSpec::interface_index), setter(&ProbeSpec::interface_index, "Probe.interface_index"))
+        .def_property("x_m", getter(&ProbeSpec::x_m), setter(&ProbeSpec::x_m, "Probe.x_m"));
     py::class_<TimeFunction> tf(m, "TimeFunction", "[loading.force_n] / [loading.displacement_m]: a function of time");
     tf.def(py::init<>())
-        .def_readwrite("mean", &TimeFunction::mean)
-        .def_readwrite("amplitude", &TimeFunction::amplitude)
-        .def_readwrite("frequency_hz", &TimeFunction::frequency_hz)
-        .def_readwrite("phase_rad", &TimeFunction::phase_rad)
-        .def_readwrite("times_s", &TimeFunction::times_s)
-        .def_readwrite("values", &TimeFunction::values);
+        .def_property("mean", getter(&TimeFunction::mean), setter(&TimeFunction::mean, "TimeFunction.mean"))
+        .def_property("amplitude", getter(&TimeFunction::amplitude), setter(&TimeFunction::amplitude, "TimeFunction.amplitude"))
+        .def_property("frequency_hz", getter(&TimeFunction::frequency_hz), setter(&TimeFunction::frequency_hz, "TimeFunction.frequency_hz"))
+        .def_property("phase_rad", getter(&TimeFunction::phase_rad), setter(&TimeFunction::phase_rad, "TimeFunction.phase_rad"))
+        .def_property("times_s", getter(&TimeFunction::times_s), setter(&TimeFunction::times_s, "TimeFunction.times_s"))
+        .def_property("values", getter(&TimeFunction::values), setter(&TimeFunction::values, "TimeFunction.values"));
     enum_property(tf, "shape", &TimeFunction::shape, kShapes);
 
     py::bind_vector<Shared<LeafSpec>>(m, "LeafList");
@@ -200,35 +213,47 @@ void bind_scenario(py::module_& m) {
     py::class_<LoadingView>(m, "Loading", "[loading]: how the run loads the spring, and R's initial conditions")
         .def_property(
             "kind", [](const LoadingView& v) { return std::string(to_string(v.s->scenario.simulation.loading.kind)); },
-            [](LoadingView& v, const std::string& text) {
-                v.s->scenario.simulation.loading.kind = parse_word(text, "loading.kind", kLoadingKinds);
+            [](LoadingView& v, const py::object& text) {
+                v.s->scenario.simulation.loading.kind = parse_word(string_arg(text, "loading.kind"), "loading.kind", kLoadingKinds);
             })
         .def_property(
             "initial_displacement_m", [](const LoadingView& v) { return v.s->scenario.model.rigid_body.initial_displacement_m; },
-            [](LoadingView& v, double x) { v.s->scenario.model.rigid_body.initial_displacement_m = x; })
+            [](LoadingView& v, const py::object& x) {
+                v.s->scenario.model.rigid_body.initial_displacement_m = real_arg(x, "loading.initial_displacement_m");
+            })
         .def_property(
             "initial_velocity_m_per_s",
             [](const LoadingView& v) { return v.s->scenario.model.rigid_body.initial_velocity_m_per_s; },
-            [](LoadingView& v, double x) { v.s->scenario.model.rigid_body.initial_velocity_m_per_s = x; })
+            [](LoadingView& v, const py::object& x) {
+                v.s->scenario.model.rigid_body.initial_velocity_m_per_s = real_arg(x, "loading.initial_velocity_m_per_s");
+            })
         .def_property(
             "gravity_m_per_s2", [](const LoadingView& v) { return v.s->scenario.simulation.loading.gravity_m_per_s2; },
-            [](LoadingView& v, double x) { v.s->scenario.simulation.loading.gravity_m_per_s2 = x; })
+            [](LoadingView& v, const py::object& x) {
+                v.s->scenario.simulation.loading.gravity_m_per_s2 = real_arg(x, "loading.gravity_m_per_s2");
+            })
         .def_property(
             "force_n", [](LoadingView& v) -> TimeFunction& { return v.s->scenario.simulation.loading.force_n; },
-            [](LoadingView& v, const TimeFunction& f) { v.s->scenario.simulation.loading.force_n = f; },
+            [](LoadingView& v, const py::object& f) {
+                v.s->scenario.simulation.loading.force_n = checked<TimeFunction>(f, "loading.force_n");
+            },
             py::return_value_policy::reference_internal)
         .def_property(
             "displacement_m", [](LoadingView& v) -> TimeFunction& { return v.s->scenario.simulation.loading.displacement_m; },
-            [](LoadingView& v, const TimeFunction& f) { v.s->scenario.simulation.loading.displacement_m = f; },
+            [](LoadingView& v, const py::object& f) {
+                v.s->scenario.simulation.loading.displacement_m = checked<TimeFunction>(f, "loading.displacement_m");
+            },
             py::return_value_policy::reference_internal);
     py::class_<MeshView>(m, "Mesh", "[mesh]: the node grid and the symmetry")
         .def_property(
             "element_length_m", [](const MeshView& v) { return v.s->scenario.model.mesh.element_length_m; },
-            [](MeshView& v, double x) { v.s->scenario.model.mesh.element_length_m = x; })
+            [](MeshView& v, const py::object& x) {
+                v.s->scenario.model.mesh.element_length_m = real_arg(x, "mesh.element_length_m");
+            })
         .def_property(
             "symmetry", [](const MeshView& v) { return std::string(v.s->scenario.model.symmetry == Symmetry::half ? "half" : "full"); },
-            [](MeshView& v, const std::string& text) {
-                v.s->scenario.model.symmetry = parse_word<Symmetry>(text, "mesh.symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}});
+            [](MeshView& v, const py::object& text) {
+                v.s->scenario.model.symmetry = parse_word<Symmetry>(string_arg(text, "mesh.symmetry"), "mesh.symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}});
             });
 
     const auto ref = py::return_value_policy::reference_internal;
@@ -242,7 +267,9 @@ void bind_scenario(py::module_& m) {
         .def_property_readonly("mesh", [](ModelView& v) { return MeshView{v.s}; })
         .def_property(
             "probe", [](ModelView& v) { return v.s->probe; },  // None when there is none
-            [](ModelView& v, std::shared_ptr<ProbeSpec> p) { v.s->probe = std::move(p); });
+            [](ModelView& v, const py::object& p) {  // None: no probe
+                v.s->probe = p.is_none() ? nullptr : std::make_shared<ProbeSpec>(checked<ProbeSpec>(p, "probe"));
+            });
 
     py::class_<OptionsView>(m, "Simulation", "The integrator's options by SimulationOptions member (file: [integrator])")
         .def("__getattr__",
@@ -260,12 +287,12 @@ void bind_scenario(py::module_& m) {
         .def("__dir__", [](const OptionsView& v) { return option_names(v.prefix); });
 
     py::class_<ScenarioOutputs>(m, "Outputs", "[outputs]: where the command line writes a run's files")
-        .def_readwrite("csv_path", &ScenarioOutputs::csv_path)
-        .def_readwrite("events_path", &ScenarioOutputs::events_path)
-        .def_readwrite("summary_path", &ScenarioOutputs::summary_path)
-        .def_readwrite("pairs_path", &ScenarioOutputs::pairs_path)
-        .def_readwrite("nodes_path", &ScenarioOutputs::nodes_path)
-        .def_readwrite("plot_prefix", &ScenarioOutputs::plot_prefix);
+        .def_property("csv_path", getter(&ScenarioOutputs::csv_path), setter(&ScenarioOutputs::csv_path, "outputs.csv_path"))
+        .def_property("events_path", getter(&ScenarioOutputs::events_path), setter(&ScenarioOutputs::events_path, "outputs.events_path"))
+        .def_property("summary_path", getter(&ScenarioOutputs::summary_path), setter(&ScenarioOutputs::summary_path, "outputs.summary_path"))
+        .def_property("pairs_path", getter(&ScenarioOutputs::pairs_path), setter(&ScenarioOutputs::pairs_path, "outputs.pairs_path"))
+        .def_property("nodes_path", getter(&ScenarioOutputs::nodes_path), setter(&ScenarioOutputs::nodes_path, "outputs.nodes_path"))
+        .def_property("plot_prefix", getter(&ScenarioOutputs::plot_prefix), setter(&ScenarioOutputs::plot_prefix, "outputs.plot_prefix"));
 
     py::class_<PyScenario, ScenarioPtr>(m, "Scenario", "A whole run: the stack, the loading, the integrator, the outputs")
         .def(py::init([] {
@@ -275,8 +302,8 @@ void bind_scenario(py::module_& m) {
         }))
         .def_static(
             "from_toml",
-            [](const std::string& text, const std::string& source) {
-                Scenario s = parse_scenario(text, source);
+            [](const py::object& text, const py::object& source) {
+                Scenario s = parse_scenario(string_arg(text, "text"), string_arg(source, "source"));
                 return make_scenario(s, file_setup(s));
             },
             "text"_a, "source"_a = "<string>", "Parses scenario TOML text (docs/model-and-scenarios.md)")
@@ -287,7 +314,7 @@ void bind_scenario(py::module_& m) {
         .def("__copy__", [](const PyScenario& p) { return std::make_shared<PyScenario>(p); })
         .def("__deepcopy__", [](const PyScenario& p, py::dict) { return std::make_shared<PyScenario>(p); })
         .def_property("description", [](const PyScenario& p) { return p.scenario.description; },
-                      [](PyScenario& p, const std::string& d) { p.scenario.description = d; })
+                      [](PyScenario& p, const py::object& d) { p.scenario.description = string_arg(d, "description"); })
         .def_property_readonly("source", [](const PyScenario& p) { return p.scenario.source; })
         .def_property_readonly("setup", [](const PyScenario& p) { return p.setup; })
         .def_property_readonly("model", [](const ScenarioPtr& p) { return ModelView{p}; })
@@ -296,16 +323,19 @@ void bind_scenario(py::module_& m) {
 
     m.def(
         "load_scenario",
-        [](const std::string& path) {
-            Scenario s = load_scenario(path);
+        [](const py::object& path) {  // a str or an os.PathLike
+            const py::object text = py::hasattr(path, "__fspath__") ? py::module_::import("os").attr("fspath")(path) : path;
+            Scenario s = load_scenario(string_arg(text, "path"));
             return make_scenario(s, file_setup(s));
         },
         "path"_a);
     m.def(
         "paper_example",
-        [](const std::string& name, int elements_per_half_leaf, bool full_model) {
+        [](const py::object& case_name, const py::object& elements, const py::object& full) {
+            const std::string name = string_arg(case_name, "case");
+            const bool full_model = bool_arg(full, "full_model");
             PaperExampleOptions o;
-            o.elements_per_half_leaf = elements_per_half_leaf;
+            o.elements_per_half_leaf = static_cast<int>(integer_arg(elements, "elements_per_half_leaf", std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
             o.symmetry = full_model ? Symmetry::full : Symmetry::half;
             const PaperCase c = parse_paper_case(name, "case");
             Scenario s;

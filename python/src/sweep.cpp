@@ -5,13 +5,19 @@ namespace stackbeam_py {
 
 namespace {
 
+/// The most threads a sweep takes (jobs): more than any machine's cores this module meets, and
+/// few enough that the threads' stacks (8 MiB of address space each by default) fit.
+constexpr int kMaxSweepJobs = 1024;
 
 /// sweep(spec_path, jobs, out_dir, restart, keep_series) -> dict(columns, axes, figures, ...):
 /// the sweep of `stackbeam sweep` (study/sweep.hpp): every point read and checked before any
 /// run, the points run on `jobs` threads with the GIL released, the table in point order. With
 /// an out_dir the points go through the same results directory as the command line's
 /// (journal, resume, points.csv, sweep.json); without one nothing is written.
-py::dict sweep(const std::string& spec_path, int jobs, const std::string& out_dir, bool restart, bool keep_series) {
+py::dict sweep(const std::string& spec_path, const py::object& jobs_arg, const std::string& out_dir, bool restart,
+               bool keep_series) {
+    // None: the machine's cores; a thread the system refuses all the same raises ThreadStartError
+    const int jobs = jobs_arg.is_none() ? 0 : static_cast<int>(integer_arg(jobs_arg, "jobs", 1, kMaxSweepJobs));
     const auto t0 = std::chrono::steady_clock::now();
     const SweepSpec spec = load_sweep_spec(spec_path);
     const std::vector<SweepPoint> points = expand_points(spec);
@@ -33,14 +39,19 @@ py::dict sweep(const std::string& spec_path, int jobs, const std::string& out_di
         // the points run on a thread of their own; this one waits, and (Python's main thread)
         // takes the GIL about every 20 ms to see Ctrl-C, which stops the sweep (points in flight
         // are dropped, the finished ones stay in out_dir's journal)
-        auto done = std::async(std::launch::async, [&] {
+        std::future<int> done;
+        try {
+            done = std::async(std::launch::async, [&] {
             return run_sweep(points, options, [&](const PointResult& r) {
                 PointResult row = r;
                 row.records = nullptr;
                 if (dir) dir->record(r);
                 results[static_cast<std::size_t>(r.index)] = std::move(row);
             });
-        });
+            });
+        } catch (const std::system_error& e) {  // ThreadStartError in Python (errors.cpp)
+            throw std::system_error(e.code(), "could not start the sweep's thread");
+        }
         while (done.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) {
             if (!main_thread) continue;
             py::gil_scoped_acquire gil;
@@ -109,6 +120,7 @@ py::dict sweep(const std::string& spec_path, int jobs, const std::string& out_di
 
 void bind_sweep(py::module_& m) {
     m.def("_sweep", &sweep, "spec"_a, "jobs"_a, "out_dir"_a, "restart"_a, "keep_series"_a);
+    m.attr("MAX_SWEEP_JOBS") = kMaxSweepJobs;
 }
 
 }  // namespace stackbeam_py
