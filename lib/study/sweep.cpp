@@ -18,6 +18,8 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <optional>
+#include <system_error>
 #include <thread>
 
 #include "stackbeam/fe/system.hpp"
@@ -583,7 +585,10 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         auto on_step = [&](const StepRecord&) {
             if (stop && stop->load(std::memory_order_relaxed)) throw SweepStopped();
         };
-        records = simulate(system, point.scenario.simulation, on_step);
+        // the stop flag also inside an output interval (mode cvode polls it every 64 steps)
+        SimulationOptions options = point.scenario.simulation;
+        if (stop) options.stop_requested = [stop] { return stop->load(std::memory_order_relaxed); };
+        records = simulate(system, options, on_step);
         result.figures = point_figures(records, point.scenario.simulation, result.message);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
@@ -594,6 +599,8 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         result.message = e.what();
     } catch (const SweepStopped&) {
         throw;
+    } catch (const RunStopped&) {  // the stop flag seen inside an output interval
+        throw SweepStopped();
     } catch (const std::exception& e) {  // any other failure of this run (e.g. out of memory)
         result.status = PointStatus::failed;
         result.message = e.what();
@@ -659,18 +666,40 @@ int run_sweep_with(std::size_t count, const PointAt& point_at, const SweepRunOpt
     };
     // a watcher turns the caller's stop flag into `abort`, which the runs poll
     std::atomic<bool> done{false};
-    std::thread watcher([&] {
-        while (!done.load()) {
-            if (opts.stop && opts.stop->load()) abort = true;
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-    });
+    // a thread the system refuses (std::system_error: the process's thread or memory limit,
+    // e.g. `ulimit -u` / `ulimit -v`) stops the threads started and throws std::system_error
+    // naming the thread and the jobs asked for, never std::terminate on a joinable thread
+    auto refused = [&](const std::system_error& e, const std::string& which) {
+        return std::system_error(e.code(), "could not start " + which + " (jobs = " + std::to_string(jobs) +
+                                               "): the system's thread or memory limit; give fewer jobs");
+    };
     std::vector<std::thread> threads;
-    for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
-    worker();
+    threads.reserve(static_cast<std::size_t>(jobs));  // no allocation between the starts below
+    std::thread watcher;
+    try {
+        watcher = std::thread([&] {
+            while (!done.load()) {
+                if (opts.stop && opts.stop->load()) abort = true;
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            }
+        });
+    } catch (const std::system_error& e) {
+        throw refused(e, "the sweep's watcher thread");
+    }
+    std::optional<std::system_error> start_error;
+    for (int j = 1; j < jobs && !start_error; ++j) try {
+            threads.emplace_back(worker);
+        } catch (const std::system_error& e) {
+            start_error.emplace(refused(e, "the sweep's thread " + std::to_string(j + 1) + " of " + std::to_string(jobs)));
+            std::lock_guard<std::mutex> lock(hand_out);
+            failed = true;  // no more points handed out; the points in flight stop at their next check
+            abort = true;
+        }
+    if (!start_error) worker();
     for (auto& t : threads) t.join();
     done = true;
     watcher.join();
+    if (start_error) throw *start_error;
     if (error) std::rethrow_exception(error);
     return run;
 }
