@@ -32,5 +32,6 @@
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/post/stresses.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
