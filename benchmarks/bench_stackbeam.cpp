@@ -39,6 +39,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/time/stepper.hpp"
 #include "test_support.hpp"  // the many-leaf stacks (tests/)
 
 using namespace stackbeam;
@@ -218,8 +219,39 @@ void MassiveStack(benchmark::State& state) {
     state.counters["mode_fact"] = static_cast<double>(rep.cvode.mode_factorizations);
 }
 
+/// The cost of the stress output (docs/stresses.md, decision 054): a rig stroke of the graduated
+/// 10-leaf spring at 100 elements per half leaf (friction, mode closed-form, the default solvers),
+/// w(t) = 20 mm tri(t / 1 s), dt = 1 ms, 100 records, with Stepper::stresses() and a
+/// StressExtremes fed at every record (stresses:1) or not (stresses:0).
+void StressOutput(benchmark::State& state) {
+    ModelSpec spec = graduated_stack(100, 10);
+    spec.rigid_body.initial_velocity_m_per_s = 0.0;  // the rig prescribes w'(0)
+    SimulationOptions so;
+    so.loading.kind = LoadingKind::prescribed_displacement;
+    so.loading.displacement_m.shape = TimeFunction::Shape::triangle;
+    so.loading.displacement_m.amplitude = 0.02;
+    so.loading.displacement_m.frequency_hz = 1.0;
+    so.dt_s = 1e-3;
+    so.t_end_s = 0.1;
+    const bool stresses = state.range(0) != 0;
+    double peak = 0.0;
+    for (auto _ : state) {
+        const System s(Model::build(spec));
+        const auto stepper = make_stepper(s, so);
+        StressExtremes extremes;
+        for (int i = 0; i < 100; ++i) {
+            stepper->advance();
+            if (stresses) extremes.add(stepper->current().t_s, stepper->stresses());
+        }
+        if (stresses) peak = extremes.leaves()[0].tension.stress_pa;
+        benchmark::DoNotOptimize(peak);
+    }
+    state.counters["peak_top_leaf_mpa"] = 1e-6 * peak;
+}
+
 }  // namespace
 
+BENCHMARK(StressOutput)->ArgNames({"stresses"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(MassiveStack)
     ->ArgNames({"stack", "ms", "beta_e7"})
     ->Args({0, 10, 0})->Args({0, 1000, 10})->Args({0, 100, 100})->Args({1, 2, 10})

@@ -34,5 +34,6 @@
 #include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/fatigue.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/post/stresses.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"

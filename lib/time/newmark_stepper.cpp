@@ -87,6 +87,7 @@ const StepRecord& NewmarkStepper::current() const noexcept { return impl_->recor
 long NewmarkStepper::record_index() const noexcept { return impl_->step_; }
 std::vector<PairRecord> NewmarkStepper::pairs() const { return impl_->pairs(); }
 std::vector<LeafNodes> NewmarkStepper::nodes() const { return impl_->system_.leaf_nodes(impl_->z_); }
+Stresses NewmarkStepper::stresses() const { return compute_stresses(impl_->system_, impl_->z_, pairs()); }
 RunReport NewmarkStepper::report() const { return impl_->report_; }
 const Eigen::VectorXd& NewmarkStepper::displacements() const noexcept { return impl_->z_; }
 const Eigen::VectorXd& NewmarkStepper::velocities() const noexcept { return impl_->v_; }

@@ -171,7 +171,9 @@ public:
     /// The pairs at the current output with the relative positions of its record.
     std::vector<PairRecord> pair_records() const { return pair_records_at(rel_out_); }
     /// Every leaf's nodes at the current output (Stepper::nodes()): displacements() at its state.
-    std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements(y_out_, p_out_)); }
+    std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements_at_output()); }
+    /// z at the current output (displacements() at its state): Stepper::nodes() and stresses().
+    Vec displacements_at_output() const { return displacements(y_out_, p_out_); }
     RunReport report() const;
     const CvodeStats& stats() const noexcept { return stats_; }
     const std::vector<ContactEvent>& events() const noexcept { return events_; }
@@ -346,6 +348,8 @@ public:
     std::vector<PairRecord> pairs() const override;
     /// The leaves' nodes at the last output (EventDriver::displacements at its state).
     std::vector<LeafNodes> nodes() const override;
+    /// The stresses at the last output (compute_stresses of nodes()' z and pairs()).
+    Stresses stresses() const override;
     /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
     RunReport report() const override;
     const CvodeStats& stats() const noexcept;
