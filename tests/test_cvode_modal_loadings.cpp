@@ -323,7 +323,7 @@ BOOST_AUTO_TEST_CASE(events_where_the_look_ahead_and_the_state_disagree_do_not_s
     // look-ahead kept it sticking while its witness stayed negative at the restart; the per-step
     // check then found the same missed event after every restart (steps of 5.4e-9 s, 8e-14 s of
     // progress each, no mode change), without end. Now a missed event's decision is settled at the
-    // state (settle_after_missed_event), with the contact problem at the state itself where the
+    // state (EventDriver::decide_modes, for every event stepper since decision 056), with the contact problem at the state itself where the
     // settling passes do not converge (the coupled layer W). Fixed: 4,012 CVODE steps. The budget
     // cvode.max_steps = 20,000 (the stall passes it in ~2-4 s of CPU and throws SolverError).
     const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/base_steel_elastic.toml");

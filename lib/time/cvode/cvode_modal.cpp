@@ -186,10 +186,6 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         wd = phiw.dot(y.segment(r, r));
     }
 
-    /// A missed event's modes are made to hold at its state (EventDriver::decide_modes; at every
-    /// event, as the massive stack, they would leave the look-ahead's decisions of the paper's
-    /// method: measured 2.3x further from the massive stack in test_cvode_modal).
-    bool settle_after_missed_event() const override { return true; }
     /// A slipping pair slips against its slip rate at (q, q') (EventDriver::signs_follow_slip_rates).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {

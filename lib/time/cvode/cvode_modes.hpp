@@ -43,6 +43,10 @@ constexpr double kMotionMargin = 1e-12;
 constexpr double kLookahead = 1e-7;
 /// At most this many events at one instant before the run is declared chattering.
 constexpr int kMaxEventsAtOneTime = 200;
+/// One instant, relative to max(1 s, t): events this close to the first of their cluster
+/// count together towards kMaxEventsAtOneTime (10x the missed-event bisection's 1e-13 plus
+/// margin; a genuine cascade of transitions at one contact front is ~1e-9 s or more apart).
+constexpr double kEventInstant = 1e-10;
 /// Passes of EventDriver::decide_modes that make the decided modes hold at the event's state.
 constexpr int kSettlePasses = 4;
 /// The event driver polls the caller's stop check (SimulationOptions::stop_requested) once

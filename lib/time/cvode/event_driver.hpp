@@ -117,10 +117,6 @@ public:
     /// True when the state y alone decides every pair's modes (no instantaneous coupling but
     /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
     virtual bool settle_at_state() const;
-    /// As settle_at_state, only at the events the per-step check found (cause "check"): a
-    /// decision at the look-ahead that leaves a witness negative at the state would restart
-    /// into the same missed event (default false).
-    virtual bool settle_after_missed_event() const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
 };
