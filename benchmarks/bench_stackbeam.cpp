@@ -219,7 +219,7 @@ void MassiveStack(benchmark::State& state) {
     state.counters["mode_fact"] = static_cast<double>(rep.cvode.mode_factorizations);
 }
 
-/// The cost of the stress output (docs/stresses.md, decision 054): a rig stroke of the graduated
+/// The cost of the stress output (docs/stresses-and-fatigue.md, decision 054): a rig stroke of the graduated
 /// 10-leaf spring at 100 elements per half leaf (friction, mode closed-form, the default solvers),
 /// w(t) = 20 mm tri(t / 1 s), dt = 1 ms, 100 records, with Stepper::stresses() and a
 /// StressExtremes fed at every record (stresses:1) or not (stresses:0).

@@ -2,7 +2,7 @@
 /// @file stresses.hpp
 /// The leaves' stress resultants and fibre stresses, the pressure between the leaves, and two
 /// accumulators over a run (the extremes of each leaf; the range and mean over a time window).
-/// docs/stresses.md says how to use them; docs/decisions/054-stress-recovery.md why so.
+/// docs/stresses-and-fatigue.md says how to use them; docs/decisions/054-stress-recovery.md why so.
 ///
 /// Sign convention (stated once, used by every figure here):
 ///  - N, the axial force [N]: tension positive.
