@@ -10,7 +10,8 @@
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "test_support.hpp"
-#include "time/cvode/cvode_testing.hpp"
+#include "time/cvode/cvode_massless.hpp"
+#include "time/initial_state.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -38,13 +39,14 @@ Run run_cvode(PaperCase c, double t_end_s, double rtol, bool root_finding = true
         r.records = simulate(s, o, {}, &r.report);
         return r;
     }
-    detail::CvodeTesting testing;  // the per-step check alone (lib/time/cvode/cvode_testing.hpp)
-    testing.root_finding = false;
-    const detail::ScopedCvodeTesting scope(testing);
-    CvodeStepper st(s, o);
-    r.records.push_back(st.current());
-    while (st.record_index() < st.num_outputs()) r.records.push_back(st.advance());
-    r.report = st.report();
+    o.validate();
+    detail::InitialState start = detail::initial_state("cvode-massless", s, o);
+    start.root_finding = false;  // the per-step check alone (a test-only field of the set-up stage)
+    const std::unique_ptr<Stepper> st = CvodeStepperAccess::build(s, start);
+    const long n = std::lround(o.t_end_s / o.dt_s);
+    r.records.push_back(st->current());
+    while (st->record_index() < n) r.records.push_back(st->advance());
+    r.report = st->report();
     return r;
 }
 

@@ -33,6 +33,7 @@
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/fatigue.hpp"
+#include "stackbeam/post/fibre.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 #include "stackbeam/post/stresses.hpp"
 #include "stackbeam/study/sweep.hpp"

@@ -33,6 +33,7 @@
 #include "stackbeam/contact/pair.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/post/fibre.hpp"
 
 namespace stackbeam {
 
@@ -90,9 +91,6 @@ struct Stresses {
 /// InputError naming z or pairs when their sizes do not fit `system`.
 Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const std::vector<PairRecord>& pairs);
 
-/// Which side of a leaf.
-enum class Fibre { top, bottom };
-const char* to_string(Fibre fibre);
 
 /// One extreme fibre stress: where and when.
 struct StressExtreme {

@@ -11,7 +11,6 @@
 #include "model/mesh_note.hpp"
 #include "stackbeam/errors.hpp"
 #include "time/contact_state.hpp"
-#include "time/cvode/cvode_testing.hpp"
 #include "time/record.hpp"
 
 namespace stackbeam::detail {
@@ -63,7 +62,7 @@ EventDriver::EventDriver(const System& system, const SimulationOptions& options,
       f_(system.model().whole_spring_factor()),
       m_body_(system.model().spec().rigid_body.mass_kg),
       d_(system.initial_offsets_m()),
-      root_finding_(cvode_testing().root_finding) {}
+      root_finding_(true) {}
 
 EventDriver::~EventDriver() = default;
 
@@ -172,6 +171,7 @@ SolverError EventDriver::failure(const std::string& what) const {
 }
 
 void EventDriver::start(const InitialState& stage, const EventStart& s) {
+    root_finding_ = stage.root_finding;
     nstate_ = s.nstate;
     ev_ = s.events;
     scales_ = s.scales;

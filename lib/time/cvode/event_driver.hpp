@@ -288,7 +288,7 @@ private:
     Vec p_out_, rel_out_, y_out_;
     double e0_ = 0.0;
     double jump_dissipation_ = 0.0;
-    bool root_finding_ = true;     // off only in tests (cvode_testing.hpp)
+    bool root_finding_ = true;     // off only in tests (InitialState::root_finding)
     long iters_since_ = 0, facts_since_ = 0;
     long steps_at_stop_check_ = 0; // CVODE's steps at the last stop check
     double last_check_residual_ = 0.0;
