@@ -107,8 +107,8 @@ void write_outputs(const FitSpec& spec, const FitResult& r, const fs::path& dir,
        << "set key top left\nset grid\nset xlabel 'w [mm]'\nset ylabel 'F [N]'\nset title 'measured and fitted loops'\nplot ";
     for (std::size_t l = 0; l < r.loops.size(); ++l) {
         const std::string name = r.loops[l].name;
-        gp << (l ? ", " : "") << "'loops.csv' using ($1 eq '" << name << "' ? 1000*$3 : NaN):4 with points pt 7 ps 0.4 title '"
-           << name << " measured', 'loops.csv' using ($1 eq '" << name << "' ? 1000*$3 : NaN):5 with points pt 1 ps 0.5 title '"
+        gp << (l ? ", " : "") << "'loops.csv' using (strcol(1) eq '" << name << "' ? 1000*$3 : NaN):4 with points pt 7 ps 0.4 title '"
+           << name << " measured', 'loops.csv' using (strcol(1) eq '" << name << "' ? 1000*$3 : NaN):5 with points pt 1 ps 0.5 title '"
            << name << " fitted'";
     }
     gp << "\n";
