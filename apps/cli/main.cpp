@@ -43,6 +43,7 @@
 #include "stackbeam/model/model.hpp"
 #include "summary.hpp"
 #include "sweep.hpp"
+#include "fit.hpp"
 
 namespace {
 
@@ -137,6 +138,11 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
                   "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
     add_sweep_options(*sweep, sweep_args);
 
+    FitArgs fit_args;
+    CLI::App* fit = app.add_subcommand("fit", "Fit scenario keys (friction, interface stiffness, preload, ...) to measured "
+                                              "force-displacement loops (docs/calibration.md)");
+    add_fit_options(*fit, fit_args);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -159,6 +165,7 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     try {
         if (sim->parsed()) return run_simulate(args);
         if (sweep->parsed()) return run_sweep_command(sweep_args, world);
+        if (fit->parsed()) return run_fit_command(fit_args);
         return exit_other;
     } catch (const ArgumentError& e) {
         return fail(exit_input, e.what());

@@ -315,5 +315,6 @@ void bind_errors(py::module_& m);    ///< errors.cpp: InputError, SolverError
 void bind_scenario(py::module_& m);  ///< scenario.cpp: Scenario, its model's entries, the options
 void bind_run(py::module_& m);       ///< run.cpp: _run, _stack_geometry, Stepper
 void bind_sweep(py::module_& m);     ///< sweep.cpp: _sweep
+void bind_fit(py::module_& m);       ///< fit.cpp: _fit
 
 }  // namespace stackbeam_py

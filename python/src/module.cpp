@@ -27,4 +27,5 @@ PYBIND11_MODULE(_core, m) {
     stackbeam_py::bind_scenario(m);
     stackbeam_py::bind_run(m);
     stackbeam_py::bind_sweep(m);
+    stackbeam_py::bind_fit(m);
 }

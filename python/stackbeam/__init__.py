@@ -40,7 +40,7 @@ from . import _core
 __all__ = [
     "InputError", "InputTypeError", "ThreadStartError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
     "Probe", "TimeFunction", "load_scenario", "paper_example", "option_table", "simulate", "make_stepper",
-    "sweep", "SweepResult", "MAX_SWEEP_JOBS",
+    "sweep", "SweepResult", "MAX_SWEEP_JOBS", "fit",
     "Result", "Stepper",
 ]
 
@@ -244,3 +244,13 @@ def make_stepper(scenario, **options):
     if not isinstance(scenario, Scenario):
         raise _input_error("scenario", "value %r is not allowed: must be a stackbeam.Scenario" % (scenario,), InputTypeError)
     return Stepper(scenario, _flatten_options(options))
+
+
+def fit(spec, *, jobs=None):
+    """Fits the scenario keys of the fit spec file `spec` (docs/calibration.md) to its measured
+    loops, as `stackbeam fit` does, and returns a dict: ``parameters`` (key, value,
+    standard_error, identifiable, note, ...), ``correlation``, ``warnings``, ``cost``,
+    ``runs``, ``loops`` (name, w_m, measured_force_n, fitted_force_n, branch as numpy arrays;
+    the loop areas), ``history`` and ``fitted_scenario`` (TOML text). Writes no file; the GIL
+    is released while the runs go on ``jobs`` threads (None: the machine's cores)."""
+    return _core._fit(str(spec), jobs)
