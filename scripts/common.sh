@@ -1,9 +1,10 @@
 # Shared by run-demo.sh and run-tests.sh (sourced, not run): installs the Debian
 # packages the project needs, if missing, and configures and builds it in build/.
 
-# The packages every build needs (pkgconf: the test of the installed stackbeam.pc; ninja-build:
+# The packages every build needs (pkgconf: the test of the installed stackbeam.pc; libzip-dev: the FMU
+# archive, fmu/ and docs/fmu.md; ninja-build:
 # the builds' generator, generator_args below).
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake ninja-build pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake ninja-build pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev libzip-dev)
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)

@@ -36,6 +36,7 @@
 #include <sstream>
 #include <string>
 
+#include "fmu.hpp"
 #include "options.hpp"
 #include "plot.hpp"
 #include "run.hpp"
@@ -137,6 +138,9 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
                   "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
     add_sweep_options(*sweep, sweep_args);
 
+    FmuArgs fmu_args;
+    CLI::App* fmu = add_fmu_command(app, fmu_args);  // `stackbeam fmu SCENARIO.toml --out spring.fmu` (fmu.hpp)
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -159,6 +163,7 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     try {
         if (sim->parsed()) return run_simulate(args);
         if (sweep->parsed()) return run_sweep_command(sweep_args, world);
+        if (fmu->parsed()) return run_fmu_command(fmu_args);
         return exit_other;
     } catch (const ArgumentError& e) {
         return fail(exit_input, e.what());
