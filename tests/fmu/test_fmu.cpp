@@ -152,14 +152,18 @@ void logger(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2St
 }
 const fmi2CallbackFunctions kCallbacks = {logger, std::calloc, std::free, nullptr, nullptr};
 
+// the functions the tests call, each through its pointer
+#define STACKBEAM_TEST_FMI_FUNCTIONS(F)                                                                          \
+    F(fmi2GetTypesPlatform) F(fmi2GetVersion) F(fmi2Instantiate) F(fmi2FreeInstance) F(fmi2SetupExperiment)     \
+    F(fmi2EnterInitializationMode) F(fmi2ExitInitializationMode) F(fmi2Terminate) F(fmi2Reset) F(fmi2GetReal)   \
+    F(fmi2SetReal) F(fmi2GetInteger) F(fmi2GetFMUstate) F(fmi2SetFMUstate) F(fmi2FreeFMUstate)                 \
+    F(fmi2SerializedFMUstateSize) F(fmi2SerializeFMUstate) F(fmi2DeSerializeFMUstate) F(fmi2DoStep)            \
+    F(fmi2GetRealStatus) F(fmi2CancelStep)
+
 struct Api {
     void* handle = nullptr;
 #define F(name) name##TYPE* name = nullptr;
-    F(fmi2GetTypesPlatform) F(fmi2GetVersion) F(fmi2Instantiate) F(fmi2FreeInstance) F(fmi2SetupExperiment)
-    F(fmi2EnterInitializationMode) F(fmi2ExitInitializationMode) F(fmi2Terminate) F(fmi2Reset) F(fmi2GetReal)
-    F(fmi2SetReal) F(fmi2GetInteger) F(fmi2GetFMUstate) F(fmi2SetFMUstate) F(fmi2FreeFMUstate)
-    F(fmi2SerializedFMUstateSize) F(fmi2SerializeFMUstate) F(fmi2DeSerializeFMUstate) F(fmi2DoStep)
-    F(fmi2GetRealStatus) F(fmi2CancelStep)
+    STACKBEAM_TEST_FMI_FUNCTIONS(F)
 #undef F
 };
 
@@ -184,11 +188,7 @@ struct Fmu {
         api.handle = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
         if (api.handle == nullptr) throw std::runtime_error(std::string("dlopen: ") + dlerror());
 #define F(name) api.name = reinterpret_cast<name##TYPE*>(dlsym(api.handle, #name));
-        F(fmi2GetTypesPlatform) F(fmi2GetVersion) F(fmi2Instantiate) F(fmi2FreeInstance) F(fmi2SetupExperiment)
-        F(fmi2EnterInitializationMode) F(fmi2ExitInitializationMode) F(fmi2Terminate) F(fmi2Reset) F(fmi2GetReal)
-        F(fmi2SetReal) F(fmi2GetInteger) F(fmi2GetFMUstate) F(fmi2SetFMUstate) F(fmi2FreeFMUstate)
-        F(fmi2SerializedFMUstateSize) F(fmi2SerializeFMUstate) F(fmi2DeSerializeFMUstate) F(fmi2DoStep)
-        F(fmi2GetRealStatus) F(fmi2CancelStep)
+        STACKBEAM_TEST_FMI_FUNCTIONS(F)
 #undef F
         scenario = stackbeam::load_scenario(FMU_SCENARIO);
         scenario.simulation.loading.prepare(false);
