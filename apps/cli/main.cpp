@@ -36,6 +36,7 @@
 #include <sstream>
 #include <string>
 
+#include "fmu.hpp"
 #include "options.hpp"
 #include "plot.hpp"
 #include "run.hpp"
@@ -142,6 +143,8 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     CLI::App* fit = app.add_subcommand("fit", "Fit scenario keys (friction, interface stiffness, preload, ...) to measured "
                                               "force-displacement loops (docs/calibration.md)");
     add_fit_options(*fit, fit_args);
+    FmuArgs fmu_args;
+    CLI::App* fmu = add_fmu_command(app, fmu_args);  // `stackbeam fmu SCENARIO.toml --out spring.fmu` (fmu.hpp)
 
     try {
         app.parse(argc, argv);
@@ -166,6 +169,7 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
         if (sim->parsed()) return run_simulate(args);
         if (sweep->parsed()) return run_sweep_command(sweep_args, world);
         if (fit->parsed()) return run_fit_command(fit_args);
+        if (fmu->parsed()) return run_fmu_command(fmu_args);
         return exit_other;
     } catch (const ArgumentError& e) {
         return fail(exit_input, e.what());

@@ -13,6 +13,10 @@
 // run.cpp (simulate's run and the Stepper), sweep.cpp.
 #include "bindings.hpp"
 
+namespace stackbeam_py {
+void bind_fmu(py::module_& m);  // fmu.cpp: export_fmu (docs/fmu.md)
+}
+
 PYBIND11_MODULE(_core, m) {
     m.doc() = "stackbeam's C++ core; use the package stackbeam (docs/python.md)";
 
@@ -28,4 +32,5 @@ PYBIND11_MODULE(_core, m) {
     stackbeam_py::bind_run(m);
     stackbeam_py::bind_sweep(m);
     stackbeam_py::bind_fit(m);
+    stackbeam_py::bind_fmu(m);
 }

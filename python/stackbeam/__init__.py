@@ -34,6 +34,7 @@ from ._core import (
     paper_example,
     option_table,
     step_record_columns,
+    export_fmu,
 )
 from . import _core
 
@@ -41,7 +42,7 @@ __all__ = [
     "InputError", "InputTypeError", "ThreadStartError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
     "Probe", "TimeFunction", "load_scenario", "paper_example", "option_table", "simulate", "make_stepper",
     "sweep", "SweepResult", "MAX_SWEEP_JOBS", "fit",
-    "Result", "Stepper",
+    "Result", "Stepper", "export_fmu",
 ]
 
 
