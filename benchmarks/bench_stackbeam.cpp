@@ -31,7 +31,7 @@
 #include <memory>
 #include <vector>
 
-#include "contact/sparse/switches.hpp"  // the sparse path's internal switches (lib/)
+#include "contact/sparse/switches.hpp"  // the sparse path's methods under their internal names (lib/)
 #include "contact/sparse/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
 #include <cstdio>
 #include "stackbeam/time/closed_form_stepper.hpp"
@@ -290,10 +290,10 @@ void Transitions(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        detail::sparse::Switches switches;
-        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
-        switches.box_qp = static_cast<detail::sparse::BoxQpMethod>(state.range(4));
-        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
+        SparsePathMethods switches;
+        switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
+        switches.box_qp = static_cast<SparseBoxQpMethod>(state.range(4));
+        so.sparse_tuning.methods = switches;  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(5));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
@@ -353,9 +353,9 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        detail::sparse::Switches switches;
-        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
-        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
+        SparsePathMethods switches;
+        switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
+        so.sparse_tuning.methods = switches;  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(4));
         ClosedFormStepper st(s, so);
         const long n = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
@@ -487,7 +487,7 @@ void ElasticRuns(benchmark::State& state) {
     if (stack >= 3)
         for (auto& f : spec.interfaces) f.law = InterfaceLaw::bonded;
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
-    detail::sparse::Switches sw;
+    SparsePathMethods sw;
     sw.incremental = state.range(5) != 0;
     if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
     if (state.range(10) >= 0) {
@@ -497,8 +497,8 @@ void ElasticRuns(benchmark::State& state) {
         if ((state.range(10) & 8) == 0) sw.schur_fresh_max_rows = -1;
     }
     if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
-    const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
+    so.sparse_tuning.methods = sw;
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
     if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
@@ -600,8 +600,8 @@ void TransitionStudy(benchmark::State& state) {
     const double t_sim = 1e-3 * static_cast<double>(state.range(2));
     const int way = static_cast<int>(state.range(3));
     detail::sparse::TransitionTrace trace;
-    const detail::sparse::Switches now;
-    detail::sparse::Switches sw = detail::sparse::Switches::before_037();
+    const SparsePathMethods now;
+    SparsePathMethods sw = SparsePathMethods::before_037();
     if ((way & 1) != 0) sw.newton_passes = now.newton_passes;
     if ((way & 2) != 0) sw.smoothing_from_rest = true;
     if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
@@ -611,7 +611,6 @@ void TransitionStudy(benchmark::State& state) {
         sw.fixed_pattern = 2;
         sw.schur_fresh_max_rows = -1;
     }
-    if (state.range(4) == 1) sw.trace = &trace;
     if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const int path_arg = static_cast<int>(state.range(7));
     sw.path_following = path_arg != 0 ? 1 : 0;
@@ -624,8 +623,9 @@ void TransitionStudy(benchmark::State& state) {
         sw.path_fold_ends = (state.range(9) & 4) != 0 ? now.path_fold_ends : true;
         sw.path_keep_base = (state.range(9) & 8) != 0 ? now.path_keep_base : 0;  // decision 045
     }
-    const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
+    so.sparse_tuning.methods = sw;
+    if (state.range(4) == 1) so.sparse_tuning.observer = &trace;  // the trace argument
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
     if (state.range(5) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(5));

@@ -241,7 +241,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     const int m = static_cast<int>(d.size());
     path.best_p.resize(0);
     path.handed_over = false;
-    TransitionTrace* const trace = path.switches.trace;
+    TransitionTrace* const trace = path.observer;
     StepTrace* const tr = trace ? trace->current : nullptr;
     auto end = [&](int how, bool result) {
         if (tr) tr->newton_end = how;
