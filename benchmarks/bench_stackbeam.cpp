@@ -31,8 +31,8 @@
 #include <memory>
 #include <vector>
 
-#include "contact/sparse/switches.hpp"  // the sparse path's methods under their internal names (lib/)
-#include "contact/sparse/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
+#include "contact/sparse/driver/switches.hpp"  // the sparse path's methods under their internal names (lib/)
+#include "contact/sparse/driver/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
 #include <cstdio>
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"

@@ -1,5 +1,5 @@
 // The parametric (homotopy) active-set transition of the sparse path, behind
-// SparsePathMethods::path_following (lib/contact/sparse/path_following.cpp, docs/decisions/040): it
+// SparsePathMethods::path_following (lib/contact/sparse/transitions/path_following.cpp, docs/decisions/040): it
 // follows the solution from the previous step's problem to this step's along the straight
 // line between their data, its modes confirmed by the active-set passes. Its answers must be
 // the default method's: both are the exact solver's solution of the same problem (the passes
@@ -14,9 +14,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "contact/sparse/switches.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/switches.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "test_support.hpp"
 
 using namespace stackbeam;

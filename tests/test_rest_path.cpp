@@ -1,5 +1,5 @@
 // The sparse path's step from rest by the homotopy from a covering start
-// (SparsePathMethods::rest_path_violations, lib/contact/sparse/covering_start.cpp and
+// (SparsePathMethods::rest_path_violations, lib/contact/sparse/transitions/covering_start.cpp and
 // SparseContactSolver::Impl::rest_transition; docs/decisions/041): the semismooth Newton method
 // from rest hands its iterate over once few laws are violated; that iterate's modes M0 are made
 // valid by moving the step's data (b, d) -> (b0, d0), and path_following takes the solution from
@@ -11,10 +11,10 @@
 #include <random>
 #include <vector>
 
-#include "contact/sparse/common.hpp"
-#include "contact/sparse/switches.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/common.hpp"
+#include "contact/sparse/driver/switches.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "test_support.hpp"
 
 using namespace stackbeam;

@@ -16,7 +16,7 @@
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/fe/system.hpp"
-#include "contact/sparse/switches.hpp"
+#include "contact/sparse/driver/switches.hpp"
 #include "fe/system_internal.hpp"
 #include "test_support.hpp"
 
@@ -234,7 +234,7 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
 
 BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
     // The sparse path's diagonal of W = G K^-1 G^T (selected inverse of K without the
-    // rigid body's DOFs plus a rank-h correction for them, contact/sparse/sparse_solver.cpp) against the
+    // rigid body's DOFs plus a rank-h correction for them, contact/sparse/driver/sparse_solver.cpp) against the
     // dense W of to_dense() (m full solves). Both are exact up to round-off: the entries
     // are sums of a few products of O(1) coefficients with entries of K^-1 whose relative
     // error is about cond(K) x 1e-16 (cond ~ 1e8-1e10 here: EA/L against EI/L^3 and the

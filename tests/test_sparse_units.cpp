@@ -20,10 +20,10 @@
 #include <vector>
 
 #include "contact/box_qp.hpp"
-#include "contact/sparse/box_qp_methods.hpp"
-#include "contact/sparse/selected_inverse.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
+#include "contact/sparse/linear/selected_inverse.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"

@@ -10,10 +10,10 @@
 namespace stackbeam {
 
 namespace detail::sparse {
-struct TransitionTrace;  // lib/contact/sparse/trace.hpp (a study aid, docs/decisions/036)
+struct TransitionTrace;  // lib/contact/sparse/driver/trace.hpp (a study aid, docs/decisions/036)
 }  // namespace detail::sparse
 /// The observer of a SparseContactSolver's transition steps: counters per route and phase,
-/// per-step traces (lib/contact/sparse/trace.hpp). The caller owns it and reads it.
+/// per-step traces (lib/contact/sparse/driver/trace.hpp). The caller owns it and reads it.
 using SparsePathObserver = detail::sparse::TransitionTrace;
 
 /// How the sparse path solves a transition that the active-set passes from the previous

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "contact/active_set.hpp"
-#include "contact/sparse/mode_solver.hpp"
-#include "contact/sparse/switches.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
+#include "contact/sparse/driver/switches.hpp"
 #include "stackbeam/contact/contact.hpp"
 
 namespace stackbeam::detail::sparse {

@@ -1,16 +1,17 @@
 // The sparse path: the exact solver's active-set method on
 //     K z = b + G^T p,  s = G z - d       (SparseContactProblem, contact.hpp)
 // without ever forming the dense W = G K^-1 G^T. This file is the orchestration; the
-// units are in lib/contact/sparse/:
-//   selected_inverse   W's diagonal from the selected inverse of K's Cholesky factor
-//   mode_solver        the linear problem of a set of modes (sparse LU, Schur complement
-//                      of the held rows, bordered updates)
-//   sparse_path        the shared state: modes, pair laws, active-set passes, natural map
-//   box_qp_*           the box QP of the Tresca fixed point (pivoting, interior point, primal)
-//   semismooth_newton, smoothing_newton, tresca (the continuation on the offsets was removed:
-//   docs/decisions/014-transition-methods-with-elastic-interface.md)
-//                      the transition methods (transitions.hpp, one signature)
-//   switches           the test-only switches (transition and box-QP methods, newton_first)
+// units are in lib/contact/sparse/, by layer:
+//   driver/       this solver, the shared state (sparse_path: modes, pair laws, active-set
+//                 passes, natural map), the methods' internal names (switches.hpp: the public
+//                 SparsePathMethods) and the observer (trace.hpp)
+//   linear/       the linear problem of one set of modes behind ModeSolver (mode_solver), one
+//                 file per route: schur (dense Schur complement, column cache, low-rank update),
+//                 bordered_lu (sparse LU and its bordered update), fixed_pattern_lu (KLU or
+//                 Eigen on one fixed pattern), primal_cholmod; selected_inverse (W's diagonal)
+//   transitions/  the transition methods, one signature (transitions.hpp): semismooth_newton,
+//                 smoothing_newton, tresca, path_following (with path_base, covering_start)
+//   qp/           the box QP of the Tresca fixed point (pivoting, interior point, primal)
 //
 // Design (why a saddle-point system per set of modes):
 //  - For a set of modes the contact conditions are linear: held rows (closed normal,
@@ -116,8 +117,8 @@
 #include <string>
 
 #include "contact/solvers.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
 

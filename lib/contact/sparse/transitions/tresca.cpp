@@ -3,8 +3,8 @@
 // QP solved on the sparse stiffness (box_qp_methods.hpp).
 #include <vector>
 
-#include "contact/sparse/box_qp_methods.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 

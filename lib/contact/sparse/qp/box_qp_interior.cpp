@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "contact/sparse/box_qp_methods.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
 
 namespace stackbeam::detail::sparse {
 

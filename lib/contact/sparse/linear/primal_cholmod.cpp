@@ -1,4 +1,4 @@
-// The primal form of a set of modes on a CHOLMOD factor (primal_solver.hpp). Compiled only
+// The primal form of a set of modes on a CHOLMOD factor (primal_cholmod.hpp). Compiled only
 // when CMake found CHOLMOD (STACKBEAM_HAVE_CHOLMOD).
 //
 // Why these choices (docs/decisions/027-primal-cholmod-route.md, measured):
@@ -10,7 +10,7 @@
 //    numeric factorisation, measured on the 10 x 400 stacks), a refactorisation otherwise;
 //  - GMRES (restarted, right-preconditioned, written here: Eigen's GMRES is in the
 //    unsupported module and takes an assembled matrix, this operator is never assembled).
-#include "contact/sparse/primal_solver.hpp"
+#include "contact/sparse/linear/primal_cholmod.hpp"
 
 #include <cholmod.h>
 
@@ -20,7 +20,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "contact/sparse/mode_solver.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
 
 namespace stackbeam::detail::sparse {
 

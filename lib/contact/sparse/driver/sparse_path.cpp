@@ -1,12 +1,12 @@
 // The state shared by the units of the sparse contact path (sparse_path.hpp).
-#include "contact/sparse/sparse_path.hpp"
+#include "contact/sparse/driver/sparse_path.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "contact/solvers.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 
