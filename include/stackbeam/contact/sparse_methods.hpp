@@ -19,12 +19,12 @@ using SparsePathObserver = detail::sparse::TransitionTrace;
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).
 enum class SparseTransitionMethod {
-    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
+    newton = 0,  ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
                  ///< Newton method; then the Tresca fixed point (default)
-    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
-                 ///< smoothing method (kept for comparison, docs/decisions/004-smoothing-newton.md)
-    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
-    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
+    // 1: semismooth, the semismooth method then the Tresca fixed point (the default before
+    // decision 004), removed by decision 053; the values stay those the benchmark passes
+    smoothing = 2,  ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
+    tresca = 3,     ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
 };
 
 /// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
@@ -36,8 +36,7 @@ enum class SparseBoxQpMethod {
                      ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
                      ///< read from the iterate); then the monotone primal active-set method (default)
     interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
-    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
-                     ///< (kept for comparison, docs/decisions/006-interior-point-box-qp.md)
+    // (2: pivoting_only, the way before decision 006, removed by decision 053)
 };
 
 /// The methods of one SparseContactSolver (SparsePathTuning::methods, fixed at its

@@ -225,7 +225,7 @@ struct SparseContactSolver::Impl {
     // the solutions of the last two solves (the semismooth Newton method's start is their
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
-    Eigen::VectorXd previous_s, last_s;  // their s (kept only with Switches::trace, for its prediction)
+    Eigen::VectorXd previous_s, last_s;  // their s (kept only with an observer, for its prediction)
     // the previous modes' linear solution for this step (the first active-set pass's), kept
     // where the passes did not settle (Switches::first_pass_start)
     Eigen::VectorXd p_first_pass;
@@ -307,7 +307,7 @@ struct SparseContactSolver::Impl {
         const bool smoothed_from_start =
             tm == TransitionMethod::newton && path.switches.smoothing_from_rest && p_start.isZero(0.0);
         if (smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
-        if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
+        if (tm == TransitionMethod::newton) {
             // the start: the previous step's forces extrapolated linearly from the two solves
             // before, when the warm start is the last solve's answer (measured, 10 x 100
             // friction: 14.4 -> 9.5 Newton iterations per step on the graduated spring, 14.2 ->
