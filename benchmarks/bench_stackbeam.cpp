@@ -31,8 +31,8 @@
 #include <memory>
 #include <vector>
 
-#include "contact/sparse/switches.hpp"  // the sparse path's internal switches (lib/)
-#include "contact/sparse/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
+#include "contact/sparse/driver/switches.hpp"  // the sparse path's methods under their internal names (lib/)
+#include "contact/sparse/driver/trace.hpp"     // the transition study's trace (lib/, docs/decisions/036)
 #include <cstdio>
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/cvode_stepper.hpp"
@@ -303,10 +303,11 @@ BENCHMARK(Scaling)
 
 /// The sparse path's transition methods on friction runs of 10 leaves (closed-form mode,
 /// dt = 1 ms). args: elements per half leaf, stack (0 identical leaves, 1 graduated),
-/// transition (0 newton: semismooth, then smoothing; 1 semismooth only; 3 Tresca
-/// only: box QPs by pivoting, then the interior-point method where pivoting does not settle;
-/// detail::sparse::TransitionMethod's values), simulated time in ms, box QP method of the
-/// Tresca fixed point (detail::sparse::BoxQpMethod's values: 0 pivoting then interior point, 2 pivoting only),
+/// transition (0 newton: semismooth, then smoothing; 3 Tresca only: box QPs by pivoting, then
+/// the interior-point method where pivoting does not settle; SparseTransitionMethod's values;
+/// 1, semismooth only, was removed by decision 053), simulated time in ms, box QP method of the
+/// Tresca fixed point (SparseBoxQpMethod's values: 0 pivoting then interior point, 1 interior
+/// point first; 2, pivoting only, was removed by decision 053),
 /// Anderson depth of the fixed point on the friction limits (SolverOptions::tresca_anderson_depth;
 /// 0 the plain fixed point, 8 the default).
 void Transitions(benchmark::State& state) {
@@ -322,10 +323,10 @@ void Transitions(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        detail::sparse::Switches switches;
-        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
-        switches.box_qp = static_cast<detail::sparse::BoxQpMethod>(state.range(4));
-        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
+        SparsePathMethods switches;
+        switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
+        switches.box_qp = static_cast<SparseBoxQpMethod>(state.range(4));
+        so.sparse_tuning.methods = switches;  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(5));
         ClosedFormStepper st(s, so);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
@@ -354,9 +355,9 @@ void Transitions(benchmark::State& state) {
 }
 BENCHMARK(Transitions)
     ->ArgNames({"el", "graduated", "transition", "ms", "box", "depth"})
-    ->Args({100, 1, 0, 100, 0, 8})->Args({100, 1, 1, 100, 0, 8})
-    ->Args({100, 0, 0, 300, 0, 8})->Args({100, 0, 1, 300, 0, 8})
-    ->Args({100, 1, 3, 5, 0, 8})->Args({100, 1, 3, 5, 2, 8})->Args({100, 0, 3, 20, 0, 8})->Args({100, 0, 3, 20, 2, 8})
+    ->Args({100, 1, 0, 100, 0, 8})
+    ->Args({100, 0, 0, 300, 0, 8})
+    ->Args({100, 1, 3, 5, 0, 8})->Args({100, 0, 3, 20, 0, 8})
     ->Args({100, 1, 3, 30, 0, 0})->Args({100, 1, 3, 30, 0, 8})->Args({100, 1, 3, 100, 0, 8})
     ->Args({100, 0, 3, 100, 0, 0})->Args({100, 0, 3, 100, 0, 8})
     // 50 elements per half leaf: friction-mesh ratio 0.5 with mu = 0.5 (FrictionMeshRatioRuns below)
@@ -385,9 +386,9 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
         SimulationOptions so;
         so.t_end_s = t_sim;
         so.contact_path = ContactPath::sparse;
-        detail::sparse::Switches switches;
-        switches.transition = static_cast<detail::sparse::TransitionMethod>(state.range(2));
-        const detail::sparse::ScopedSwitches scoped(switches);  // for the stepper's solvers
+        SparsePathMethods switches;
+        switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
+        so.sparse_tuning.methods = switches;  // for the stepper's solvers
         so.solver.tresca_anderson_depth = static_cast<int>(state.range(4));
         ClosedFormStepper st(s, so);
         const long n = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
@@ -519,7 +520,7 @@ void ElasticRuns(benchmark::State& state) {
     if (stack >= 3)
         for (auto& f : spec.interfaces) f.law = InterfaceLaw::bonded;
     const double t_sim = 1e-3 * static_cast<double>(state.range(3));
-    detail::sparse::Switches sw;
+    SparsePathMethods sw;
     sw.incremental = state.range(5) != 0;
     if (state.range(8) >= 0) sw.fixed_pattern = static_cast<int>(state.range(8));
     if (state.range(10) >= 0) {
@@ -529,8 +530,8 @@ void ElasticRuns(benchmark::State& state) {
         if ((state.range(10) & 8) == 0) sw.schur_fresh_max_rows = -1;
     }
     if (state.range(11) >= 0) sw.fixed_border_rows = static_cast<int>(state.range(11));
-    const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
+    so.sparse_tuning.methods = sw;
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
     if (state.range(4) == 1) so.contact_path = ContactPath::sparse;
@@ -607,7 +608,7 @@ BENCHMARK(ElasticRuns)
 /// Switches::fixed_pattern 4 and schur_fresh_max_rows 200, else 2 and none; 61 every default;
 /// bit 64 decision 041's homotopy from rest off, Switches::rest_path_violations 0, so 125 is
 /// 61 the way before 041) and, with trace 1, the statistics of
-/// every transition step (Switches::trace, trace.hpp) printed to stderr: mode changes per Newton
+/// every transition step (SparsePathTuning::observer, trace.hpp) printed to stderr: mode changes per Newton
 /// iteration, pairs back in a mode they had left, the distances of the start, a predicted start
 /// and the Newton method's first modes to the step's final modes, how the semismooth method
 /// ended; per phase and route the mode solver's calls and their CPU time (decision 038).
@@ -632,8 +633,8 @@ void TransitionStudy(benchmark::State& state) {
     const double t_sim = 1e-3 * static_cast<double>(state.range(2));
     const int way = static_cast<int>(state.range(3));
     detail::sparse::TransitionTrace trace;
-    const detail::sparse::Switches now;
-    detail::sparse::Switches sw = detail::sparse::Switches::before_037();
+    const SparsePathMethods now;
+    SparsePathMethods sw = SparsePathMethods::before_037();
     if ((way & 1) != 0) sw.newton_passes = now.newton_passes;
     if ((way & 2) != 0) sw.smoothing_from_rest = true;
     if ((way & 4) != 0) sw.first_pass_start = now.first_pass_start;
@@ -643,7 +644,6 @@ void TransitionStudy(benchmark::State& state) {
         sw.fixed_pattern = 2;
         sw.schur_fresh_max_rows = -1;
     }
-    if (state.range(4) == 1) sw.trace = &trace;
     if (state.range(6) >= 0) sw.fixed_pattern = static_cast<int>(state.range(6));
     const int path_arg = static_cast<int>(state.range(7));
     sw.path_following = path_arg != 0 ? 1 : 0;
@@ -656,8 +656,9 @@ void TransitionStudy(benchmark::State& state) {
         sw.path_fold_ends = (state.range(9) & 4) != 0 ? now.path_fold_ends : true;
         sw.path_keep_base = (state.range(9) & 8) != 0 ? now.path_keep_base : 0;  // decision 045
     }
-    const detail::sparse::ScopedSwitches scoped(sw);
     SimulationOptions so;
+    so.sparse_tuning.methods = sw;
+    if (state.range(4) == 1) so.sparse_tuning.observer = &trace;  // the trace argument
     so.t_end_s = t_sim;
     so.stop_on_nonconvergence = false;
     if (state.range(5) > 0) so.sparse_tuning.schur_max_rows = static_cast<int>(state.range(5));

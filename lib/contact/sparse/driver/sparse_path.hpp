@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "contact/active_set.hpp"
-#include "contact/sparse/mode_solver.hpp"
-#include "contact/sparse/switches.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
+#include "contact/sparse/driver/switches.hpp"
 #include "stackbeam/contact/contact.hpp"
 
 namespace stackbeam::detail::sparse {
@@ -55,7 +55,9 @@ struct KeptBase;  // the homotopy's base kept across steps (path_following.cpp, 
 
 struct SparsePath {
     SolverOptions options;   ///< tolerance_m, max_active_set_iterations, tresca_anderson_depth
-    Switches switches;       ///< the test-only switches (switches.hpp)
+    Switches switches;       ///< the methods (SparsePathTuning::methods, switches.hpp)
+    /// the caller's observer (SparsePathTuning::observer, trace.hpp), or nullptr: nothing recorded
+    TransitionTrace* observer = nullptr;
     ModeSolver solver;       ///< the linear problem of a set of modes on the current (K, G)
     ContactProblem laws;     ///< pairs and tau rule; W empty, q zero (sizes only)
     modes::ModeSet modes;    ///< the current modes
@@ -78,9 +80,10 @@ struct SparsePath {
     /// it are the cached affine solves, not a kept-base solve each)
     int solves_since_path = 0;
 
-    SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw)
-        : options(o), switches(sw), solver(with_switches(tuning, sw)) {
-        if (sw.trace) solver.set_route_stats(&sw.trace->routes);  // the study's routes (decision 038)
+    SparsePath(const SolverOptions& o, const ModeSolverTuning& tuning, const Switches& sw,
+               TransitionTrace* obs = nullptr)
+        : options(o), switches(sw), observer(obs), solver(with_switches(tuning, sw)) {
+        if (obs) solver.set_route_stats(&obs->routes);  // the study's routes (decision 038)
     }
 
     /// A new structure (K, G, pairs): validates `pr` (InputError), refactorises, forgets the modes.

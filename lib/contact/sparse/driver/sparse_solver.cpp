@@ -1,16 +1,17 @@
 // The sparse path: the exact solver's active-set method on
 //     K z = b + G^T p,  s = G z - d       (SparseContactProblem, contact.hpp)
 // without ever forming the dense W = G K^-1 G^T. This file is the orchestration; the
-// units are in lib/contact/sparse/:
-//   selected_inverse   W's diagonal from the selected inverse of K's Cholesky factor
-//   mode_solver        the linear problem of a set of modes (sparse LU, Schur complement
-//                      of the held rows, bordered updates)
-//   sparse_path        the shared state: modes, pair laws, active-set passes, natural map
-//   box_qp_*           the box QP of the Tresca fixed point (pivoting, interior point, primal)
-//   semismooth_newton, smoothing_newton, tresca (the continuation on the offsets was removed:
-//   docs/decisions/014-transition-methods-with-elastic-interface.md)
-//                      the transition methods (transitions.hpp, one signature)
-//   switches           the test-only switches (transition and box-QP methods, newton_first)
+// units are in lib/contact/sparse/, by layer:
+//   driver/       this solver, the shared state (sparse_path: modes, pair laws, active-set
+//                 passes, natural map), the methods' internal names (switches.hpp: the public
+//                 SparsePathMethods) and the observer (trace.hpp)
+//   linear/       the linear problem of one set of modes behind ModeSolver (mode_solver), one
+//                 file per route: schur (dense Schur complement, column cache, low-rank update),
+//                 bordered_lu (sparse LU and its bordered update), fixed_pattern_lu (KLU or
+//                 Eigen on one fixed pattern), primal_cholmod; selected_inverse (W's diagonal)
+//   transitions/  the transition methods, one signature (transitions.hpp): semismooth_newton,
+//                 smoothing_newton, tresca, path_following (with path_base, covering_start)
+//   qp/           the box QP of the Tresca fixed point (pivoting, interior point, primal)
 //
 // Design (why a saddle-point system per set of modes):
 //  - For a set of modes the contact conditions are linear: held rows (closed normal,
@@ -112,11 +113,12 @@
 //    the line search finds no decrease) and the Tresca fixed point still has to finish.
 //    That count, not the cost of a pass, is what keeps large friction runs slow.
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include "contact/solvers.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/errors.hpp"
 
@@ -157,16 +159,6 @@ ContactProblem SparseContactProblem::to_dense() const {
     pr.tau_previous_n = tau_previous_n;
     return pr;
 }
-
-namespace detail::sparse {
-namespace {
-thread_local Switches g_switches;  // the switches of solvers constructed now on this thread
-}  // namespace
-
-Switches current_switches() { return g_switches; }
-ScopedSwitches::ScopedSwitches(const Switches& switches) : saved_(g_switches) { g_switches = switches; }
-ScopedSwitches::~ScopedSwitches() { g_switches = saved_; }
-}  // namespace detail::sparse
 
 namespace {
 bool same_matrix(const SpMat& a, const SpMat& b) {
@@ -233,7 +225,7 @@ struct SparseContactSolver::Impl {
     // the solutions of the last two solves (the semismooth Newton method's start is their
     // linear extrapolation when the caller continues that sequence)
     Eigen::VectorXd previous_p, last_p;
-    Eigen::VectorXd previous_s, last_s;  // their s (kept only with Switches::trace, for its prediction)
+    Eigen::VectorXd previous_s, last_s;  // their s (kept only with an observer, for its prediction)
     // the previous modes' linear solution for this step (the first active-set pass's), kept
     // where the passes did not settle (Switches::first_pass_start)
     Eigen::VectorXd p_first_pass;
@@ -241,9 +233,8 @@ struct SparseContactSolver::Impl {
     Impl(const SolverOptions& options, const SparsePathTuning& tuning)
         : path(options,
                detail::sparse::ModeSolverTuning{tuning.schur_max_rows, tuning.max_border_rows,
-                                                detail::sparse::current_switches().incremental,
-                                                tuning.primal_min_rows},
-               detail::sparse::current_switches()),
+                                                tuning.methods.incremental, tuning.primal_min_rows},
+               tuning.methods, tuning.observer),
           newton_min_rows(tuning.newton_min_rows) {}
 
     // The elastic layer (SparseContactProblem::layer_compliance) as extra degrees of freedom:
@@ -288,13 +279,13 @@ struct SparseContactSolver::Impl {
         const int m = static_cast<int>(step.d.size());
         const TransitionMethod tm = path.switches.transition;
         const TransitionStart passes_end(p, z, path.modes);  // the Tresca fixed point starts there
-        StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr;
+        StepTrace* tr = path.observer ? path.observer->current : nullptr;
         auto confirmed = [&](TransitionFn method, const Eigen::VectorXd& start) {
             p = start;
             path.s = path.stiffness().positions(step.b, step.d, p, z);
             const int smooth0 = r.smoothing_iterations;
             const bool ok = method(path, step, p, z, r);
-            if (tr) path.switches.trace->close_phase(method == smoothing_newton ? phase_smoothing : phase_semismooth);
+            if (tr) path.observer->close_phase(method == smoothing_newton ? phase_smoothing : phase_semismooth);
             if (tr && method == smoothing_newton) {
                 tr->smoothing_iterations += r.smoothing_iterations - smooth0;
                 tr->smoothing_ok = ok;
@@ -303,7 +294,7 @@ struct SparseContactSolver::Impl {
             const int it0 = r.iterations;
             const bool conf = passes_from_modes(path, step, p, z, r);
             if (tr) {
-                path.switches.trace->close_phase(phase_confirm);
+                path.observer->close_phase(phase_confirm);
                 tr->confirm_solves += r.iterations - it0;
                 if (method == semismooth_newton) tr->newton_confirmed = conf;
             }
@@ -316,7 +307,7 @@ struct SparseContactSolver::Impl {
         const bool smoothed_from_start =
             tm == TransitionMethod::newton && path.switches.smoothing_from_rest && p_start.isZero(0.0);
         if (smoothed_from_start && confirmed(smoothing_newton, p_start)) return true;
-        if (tm == TransitionMethod::newton || tm == TransitionMethod::semismooth) {
+        if (tm == TransitionMethod::newton) {
             // the start: the previous step's forces extrapolated linearly from the two solves
             // before, when the warm start is the last solve's answer (measured, 10 x 100
             // friction: 14.4 -> 9.5 Newton iterations per step on the graduated spring, 14.2 ->
@@ -341,7 +332,7 @@ struct SparseContactSolver::Impl {
                 const bool handed_over = path.handed_over;
                 const Eigen::VectorXd p_newton = p;
                 const bool ok = rest_transition(step, p, z, r);
-                if (tr) path.switches.trace->close_phase(phase_path);
+                if (tr) path.observer->close_phase(phase_path);
                 if (ok) return true;
                 if (handed_over && confirmed(semismooth_newton, p_newton)) return true;
             }
@@ -389,7 +380,7 @@ struct SparseContactSolver::Impl {
             }
             confirm = r.iterations - it0;
         }
-        if (StepTrace* tr = path.switches.trace ? path.switches.trace->current : nullptr) {
+        if (StepTrace* tr = path.observer ? path.observer->current : nullptr) {
             tr->path = ps;
             tr->path_confirmed = settled;
             tr->path_confirm_solves = confirm;
@@ -437,10 +428,225 @@ struct SparseContactSolver::Impl {
         r.fell_back = true;
         return true;
     }
+
+    /// The observer's record of one solve (trace.hpp): the start modes, the modes at the last
+    /// two steps' (p, s) extrapolated, the modes the passes from the previous modes ended with.
+    struct StepRecord {
+        detail::sparse::StepTrace* tr = nullptr;  // the observer's current step (nullptr: none attached)
+        std::vector<signed char> start_n, start_t, pred_n, pred_t, passes_n, passes_t;
+    };
+
+    /// A new step in the observer's record (where one is attached): the start modes and a prediction.
+    void open_record(int m, StepRecord& rec) {
+        using namespace detail::sparse;
+        TransitionTrace* const trace = path.observer;
+        if (!trace) return;
+        rec.tr = &trace->new_step();
+        rec.start_n = path.modes.nmode;
+        rec.start_t = path.modes.tmode;
+        trace->begin(rec.start_n, rec.start_t);
+        if (previous_p.size() == m && last_p.size() == m && previous_s.size() == m && last_s.size() == m) {
+            Eigen::VectorXd F;
+            path.natural_residual(2.0 * last_p - previous_p, 2.0 * last_s - previous_s, F, true);
+            rec.pred_n = path.modes.nmode;
+            rec.pred_t = path.modes.tmode;
+            path.modes.nmode = rec.start_n;
+            path.modes.tmode = rec.start_t;
+        }
+        trace->open_phase();
+    }
+
+    /// Step 1, the active-set passes from the previous step's modes: most steps end here in one
+    /// pass. Where a Newton method follows, SparsePathMethods::newton_passes of them (1: its start
+    /// is not the passes' answer, and further passes switch every violated row and move away from
+    /// the step's answer, docs/decisions/036 / 037), else max_active_set_iterations. From rest in
+    /// the run's first solve (no converged solve before on this structure), none
+    /// (SparsePathMethods::rest_first_pass, docs/decisions/046): the Newton methods start from p = 0,
+    /// not from the pass's solution; z = K^-1 b and s as the passes would leave them.
+    void first_passes(const detail::sparse::Step& step, const Eigen::VectorXd& p_start, bool newton_follows,
+                      Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
+        const auto& sw = path.switches;
+        const int m = static_cast<int>(step.d.size());
+        const int max_passes =
+            newton_follows && sw.newton_passes > 0 ? sw.newton_passes : path.options.max_active_set_iterations;
+        const bool rest_pass =
+            sw.rest_first_pass || !newton_follows || !p_start.isZero(0.0) || last_p.size() == static_cast<Eigen::Index>(m);
+        if (!rest_pass && !sw.newton_first) {
+            path.s = path.stiffness().positions(step.b, step.d, p, z);
+        } else if (!sw.newton_first && max_passes > 4) {
+            r.converged = path.passes(step, p, z, max_passes, r);
+        } else if (!sw.newton_first) {
+            // the first pass alone, then the rest: the same sequence (the passes' budget before
+            // Murty's rule, 3 passes without fewer violations, cannot run out within 4)
+            r.converged = path.passes(step, p, z, 1, r);
+            if (!r.converged) {
+                p_first_pass = p;
+                if (max_passes > 1) r.converged = path.passes(step, p, z, max_passes - 1, r);
+            }
+        }
+    }
+
+    /// Steps 1 to 2b: the passes, then (where they do not settle) the transition methods in turn.
+    /// Throws SingularModes.
+    void settle(const detail::sparse::Step& step, const Eigen::VectorXd& p_start, Eigen::VectorXd& p,
+                Eigen::VectorXd& z, SolveResult& r, StepRecord& rec) {
+        using namespace detail::sparse;
+        const auto& sw = path.switches;
+        const int m = static_cast<int>(step.d.size());
+        TransitionTrace* const trace = path.observer;
+        const bool newton_follows = sw.transition != TransitionMethod::tresca && m >= newton_min_rows;
+        first_passes(step, p_start, newton_follows, p, z, r);
+        if (rec.tr) {
+            trace->close_phase(phase_passes);
+            rec.tr->pass_solves = r.iterations;
+            rec.tr->passes_settled = r.converged;
+            rec.passes_n = path.modes.nmode;
+            rec.passes_t = path.modes.tmode;
+        }
+        // 1b. The homotopy from the last step's data and modes (SparsePathMethods::path_following),
+        //     where a Newton method would follow (the same problems, the same confirmation)
+        if (!r.converged && newton_follows && sw.path_following != 0 && !sw.newton_first) {
+            r.converged = path_transition(step, p, z, r);
+            if (rec.tr) trace->close_phase(phase_path);
+        }
+        // 2a. A transition the passes do not settle: the semismooth Newton method on the
+        //     natural map from the previous step's forces, extrapolated (for the first
+        //     step: the stepper's start), then the active-set passes from its modes
+        //     (one pass, normally: they re-solve its last set of modes and find no violation,
+        //     so the answer is the exact solver's linear solution of those modes). If it
+        //     fails, the smoothing Newton method from its best iterate (then from the step's
+        //     start), then the passes from its modes.
+        if (!r.converged && sw.transition != TransitionMethod::tresca && (m >= newton_min_rows || sw.newton_first))
+            r.converged = newton_transition(step, p_start, p, z, r);
+        // 2b. Otherwise (or if it failed): the Tresca fixed point.
+        if (!r.converged) {
+            r.converged = tresca_transition(step, p, z, r);
+            if (rec.tr) trace->close_phase(phase_tresca);
+        }
+    }
+
+    /// Step 3, the last resort for problems small enough: the dense problem and the dense exact
+    /// solver (Tresca fixed point, Gauss-Seidel). O(m^2) memory; reported. False (p back to
+    /// p_start, the message and residual in r) where the problem is too large for it.
+    bool dense_fallback(const SparseContactProblem& problem, const Eigen::VectorXd& p_start, bool singular,
+                        Eigen::VectorXd& p, Eigen::VectorXd& z, SolveResult& r) {
+        const int m = problem.size();
+        const detail::sparse::SparseStiffness& st = path.stiffness();
+        if (m > kDenseFallbackMaxRows) {
+            p = p_start;
+            r.message = std::string("sparse path: the active-set passes ") +
+                        (singular ? "met a singular set of modes" : "and the Tresca fixed point did not settle") +
+                        "; the dense fallback is not tried for " + std::to_string(m) + " > " +
+                        std::to_string(kDenseFallbackMaxRows) + " contact rows";
+            path.s = st.positions(problem.b, problem.d, p, z);
+            r.residual_m = error_vector(path.laws, p, path.s).norm();
+            return false;
+        }
+        const ContactProblem dense = problem.to_dense();
+        SolveResult d = make_solver(path.options)->solve(dense, p);
+        r.iterations += d.iterations;
+        r.factorizations += d.factorizations;
+        r.tresca_iterations += d.tresca_iterations;
+        r.fell_back = true;
+        r.converged = d.converged;
+        if (!d.converged)
+            r.message = std::string("sparse path: the active-set passes ") +
+                        (singular ? "met a singular set of modes" : "did not settle") +
+                        " and the dense fallback failed: " + d.message;
+        path.s = st.positions(problem.b, problem.d, p, z);
+        path.modes.init(path.laws, p, path.s);
+        return true;
+    }
+
+    /// After a solve: its residuals checked against the tolerance, the homotopy's next start
+    /// (the converged solve's data and modes), the accepted modes and the last answers kept.
+    void conclude(const SparseContactProblem& problem, const Eigen::VectorXd& p, SolveResult& r) {
+        r.updates = path.solver.updates();
+        detail::residual_norms(path.laws, path.diag(), p, path.s, r.residual_m, r.natural_residual_m);
+        if (r.converged && !(r.residual_m < path.options.tolerance_m)) {
+            r.converged = false;
+            r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +
+                        " m above the tolerance " + format_value(path.options.tolerance_m) + " m (natural-map residual " +
+                        format_value(r.natural_residual_m) + " m)";
+        }
+        if (path.switches.path_following != 0) {  // the homotopy's next start
+            if (r.converged) {
+                path_b = problem.b;
+                path_d = problem.d;
+                path_n = path.modes.nmode;
+                path_t = path.modes.tmode;
+            } else {
+                path_d.resize(0);
+            }
+        }
+        if (r.converged) {
+            path.solver.accept();  // the accepted modes: the base of the next step's updates
+            previous_p = last_p;
+            last_p = p;
+            if (path.observer) {
+                previous_s = last_s;
+                last_s = path.s;
+            }
+        }
+    }
+
+    /// The observer's record of the solve closed: its counts, and the distances of the start,
+    /// predicted, passes' and first Newton modes to the final ones.
+    void close_record(const SolveResult& r, StepRecord& rec) {
+        using namespace detail::sparse;
+        StepTrace* const tr = rec.tr;
+        if (!tr) return;
+        TransitionTrace* const trace = path.observer;
+        tr->solves = r.factorizations + r.updates;
+        tr->factorizations = r.factorizations;
+        for (const auto& c : path.laws.pairs) tr->pairs += c.row_n >= 0 || c.row_t >= 0;
+        for (const int c : trace->changes) {
+            tr->pairs_changed += c > 0;
+            tr->max_changes_per_pair = std::max(tr->max_changes_per_pair, c);
+        }
+        if (r.converged) {
+            const auto& fn = path.modes.nmode;
+            const auto& ft = path.modes.tmode;
+            TransitionTrace::distance(rec.start_n, rec.start_t, fn, ft, tr->start_n, tr->start_t);
+            if (!rec.pred_n.empty()) TransitionTrace::distance(rec.pred_n, rec.pred_t, fn, ft, tr->pred_n, tr->pred_t);
+            if (!rec.passes_n.empty())
+                TransitionTrace::distance(rec.passes_n, rec.passes_t, fn, ft, tr->passes_n, tr->passes_t);
+            if (!trace->first_n.empty())
+                TransitionTrace::distance(trace->first_n, trace->first_t, fn, ft, tr->first_n, tr->first_t);
+        }
+        trace->first_n.clear();
+        trace->current = nullptr;
+    }
 };
+
+namespace {
+/// Throws InputError naming `tuning.<field>` unless lo <= value <= hi.
+void check_range(const char* field, int value, int lo, int hi, const char* allowed) {
+    if (value < lo || value > hi)
+        throw InputError(std::string("tuning.") + field, "value " + std::to_string(value) + " must be " + allowed);
+}
+
+/// The methods' integer fields (sparse_methods.hpp: each field's note says what its values mean).
+void validate_methods(const SparsePathMethods& m) {
+    constexpr int big = std::numeric_limits<int>::max();
+    check_range("methods.fixed_pattern", m.fixed_pattern, 0, 4, "0, 1, 2, 3 or 4");
+    check_range("methods.fixed_border_rows", m.fixed_border_rows, -1, big, ">= -1 (-1: max_border_rows alone)");
+    check_range("methods.newton_passes", m.newton_passes, 0, big, ">= 0");
+    check_range("methods.creep_limit", m.creep_limit, 0, big, ">= 0 (0: never)");
+    check_range("methods.nonmonotone_memory", m.nonmonotone_memory, 0, big, ">= 0 (0: monotone)");
+    check_range("methods.schur_fresh_max_rows", m.schur_fresh_max_rows, -1, big, ">= -1 (-1: no limit)");
+    check_range("methods.path_following", m.path_following, 0, 1, "0 (off) or 1 (on)");
+    check_range("methods.path_rebase_rows", m.path_rebase_rows, 0, big, ">= 0 (0: never)");
+    check_range("methods.path_max_start_hits", m.path_max_start_hits, 0, big, ">= 0 (0: no limit)");
+    check_range("methods.rest_path_violations", m.rest_path_violations, 0, big, ">= 0 (0: off)");
+    check_range("methods.path_max_pair_switches", m.path_max_pair_switches, 0, big, ">= 0 (0: no limit)");
+    check_range("methods.path_keep_base", m.path_keep_base, 0, big, ">= 0 (0: off)");
+}
+}  // namespace
 
 SparseContactSolver::SparseContactSolver(const SolverOptions& options, const SparsePathTuning& tuning) {
     make_solver(options);  // validates the options
+    validate_methods(tuning.methods);
     if (tuning.schur_max_rows < 0)
         throw InputError("tuning.schur_max_rows", "value " + std::to_string(tuning.schur_max_rows) + " must be >= 0");
     if (tuning.newton_min_rows < 0)
@@ -512,158 +718,18 @@ SolveResult SparseContactSolver::solve(const SparseContactProblem& problem, Eige
     bool singular = false;
     const Eigen::VectorXd p_start = p;
     const Step step{problem.b, problem.d};
-    // the study's trace (Switches::trace, trace.hpp): the start modes and a prediction
-    TransitionTrace* const trace = path.switches.trace;
-    StepTrace* tr = nullptr;
-    std::vector<signed char> start_n, start_t, pred_n, pred_t, passes_n, passes_t;
-    if (trace) {
-        tr = &trace->new_step();
-        start_n = path.modes.nmode;
-        start_t = path.modes.tmode;
-        trace->begin(start_n, start_t);
-        if (im.previous_p.size() == m && im.last_p.size() == m && im.previous_s.size() == m && im.last_s.size() == m) {
-            Eigen::VectorXd F;
-            path.natural_residual(2.0 * im.last_p - im.previous_p, 2.0 * im.last_s - im.previous_s, F, true);
-            pred_n = path.modes.nmode;
-            pred_t = path.modes.tmode;
-            path.modes.nmode = start_n;
-            path.modes.tmode = start_t;
-        }
-        trace->open_phase();
-    }
+    Impl::StepRecord rec;  // the observer's record (SparsePathTuning::observer, trace.hpp)
+    im.open_record(m, rec);
     im.p_first_pass.resize(0);
     try {
-        // 1. From the previous step's modes: most steps end here in one pass. Where a Newton
-        //    method follows, Switches::newton_passes of them (1: its start is not the passes'
-        //    answer, and further passes switch every violated row and move away from the step's
-        //    answer, docs/decisions/036 / 037), else max_active_set_iterations.
-        const bool newton_follows = path.switches.transition != TransitionMethod::tresca && m >= im.newton_min_rows;
-        const int max_passes = newton_follows && path.switches.newton_passes > 0 ? path.switches.newton_passes
-                                                                                 : path.options.max_active_set_iterations;
-        //    From rest in the run's first solve (no converged solve before on this structure), none
-        //    (Switches::rest_first_pass, docs/decisions/046): the Newton methods start from p = 0,
-        //    not from the pass's solution; z = K^-1 b and s as the passes would leave them.
-        const bool rest_pass = path.switches.rest_first_pass || !newton_follows || !p_start.isZero(0.0) ||
-                               im.last_p.size() == static_cast<Eigen::Index>(m);
-        if (!rest_pass && !path.switches.newton_first) {
-            path.s = st.positions(problem.b, problem.d, p, z);
-        } else if (!path.switches.newton_first && max_passes > 4) {
-            r.converged = path.passes(step, p, z, max_passes, r);
-        } else if (!path.switches.newton_first) {
-            // the first pass alone, then the rest: the same sequence (the passes' budget before
-            // Murty's rule, 3 passes without fewer violations, cannot run out within 4)
-            r.converged = path.passes(step, p, z, 1, r);
-            if (!r.converged) {
-                im.p_first_pass = p;
-                if (max_passes > 1) r.converged = path.passes(step, p, z, max_passes - 1, r);
-            }
-        }
-        if (tr) {
-            trace->close_phase(phase_passes);
-            tr->pass_solves = r.iterations;
-            tr->passes_settled = r.converged;
-            passes_n = path.modes.nmode;
-            passes_t = path.modes.tmode;
-        }
-        // 1b. The homotopy from the last step's data and modes (Switches::path_following),
-        //     where a Newton method would follow (the same problems, the same confirmation)
-        if (!r.converged && newton_follows && path.switches.path_following != 0 && !path.switches.newton_first) {
-            r.converged = im.path_transition(step, p, z, r);
-            if (tr) trace->close_phase(phase_path);
-        }
-        // 2a. A transition the passes do not settle: the semismooth Newton method on the
-        //     natural map from the previous step's forces, extrapolated (for the first
-        //     step: the stepper's start), then the active-set passes from its modes
-        //     (one pass, normally: they re-solve its last set of modes and find no violation,
-        //     so the answer is the exact solver's linear solution of those modes). If it
-        //     fails, the smoothing Newton method from its best iterate (then from the step's
-        //     start), then the passes from its modes.
-        if (!r.converged && path.switches.transition != TransitionMethod::tresca &&
-            (m >= im.newton_min_rows || path.switches.newton_first))
-            r.converged = im.newton_transition(step, p_start, p, z, r);
-        // 2b. Otherwise (or if it failed): the Tresca fixed point.
-        if (!r.converged) {
-            r.converged = im.tresca_transition(step, p, z, r);
-            if (tr) trace->close_phase(phase_tresca);
-        }
+        im.settle(step, p_start, p, z, r, rec);
     } catch (const SingularModes&) {
         singular = true;  // a set of modes with dependent held rows: leave it to the dense solver
         path.solver.forget();
     }
-    if (!r.converged) {
-        // 3. Last resort for problems small enough: the dense problem and the dense exact
-        //    solver (Tresca fixed point, Gauss-Seidel). O(m^2) memory; reported.
-        if (m > kDenseFallbackMaxRows) {
-            p = p_start;
-            r.message = std::string("sparse path: the active-set passes ") +
-                        (singular ? "met a singular set of modes" : "and the Tresca fixed point did not settle") +
-                        "; the dense fallback is not tried for " + std::to_string(m) + " > " +
-                        std::to_string(kDenseFallbackMaxRows) + " contact rows";
-            path.s = st.positions(problem.b, problem.d, p, z);
-            r.residual_m = error_vector(path.laws, p, path.s).norm();
-            return r;
-        }
-        const ContactProblem dense = problem.to_dense();
-        SolveResult d = make_solver(path.options)->solve(dense, p);
-        r.iterations += d.iterations;
-        r.factorizations += d.factorizations;
-        r.tresca_iterations += d.tresca_iterations;
-        r.fell_back = true;
-        r.converged = d.converged;
-        if (!d.converged)
-            r.message = std::string("sparse path: the active-set passes ") +
-                        (singular ? "met a singular set of modes" : "did not settle") +
-                        " and the dense fallback failed: " + d.message;
-        path.s = st.positions(problem.b, problem.d, p, z);
-        path.modes.init(path.laws, p, path.s);
-    }
-    r.updates = path.solver.updates();
-    detail::residual_norms(path.laws, path.diag(), p, path.s, r.residual_m, r.natural_residual_m);
-    if (r.converged && !(r.residual_m < path.options.tolerance_m)) {
-        r.converged = false;
-        r.message = "sparse path (active set) ended with ||v|| = " + format_value(r.residual_m) +
-                    " m above the tolerance " + format_value(path.options.tolerance_m) + " m (natural-map residual " +
-                    format_value(r.natural_residual_m) + " m)";
-    }
-    if (path.switches.path_following != 0) {  // the homotopy's next start
-        if (r.converged) {
-            im.path_b = problem.b;
-            im.path_d = problem.d;
-            im.path_n = path.modes.nmode;
-            im.path_t = path.modes.tmode;
-        } else {
-            im.path_d.resize(0);
-        }
-    }
-    if (r.converged) {
-        path.solver.accept();  // the accepted modes: the base of the next step's updates
-        im.previous_p = im.last_p;
-        im.last_p = p;
-        if (trace) {
-            im.previous_s = im.last_s;
-            im.last_s = path.s;
-        }
-    }
-    if (tr) {
-        tr->solves = r.factorizations + r.updates;
-        tr->factorizations = r.factorizations;
-        for (const auto& c : path.laws.pairs) tr->pairs += c.row_n >= 0 || c.row_t >= 0;
-        for (const int c : trace->changes) {
-            tr->pairs_changed += c > 0;
-            tr->max_changes_per_pair = std::max(tr->max_changes_per_pair, c);
-        }
-        if (r.converged) {
-            const auto& fn = path.modes.nmode;
-            const auto& ft = path.modes.tmode;
-            TransitionTrace::distance(start_n, start_t, fn, ft, tr->start_n, tr->start_t);
-            if (!pred_n.empty()) TransitionTrace::distance(pred_n, pred_t, fn, ft, tr->pred_n, tr->pred_t);
-            if (!passes_n.empty()) TransitionTrace::distance(passes_n, passes_t, fn, ft, tr->passes_n, tr->passes_t);
-            if (!trace->first_n.empty())
-                TransitionTrace::distance(trace->first_n, trace->first_t, fn, ft, tr->first_n, tr->first_t);
-        }
-        trace->first_n.clear();
-        trace->current = nullptr;
-    }
+    if (!r.converged && !im.dense_fallback(problem, p_start, singular, p, z, r)) return r;
+    im.conclude(problem, p, r);
+    im.close_record(r, rec);
     return r;
 }
 

@@ -1,7 +1,7 @@
 // The covering start of the homotopy (transitions.hpp, covering_start; docs/decisions/041).
 #include <algorithm>
 
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 

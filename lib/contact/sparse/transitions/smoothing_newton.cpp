@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 

@@ -1,6 +1,6 @@
 #pragma once
 // Internal, a study aid (docs/decisions/036): what the sparse path's transition steps do,
-// recorded per step when Switches::trace points at a TransitionTrace (the benchmark's
+// recorded per step when SparsePathTuning::observer points at a TransitionTrace (the benchmark's
 // `trace` argument). Off (nullptr) by default: nothing is recorded and nothing costs.
 #include <algorithm>
 #include <ctime>

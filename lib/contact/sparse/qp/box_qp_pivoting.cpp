@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "contact/box_qp.hpp"
-#include "contact/sparse/box_qp_methods.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
 
 namespace stackbeam::detail::sparse {
 

@@ -9,7 +9,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "contact/sparse/sparse_path.hpp"
+#include "contact/sparse/driver/sparse_path.hpp"
 
 namespace stackbeam::detail::sparse {
 

@@ -1,5 +1,5 @@
 // The diagonal of W = G K^-1 G^T from the selected inverse of K (see the header).
-#include "contact/sparse/selected_inverse.hpp"
+#include "contact/sparse/linear/selected_inverse.hpp"
 
 #include <algorithm>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the saddle-point system of a set of modes on one pattern for every set
-// (fixed_saddle.cpp; docs/decisions/031-fixed-pattern-refactorisation.md).
+// (fixed_pattern_lu.cpp; docs/decisions/031-fixed-pattern-refactorisation.md).
 //
 // The mode solver's sparse LU factorised, per held set S, the scaled system
 //     [ Dz K Dz                  -Dz (G_S^T + G_slip^T D) R ] [y  ]   [Dz f  ]
@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "contact/active_set.hpp"
-#include "contact/sparse/common.hpp"
+#include "contact/sparse/driver/common.hpp"
 
 namespace stackbeam::detail::sparse {
 

@@ -5,8 +5,8 @@
 #include <utility>
 #include <vector>
 
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -43,21 +43,23 @@ void set_open_modes(SparsePath& path) {
 /// kinks are sorted and swept once, each pair's lines recomputed only at its own kinks, and
 /// the quadratic of each interval minimised in closed form: O(m log m) for the whole search
 /// instead of O(m) per trial point. Returns the minimiser (the caller evaluates F there).
-double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const Eigen::VectorXd& dp,
-                         const Eigen::VectorXd& s, const Eigen::VectorXd& ds, double a_min) {
-    const auto& laws = path.laws;
-    const Eigen::VectorXd& diag = path.diag();
-    const bool prev = laws.tau_rule == TauRule::previous_step;
-    const int np = static_cast<int>(laws.pairs.size());
-    // tau's argument as a line q0 + q1 a (clamp: F_c - p_n; coulomb: -p_n; tau = max(0, q)),
-    // and the limit L = mu tau as a line on the piece where tau's argument has sign of q
-    auto tau_line = [&](int k, double& q0, double& q1) {
+/// The natural map's components along the step (p + a dp, s + a ds) as lines in a, piece by
+/// piece (breakpoint_search).
+struct StepLines {
+    const ContactProblem& laws;
+    const Eigen::VectorXd& diag;
+    const bool prev;  // TauRule::previous_step
+    const Eigen::VectorXd &p, &dp, &s, &ds;
+
+    /// tau's argument as a line q0 + q1 a (clamp: F_c - p_n; coulomb: -p_n; tau = max(0, q))
+    void tau_line(int k, double& q0, double& q1) const {
         const auto& c = laws.pairs[static_cast<std::size_t>(k)];
         const double pn0 = c.row_n >= 0 ? p[c.row_n] : 0.0, pn1 = c.row_n >= 0 ? dp[c.row_n] : 0.0;
         q0 = (c.kind == PairKind::clamp ? c.preload_n : 0.0) - pn0;
         q1 = -pn1;
-    };
-    auto limit_line = [&](int k, double q, double q0, double q1, double& l0, double& l1) {
+    }
+    /// the limit L = mu tau as a line on the piece where tau's argument has sign of q
+    void limit_line(int k, double q, double q0, double q1, double& l0, double& l1) const {
         const auto& c = laws.pairs[static_cast<std::size_t>(k)];
         const double mu = c.friction_coefficient;
         l0 = l1 = 0.0;
@@ -69,10 +71,10 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
             l0 = mu * q0;
             l1 = mu * q1;
         }
-    };
-    // per pair: the lines (f0 + f1 a) of its normal and tangential components on the piece
-    // containing a (the rows of no pair, and bilateral rows, are s itself: F = s)
-    auto lines = [&](int k, double a, double f[4]) {
+    }
+    /// per pair: the lines (f0 + f1 a) of its normal and tangential components on the piece
+    /// containing a (the rows of no pair, and bilateral rows, are s itself: F = s)
+    void lines(int k, double a, double f[4]) const {
         const auto& c = laws.pairs[static_cast<std::size_t>(k)];
         f[0] = f[1] = f[2] = f[3] = 0.0;
         if (c.row_n >= 0) {
@@ -104,41 +106,53 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
             f[2] = w * (p[c.row_t] + l0);
             f[3] = w * (dp[c.row_t] + l1);
         }
-    };
-    // the kinks of each pair in (a_min, 1)
-    std::vector<std::pair<double, int>> events;
-    auto add_root = [&](double num, double den, double lo, double hi, int k) {  // root of num + den a in (lo, hi)
-        if (den == 0.0) return;
-        const double a = -num / den;
-        if (a > lo && a < hi) events.emplace_back(a, k);
-    };
-    for (int k = 0; k < np; ++k) {
-        const auto& c = laws.pairs[static_cast<std::size_t>(k)];
-        if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
-            const double w = diag[c.row_n];
-            add_root(p[c.row_n] - s[c.row_n] / w, dp[c.row_n] - ds[c.row_n] / w, a_min, 1.0, k);
-        }
-        if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
-        const double w = diag[c.row_t];
-        const double t0 = p[c.row_t] - s[c.row_t] / w, t1 = dp[c.row_t] - ds[c.row_t] / w;
-        double q0, q1;
-        tau_line(k, q0, q1);
-        double a_tau = 2.0;  // tau's kink (none in the range: 2)
-        if (q1 != 0.0 && -q0 / q1 > a_min && -q0 / q1 < 1.0) {
-            a_tau = -q0 / q1;
-            events.emplace_back(a_tau, k);
-        }
-        // crossings of a_t = +-L on each piece of L (at most two)
-        const double cuts[3] = {a_min, std::min(a_tau, 1.0), 1.0};
-        for (int piece = 0; piece < (a_tau < 1.0 ? 2 : 1); ++piece) {
-            const double lo = cuts[piece], hi = cuts[piece + 1];
-            const double mid = 0.5 * (lo + hi);
-            double l0, l1;
-            limit_line(k, q0 + mid * q1, q0, q1, l0, l1);
-            add_root(t0 - l0, t1 - l1, lo, hi, k);  // a_t = L
-            add_root(t0 + l0, t1 + l1, lo, hi, k);  // a_t = -L
-        }
     }
+    /// the kinks of each pair in (a_min, 1), unsorted: (a, pair)
+    std::vector<std::pair<double, int>> kinks(double a_min) const {
+        std::vector<std::pair<double, int>> events;
+        auto add_root = [&](double num, double den, double lo, double hi, int k) {  // root of num + den a in (lo, hi)
+            if (den == 0.0) return;
+            const double a = -num / den;
+            if (a > lo && a < hi) events.emplace_back(a, k);
+        };
+        const int np = static_cast<int>(laws.pairs.size());
+        for (int k = 0; k < np; ++k) {
+            const auto& c = laws.pairs[static_cast<std::size_t>(k)];
+            if (c.row_n >= 0 && c.kind == PairKind::coulomb) {
+                const double w = diag[c.row_n];
+                add_root(p[c.row_n] - s[c.row_n] / w, dp[c.row_n] - ds[c.row_n] / w, a_min, 1.0, k);
+            }
+            if (c.row_t < 0 || c.kind == PairKind::bonded) continue;
+            const double w = diag[c.row_t];
+            const double t0 = p[c.row_t] - s[c.row_t] / w, t1 = dp[c.row_t] - ds[c.row_t] / w;
+            double q0, q1;
+            tau_line(k, q0, q1);
+            double a_tau = 2.0;  // tau's kink (none in the range: 2)
+            if (q1 != 0.0 && -q0 / q1 > a_min && -q0 / q1 < 1.0) {
+                a_tau = -q0 / q1;
+                events.emplace_back(a_tau, k);
+            }
+            // crossings of a_t = +-L on each piece of L (at most two)
+            const double cuts[3] = {a_min, std::min(a_tau, 1.0), 1.0};
+            for (int piece = 0; piece < (a_tau < 1.0 ? 2 : 1); ++piece) {
+                const double lo = cuts[piece], hi = cuts[piece + 1];
+                const double mid = 0.5 * (lo + hi);
+                double l0, l1;
+                limit_line(k, q0 + mid * q1, q0, q1, l0, l1);
+                add_root(t0 - l0, t1 - l1, lo, hi, k);  // a_t = L
+                add_root(t0 + l0, t1 + l1, lo, hi, k);  // a_t = -L
+            }
+        }
+        return events;
+    }
+};
+
+double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const Eigen::VectorXd& dp,
+                         const Eigen::VectorXd& s, const Eigen::VectorXd& ds, double a_min) {
+    const auto& laws = path.laws;
+    const int np = static_cast<int>(laws.pairs.size());
+    const StepLines sl{laws, path.diag(), laws.tau_rule == TauRule::previous_step, p, dp, s, ds};
+    std::vector<std::pair<double, int>> events = sl.kinks(a_min);
     std::sort(events.begin(), events.end());
     // the sweep: theta = A a^2 + B a + C on each interval, each pair's share kept so that
     // only the pairs with a kink at an interval's end are recomputed
@@ -148,7 +162,7 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
     double A = 0.0, B = 0.0, C = 0.0;
     auto update = [&](int k, double a) {
         double f[4];
-        lines(k, a, f);
+        sl.lines(k, a, f);
         double* q = &share[static_cast<std::size_t>(k) * 3];
         A -= q[0];
         B -= q[1];
@@ -206,6 +220,68 @@ double breakpoint_search(const SparsePath& path, const Eigen::VectorXd& p, const
     }
     return best_a;
 }
+/// The line search along the Newton step from (p, sk) to its full step (p1, s1), theta = ||F||^2
+/// at p: the step length into `a` (1 on entry), its theta returned (infinity where no trial was
+/// better than none); nonmonotone_full where the nonmonotone test took the full step. pa, sa, F1:
+/// workspaces.
+double line_search(SparsePath& path, const Eigen::VectorXd& p, const Eigen::VectorXd& sk, const Eigen::VectorXd& p1,
+                   const Eigen::VectorXd& s1, double theta, const std::vector<double>& recent, double& a,
+                   bool& nonmonotone_full, Eigen::VectorXd& pa, Eigen::VectorXd& sa, Eigen::VectorXd& F1) {
+    const int memory = path.switches.nonmonotone_memory;
+    // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
+    // (each trial O(m)); theta is piecewise quadratic along the step with many kinks
+    // (every component that changes branch), so the grid's best point is taken rather
+    // than the first that passes Armijo's test (measured: 26 instead of 48 iterations
+    // on the first step of 10 leaves x 100 elements). Where no trial lowers theta, the
+    // full step is taken (non-monotone; at most kNewtonNonmonotone times).
+    double grid_theta = std::numeric_limits<double>::infinity();
+    const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
+    bool searched = false;
+    if (memory > 0) {
+        // the nonmonotone search (Grippo, Lampariello and Lucidi, SIAM J. Numer. Anal. 23
+        // (1986)): the full step wherever it lowers theta below the largest of the last
+        // `memory` iterates' (Switches::nonmonotone_memory; docs/decisions/037: the exact
+        // minimiser creeps, 0.1-0.3 of the step per iteration for tens of iterations, where
+        // the full step is the linear solution of the new modes), else the exact search
+        path.natural_residual(p1, s1, F1, false);
+        const double t1 = F1.squaredNorm();
+        if (t1 < (1.0 - kNonmonotoneDecrease) * *std::max_element(recent.begin(), recent.end())) {
+            grid_theta = t1;
+            a = 1.0;
+            searched = nonmonotone_full = true;
+        }
+    }
+    if (!searched && path.switches.incremental) {
+        // the exact minimiser over the grid's range (breakpoint_search), checked by one
+        // evaluation of F (the sweep's sums are exact up to their round-off); the full
+        // step where it is as good (p is then the linear solution of its modes)
+        const double ab = breakpoint_search(path, p, p1 - p, sk, s1 - sk, a_min);
+        for (const double aj : {ab, 1.0}) {
+            pa = p + aj * (p1 - p);
+            sa = sk + aj * (s1 - sk);
+            path.natural_residual(pa, sa, F1, false);
+            const double tj = F1.squaredNorm();
+            if (tj < grid_theta || (aj == 1.0 && tj <= grid_theta * (1.0 + 1e-12))) {
+                grid_theta = tj;
+                a = aj;
+            }
+            if (ab == 1.0) break;
+        }
+        searched = grid_theta < theta;  // else the grid below decides, as before
+    }
+    for (int j = 0; !searched && j <= 4 * kLineSearchOctaves; ++j) {
+        const double aj = std::pow(2.0, -0.25 * j);
+        pa = p + aj * (p1 - p);
+        sa = sk + aj * (s1 - sk);
+        path.natural_residual(pa, sa, F1, false);
+        const double tj = F1.squaredNorm();
+        if (tj < grid_theta) {
+            grid_theta = tj;
+            a = aj;
+        }
+    }
+    return grid_theta;
+}
 }  // namespace
 
 /// Semismooth Newton method on the natural map (Alart-Curnier / Pang's natural-map
@@ -241,7 +317,7 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
     const int m = static_cast<int>(d.size());
     path.best_p.resize(0);
     path.handed_over = false;
-    TransitionTrace* const trace = path.switches.trace;
+    TransitionTrace* const trace = path.observer;
     StepTrace* const tr = trace ? trace->current : nullptr;
     auto end = [&](int how, bool result) {
         if (tr) tr->newton_end = how;
@@ -305,59 +381,9 @@ bool semismooth_newton(SparsePath& path, const Step& step, Eigen::VectorXd& p, E
             return end(4, false);
         }
         s1 = st.Grow * z1 - d;
-        // line search: the smallest theta on the grid a = 2^(-j/4), j = 0 .. 4 kLineSearchOctaves
-        // (each trial O(m)); theta is piecewise quadratic along the step with many kinks
-        // (every component that changes branch), so the grid's best point is taken rather
-        // than the first that passes Armijo's test (measured: 26 instead of 48 iterations
-        // on the first step of 10 leaves x 100 elements). Where no trial lowers theta, the
-        // full step is taken (non-monotone; at most kNewtonNonmonotone times).
-        double a = 1.0, grid_theta = std::numeric_limits<double>::infinity();
-        const double a_min = std::pow(2.0, -static_cast<double>(kLineSearchOctaves));
-        bool searched = false;
         bool nonmonotone_full = false;
-        if (memory > 0) {
-            // the nonmonotone search (Grippo, Lampariello and Lucidi, SIAM J. Numer. Anal. 23
-            // (1986)): the full step wherever it lowers theta below the largest of the last
-            // `memory` iterates' (Switches::nonmonotone_memory; docs/decisions/037: the exact
-            // minimiser creeps, 0.1-0.3 of the step per iteration for tens of iterations, where
-            // the full step is the linear solution of the new modes), else the exact search
-            path.natural_residual(p1, s1, F1, false);
-            const double t1 = F1.squaredNorm();
-            if (t1 < (1.0 - kNonmonotoneDecrease) * *std::max_element(recent.begin(), recent.end())) {
-                grid_theta = t1;
-                a = 1.0;
-                searched = nonmonotone_full = true;
-            }
-        }
-        if (!searched && path.switches.incremental) {
-            // the exact minimiser over the grid's range (breakpoint_search), checked by one
-            // evaluation of F (the sweep's sums are exact up to their round-off); the full
-            // step where it is as good (p is then the linear solution of its modes)
-            const double ab = breakpoint_search(path, p, p1 - p, sk, s1 - sk, a_min);
-            for (const double aj : {ab, 1.0}) {
-                pa = p + aj * (p1 - p);
-                sa = sk + aj * (s1 - sk);
-                path.natural_residual(pa, sa, F1, false);
-                const double tj = F1.squaredNorm();
-                if (tj < grid_theta || (aj == 1.0 && tj <= grid_theta * (1.0 + 1e-12))) {
-                    grid_theta = tj;
-                    a = aj;
-                }
-                if (ab == 1.0) break;
-            }
-            searched = grid_theta < theta;  // else the grid below decides, as before
-        }
-        for (int j = 0; !searched && j <= 4 * kLineSearchOctaves; ++j) {
-            const double aj = std::pow(2.0, -0.25 * j);
-            pa = p + aj * (p1 - p);
-            sa = sk + aj * (s1 - sk);
-            path.natural_residual(pa, sa, F1, false);
-            const double tj = F1.squaredNorm();
-            if (tj < grid_theta) {
-                grid_theta = tj;
-                a = aj;
-            }
-        }
+        double a = 1.0;
+        const double grid_theta = line_search(path, p, sk, p1, s1, theta, recent, a, nonmonotone_full, pa, sa, F1);
         if (!(grid_theta < theta) && !nonmonotone_full) {
             if (itr) itr->nonmonotone = true;
             if (++nonmonotone > kNewtonNonmonotone) return end(3, false);

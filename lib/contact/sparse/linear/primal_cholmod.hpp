@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the linear problem of a set of modes with many held layer rows, in the primal
-// form on a CHOLMOD factor (primal_solver.cpp; docs/decisions/027-primal-cholmod-route.md).
+// form on a CHOLMOD factor (primal_cholmod.cpp; docs/decisions/027-primal-cholmod-route.md).
 //
 // An elastic interface's row r carries its own layer degree of freedom u_r (stiffness k_r,
 // G'(r, u_r) = e_r; SparseContactSolver's layered problem), so a held layer row is a spring,
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "contact/active_set.hpp"
-#include "contact/sparse/common.hpp"
+#include "contact/sparse/driver/common.hpp"
 
 namespace stackbeam::detail::sparse {
 

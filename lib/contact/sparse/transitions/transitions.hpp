@@ -7,8 +7,8 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "contact/sparse/sparse_path.hpp"
-#include "contact/sparse/trace.hpp"
+#include "contact/sparse/driver/sparse_path.hpp"
+#include "contact/sparse/driver/trace.hpp"
 
 namespace stackbeam::detail::sparse {
 

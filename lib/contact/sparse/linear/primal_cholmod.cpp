@@ -1,4 +1,4 @@
-// The primal form of a set of modes on a CHOLMOD factor (primal_solver.hpp). Compiled only
+// The primal form of a set of modes on a CHOLMOD factor (primal_cholmod.hpp). Compiled only
 // when CMake found CHOLMOD (STACKBEAM_HAVE_CHOLMOD).
 //
 // Why these choices (docs/decisions/027-primal-cholmod-route.md, measured):
@@ -10,7 +10,7 @@
 //    numeric factorisation, measured on the 10 x 400 stacks), a refactorisation otherwise;
 //  - GMRES (restarted, right-preconditioned, written here: Eigen's GMRES is in the
 //    unsupported module and takes an assembled matrix, this operator is never assembled).
-#include "contact/sparse/primal_solver.hpp"
+#include "contact/sparse/linear/primal_cholmod.hpp"
 
 #include <cholmod.h>
 
@@ -20,7 +20,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "contact/sparse/mode_solver.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -35,6 +35,71 @@ constexpr double kKrylovTolerance = 1e-14;
 constexpr double kKrylovAccept = 1e-10;  // a stagnated iteration is still accepted below this
 constexpr int kRestart = 30;
 constexpr int kMaxKrylov = 120;
+
+/// Restarted GMRES(kRestart) on apply_T B^-1 (apply_Binv: the preconditioner B^-1) for rhs
+/// (its norm rhs_norm), from xh (updated), the true residual at each restart; the Krylov
+/// iterations added to `iterations`. True where it reached kKrylovTolerance x rhs_norm (false
+/// also where it stagnated: the caller judges the residual).
+template <class ApplyT, class ApplyBinv>
+bool restarted_gmres(const ApplyT& apply_T, const ApplyBinv& apply_Binv, const Eigen::VectorXd& rhs, double rhs_norm,
+                     Eigen::VectorXd& xh, int& iterations) {
+    bool converged = rhs_norm == 0.0;
+    double last = std::numeric_limits<double>::infinity();
+    // restarted GMRES(kRestart) on T^ B^-1, the true residual at each restart
+    const Eigen::Index N = rhs.size();
+    Eigen::VectorXd r, tmp, tmp2;
+    Eigen::MatrixXd V(N, kRestart + 1), H = Eigen::MatrixXd::Zero(kRestart + 1, kRestart);
+    Eigen::VectorXd cs(kRestart), sn(kRestart), g(kRestart + 1);
+    while (!converged && iterations < kMaxKrylov) {
+        apply_T(xh, tmp);
+        r = rhs - tmp;
+        const double beta = r.norm();
+        if (beta <= kKrylovTolerance * rhs_norm) {
+            converged = true;
+            break;
+        }
+        if (beta > 0.5 * last) break;  // stagnated (round-off): judged below
+        last = beta;
+        V.col(0) = r / beta;
+        g.setZero();
+        g[0] = beta;
+        H.setZero();
+        int j = 0;
+        for (; j < kRestart && iterations < kMaxKrylov; ++j) {
+            ++iterations;
+            apply_Binv(V.col(j), tmp);
+            apply_T(tmp, tmp2);
+            for (int i = 0; i <= j; ++i) {  // modified Gram-Schmidt
+                H(i, j) = V.col(i).dot(tmp2);
+                tmp2 -= H(i, j) * V.col(i);
+            }
+            H(j + 1, j) = tmp2.norm();
+            if (H(j + 1, j) > 0.0) V.col(j + 1) = tmp2 / H(j + 1, j);
+            for (int i = 0; i < j; ++i) {  // the previous Givens rotations
+                const double a = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
+                H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
+                H(i, j) = a;
+            }
+            const double den = std::hypot(H(j, j), H(j + 1, j));
+            cs[j] = den > 0.0 ? H(j, j) / den : 1.0;
+            sn[j] = den > 0.0 ? H(j + 1, j) / den : 0.0;
+            H(j, j) = den;
+            H(j + 1, j) = 0.0;
+            g[j + 1] = -sn[j] * g[j];
+            g[j] = cs[j] * g[j];
+            if (std::abs(g[j + 1]) <= 0.1 * kKrylovTolerance * rhs_norm || H(j, j) == 0.0) {
+                ++j;
+                break;
+            }
+        }
+        if (j == 0) break;
+        const Eigen::VectorXd y =
+            H.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
+        apply_Binv(V.leftCols(j) * y, tmp);
+        xh += tmp;
+    }
+    return converged;
+}
 }  // namespace
 
 struct CholmodPrimal final : PrimalSolver {
@@ -418,62 +483,10 @@ bool CholmodPrimal::solve(const modes::ModeLinearization& lin, const std::vector
     rhs.head(nz) = s.dzz.cwiseProduct(h);
     for (int i = 0; i < nr; ++i) rhs[nz + i] = s.rs[i] * dR[i];
     const double rhs_norm = rhs.norm();
-    Eigen::VectorXd xh, r, tmp, tmp2;
+    Eigen::VectorXd xh, tmp;
     apply_Binv(rhs, xh);
-    bool converged = rhs_norm == 0.0;
-    double last = std::numeric_limits<double>::infinity();
     int iterations = 0;
-    // restarted GMRES(kRestart) on T^ B^-1, the true residual at each restart
-    Eigen::MatrixXd V(N, kRestart + 1), H = Eigen::MatrixXd::Zero(kRestart + 1, kRestart);
-    Eigen::VectorXd cs(kRestart), sn(kRestart), g(kRestart + 1);
-    while (!converged && iterations < kMaxKrylov) {
-        apply_T(xh, tmp);
-        r = rhs - tmp;
-        const double beta = r.norm();
-        if (beta <= kKrylovTolerance * rhs_norm) {
-            converged = true;
-            break;
-        }
-        if (beta > 0.5 * last) break;  // stagnated (round-off): judged below
-        last = beta;
-        V.col(0) = r / beta;
-        g.setZero();
-        g[0] = beta;
-        H.setZero();
-        int j = 0;
-        for (; j < kRestart && iterations < kMaxKrylov; ++j) {
-            ++iterations;
-            apply_Binv(V.col(j), tmp);
-            apply_T(tmp, tmp2);
-            for (int i = 0; i <= j; ++i) {  // modified Gram-Schmidt
-                H(i, j) = V.col(i).dot(tmp2);
-                tmp2 -= H(i, j) * V.col(i);
-            }
-            H(j + 1, j) = tmp2.norm();
-            if (H(j + 1, j) > 0.0) V.col(j + 1) = tmp2 / H(j + 1, j);
-            for (int i = 0; i < j; ++i) {  // the previous Givens rotations
-                const double a = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
-                H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
-                H(i, j) = a;
-            }
-            const double den = std::hypot(H(j, j), H(j + 1, j));
-            cs[j] = den > 0.0 ? H(j, j) / den : 1.0;
-            sn[j] = den > 0.0 ? H(j + 1, j) / den : 0.0;
-            H(j, j) = den;
-            H(j + 1, j) = 0.0;
-            g[j + 1] = -sn[j] * g[j];
-            g[j] = cs[j] * g[j];
-            if (std::abs(g[j + 1]) <= 0.1 * kKrylovTolerance * rhs_norm || H(j, j) == 0.0) {
-                ++j;
-                break;
-            }
-        }
-        if (j == 0) break;
-        const Eigen::VectorXd y =
-            H.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
-        apply_Binv(V.leftCols(j) * y, tmp);
-        xh += tmp;
-    }
+    bool converged = restarted_gmres(apply_T, apply_Binv, rhs, rhs_norm, xh, iterations);
     s.stats_.krylov_iterations += iterations;
     if (!converged) {
         apply_T(xh, tmp);

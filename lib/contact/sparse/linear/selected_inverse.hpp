@@ -3,7 +3,7 @@
 // inverse of K's Cholesky factor, without forming W (selected_inverse.cpp).
 #include <Eigen/Dense>
 
-#include "contact/sparse/common.hpp"
+#include "contact/sparse/driver/common.hpp"
 
 namespace stackbeam::detail::sparse {
 

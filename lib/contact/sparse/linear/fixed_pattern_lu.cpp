@@ -1,11 +1,11 @@
-// The saddle-point system of a set of modes on one fixed pattern (fixed_saddle.hpp).
-#include "contact/sparse/fixed_saddle.hpp"
+// The saddle-point system of a set of modes on one fixed pattern (fixed_pattern_lu.hpp).
+#include "contact/sparse/linear/fixed_pattern_lu.hpp"
 
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 
-#include "contact/sparse/mode_solver.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
 
 #ifdef STACKBEAM_HAVE_KLU
 #include <klu.h>

@@ -1,39 +1,50 @@
 #pragma once
-// Internal: the sparse path's test-only and historical switches (SparseContactSolver).
-// They are not part of the public API: the defaults are the production method; tests and
-// the benchmark force each way through ScopedSwitches to check or measure it alone.
-namespace stackbeam::detail::sparse {
+/// @file sparse_methods.hpp
+/// The sparse contact path's methods as a typed configuration (SparsePathTuning::methods), and
+/// the observer a caller may attach to record what its transition steps do
+/// (SparsePathTuning::observer). The defaults are the production method; the other values
+/// are the ways before a decision, kept to check or measure it (tests, benchmarks/), each
+/// named with its decision note (docs/decisions/). A solver takes them at its construction:
+/// nothing of it is global or per-thread state.
 
-struct TransitionTrace;  // trace.hpp
+namespace stackbeam {
+
+namespace detail::sparse {
+struct TransitionTrace;  // lib/contact/sparse/driver/trace.hpp (a study aid, docs/decisions/036)
+}  // namespace detail::sparse
+/// The observer of a SparseContactSolver's transition steps: counters per route and phase,
+/// per-step traces (lib/contact/sparse/driver/trace.hpp). The caller owns it and reads it.
+using SparsePathObserver = detail::sparse::TransitionTrace;
 
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).
-enum class TransitionMethod {
-    newton,      ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
+enum class SparseTransitionMethod {
+    newton = 0,  ///< semismooth Newton on the natural map with a line search; if it fails, the smoothing
                  ///< Newton method; then the Tresca fixed point (default)
-    semismooth,  ///< semismooth Newton, then (if it fails) the Tresca fixed point: the default before the
-                 ///< smoothing method (kept for comparison, docs/decisions/004-smoothing-newton.md)
-    smoothing,   ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
-    tresca,      ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
+    // 1: semismooth, the semismooth method then the Tresca fixed point (the default before
+    // decision 004), removed by decision 053; the values stay those the benchmark passes
+    smoothing = 2,  ///< the smoothing Newton method alone, then the Tresca fixed point (tests)
+    tresca = 3,     ///< the Tresca fixed point on a box QP only (the method before the Newton ones)
 };
 
 /// How the sparse path solves the box-constrained QP of the Tresca fixed point (friction
 /// limits frozen): min 1/2 p^T W p + q^T p over lower <= p <= upper, with W = G K^-1 G^T
 /// never formed. All end at the same working-set test, so their answers agree to round-off.
-enum class BoxQpMethod {
+enum class SparseBoxQpMethod {
     pivoting,        ///< block principal pivoting (a few sparse solves where it settles); where it does not
                      ///< settle in 50 passes, a primal-dual interior-point method (Mehrotra's predictor-
                      ///< corrector, one sparse LDL^T of K + G^T Sigma^-1 G per iteration, its working set
                      ///< read from the iterate); then the monotone primal active-set method (default)
     interior_point,  ///< the interior-point method first, then as `pivoting` (tests)
-    pivoting_only,   ///< pivoting, then the primal method: the way before the interior-point method
-                     ///< (kept for comparison, docs/decisions/006-interior-point-box-qp.md)
+    // (2: pivoting_only, the way before decision 006, removed by decision 053)
 };
 
-/// The switches of one SparseContactSolver (fixed at its construction).
-struct Switches {
-    TransitionMethod transition = TransitionMethod::newton;
-    BoxQpMethod box_qp = BoxQpMethod::pivoting;
+/// The methods of one SparseContactSolver (SparsePathTuning::methods, fixed at its
+/// construction): the defaults are the production method; tests and the benchmark set a field
+/// to check or measure one way alone, or the way before a decision (the field's note says which).
+struct SparsePathMethods {
+    SparseTransitionMethod transition = SparseTransitionMethod::newton;
+    SparseBoxQpMethod box_qp = SparseBoxQpMethod::pivoting;
     /// Every solve starts with the transition method from the warm start (no active-set
     /// passes from the previous modes first, and whatever the problem's size), so its
     /// answers can be checked alone.
@@ -88,8 +99,8 @@ struct Switches {
     /// minimiser along the step, monotone)
     int nonmonotone_memory = 10;
     /// All of the above the way before decision 037 (the benchmark's before).
-    static Switches before_037() {
-        Switches s;
+    static SparsePathMethods before_037() {
+        SparsePathMethods s;
         s.newton_passes = 0;
         s.smoothing_from_rest = false;
         s.first_pass_start = false;
@@ -97,9 +108,6 @@ struct Switches {
         s.nonmonotone_memory = 0;
         return s;
     }
-    /// A study aid (docs/decisions/036): where not null, every solve records its transition's
-    /// statistics there (trace.hpp). The caller owns it; nullptr (default): nothing recorded.
-    TransitionTrace* trace = nullptr;
     /// The Schur way's fresh dense LU (a held set no low-rank update of the base reaches) only
     /// up to this many held rows; larger sets take the sparse LU (ModeSolverTuning::
     /// schur_fresh_max_rows; docs/decisions/038). -1: no limit, the way before.
@@ -175,21 +183,4 @@ struct Switches {
     int path_keep_base = 10000;
 };
 
-/// The switches a SparseContactSolver constructed now on this thread takes: the defaults,
-/// or those of the innermost live ScopedSwitches.
-Switches current_switches();
-
-/// While alive, every SparseContactSolver constructed on this thread (directly, or by a
-/// stepper) takes `switches`; the previous ones are restored at the end of its scope.
-class ScopedSwitches {
-public:
-    explicit ScopedSwitches(const Switches& switches);
-    ~ScopedSwitches();
-    ScopedSwitches(const ScopedSwitches&) = delete;
-    ScopedSwitches& operator=(const ScopedSwitches&) = delete;
-
-private:
-    Switches saved_;
-};
-
-}  // namespace stackbeam::detail::sparse
+}  // namespace stackbeam

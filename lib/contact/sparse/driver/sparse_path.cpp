@@ -1,12 +1,12 @@
 // The state shared by the units of the sparse contact path (sparse_path.hpp).
-#include "contact/sparse/sparse_path.hpp"
+#include "contact/sparse/driver/sparse_path.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "contact/solvers.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -66,7 +66,7 @@ int SparsePath::solve_modes(const Step& step, Eigen::VectorXd& p, Eigen::VectorX
         return 0;
     }
     // the trace counts the new-set solves of a set solved before (docs/decisions/038: none recurs)
-    if (switches.trace && switches.trace->current && !solver.is_current(lin_key_)) switches.trace->count_solve(lin_key_);
+    if (observer && observer->current && !solver.is_current(lin_key_)) observer->count_solve(lin_key_);
     const int f = solver.solve(lin_, lin_key_, step.b, step.d, p, z);
     modes.put_slip_forces(laws, p);  // p_t = e_t + D p_n, written with the friction-limit formula
     return f;

@@ -30,10 +30,10 @@
 #include <vector>
 
 #include "contact/active_set.hpp"
-#include "contact/sparse/common.hpp"
-#include "contact/sparse/fixed_saddle.hpp"
-#include "contact/sparse/primal_solver.hpp"
-#include "contact/sparse/trace.hpp"
+#include "contact/sparse/driver/common.hpp"
+#include "contact/sparse/linear/fixed_pattern_lu.hpp"
+#include "contact/sparse/linear/primal_cholmod.hpp"
+#include "contact/sparse/driver/trace.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -82,12 +82,12 @@ struct ModeSolverTuning {
     /// new held set's Schur complement computed and factorised from scratch, as before)
     bool schur_updates = true;
     /// > 0: held sets of at least this many rows, some of them layer rows, take the primal
-    /// route (primal_solver.hpp: CHOLMOD, rank-k updates) when this build has CHOLMOD;
+    /// route (primal_cholmod.hpp: CHOLMOD, rank-k updates) when this build has CHOLMOD;
     /// 0: never (SparsePathTuning::primal_min_rows; docs/decisions/027)
     int primal_min_rows = 0;
     PrimalOrdering primal_ordering = PrimalOrdering::amd;  ///< its fill-reducing ordering
     /// the sparse LU of held sets above schur_max_rows: on one pattern for every set, ordered
-    /// once per (K, G) (fixed_saddle.hpp; docs/decisions/031), or `off`: the variable system
+    /// once per (K, G) (fixed_pattern_lu.hpp; docs/decisions/031), or `off`: the variable system
     /// of each set ordered and factorised from scratch (the way before)
     FixedPatternLu fixed_pattern = FixedPatternLu::off;
     /// the fixed pattern only for held sets with at most this many rigid (not layer) rows:
@@ -245,7 +245,7 @@ private:
     std::vector<Eigen::VectorXd> bcol;   // per contact row: A0^-1 U_j, or empty
     std::size_t bcol_count = 0;          // non-empty entries of bcol
     int key_uses = 0;                    // solves with the current factorisation
-    // the primal route (primal_solver.hpp), shared_ptr: PrimalSolver is defined only in
+    // the primal route (primal_cholmod.hpp), shared_ptr: PrimalSolver is defined only in
     // builds with CHOLMOD
     std::shared_ptr<PrimalSolver> primal_;
     bool lu_primal = false;

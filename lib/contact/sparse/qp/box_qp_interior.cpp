@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "contact/sparse/box_qp_methods.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -13,6 +13,86 @@ namespace {
 // recomputed exactly, so this only slows convergence)
 constexpr int kIpmIterations = 100;
 constexpr double kIpmRegularisation = 1e-8;
+
+/// Row i's bound kind: 0 free, 1 lower only, 2 upper only, 3 both, 4 fixed (lower == upper).
+bool has_bound(const std::vector<signed char>& kind, int i, bool up) {
+    return up ? (kind[i] == 2 || kind[i] == 3) : (kind[i] == 1 || kind[i] == 3);
+}
+
+/// The rows' bound kinds (has_bound), and x moved strictly inside its box (the start).
+std::vector<signed char> interior_start(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, Eigen::VectorXd& x) {
+    const int m = static_cast<int>(x.size());
+    std::vector<signed char> kind(m);  // 0 free, 1 lower only, 2 upper only, 3 both, 4 fixed
+    double fscale = 0.0;               // force scale [N]
+    for (int i = 0; i < m; ++i) {
+        const bool hl = std::isfinite(lower[i]), hu = std::isfinite(upper[i]);
+        kind[i] = hl && hu ? (lower[i] == upper[i] ? 4 : 3) : hl ? 1 : hu ? 2 : 0;
+        if (hl) fscale = std::max(fscale, std::abs(lower[i]));
+        if (hu) fscale = std::max(fscale, std::abs(upper[i]));
+        fscale = std::max(fscale, std::abs(x[i]));
+    }
+    if (!(fscale > 0.0)) fscale = 1.0;
+    // start: x strictly inside its box, multipliers from s at that x (at least a floor)
+    for (int i = 0; i < m; ++i) {
+        switch (kind[i]) {
+            case 4: x[i] = lower[i]; break;
+            case 3: {
+                const double w = upper[i] - lower[i];
+                x[i] = std::clamp(x[i], lower[i] + 0.1 * w, upper[i] - 0.1 * w);
+                break;
+            }
+            case 1: x[i] = std::max(x[i], lower[i] + 1e-2 * fscale); break;
+            case 2: x[i] = std::min(x[i], upper[i] - 1e-2 * fscale); break;
+            default: break;
+        }
+    }
+    return kind;
+}
+
+/// The working set the iterate (x; yl, gl, yu, gu) points at (at a bound where the multiplier
+/// exceeds the gap, both in metres), its bounded variables put on their bounds: true (x, z set)
+/// where the box QP's natural residual is then within `tolerance` in every row.
+bool try_working_set(const SparseStiffness& st, const BoxQp& box, const std::vector<signed char>& kind,
+                     const Eigen::VectorXd& yl, const Eigen::VectorXd& gl, const Eigen::VectorXd& yu,
+                     const Eigen::VectorXd& gu, Eigen::VectorXd& x, Eigen::VectorXd& z, Eigen::VectorXd& zc,
+                     std::vector<signed char>& at_bound) {
+    const Eigen::VectorXd &lower = box.lower, &upper = box.upper;
+    const int m = static_cast<int>(x.size());
+    at_bound.assign(m, 0);
+    Eigen::VectorXd xs = x;
+    for (int i = 0; i < m; ++i) {
+        if (kind[i] == 4) at_bound[i] = +1;
+        else if (has_bound(kind, i, false) && yl[i] > st.diag[i] * gl[i]) at_bound[i] = -1;
+        else if (has_bound(kind, i, true) && yu[i] > st.diag[i] * gu[i]) at_bound[i] = +1;
+        if (at_bound[i] != 0) xs[i] = at_bound[i] < 0 ? lower[i] : upper[i];
+    }
+    const Eigen::VectorXd ss = st.positions(box.step.b, box.step.d, xs, zc);
+    double worst = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double v = box_row_violation(i, at_bound, xs, ss, lower, upper, st.diag);
+        worst = std::max(worst, at_bound[i] == 0 ? std::max(std::abs(ss[i]), v) : v);
+    }
+    if (worst <= box.tolerance && xs.allFinite()) {
+        x = xs;
+        z = zc;
+        return true;
+    }
+    return false;
+}
+
+/// The Newton system's matrix K + G^T Sigma^-1 G (winv = Sigma^-1) factorised into
+/// path.ipm_ldlt (its pattern analysed once while it stays). False where it fails.
+bool factor_newton_system(SparsePath& path, const Eigen::VectorXd& winv) {
+    const SparseStiffness& st = path.stiffness();
+    SpMat M = st.K + SpMat(st.Gt * winv.asDiagonal() * st.Grow);
+    if (!path.ipm_analysed || M.nonZeros() != path.ipm_nnz) {
+        path.ipm_ldlt.analyzePattern(M);
+        path.ipm_analysed = true;
+        path.ipm_nnz = M.nonZeros();
+    }
+    path.ipm_ldlt.factorize(M);
+    return path.ipm_ldlt.info() == Eigen::Success;
+}
 }  // namespace
 
 /// The box QP by a primal-dual interior-point method (Mehrotra's
@@ -40,31 +120,8 @@ bool box_qp_interior_point(SparsePath& path, const BoxQp& box, Eigen::VectorXd& 
     const Eigen::VectorXd &b = box.step.b, &d = box.step.d, &lower = box.lower, &upper = box.upper;
     const double tolerance = box.tolerance;
     const int m = static_cast<int>(x.size());
-    std::vector<signed char> kind(m);  // 0 free, 1 lower only, 2 upper only, 3 both, 4 fixed
-    double fscale = 0.0;               // force scale [N]
-    for (int i = 0; i < m; ++i) {
-        const bool hl = std::isfinite(lower[i]), hu = std::isfinite(upper[i]);
-        kind[i] = hl && hu ? (lower[i] == upper[i] ? 4 : 3) : hl ? 1 : hu ? 2 : 0;
-        if (hl) fscale = std::max(fscale, std::abs(lower[i]));
-        if (hu) fscale = std::max(fscale, std::abs(upper[i]));
-        fscale = std::max(fscale, std::abs(x[i]));
-    }
-    if (!(fscale > 0.0)) fscale = 1.0;
-    // start: x strictly inside its box, multipliers from s at that x (at least a floor)
-    for (int i = 0; i < m; ++i) {
-        switch (kind[i]) {
-            case 4: x[i] = lower[i]; break;
-            case 3: {
-                const double w = upper[i] - lower[i];
-                x[i] = std::clamp(x[i], lower[i] + 0.1 * w, upper[i] - 0.1 * w);
-                break;
-            }
-            case 1: x[i] = std::max(x[i], lower[i] + 1e-2 * fscale); break;
-            case 2: x[i] = std::min(x[i], upper[i] - 1e-2 * fscale); break;
-            default: break;
-        }
-    }
-    auto bounded = [&](int i, bool up) { return up ? (kind[i] == 2 || kind[i] == 3) : (kind[i] == 1 || kind[i] == 3); };
+    const std::vector<signed char> kind = interior_start(lower, upper, x);
+    auto bounded = [&](int i, bool up) { return has_bound(kind, i, up); };
     Eigen::VectorXd sx = st.positions(b, d, x, z);
     const double yfloor = std::max(1e-2 * sx.lpNorm<Eigen::Infinity>(), tolerance);
     // multipliers yl, yu and gaps gl, gu; the gaps are iterated themselves (not x - bound:
@@ -142,27 +199,9 @@ bool box_qp_interior_point(SparsePath& path, const BoxQp& box, Eigen::VectorXd& 
             }
         }
         // close enough to try the working set it points at (each row's error ~ sqrt(gap W y))
-        if (rd_max < 0.1 * tolerance && comp_max < 1e-2 * tolerance * tolerance) {
-            at_bound.assign(m, 0);
-            Eigen::VectorXd xs = x;
-            for (int i = 0; i < m; ++i) {
-                if (kind[i] == 4) at_bound[i] = +1;
-                else if (bounded(i, false) && yl[i] > st.diag[i] * gl[i]) at_bound[i] = -1;
-                else if (bounded(i, true) && yu[i] > st.diag[i] * gu[i]) at_bound[i] = +1;
-                if (at_bound[i] != 0) xs[i] = at_bound[i] < 0 ? lower[i] : upper[i];
-            }
-            const Eigen::VectorXd ss = st.positions(b, d, xs, zc);
-            double worst = 0.0;
-            for (int i = 0; i < m; ++i) {
-                const double v = box_row_violation(i, at_bound, xs, ss, lower, upper, st.diag);
-                worst = std::max(worst, at_bound[i] == 0 ? std::max(std::abs(ss[i]), v) : v);
-            }
-            if (worst <= tolerance && xs.allFinite()) {
-                x = xs;
-                z = zc;
-                return true;
-            }
-        }
+        if (rd_max < 0.1 * tolerance && comp_max < 1e-2 * tolerance * tolerance &&
+            try_working_set(st, box, kind, yl, gl, yu, gu, x, z, zc, at_bound))
+            return true;
         ++r.iterations;
         ++r.factorizations;
         const double mu = nb > 0 ? comp / nb : 0.0;
@@ -172,14 +211,7 @@ bool box_qp_interior_point(SparsePath& path, const BoxQp& box, Eigen::VectorXd& 
             if (bounded(i, true)) si += yu[i] / gu[i];  // free rows: 0, raised to the proximal floor
             winv[i] = kind[i] == 4 ? 0.0 : 1.0 / std::max(si, kIpmRegularisation * st.diag[i]);
         }
-        SpMat M = st.K + SpMat(st.Gt * winv.asDiagonal() * st.Grow);
-        if (!path.ipm_analysed || M.nonZeros() != path.ipm_nnz) {
-            path.ipm_ldlt.analyzePattern(M);
-            path.ipm_analysed = true;
-            path.ipm_nnz = M.nonZeros();
-        }
-        path.ipm_ldlt.factorize(M);
-        if (path.ipm_ldlt.info() != Eigen::Success) return false;
+        if (!factor_newton_system(path, winv)) return false;
         // predictor (affine scaling: complementarity targets 0)
         for (int i = 0; i < m; ++i) {
             rl[i] = bounded(i, false) ? -gl[i] * yl[i] : 0.0;

@@ -3,8 +3,8 @@
 // QP solved on the sparse stiffness (box_qp_methods.hpp).
 #include <vector>
 
-#include "contact/sparse/box_qp_methods.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 
 namespace stackbeam::detail::sparse {
 
@@ -32,7 +32,6 @@ bool tresca_fixed_point(SparsePath& path, const Step& step, Eigen::VectorXd& p, 
     switch (path.switches.box_qp) {
         case BoxQpMethod::pivoting: methods = {box_qp_pivoting, box_qp_interior_point, box_qp_primal}; break;
         case BoxQpMethod::interior_point: methods = {box_qp_interior_point, box_qp_pivoting, box_qp_primal}; break;
-        case BoxQpMethod::pivoting_only: methods = {box_qp_pivoting, box_qp_primal}; break;
     }
     bool s_current = false;  // path.s = G z - d of the final z, made once when needed
     const bool settled = detail::tresca_fixed_point(
