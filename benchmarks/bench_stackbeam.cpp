@@ -222,7 +222,9 @@ void MassiveStack(benchmark::State& state) {
 /// The cost of the stress output (docs/stresses-and-fatigue.md, decision 054): a rig stroke of the graduated
 /// 10-leaf spring at 100 elements per half leaf (friction, mode closed-form, the default solvers),
 /// w(t) = 20 mm tri(t / 1 s), dt = 1 ms, 100 records, with Stepper::stresses() and a
-/// StressExtremes fed at every record (stresses:1) or not (stresses:0).
+/// StressExtremes fed at every record (stresses:1), or a StressMonitor with a material on every leaf
+/// (irregular loading: every node's turning points kept, rainflow at the end; decision 061) (stresses:2),
+/// or neither (stresses:0).
 void StressOutput(benchmark::State& state) {
     ModelSpec spec = graduated_stack(100, 10);
     spec.rigid_body.initial_velocity_m_per_s = 0.0;  // the rig prescribes w'(0)
@@ -233,17 +235,28 @@ void StressOutput(benchmark::State& state) {
     so.loading.displacement_m.frequency_hz = 1.0;
     so.dt_s = 1e-3;
     so.t_end_s = 0.1;
-    const bool stresses = state.range(0) != 0;
+    const bool stresses = state.range(0) != 0, monitor = state.range(0) == 2;
+    if (monitor) {
+        FatigueMaterial m;  // about 50CrV4 (docs/stresses-and-fatigue.md)
+        m.ultimate_strength_pa = 1.6e9;
+        m.endurance_limit_pa = 6.0e8;
+        m.fatigue_strength_coefficient_pa = 2.0e9;
+        m.fatigue_strength_exponent = -0.1;
+        for (auto& l : spec.leaves) l.material = m;
+    }
     double peak = 0.0;
     for (auto _ : state) {
         const System s(Model::build(spec));
         const auto stepper = make_stepper(s, so);
         StressExtremes extremes;
+        StressMonitor mon(spec, StressMonitorOptions{});
         for (int i = 0; i < 100; ++i) {
             stepper->advance();
-            if (stresses) extremes.add(stepper->current().t_s, stepper->stresses());
+            if (monitor) mon.add(stepper->current().t_s, stepper->stresses());
+            else if (stresses) extremes.add(stepper->current().t_s, stepper->stresses());
         }
-        if (stresses) peak = extremes.leaves()[0].tension.stress_pa;
+        if (monitor) peak = mon.summary().extremes[0].tension.stress_pa;
+        else if (stresses) peak = extremes.leaves()[0].tension.stress_pa;
         benchmark::DoNotOptimize(peak);
     }
     state.counters["peak_top_leaf_mpa"] = 1e-6 * peak;
@@ -251,7 +264,7 @@ void StressOutput(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(StressOutput)->ArgNames({"stresses"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(StressOutput)->ArgNames({"stresses"})->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(MassiveStack)
     ->ArgNames({"stack", "ms", "beta_e7"})
     ->Args({0, 10, 0})->Args({0, 1000, 10})->Args({0, 100, 100})->Args({1, 2, 10})

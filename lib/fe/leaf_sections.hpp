@@ -90,6 +90,29 @@ inline ElementMatrix profiled_mass(const LeafSpec& leaf, double x1, double x2) {
     return m;
 }
 
+/// Consistent mass of a Bernoulli-Euler 2-node element of a uniform leaf, m = rho A L [kg], DOFs
+/// (u1, v1, th1, u2, v2, th2): axial m/6 [2 1; 1 2]; bending (cubic Hermite shapes, rotary inertia
+/// neglected as in the stiffness) m/420 [156 22L 54 -13L; 22L 4L^2 13L -3L^2; ...].
+inline ElementMatrix uniform_mass(double m, double L) {
+    ElementMatrix me{};
+    me[0][0] = me[3][3] = m / 3.0;
+    me[0][3] = me[3][0] = m / 6.0;
+    const double c = m / 420.0;
+    const double mb[4][4] = {{156 * c, 22 * L * c, 54 * c, -13 * L * c},
+                             {22 * L * c, 4 * L * L * c, 13 * L * c, -3 * L * L * c},
+                             {54 * c, 13 * L * c, 156 * c, -22 * L * c},
+                             {-13 * L * c, -3 * L * L * c, -22 * L * c, 4 * L * L * c}};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) me[kBendingDofs[i]][kBendingDofs[j]] = mb[i][j];
+    return me;
+}
+
+/// The consistent mass of element [x1, x2] of `leaf` (uniform or profiled), as System assembles it.
+inline ElementMatrix element_mass(const LeafSpec& leaf, double x1, double x2) {
+    if (!leaf.profile.x_m.empty()) return profiled_mass(leaf, x1, x2);
+    return uniform_mass(leaf.density_kg_per_m3 * leaf.width_m * leaf.height_m * (x2 - x1), x2 - x1);
+}
+
 /// Adds a 6 x 6 element matrix over nodes a, b (full DOF offsets / 3): its nonzero entries.
 inline void add_matrix(std::vector<Eigen::Triplet<double>>& t, int a, int b, const ElementMatrix& k) {
     const int d[6] = {3 * a, 3 * a + 1, 3 * a + 2, 3 * b, 3 * b + 1, 3 * b + 2};

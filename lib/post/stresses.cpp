@@ -38,32 +38,59 @@ std::pair<double, double> contact_load(const System& system, const std::vector<P
 /// their end values; at the leaf's end the tributary lies inside, so the value is the element's end
 /// value with the contact's axial force and moment at that node taken back (the support's reaction:
 /// 0 at a free or pinned end). The half model's seat is not an end (the mirror continues it).
-void leaf_resultants(const System& system, const Eigen::VectorXd& u, const std::vector<PairRecord>& pairs, int l,
-                     LeafStresses& out) {
+/// The leaves' nodal velocities and accelerations (full DOFs) for the elements' distributed loads;
+/// empty when the stack has none to take off (massless leaves, no motion and no frame acceleration).
+struct NodalMotion {
+    Eigen::VectorXd v, a;  // [m/s, rad/s], [m/s^2, rad/s^2] (empty: zero)
+    double a_frame = 0.0;  // g + y_b'' [m/s^2]
+    double alpha = 0.0, beta = 0.0;  // Rayleigh's C = alpha M + beta K [1/s, s]
+};
+
+/// With leaf mass, N, M, V at an element's ends: the end forces on the element,
+/// f_e = K_e (u_e + beta v_e) + M_e (a_e + alpha v_e + a_f e_y) (stresses.hpp), are what its nodes
+/// give it; its own loads (inertia, weight, damping) act between them, so N, M, V are no longer
+/// constant / linear: each end's value is its own end force (N1 = -f0, N2 = f3; M1 = -f2, M2 = f5;
+/// V1 = f1, V2 = -f4, which for an unloaded element are the constant N, V and the linear M's ends).
+void leaf_resultants(const System& system, const Eigen::VectorXd& u, const NodalMotion& motion,
+                     const std::vector<PairRecord>& pairs, int l, LeafStresses& out) {
     const Model& model = system.model();
     const LeafSpec& leaf = model.spec().leaves[l];
     const auto& xs = model.nodes_x();
     const int first = model.first_node(l), last = model.last_node(l);
     const std::size_t n = static_cast<std::size_t>(last - first + 1);
     std::vector<double> N(n, 0.0), M(n, 0.0), V(n, 0.0), count(n, 0.0);
+    const bool massive = leaf.density_kg_per_m3 > 0.0 && (motion.a.size() > 0 || motion.v.size() > 0 || motion.a_frame != 0.0);
     for (int j = first; j < last; ++j) {
         const detail::ElementMatrix k = detail::element_stiffness(leaf, xs[j], xs[j + 1]);
         const int a = 3 * system.node_dof(l, j), b = 3 * system.node_dof(l, j + 1);
-        const double ue[6] = {u[a], u[a + 1], u[a + 2], u[b], u[b + 1], u[b + 2]};
-        double f[6] = {};  // the end forces on the element: K_e u_e
+        const int dof[6] = {a, a + 1, a + 2, b, b + 1, b + 2};
+        double ue[6], me_in[6] = {0.0, motion.a_frame, 0.0, 0.0, motion.a_frame, 0.0};  // me_in: a_e + alpha v_e + a_f e_y
+        for (int r = 0; r < 6; ++r) {
+            ue[r] = u[dof[r]];
+            if (!massive) continue;
+            if (motion.v.size() > 0) {
+                ue[r] += motion.beta * motion.v[dof[r]];
+                me_in[r] += motion.alpha * motion.v[dof[r]];
+            }
+            if (motion.a.size() > 0) me_in[r] += motion.a[dof[r]];
+        }
+        double f[6] = {};  // the end forces on the element: K_e (u_e + beta v_e) (+ M_e (a_e + alpha v_e + a_f e_y))
         for (int r = 0; r < 6; ++r)
             for (int c = 0; c < 6; ++c) f[r] += k[r][c] * ue[c];
-        // The element carries no load between its ends, so N is constant (f[3] = -f[0]), M linear
-        // from -m1 to m2 (m the end moments on it, counter-clockwise), V = dM/dx = (m2 + m1)/L.
-        const double L = xs[j + 1] - xs[j];
-        const double Ne = 0.5 * (f[3] - f[0]), M1 = -f[2], M2 = f[5], Ve = (M2 - M1) / L;
+        if (massive) {
+            const detail::ElementMatrix m = detail::element_mass(leaf, xs[j], xs[j + 1]);
+            for (int r = 0; r < 6; ++r)
+                for (int c = 0; c < 6; ++c) f[r] += m[r][c] * me_in[c];
+        }
+        // N positive in tension, M from the end moments on the element (counter-clockwise) -m1, m2,
+        // V = dM/dx; without loads between the ends f[3] = -f[0] and f[1] = -f[4] = (m2 + m1)/L.
         const std::size_t i = static_cast<std::size_t>(j - first);
-        N[i] += Ne;
-        N[i + 1] += Ne;
-        M[i] += M1;
-        M[i + 1] += M2;
-        V[i] += Ve;
-        V[i + 1] += Ve;
+        N[i] += -f[0];
+        N[i + 1] += f[3];
+        M[i] += -f[2];
+        M[i + 1] += f[5];
+        V[i] += f[1];
+        V[i + 1] += -f[4];
         count[i] += 1.0;
         count[i + 1] += 1.0;
     }
@@ -136,20 +163,34 @@ void check_leaves(const Stresses& s, std::vector<std::size_t>& nodes, const char
 
 }  // namespace
 
-Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const std::vector<PairRecord>& pairs) {
+Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const std::vector<PairRecord>& pairs,
+                          const LeafMotion& motion) {
     if (pairs.size() != system.pairs().size())
         throw InputError("pairs", "has " + std::to_string(pairs.size()) + " entries: compute_stresses needs one per System::pairs(), " +
                                       std::to_string(system.pairs().size()));
     const Model& model = system.model();
     const ModelSpec& spec = model.spec();
     const Eigen::VectorXd u = system.leaf_displacements(z);  // InputError naming z on a wrong size
+    NodalMotion nodal;
+    auto full = [&](const Eigen::VectorXd& r, const char* name) {
+        if (r.size() == 0) return Eigen::VectorXd();
+        if (r.size() != z.size())
+            throw InputError(name, "has " + std::to_string(r.size()) + " entries: compute_stresses needs none or one per reduced DOF, " +
+                                       std::to_string(z.size()));
+        return Eigen::VectorXd(system.leaf_displacements(r));  // P r: the map is linear
+    };
+    nodal.a = full(motion.acceleration, "motion.acceleration");
+    if (motion.damping.active()) nodal.v = full(motion.velocity, "motion.velocity");
+    nodal.a_frame = motion.frame_acceleration_m_per_s2;
+    nodal.alpha = motion.damping.rayleigh_alpha_per_s;
+    nodal.beta = motion.damping.rayleigh_beta_s;
     const bool half = spec.symmetry == Symmetry::half;
     const double x_r = model.nodes_x()[model.attachment_node()];
     Stresses out;
     out.leaves.resize(spec.leaves.size());
     for (int l = 0; l < static_cast<int>(spec.leaves.size()); ++l) {
         LeafStresses& s = out.leaves[l];
-        leaf_resultants(system, u, pairs, l, s);
+        leaf_resultants(system, u, nodal, pairs, l, s);
         if (half) mirror(s, x_r);
         const std::size_t n = s.x_m.size();
         s.top_stress_pa.resize(n);
@@ -199,8 +240,6 @@ Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const 
     }
     return out;
 }
-
-const char* to_string(Fibre fibre) { return fibre == Fibre::top ? "top" : "bottom"; }
 
 void StressExtremes::add(double t_s, const Stresses& stresses) {
     check_leaves(stresses, nodes_, "StressExtremes");
@@ -274,6 +313,143 @@ LargestRange StressWindow::largest_range() const {
                 if (best.leaf < 0 || fc.range_pa > best.range_pa) best = {c.leaf, c.x_m[i], f, fc.range_pa, fc.mean_pa};
             }
     return best;
+}
+
+}  // namespace stackbeam
+
+namespace stackbeam {
+namespace {
+
+/// Appends s to a history kept as its turning points: a sample that continues the last
+/// excursion moves its end, one that reverses it starts a new one (rainflow_cycles counts the
+/// same cycles from these as from every sample; equal samples add nothing).
+void add_turning_point(std::vector<double>& tp, double s) {
+    const std::size_t n = tp.size();
+    if (n == 0 || (n == 1 && s != tp[0])) {
+        tp.push_back(s);
+        return;
+    }
+    if (n == 1 || s == tp[n - 1]) return;
+    if ((s > tp[n - 1]) == (tp[n - 1] > tp[n - 2])) tp[n - 1] = s;
+    else tp.push_back(s);
+}
+
+StressWindow monitor_window(const StressMonitorOptions& o) {
+    if (!(std::isfinite(o.period_s) && o.period_s >= 0.0))
+        throw InputError("options.period_s", "value " + format_value(o.period_s) + " is not allowed: it must be >= 0 (0: not periodic)");
+    if (o.period_s == 0.0) return StressWindow(std::numeric_limits<double>::lowest(), std::numeric_limits<double>::max());
+    if (!(std::isfinite(o.t_end_s) && o.t_end_s >= o.period_s))
+        throw InputError("options.t_end_s", "value " + format_value(o.t_end_s) +
+                                                " is not allowed: with a periodic loading it must be >= options.period_s = " +
+                                                format_value(o.period_s) + " (the last period is the cycle)");
+    const double tol = 1e-9 * std::max(1.0, o.t_end_s);  // the output grid's round-off
+    return StressWindow(o.t_end_s - o.period_s - tol, o.t_end_s + tol);
+}
+
+}  // namespace
+
+StressMonitor::StressMonitor(const ModelSpec& spec, const StressMonitorOptions& options)
+    : options_(options), window_(monitor_window(options)) {
+    if (options.critical_nodes < 1)
+        throw InputError("options.critical_nodes", "value " + std::to_string(options.critical_nodes) + " is not allowed: it must be >= 1");
+    if (!(std::isfinite(options.gate_pa) && options.gate_pa >= 0.0))
+        throw InputError("options.gate_pa", "value " + format_value(options.gate_pa) + " is not allowed: it must be finite and >= 0");
+    for (const LeafSpec& l : spec.leaves) {
+        materials_.push_back(l.material);
+        keep_histories_ = keep_histories_ || (options.period_s == 0.0 && l.material.has_value());
+    }
+}
+
+void StressMonitor::add(double t_s, const Stresses& stresses) {
+    extremes_.add(t_s, stresses);  // checks the leaves against the first call's
+    window_.add(t_s, stresses);
+    ++samples_;
+    if (!keep_histories_) return;
+    if (top_.empty()) {
+        top_.resize(stresses.leaves.size());
+        bottom_.resize(stresses.leaves.size());
+        for (std::size_t l = 0; l < stresses.leaves.size(); ++l) {
+            top_[l].resize(stresses.leaves[l].x_m.size());
+            bottom_[l].resize(stresses.leaves[l].x_m.size());
+        }
+    }
+    for (std::size_t l = 0; l < stresses.leaves.size(); ++l) {
+        if (l >= materials_.size() || !materials_[l]) continue;
+        const LeafStresses& s = stresses.leaves[l];
+        for (std::size_t i = 0; i < s.x_m.size(); ++i) {
+            add_turning_point(top_[l][i], s.top_stress_pa[i]);
+            add_turning_point(bottom_[l][i], s.bottom_stress_pa[i]);
+        }
+    }
+}
+
+StressSummary StressMonitor::summary() const {
+    if (samples_ == 0) throw InputError("stresses", "none were given to StressMonitor: feed it the run's outputs (add())");
+    if (window_.samples() == 0)
+        throw InputError("stresses", "none fell in the last period [" + format_value(options_.t_end_s - options_.period_s) + ", " +
+                                         format_value(options_.t_end_s) + "] s: options.t_end_s must be the run's end");
+    StressSummary out;
+    out.samples = samples_;
+    out.extremes = extremes_.leaves();
+    const bool periodic = options_.period_s > 0.0;
+    out.cycle_start_s = periodic ? options_.t_end_s - options_.period_s : 0.0;
+    out.cycle_end_s = options_.t_end_s;
+    out.cycle_samples = window_.samples();
+    out.cycle = window_.cycles();
+    out.largest_range = window_.largest_range();
+    out.counting = periodic ? CycleCounting::periodic : CycleCounting::rainflow;
+    for (std::size_t l = 0; l < out.cycle.size(); ++l) {
+        LeafFatigueResult r;
+        r.leaf = out.cycle[l].leaf;
+        r.has_material = l < materials_.size() && materials_[l].has_value();
+        if (r.has_material) {
+            const LeafCycle& c = out.cycle[l];
+            LeafStressHistories h;
+            auto take = [&](std::size_t i, std::vector<double> top, std::vector<double> bottom) {
+                h.node.push_back(static_cast<int>(i));
+                h.x_m.push_back(c.x_m[i]);
+                h.top_pa.push_back(std::move(top));
+                h.bottom_pa.push_back(std::move(bottom));
+            };
+            if (periodic) {  // one cycle per node and fibre from the period's max and min
+                for (std::size_t i = 0; i < c.x_m.size(); ++i)
+                    take(i, {c.top[i].mean_pa - 0.5 * c.top[i].range_pa, c.top[i].mean_pa + 0.5 * c.top[i].range_pa},
+                         {c.bottom[i].mean_pa - 0.5 * c.bottom[i].range_pa, c.bottom[i].mean_pa + 0.5 * c.bottom[i].range_pa});
+                r.fatigue = leaf_fatigue(*materials_[l], h, CycleCounting::periodic, options_.gate_pa);
+            } else {  // the critical nodes' turning points by rainflow, one node at a time (their lengths differ)
+                std::vector<std::size_t> order(c.x_m.size());
+                for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+                auto range = [&](std::size_t i) { return std::max(c.top[i].range_pa, c.bottom[i].range_pa); };
+                const std::size_t k = std::min(order.size(), static_cast<std::size_t>(options_.critical_nodes));
+                std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(),
+                                  [&](std::size_t a, std::size_t b) { return range(a) > range(b); });
+                bool first = true;
+                for (std::size_t n = 0; n < k; ++n) {
+                    h = {};
+                    take(order[n], top_[l][order[n]], bottom_[l][order[n]]);
+                    const LeafFatigue f = leaf_fatigue(*materials_[l], h, CycleCounting::rainflow, options_.gate_pa);
+                    if (first) {
+                        r.fatigue = f;
+                    } else {
+                        if (f.has_safety_factor && f.least_safety_factor < r.fatigue.least_safety_factor) {
+                            r.fatigue.least_safety_factor = f.least_safety_factor;
+                            r.fatigue.safety_spot = f.safety_spot;
+                        }
+                        // the leaf's life is known where every critical node's is: the largest damage
+                        if (r.fatigue.has_life && (!f.has_life || f.damage_per_repetition > r.fatigue.damage_per_repetition)) {
+                            r.fatigue.has_life = f.has_life;
+                            r.fatigue.shortest_life_repetitions = f.shortest_life_repetitions;
+                            r.fatigue.damage_per_repetition = f.damage_per_repetition;
+                            r.fatigue.life_spot = f.life_spot;
+                        }
+                    }
+                    first = false;
+                }
+            }
+        }
+        out.fatigue.push_back(std::move(r));
+    }
+    return out;
 }
 
 }  // namespace stackbeam

@@ -24,14 +24,20 @@
 /// the mean of the two elements' end values (a node-to-node friction force jumps them there); at a
 /// leaf's end the tributary lies inside, so the pair's axial force and moment there are taken back
 /// (the value is the support's reaction: 0 at a free or pinned end).
-/// With leaf mass the elements' own distributed loads (inertia, gravity) are not taken off:
-/// their fixed-end moments, q h^2 / 12, are the error, O(h^2) (decision 054).
+/// With leaf mass the elements' own distributed loads are taken off (LeafMotion, decision 061):
+/// f_e = K_e u_e + C_e v_e + M_e (a_e + a_f e_y), the element's consistent mass M_e times its
+/// nodal accelerations relative to the supports a_e plus the frame's a_f = g + y_b'' on every
+/// node's v (M_e e_y is the consistent load of a uniform rho A per unit acceleration), and the
+/// Rayleigh damping C_e = alpha M_e + beta K_e; the nodal resultants are then in equilibrium
+/// with the contact, support and inertia forces (the section's sums close to round-off).
 #include <Eigen/Dense>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "stackbeam/contact/pair.hpp"
 #include "stackbeam/fe/system.hpp"
+#include "stackbeam/post/fatigue.hpp"  // the fatigue figures of StressMonitor
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/post/fibre.hpp"
 
@@ -86,11 +92,30 @@ struct Stresses {
     std::vector<InterfacePeak> interfaces; ///< one per interface (ModelSpec::interfaces order)
 };
 
-/// The stresses for reduced displacements z (System::num_reduced_dofs(), w last) and the pairs'
-/// forces at the same time (one PairRecord per System::pairs(), as Stepper::pairs() gives them).
-/// InputError naming z or pairs when their sizes do not fit `system`.
-Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const std::vector<PairRecord>& pairs);
+/// The leaves' motion at the time of z, for the elements' distributed loads when the leaves have
+/// mass (density > 0). A massless stack (or a static state without gravity) needs none of it:
+/// the default is no motion. The steppers with leaf mass fill it (Stepper::stresses()).
+struct LeafMotion {
+    /// Reduced accelerations z'' [m/s^2, rad/s^2] (System::num_reduced_dofs(), w last), relative to
+    /// the supports' frame; empty: zero.
+    Eigen::VectorXd acceleration;
+    /// Reduced velocities z' [m/s, rad/s], for the structural damping's force; empty: zero.
+    Eigen::VectorXd velocity;
+    /// The frame's acceleration a_f = g + y_b''(t) [m/s^2], + meaning gravity's sense (-y): every
+    /// mass of the leaves carries -rho A a_f per length (gravity and a base acceleration, in the
+    /// supports' frame; ReducedLoad's q = -(g + y_b'') l).
+    double frame_acceleration_m_per_s2 = 0.0;
+    /// Rayleigh damping of the leaves, C = alpha M + beta K (SimulationOptions::damping).
+    StructuralDamping damping;
+};
 
+/// The stresses for reduced displacements z (System::num_reduced_dofs(), w last) and the pairs'
+/// forces at the same time (one PairRecord per System::pairs(), as Stepper::pairs() gives them),
+/// with the leaves' motion at that time for their distributed loads (leaves with mass).
+/// InputError naming z, pairs, motion.acceleration or motion.velocity when their sizes do not fit
+/// `system`.
+Stresses compute_stresses(const System& system, const Eigen::VectorXd& z, const std::vector<PairRecord>& pairs,
+                          const LeafMotion& motion = {});
 
 /// One extreme fibre stress: where and when.
 struct StressExtreme {
@@ -161,6 +186,79 @@ private:
     int samples_ = 0;
     std::vector<LeafCycle> shape_;                    // leaf and x per node
     std::vector<std::vector<double>> min_top_, max_top_, min_bottom_, max_bottom_;
+};
+
+}  // namespace stackbeam
+
+namespace stackbeam {
+
+/// What a StressMonitor is asked for (the run's loading and length).
+struct StressMonitorOptions {
+    /// > 0: the loading is periodic with this period [s] (Loading::period_s()): the cycle is the last
+    /// period, [t_end_s - period_s, t_end_s], and fatigue takes its max and min at every node
+    /// (CycleCounting::periodic; lives in cycles of the loading). 0: an irregular loading (base
+    /// excitation, a table, free vibration): the whole run is counted by rainflow at the critical
+    /// nodes (lives in repetitions of the run).
+    double period_s = 0.0;
+    /// The run's end [s] (SimulationOptions::t_end_s): the last record's time. Needed with period_s.
+    double t_end_s = 0.0;
+    /// Irregular loadings: per leaf, the nodes of the largest stress range (over the run, either
+    /// fibre) whose histories are counted by rainflow and Miner, >= 1. With Basquin's exponent
+    /// 1/b ~ -10 a node at 0.8 of the largest range takes ~0.1 of its damage, but a node of a
+    /// smaller range and a larger tensile mean can be worse: 4 covers a leaf's few hot spots
+    /// (the seat, a clamp, the end of the leaf above).
+    int critical_nodes = 4;
+    /// The rainflow's hysteresis gate [Pa], >= 0 (rainflow_cycles).
+    double gate_pa = 0.0;
+};
+
+/// One leaf's fatigue over the run (only where the leaf has a material: LeafSpec::material).
+struct LeafFatigueResult {
+    int leaf = 0;
+    bool has_material = false;  ///< false: no figures (fatigue is default)
+    /// leaf_fatigue's figures; FatigueSpot::node is the index into LeafStresses::x_m (whole leaf)
+    LeafFatigue fatigue;
+};
+
+/// Everything a run's stresses give at its end (StressMonitor::summary()).
+struct StressSummary {
+    int samples = 0;                       ///< outputs fed
+    std::vector<LeafExtremes> extremes;    ///< each leaf's largest tension and compression (StressExtremes)
+    /// The cycle: the last period (periodic), else the whole run; its range and mean at every node
+    /// and fibre, and where the range is largest (StressWindow).
+    double cycle_start_s = 0.0, cycle_end_s = 0.0;
+    int cycle_samples = 0;
+    std::vector<LeafCycle> cycle;
+    LargestRange largest_range;
+    CycleCounting counting = CycleCounting::periodic;  ///< how fatigue counted (periodic or rainflow)
+    std::vector<LeafFatigueResult> fatigue;            ///< one per leaf
+};
+
+/// The per-run stress figures in one place: feed it each output's stresses (add()), read summary()
+/// at the end. The one call the front-ends make (command line, JSON summary, sweep table, Python).
+/// It keeps the extremes and the cycle's max and min per node and fibre; for an irregular loading
+/// with a material on some leaf, also each node's turning points (the reversals of its fibres'
+/// stresses: rainflow needs nothing else), so its memory grows with the reversals, not the outputs.
+class StressMonitor {
+public:
+    /// InputError naming options.period_s, options.t_end_s, options.critical_nodes or
+    /// options.gate_pa when out of range; spec gives each leaf's material.
+    StressMonitor(const ModelSpec& spec, const StressMonitorOptions& options);
+    /// The stresses of the output at t_s [s] (times increasing). InputError naming stresses when
+    /// its leaves differ from the first call's.
+    void add(double t_s, const Stresses& stresses);
+    /// The figures so far. InputError naming stresses when nothing was fed (or nothing in the
+    /// last period).
+    StressSummary summary() const;
+
+private:
+    StressMonitorOptions options_;
+    std::vector<std::optional<FatigueMaterial>> materials_;
+    bool keep_histories_ = false;
+    int samples_ = 0;
+    StressExtremes extremes_;
+    StressWindow window_;
+    std::vector<std::vector<std::vector<double>>> top_, bottom_;  // [leaf][node]: turning points [Pa]
 };
 
 }  // namespace stackbeam

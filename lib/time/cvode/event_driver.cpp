@@ -658,7 +658,10 @@ const StepRecord& EventStepper::current() const noexcept { return driver_->curre
 long EventStepper::record_index() const noexcept { return driver_->record_index(); }
 std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records(); }
 std::vector<LeafNodes> EventStepper::nodes() const { return driver_->nodes_at_output(); }
-Stresses EventStepper::stresses() const { return compute_stresses(driver_->system(), driver_->displacements_at_output(), pairs()); }
+Stresses EventStepper::stresses() const {
+    return compute_stresses(driver_->system(), driver_->displacements_at_output(), pairs(), driver_->leaf_motion_at_output());
+}
+LeafMotion EventDriver::leaf_motion(double, const State&, const Vec&) const { return {}; }
 RunReport EventStepper::report() const { return driver_->report(); }
 const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats(); }
 const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events(); }

@@ -170,6 +170,8 @@ public:
     std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements_at_output()); }
     /// z at the current output (displacements() at its state): Stepper::nodes() and stresses().
     Vec displacements_at_output() const { return displacements(y_out_, p_out_); }
+    /// The leaves' motion at the current output for their distributed loads (Stepper::stresses()).
+    LeafMotion leaf_motion_at_output() const { return leaf_motion(record_.t_s, y_out_, p_out_); }
     RunReport report() const;
     const CvodeStats& stats() const noexcept { return stats_; }
     const std::vector<ContactEvent>& events() const noexcept { return events_; }
@@ -259,6 +261,11 @@ protected:
     /// The reduced displacements z = [z_r; w] [m, rad] at state y with the forces p [N] of its
     /// record (System::leaf_nodes makes the nodes of them).
     virtual Vec displacements(const State& y, const Vec& p) const = 0;
+    /// The leaves' accelerations z'' (relative to the supports), velocities (damped) and the frame's
+    /// acceleration g + y_b'' at time t_s, state y with the forces p of its record, such that
+    /// M z'' + C z' + K z = G^T p + e_w F - (g + y_b'') l holds on the leaves' DOFs (compute_stresses
+    /// takes the elements' distributed loads off with them; decision 061). Default: none.
+    virtual LeafMotion leaf_motion(double t_s, const State& y, const Vec& p) const;
 
 private:
     using Clock = std::chrono::steady_clock;
