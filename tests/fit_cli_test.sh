@@ -28,19 +28,21 @@ exit)
     "$cli" fit "$spec" --out-dir "$out" --jobs 2 --no-plot > "$dir/good.out" || fail "good spec: exit status $?"
     for f in fitted.toml fit.json history.csv loops.csv; do [ -s "$out/$f" ] || fail "$f not written"; done
     grep -q '"converged": true' "$out/fit.json" || fail "not converged: $(cat "$out/fit.json")"
-    # a bad spec: a column the CSV does not have -> 2, the key and the file's columns named
-    sed 's/force_column = "load_cell_n"/force_column = "load_n"/; s|"\.\./\.\./|"'"$src"'/|' "$spec" > "$dir/bad_column.toml"
-    "$cli" fit "$dir/bad_column.toml" --out-dir "$dir/exit_bad" --no-plot 2> "$dir/bad.err"
-    rc=$?
-    [ $rc = 2 ] || fail "a missing column: exit status $rc, expected 2"
-    grep -q "loops\[0\].force_column" "$dir/bad.err" || fail "the key is not named: $(cat "$dir/bad.err")"
-    grep -q "'load_n' is not a column" "$dir/bad.err" || fail "the value is not named: $(cat "$dir/bad.err")"
-    # bounds the scenario refuses (a negative friction coefficient) -> 2, the parameter named
-    sed 's/lower = 0.05/lower = -0.05/; s|"\.\./\.\./|"'"$src"'/|' "$spec" > "$dir/bad_bound.toml"
-    "$cli" fit "$dir/bad_bound.toml" --out-dir "$dir/exit_bad" --no-plot 2> "$dir/bound.err"
-    rc=$?
-    [ $rc = 2 ] || fail "a refused bound: exit status $rc, expected 2"
-    grep -q "parameters\[0\].*refuses the bound -0.05" "$dir/bound.err" || fail "the bound is not named: $(cat "$dir/bound.err")"
+    # refused NAME SED PATTERN...: the spec edited by SED (its relative paths made absolute) is
+    # refused with exit status 2 and a message matching every PATTERN
+    refused() {
+        local name=$1 edit=$2
+        shift 2
+        sed "$edit"'; s|"\.\./\.\./|"'"$src"'/|' "$spec" > "$dir/$name.toml"
+        "$cli" fit "$dir/$name.toml" --out-dir "$dir/exit_bad" --no-plot 2> "$dir/$name.err"
+        local rc=$?
+        [ $rc = 2 ] || fail "$name: exit status $rc, expected 2"
+        for pattern in "$@"; do grep -q "$pattern" "$dir/$name.err" || fail "$name: no '$pattern' in: $(cat "$dir/$name.err")"; done
+    }
+    # a column the CSV does not have: the key and the value named
+    refused bad_column 's/force_column = "load_cell_n"/force_column = "load_n"/' "loops\[0\].force_column" "'load_n' is not a column"
+    # bounds the scenario refuses (a negative friction coefficient): the parameter named
+    refused bad_bound 's/lower = 0.05/lower = -0.05/' "parameters\[0\].*refuses the bound -0.05"
     # a bad option -> 2 naming it; a missing spec file -> 2 naming it
     "$cli" fit "$spec" --jobs -1 --no-plot > "$dir/jobs.out" 2>&1
     rc=$?
