@@ -125,6 +125,8 @@ void add_fit_options(CLI::App& fit, FitArgs& args) {
     fit.add_option("--out-dir", args.out_dir, "Output directory (default: the spec's [outputs] directory, else SPEC_fit)");
     fit.add_flag("--restart", args.restart, "Start from the spec's starting values, not from an earlier history.csv");
     fit.add_flag("--no-plot", args.no_plot, "No gnuplot figure");
+    fit.add_option("--stop-after", args.stop_after, "tests: stop as on SIGINT after this many iterations")
+        ->check(CLI::Range(0, 1000000));
 }
 
 int run_fit_command(const FitArgs& args) {
@@ -152,6 +154,7 @@ int run_fit_command(const FitArgs& args) {
         for (const auto& p : spec.parameters) history << "," << p.key;
         history << "\n";
     }
+    int iterations = 0;
     options.on_iteration = [&](const FitIteration& it) {
         history << it.start << "," << it.iteration << "," << csv_number(it.cost) << "," << (it.accepted ? 1 : 0) << ","
                 << it.runs;
@@ -162,6 +165,7 @@ int run_fit_command(const FitArgs& args) {
             std::printf(" %s = %.6g", spec.parameters[j].key.c_str(), it.values[j]);
         std::printf("%s\n", it.accepted ? "" : "  (step rejected)");
         std::fflush(stdout);
+        if (args.stop_after > 0 && ++iterations >= args.stop_after) g_fit_stop = true;
     };
     std::signal(SIGINT, on_fit_signal);
     std::signal(SIGTERM, on_fit_signal);
@@ -169,7 +173,7 @@ int run_fit_command(const FitArgs& args) {
     history.close();
     if (r.stopped) {
         std::printf("stopped: %s keeps the iterations; run the same command again to resume\n", history_path.c_str());
-        return 128 + g_fit_signal.load();
+        return 128 + (g_fit_signal != 0 ? g_fit_signal.load() : SIGINT);  // --stop-after: as SIGINT
     }
     std::printf("\nfit of %s (%d runs, %d iterations, start %d of %d): %s\n", spec.source.c_str(), r.runs, r.iterations,
                 r.best_start + 1, resume ? 1 : spec.starts, r.termination.c_str());

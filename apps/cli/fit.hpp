@@ -17,6 +17,7 @@ struct FitArgs {
     std::string out_dir;   ///< "": the spec's [outputs] directory, else SPEC's name without .toml + "_fit"
     bool restart = false;  ///< ignore an earlier history.csv (start from the spec's starts)
     bool no_plot = false;
+    int stop_after = 0;    ///< tests: stop as on SIGINT after this many iterations (0: never)
 };
 
 void add_fit_options(CLI::App& fit, FitArgs& args);

@@ -16,6 +16,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fit_trial.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 
 namespace stackbeam {
@@ -140,23 +141,12 @@ private:
     void run_batch(const std::vector<VectorXd>& us, const std::vector<std::vector<double>>& keys,
                    const std::vector<std::size_t>& missing) {
         const std::size_t loops = spec_.loops.size();
-        std::vector<SweepSpec> specs(loops);
         std::vector<SweepPoint> points;
+        std::vector<std::vector<double>> values;
+        for (const std::size_t k : missing) values.push_back(values_of(us[k]));
         for (std::size_t l = 0; l < loops; ++l) {
-            SweepSpec& s = specs[l];
-            s.source = spec_.source;
-            s.scenario_path = spec_.scenario_path;
-            s.scenario_text = spec_.scenario_text;
-            s.scenario_location = spec_.scenario_location;
-            s.combine = Combine::zip;
-            for (int j = 0; j < n_; ++j) {
-                SweepAxis axis{spec_.parameters[static_cast<std::size_t>(j)].key, {}, spec_.parameters[static_cast<std::size_t>(j)].location};
-                for (const std::size_t k : missing) axis.values.emplace_back(value_of(j, us[k][j]));
-                s.axes.push_back(std::move(axis));
-            }
-            for (const auto& [key, value] : spec_.loops[l].settings)
-                s.axes.push_back({key, std::vector<AxisValue>(missing.size(), value), spec_.loops[l].location});
-            const SweepPoints generator(s);
+            const SweepSpec sweep = detail::trial_sweep(spec_, values, &spec_.loops[l]);  // SweepPoints keeps a reference
+            const SweepPoints generator(sweep);
             for (std::size_t q = 0; q < missing.size(); ++q) {
                 SweepPoint p = generator.point(static_cast<int>(q));
                 p.index = static_cast<int>(q * loops + l);
@@ -261,17 +251,50 @@ private:
     std::map<std::vector<double>, Evaluation> cache_;
 };
 
-/// The forward-difference points around u: u + h_j e_j (backwards at the upper bound).
-std::vector<VectorXd> difference_points(const VectorXd& u, double h, std::vector<double>& steps) {
-    std::vector<VectorXd> us{u};
-    steps.assign(static_cast<std::size_t>(u.size()), h);
-    for (int j = 0; j < u.size(); ++j) {
+/// The runs of one evaluation at u: u itself and the points of its Jacobian, run as one batch.
+/// Forward differences u + s_j e_j (s_j = h, or -h when u_j + h > 1), and, when that makes an
+/// odd number of runs (n even), the backward point u - s_0 e_0 too, so the first column is a
+/// central difference: a batch of an even number of runs fills two threads (the extra run
+/// costs no wall time there and makes one column second-order accurate). The same points
+/// whatever `jobs` is, so the answer does not depend on it.
+struct Stencil {
+    std::vector<VectorXd> points;  ///< [0] u, [1 + j] u + s_j e_j, [n + 1] (when central) u - s_0 e_0
+    std::vector<double> steps;     ///< s_j
+    bool central = false;          ///< column 0 by central difference
+};
+
+Stencil stencil_at(const VectorXd& u, double h) {
+    Stencil st;
+    const int n = static_cast<int>(u.size());
+    st.points.push_back(u);
+    st.steps.assign(static_cast<std::size_t>(n), h);
+    for (int j = 0; j < n; ++j) {
         VectorXd v = u;
-        if (v[j] + h > 1.0) steps[static_cast<std::size_t>(j)] = -h;
-        v[j] += steps[static_cast<std::size_t>(j)];
-        us.push_back(v);
+        if (v[j] + h > 1.0) st.steps[static_cast<std::size_t>(j)] = -h;
+        v[j] += st.steps[static_cast<std::size_t>(j)];
+        st.points.push_back(v);
     }
-    return us;
+    const double back = u[0] - st.steps[0];
+    if ((n + 1) % 2 == 1 && back >= 0.0 && back <= 1.0) {
+        VectorXd v = u;
+        v[0] = back;
+        st.points.push_back(v);
+        st.central = true;
+    }
+    return st;
+}
+
+/// The Jacobian of the residuals in the scaled values from the evaluations at the stencil's points.
+MatrixXd jacobian_of(const Stencil& st, const std::vector<const Evaluation*>& e) {
+    const int n = static_cast<int>(st.steps.size());
+    MatrixXd ju(e[0]->residuals.size(), n);
+    for (int j = 0; j < n; ++j) {
+        const double s = st.steps[static_cast<std::size_t>(j)];
+        ju.col(j) = j == 0 && st.central
+                        ? ((e[1]->residuals - e[static_cast<std::size_t>(n + 1)]->residuals) / (2.0 * s)).eval()
+                        : ((e[static_cast<std::size_t>(j + 1)]->residuals - e[0]->residuals) / s).eval();
+    }
+    return ju;
 }
 
 /// The misfit as Ceres sees it: one residual block of m residuals in the n scaled values.
@@ -285,17 +308,21 @@ public:
         const int n = objective_.n(), m = objective_.m();
         const VectorXd u = Eigen::Map<const VectorXd>(parameters[0], n);
         const bool with_jacobian = jacobians && jacobians[0];
-        std::vector<double> steps;
-        const std::vector<VectorXd> us = with_jacobian ? difference_points(u, step_, steps) : std::vector<VectorXd>{u};
-        const auto e = objective_.evaluate(us);
-        for (const Evaluation* x : e)
-            if (!x || !x->ok) return false;  // a failed run: Ceres shrinks the step
+        // The trial point is run with its Jacobian's points (speculatively: if Ceres accepts
+        // the step it asks for the Jacobian there next, from the cache; if it rejects it the
+        // n extra runs are wasted): one batch of n + 1 or n + 2 runs instead of a trial run
+        // alone, then n runs.
+        const Stencil st = stencil_at(u, step_);
+        const auto e = objective_.evaluate(st.points);
+        if (!e[0] || !e[0]->ok) return false;  // a failed run: Ceres shrinks the step
         Eigen::Map<VectorXd>(residuals, m) = e[0]->residuals;
-        if (with_jacobian)
-            for (int j = 0; j < n; ++j) {
-                const VectorXd col = (e[static_cast<std::size_t>(j + 1)]->residuals - e[0]->residuals) / steps[static_cast<std::size_t>(j)];
-                for (int i = 0; i < m; ++i) jacobians[0][i * n + j] = col[i];  // row-major
-            }
+        if (with_jacobian) {
+            for (const Evaluation* x : e)
+                if (!x || !x->ok) return false;
+            const MatrixXd ju = jacobian_of(st, e);
+            for (int i = 0; i < m; ++i)
+                for (int j = 0; j < n; ++j) jacobians[0][i * n + j] = ju(i, j);  // row-major
+        }
         return true;
     }
 
@@ -438,9 +465,10 @@ FitResult fit(const FitSpec& spec, const FitOptions& options) {
         starts.push_back(u);
     }
 
-    // the starting point run first: a loop the loading cannot stroke is bad input, named
+    // the starting point run first (with its Jacobian's points, which the optimiser asks for
+    // next): a loop the loading cannot stroke is bad input, named
     {
-        const auto e = objective.evaluate({first});
+        const auto e = objective.evaluate(stencil_at(first, spec.difference_step).points);
         if (objective.stopped()) {
             result.stopped = true;
             result.termination = "stopped before the first run finished";
@@ -509,9 +537,8 @@ FitResult fit(const FitSpec& spec, const FitOptions& options) {
     result.stopped = objective.stopped();
 
     // the answer at the best values: the Jacobian there (its runs mostly cached), the covariance
-    std::vector<double> steps;
-    const auto around = difference_points(best_u, spec.difference_step, steps);
-    const auto e = result.stopped ? objective.evaluate({best_u}) : objective.evaluate(around);
+    const Stencil around = stencil_at(best_u, spec.difference_step);
+    const auto e = result.stopped ? objective.evaluate({best_u}) : objective.evaluate(around.points);
     if (!e[0] || !e[0]->ok) throw std::runtime_error("the run at the fitted values failed: " + (e[0] ? e[0]->message : std::string("stopped")));
     result.cost = 0.5 * e[0]->residuals.squaredNorm();
     result.loops = e[0]->loops;
@@ -529,9 +556,7 @@ FitResult fit(const FitSpec& spec, const FitOptions& options) {
     bool jacobian = !result.stopped;
     for (const Evaluation* x_e : e) jacobian = jacobian && x_e && x_e->ok;
     if (jacobian) {
-        MatrixXd ju(objective.m(), n);
-        for (int j = 0; j < n; ++j)
-            ju.col(j) = (e[static_cast<std::size_t>(j + 1)]->residuals - e[0]->residuals) / steps[static_cast<std::size_t>(j)];
+        const MatrixXd ju = jacobian_of(around, e);
         covariance(spec, ju, result.cost, result);
     } else {
         result.correlation.assign(static_cast<std::size_t>(n), std::vector<double>(static_cast<std::size_t>(n), nan));
@@ -543,14 +568,36 @@ FitResult fit(const FitSpec& spec, const FitOptions& options) {
     result.runs = objective.runs();
 
     // the fitted scenario: the base with the values set (as a sweep point's scenario)
-    SweepSpec s;
-    s.source = spec.source;
-    s.scenario_path = spec.scenario_path;
-    s.scenario_text = spec.scenario_text;
-    s.scenario_location = spec.scenario_location;
-    for (int j = 0; j < n; ++j) s.axes.push_back({spec.parameters[static_cast<std::size_t>(j)].key, {x[static_cast<std::size_t>(j)]}, spec.parameters[static_cast<std::size_t>(j)].location});
-    result.fitted_scenario_text = SweepPoints(s).point(0).scenario_text;
+    const SweepSpec fitted = detail::trial_sweep(spec, {x}, nullptr);  // SweepPoints keeps a reference
+    result.fitted_scenario_text = SweepPoints(fitted).point(0).scenario_text;
     return result;
+}
+
+std::vector<std::vector<double>> fit_residuals(const FitSpec& spec, const std::vector<std::vector<double>>& values,
+                                               const FitOptions& options) {
+    Objective objective(spec, options);
+    std::vector<VectorXd> us;
+    for (const auto& x : values) {
+        if (x.size() != spec.parameters.size())
+            throw InputError("values", "has " + std::to_string(x.size()) + " values; the spec has " +
+                                           std::to_string(spec.parameters.size()) + " parameters");
+        VectorXd u(objective.n());
+        for (int j = 0; j < objective.n(); ++j) {
+            const FitParameter& p = spec.parameters[static_cast<std::size_t>(j)];
+            const double xj = x[static_cast<std::size_t>(j)];
+            if (!(xj >= p.lower && xj <= p.upper))
+                throw InputError(p.key, "value " + format_value(xj) + " is not allowed: must lie in its bounds [" +
+                                            format_value(p.lower) + ", " + format_value(p.upper) + "]",
+                                 p.location);
+            u[j] = (xj - p.lower) / (p.upper - p.lower);
+        }
+        us.push_back(u);
+    }
+    std::vector<std::vector<double>> out;
+    for (const Evaluation* e : objective.evaluate(us))
+        out.push_back(e && e->ok ? std::vector<double>(e->residuals.data(), e->residuals.data() + e->residuals.size())
+                                 : std::vector<double>());
+    return out;
 }
 
 }  // namespace stackbeam

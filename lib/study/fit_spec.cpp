@@ -3,6 +3,7 @@
 // key-path editing, SweepPoints).
 #include "stackbeam/study/fit.hpp"
 #include "../io/toml_text.hpp"
+#include "fit_trial.hpp"
 
 #include <toml.hpp>
 
@@ -58,22 +59,25 @@ std::vector<std::string> split_csv_line(const std::string& line) {
     return cells;
 }
 
-/// The scenario of the base with `values` set at the parameters' keys and the loop's settings;
-/// made and checked as a sweep point (SweepPoints::point), so any InputError names the key.
-void check_bound_scenario(const FitSpec& spec, const MeasuredLoop& loop, const std::vector<double>& values) {
+}  // namespace
+
+SweepSpec detail::trial_sweep(const FitSpec& spec, const std::vector<std::vector<double>>& values, const MeasuredLoop* loop) {
     SweepSpec s;
     s.source = spec.source;
     s.scenario_path = spec.scenario_path;
     s.scenario_text = spec.scenario_text;
     s.scenario_location = spec.scenario_location;
     s.combine = Combine::zip;
-    for (std::size_t j = 0; j < spec.parameters.size(); ++j)
-        s.axes.push_back({spec.parameters[j].key, {values[j]}, spec.parameters[j].location});
-    for (const auto& [key, value] : loop.settings) s.axes.push_back({key, {value}, loop.location});
-    SweepPoints(s).point(0);
+    for (std::size_t j = 0; j < spec.parameters.size(); ++j) {
+        SweepAxis axis{spec.parameters[j].key, {}, spec.parameters[j].location};
+        for (const auto& v : values) axis.values.emplace_back(v.at(j));
+        s.axes.push_back(std::move(axis));
+    }
+    if (loop)
+        for (const auto& [key, value] : loop->settings)
+            s.axes.push_back({key, std::vector<AxisValue>(values.size(), value), loop->location});
+    return s;
 }
-
-}  // namespace
 
 void read_loop_csv(const std::string& text, MeasuredLoop& loop, double closure_tolerance, const std::string& field) {
     std::istringstream in(text);
@@ -314,7 +318,10 @@ FitSpec parse_fit_spec(const std::string& text, const std::string& source_name) 
         for (const double bound : {spec.parameters[j].lower, spec.parameters[j].upper}) {
             values[j] = bound;
             try {
-                for (const auto& loop : spec.loops) check_bound_scenario(spec, loop, values);
+                for (const auto& loop : spec.loops) {
+                    const SweepSpec sweep = detail::trial_sweep(spec, {values}, &loop);  // SweepPoints keeps a reference
+                    SweepPoints(sweep).point(0);
+                }
             } catch (const InputError& e) {
                 throw InputError("parameters[" + std::to_string(j) + "]",
                                  "the scenario refuses the bound " + format_value(bound) + " of " + spec.parameters[j].key +

@@ -19,8 +19,10 @@
 /// with F_half = (F_max - F_min)/2 of the measured loop and A_scale = max(|A_meas|, 1e-3 F_half w_half).
 /// Minimised by Ceres' Levenberg-Marquardt within the bounds, on the parameters scaled to
 /// their bounds (u = (x - lower)/(upper - lower) in [0, 1]); the Jacobian by forward
-/// differences, the n + 1 runs of one Jacobian on `jobs` threads (run_sweep); restarts from
-/// several starting points keep the lowest misfit.
+/// differences (the first column central when n is even, so that a batch has an even number
+/// of runs); every trial point is run together with its Jacobian's points as one batch on
+/// `jobs` threads (run_sweep), speculatively: an accepted step finds its Jacobian done, a
+/// rejected one wastes n runs; restarts from several starting points keep the lowest misfit.
 ///
 /// Uncertainty: the covariance s^2 (J^T J)^-1 at the optimum (J the Jacobian of the residuals
 /// in the parameters' units, s^2 = sum r^2 / (m - n)): the standard error assumes the misfit
@@ -171,5 +173,12 @@ struct FitResult {
 /// scenario's loading does not reach (naming the loop), std::runtime_error when the runs at
 /// the starting values fail.
 FitResult fit(const FitSpec& spec, const FitOptions& options = {});
+
+/// The misfit's residuals (the m of FitResult::residual_count, in the order of the objective
+/// above) at each of `values` (one value per parameter, parameters' units), the runs as one
+/// batch on options.jobs threads. For studies of the objective (another optimiser, a misfit
+/// map); an entry is empty when its run failed or was stopped.
+std::vector<std::vector<double>> fit_residuals(const FitSpec& spec, const std::vector<std::vector<double>>& values,
+                                               const FitOptions& options = {});
 
 }  // namespace stackbeam
