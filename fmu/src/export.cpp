@@ -86,6 +86,9 @@ std::string model_description(const Scenario& scenario, const std::string& scena
          "work done on the spring through the seat since the start", false, 0.0},
         {"integrator.dt_s", vr_dt, "parameter", "fixed", "exact", "s",
          "the stepper's time step: every communication step is a whole number of it", true, o.dt_s},
+        {"seat.max_stroke_m", vr_max_stroke, "parameter", "fixed", "exact", "m",
+         "largest |seat.displacement_m| the importer will set (the cvode steppers' error and event scales), > 0",
+         true, default_max_stroke_m(o.loading.displacement_m, seat_moves(o.loading))},
     };
     for (std::size_t i = 0; i < m.interfaces.size() && i < kMaxListed; ++i)
         vars.push_back({"interfaces[" + std::to_string(i) + "].friction_coefficient", vr_friction0 + unsigned(i), "parameter",

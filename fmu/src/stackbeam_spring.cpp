@@ -55,6 +55,7 @@ const char* to_string(Phase p) {
 struct Snapshot {
     std::vector<double> friction, preload;
     double dt_s = 0.0;
+    double max_stroke_m = 0.0;
     ExternalSamples samples;
     long comm_index = 0;
     double u[3] = {0.0, 0.0, 0.0};
@@ -70,6 +71,7 @@ struct Instance {
     Scenario scenario;  // as read from resources/scenario.toml
     ModelSpec spec;     // with the parameters set
     SimulationOptions options;
+    double max_stroke_m = 1e-3;  // seat.max_stroke_m: the importer's bound on |w| [m] (the cvode scales)
     double start_s = 0.0;
     double stop_s = 0.0;  // stop time - start time when the experiment defines it [s], 0: none
 
@@ -149,6 +151,10 @@ void ensure_current(Instance& in) {
         options.loading = Loading{};
         options.loading.kind = LoadingKind::prescribed_displacement;
         options.loading.displacement_m.external = in.samples;
+        // The seat's declared stroke stands for the samples' largest |w| in the cvode steppers' scales
+        // (event_driver.cpp: largest_value = |mean| + amplitude, EventScales' motion_max); value() and
+        // its derivatives are the samples' whatever the shape (TimeFunction::external).
+        options.loading.displacement_m.amplitude = in.max_stroke_m;
         if (!in.system) rebuild_system(in);
         in.stepper.reset();
         in.stepper = make_stepper(*in.system, options);
@@ -197,6 +203,7 @@ long preload_index(const Instance& in, fmi2ValueReference vr) {
 double get_real(Instance& in, fmi2ValueReference vr) {
     if (is_input(vr)) return in.u[vr - vr_seat_displacement];
     if (vr == vr_dt) return in.options.dt_s;
+    if (vr == vr_max_stroke) return in.max_stroke_m;
     if (const long i = friction_index(in, vr); i >= 0) return in.spec.interfaces[i].friction_coefficient;
     if (const long j = preload_index(in, vr); j >= 0) return in.spec.clamps[j].preload_n;
     require_phase(in, "fmi2GetReal of an output", {Phase::initialization, Phase::step_complete, Phase::terminated});
@@ -212,9 +219,17 @@ void set_real(Instance& in, fmi2ValueReference vr, double v) {
         slot = v;
         return;
     }
-    const bool parameter = vr == vr_dt || friction_index(in, vr) >= 0 || preload_index(in, vr) >= 0;
+    const bool parameter = vr == vr_dt || vr == vr_max_stroke || friction_index(in, vr) >= 0 || preload_index(in, vr) >= 0;
     if (!parameter) throw FmuError("value reference " + std::to_string(vr) + " cannot be set (not an input or parameter)");
     require_phase(in, "fmi2SetReal of a parameter (variability fixed)", {Phase::instantiated, Phase::initialization});
+    if (vr == vr_max_stroke) {
+        if (!(std::isfinite(v) && v > 0.0))
+            throw FmuError("parameter seat.max_stroke_m = " + fmt(v) +
+                           " is not allowed: it must be a finite length > 0 m (the largest |seat.displacement_m| to come)");
+        in.max_stroke_m = v;
+        in.stepper.reset();
+        return;
+    }
     if (vr == vr_dt) {
         SimulationOptions o = in.options;
         o.dt_s = v;
@@ -227,15 +242,16 @@ void set_real(Instance& in, fmi2ValueReference vr, double v) {
         in.stepper.reset();
         return;
     }
-    ModelSpec s = in.spec;
-    if (const long i = friction_index(in, vr); i >= 0) s.interfaces[i].friction_coefficient = v;
-    if (const long j = preload_index(in, vr); j >= 0) s.clamps[j].preload_n = v;
-    try {
-        in.system = std::make_unique<System>(Model::build(s));  // the library's checks, naming the field
-    } catch (const InputError& e) {
-        throw FmuError(std::string("parameter ") + e.what());
-    }
-    in.spec = s;
+    // Each value alone: finite and >= 0 (both are). The model is rebuilt, with the library's checks
+    // of the whole stack (e.g. the half model's mirrored clamps, set one by one), when the run starts
+    // (fmi2ExitInitializationMode, or the first read of an output): a message naming the key.
+    const long i = friction_index(in, vr), j = preload_index(in, vr);
+    const std::string name = i >= 0 ? "interfaces[" + std::to_string(i) + "].friction_coefficient"
+                                    : "clamps[" + std::to_string(j) + "].preload_n";
+    if (!(std::isfinite(v) && v >= 0.0))
+        throw FmuError("parameter " + name + " = " + fmt(v) + " is not allowed: it must be a finite number >= 0");
+    (i >= 0 ? in.spec.interfaces[i].friction_coefficient : in.spec.clamps[j].preload_n) = v;
+    in.system.reset();
     in.stepper.reset();
 }
 
@@ -269,6 +285,7 @@ fmi2Status guarded(fmi2Component c, const char* function, Body body) {
 void reset_instance(Instance& in) {
     in.spec = in.scenario.model;
     in.options = in.scenario.simulation;
+    in.max_stroke_m = default_max_stroke_m(in.options.loading.displacement_m, seat_moves(in.options.loading));
     in.start_s = 0.0;
     in.stop_s = 0.0;
     in.stepper.reset();
@@ -359,6 +376,9 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     return guarded(c, "fmi2ExitInitializationMode", [&](Instance& in) {
         require_phase(in, "fmi2ExitInitializationMode", {Phase::initialization});
+        // the stepper of the parameters set, at t = 0 with the inputs set: a mode that cannot run the
+        // rig, or a bad combination of parameters, is refused here, naming the scenario's key
+        ensure_current(in);
         in.phase = Phase::step_complete;
     });
 }
@@ -415,6 +435,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
         for (const auto& i : in.spec.interfaces) s->friction.push_back(i.friction_coefficient);
         for (const auto& j : in.spec.clamps) s->preload.push_back(j.preload_n);
         s->dt_s = in.options.dt_s;
+        s->max_stroke_m = in.max_stroke_m;
         s->samples = *in.samples;
         s->comm_index = in.comm_index;
         std::memcpy(s->u, in.u, sizeof in.u);
@@ -432,6 +453,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
         for (std::size_t i = 0; i < s.friction.size(); ++i) in.spec.interfaces[i].friction_coefficient = s.friction[i];
         for (std::size_t j = 0; j < s.preload.size(); ++j) in.spec.clamps[j].preload_n = s.preload[j];
         in.options.dt_s = s.dt_s;
+        in.max_stroke_m = s.max_stroke_m;
         rebuild_system(in);
         in.stepper.reset();  // rebuilt and replayed on demand (ensure_current)
         in.samples = std::make_shared<ExternalSamples>(s.samples);
@@ -461,11 +483,12 @@ void put_vec(std::vector<char>& b, const std::vector<double>& v) {
 }
 std::vector<char> serialize(const Snapshot& s) {
     std::vector<char> b;
-    const char magic[8] = {'S', 'B', 'F', 'M', 'U', 'S', '1', '\0'};
+    const char magic[8] = {'S', 'B', 'F', 'M', 'U', 'S', '2', '\0'};
     put(b, magic, sizeof magic);
     put_vec(b, s.friction);
     put_vec(b, s.preload);
     put(b, &s.dt_s, sizeof s.dt_s);
+    put(b, &s.max_stroke_m, sizeof s.max_stroke_m);
     put_vec(b, s.samples.times_s);
     put_vec(b, s.samples.values);
     put_vec(b, s.samples.derivatives);
@@ -518,11 +541,12 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
         Reader r{serializedState, size};
         char magic[8];
         r.get(magic, sizeof magic);
-        if (std::memcmp(magic, "SBFMUS1", 8) != 0) throw FmuError("the serialized FMU state is not one of this FMU's");
+        if (std::memcmp(magic, "SBFMUS2", 8) != 0) throw FmuError("the serialized FMU state is not one of this FMU's");
         auto s = std::make_unique<Snapshot>();
         s->friction = r.vec();
         s->preload = r.vec();
         r.get(&s->dt_s, sizeof s->dt_s);
+        r.get(&s->max_stroke_m, sizeof s->max_stroke_m);
         s->samples.times_s = r.vec();
         s->samples.values = r.vec();
         s->samples.derivatives = r.vec();

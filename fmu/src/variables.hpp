@@ -7,9 +7,13 @@
 // Signs (include/stackbeam/conventions.hpp): y is up. The seat (the rigid body R's attachment,
 // the axle seat) moves by w relative to the spring's frame (the supports), +y; the force output
 // is the force of the spring on the seat, +y (a spring pushed down, w < 0, pushes the seat up).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <string>
+
+#include "stackbeam/model/loading.hpp"
 
 namespace stackbeam::fmu {
 
@@ -24,10 +28,27 @@ enum : unsigned int {
     vr_strain_energy = 13,     ///< output: elastic energy of the leaves [J]
     vr_external_work = 14,     ///< output: work done on the spring through the seat since t = 0 [J]
     vr_dt = 100,               ///< parameter integrator.dt_s [s]
+    vr_max_stroke = 101,       ///< parameter seat.max_stroke_m [m]: the largest |w| the importer will set
+                               ///< (the cvode steppers' scales: EventScales' motion_max, event_driver.cpp)
     vr_friction0 = 1000,       ///< parameter interfaces[i].friction_coefficient, vr 1000 + i [-]
     vr_preload0 = 2000,        ///< parameter clamps[j].preload_n, vr 2000 + j [N]
 };
 constexpr unsigned int kMaxListed = 1000;  ///< at most this many interfaces (clamps) get a parameter each
+
+/// The start value of seat.max_stroke_m [m]: the largest |w| of the scenario's own seat motion
+/// (|mean| + amplitude, or the table's largest |value|) when its loading moves the seat (rig or
+/// base excitation), else 1 mm (the event driver's own scale of a spring at rest). The importer
+/// sets its vehicle's travel; only the cvode steppers read it (their error and event scales).
+inline double default_max_stroke_m(const TimeFunction& w, bool moves_seat) {
+    double v = std::abs(w.mean) + w.amplitude;
+    for (double x : w.values) v = std::max(v, std::abs(x));
+    return moves_seat && v > 0.0 ? v : 1e-3;
+}
+
+/// Whether the scenario's loading moves the seat (its displacement_m is the seat's motion).
+inline bool seat_moves(const Loading& L) {
+    return L.kind == LoadingKind::prescribed_displacement || L.kind == LoadingKind::base_excitation;
+}
 
 /// The FMU's model identifier: the binary is binaries/linux64/<it>.so.
 inline const char* model_identifier() { return "stackbeam_spring"; }

@@ -12,6 +12,8 @@
 
 namespace stackbeam {
 
+const char* to_string(Fibre fibre) { return fibre == Fibre::top ? "top" : "bottom"; }
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
