@@ -195,8 +195,8 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
 }
 
-RunRequest make_request(const SimulateArgs& a) {
-    RunRequest r;
+SimulateRequest make_request(const SimulateArgs& a) {
+    SimulateRequest r;
     r.out = a.out;
     r.events = a.events;
     r.summary = a.summary;
