@@ -24,16 +24,16 @@
 #include <thread>
 #include <vector>
 
-#include "run.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/run/run.hpp"
+#include "stackbeam/run/summary_json.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
 #include "stackbeam/time/option_table.hpp"
 #include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/stepper.hpp"
-#include "summary.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
