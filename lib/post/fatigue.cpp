@@ -74,8 +74,6 @@ std::vector<RainflowCycle> count_rainflow(const std::vector<double>& v, const st
 
 }  // namespace
 
-const char* to_string(Fibre fibre) { return fibre == Fibre::top ? "top" : "bottom"; }
-
 std::vector<std::size_t> turning_points(const std::vector<double>& stress_pa, double gate_pa) {
     require_finite_history(stress_pa, "stress_pa");
     if (!std::isfinite(gate_pa) || gate_pa < 0.0)

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "stackbeam/model/model.hpp"  // FatigueMaterial, MeanStressCorrection
+#include "stackbeam/post/stresses.hpp"  // Fibre
 
 namespace stackbeam {
 
@@ -75,9 +76,7 @@ double basquin_life_cycles(const FatigueMaterial& material, double equivalent_am
 /// history is 1 / D (+infinity for D = 0).
 double miner_damage(const FatigueMaterial& material, const std::vector<RainflowCycle>& cycles);
 
-/// A fibre of a leaf's section: its top (+y) or bottom surface.
-enum class Fibre { top, bottom };
-const char* to_string(Fibre fibre);
+// Fibre (a leaf's top or bottom surface) and its to_string: stresses.hpp
 
 /// Stress histories of one leaf's nodes at its two fibres [Pa]: top_pa[k] and bottom_pa[k] are
 /// node k's time series (the same samples for every node and fibre).
