@@ -11,6 +11,15 @@
 
 namespace stackbeam {
 
+std::string case_setup(PaperCase c, const PaperExampleOptions& options) {
+    return std::string("case ") + to_string(c) + ", " + std::to_string(options.elements_per_half_leaf) +
+           " elements per half leaf (" + word_of(options.symmetry) + " model), ";
+}
+
+std::string scenario_setup(const std::string& source, const std::string& description) {
+    return "scenario " + source + (description.empty() ? "" : " (" + description + ")") + "\n";
+}
+
 void RunStats::add(const StepRecord& r) {
     if (records == 0) {
         first = r;

@@ -42,6 +42,8 @@
 #include <string>
 #include <vector>
 
+#include "stackbeam/words.hpp"
+
 namespace stackbeam {
 
 /// A scalar function of time, in the unit of what it describes ([N] or [m]).
@@ -80,6 +82,8 @@ struct TimeFunction {
     std::vector<double> spline_m2;
 };
 
+template <>
+const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>();
 const char* to_string(TimeFunction::Shape shape);
 
 enum class LoadingKind {
@@ -88,6 +92,8 @@ enum class LoadingKind {
     prescribed_displacement,  ///< w(t) imposed on R: the test-rig loop
     base_excitation,          ///< the supports move by y_b(t) (plus the initial conditions)
 };
+template <>
+const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>();
 const char* to_string(LoadingKind kind);
 
 struct Loading {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "stackbeam/fe/system.hpp"
+#include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/post/stresses.hpp"
 #include "stackbeam/run/loop_figures.hpp"
 #include "stackbeam/time/run_report.hpp"
@@ -50,6 +51,14 @@ public:
     /// t [s], every leaf's resultants and fibre stresses and every pair's pressure
     virtual void on_stresses(double t_s, const Stresses& stresses) { (void)t_s, (void)stresses; }
 };
+
+/// The summary's first line (RunRequest::setup) for the paper's case `c` meshed by `options`:
+/// "case friction, 20 elements per half leaf (half model), " (the mode follows on the same line).
+std::string case_setup(PaperCase c, const PaperExampleOptions& options);
+
+/// The summary's first line for a scenario read from `source` (its description, "" none):
+/// "scenario FILE (DESCRIPTION)\n".
+std::string scenario_setup(const std::string& source, const std::string& description);
 
 /// One run, as a plain value: the integrator's options, what to output and where.
 struct RunRequest {
