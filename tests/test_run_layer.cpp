@@ -133,7 +133,8 @@ BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {
     for (const auto& w : enum_words<SupportKind>()) BOOST_TEST(std::string(to_string(w.value)) == w.word);
     for (const auto& w : enum_words<LoadingKind>()) BOOST_TEST(std::string(to_string(w.value)) == w.word);
     BOOST_TEST(word_list<Mode>() == "closed-form, cvode, newmark");
-    BOOST_TEST(word_list<Symmetry>("'", " or ") == "'full' or 'half'");
+    BOOST_TEST(word_list<Symmetry>("'", ", ", " or ") == "'full' or 'half'");
+    BOOST_TEST(word_list<SolverKind>("", " | ") == "exact | accelerated | block-jacobi | paper");
     BOOST_TEST(!find_word<Mode>("rk4").has_value());
     try {
         parse_mode("rk4", "--mode");

@@ -39,15 +39,16 @@ std::optional<E> find_word(const std::string& text) {
     return std::nullopt;
 }
 
-/// The words for a message: each in `quote`, separated by ", " and the last by `last_separator`
-/// (word_list<Mode>() is "closed-form, cvode, newmark"; word_list<Symmetry>("'", " or ") is
-/// "'full' or 'half'").
+/// The words for a message: each in `quote`, separated by `separator` and the last by
+/// `last_separator` (nullptr: `separator`): word_list<Mode>() is "closed-form, cvode, newmark",
+/// word_list<Symmetry>("'", ", ", " or ") is "'full' or 'half'", word_list<Mode>("", " | ") is
+/// "closed-form | cvode | newmark".
 template <class E>
-std::string word_list(const char* quote = "", const char* last_separator = ", ") {
+std::string word_list(const char* quote = "", const char* separator = ", ", const char* last_separator = nullptr) {
     const auto& words = enum_words<E>();
     std::string out;
     for (std::size_t i = 0; i < words.size(); ++i) {
-        if (i > 0) out += i + 1 == words.size() ? last_separator : ", ";
+        if (i > 0) out += i + 1 == words.size() && last_separator ? last_separator : separator;
         out += std::string(quote) + words[i].word + quote;
     }
     return out;

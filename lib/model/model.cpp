@@ -59,7 +59,7 @@ const char* to_string(MeanStressCorrection correction) { return word_of(correcti
 
 InterfaceContact parse_interface_contact(const std::string& text, const std::string& field) {
     if (const auto contact = find_word<InterfaceContact>(text)) return *contact;
-    throw InputError(field, "value '" + text + "' is not allowed: must be " + word_list<InterfaceContact>("'", " or "));
+    throw InputError(field, "value '" + text + "' is not allowed: must be " + word_list<InterfaceContact>("'", ", ", " or "));
 }
 
 namespace {
