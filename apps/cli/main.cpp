@@ -50,7 +50,7 @@ namespace {
 
 using namespace stackbeam::cli;
 
-int run_request(const RunRequest& request) {
+int run_request(const SimulateRequest& request) {
     const stackbeam::Model model = stackbeam::Model::build(request.spec);
     const stackbeam::System system(model);
     if (const std::string advice = stackbeam::friction_mesh_advice(model); !advice.empty())
@@ -58,12 +58,11 @@ int run_request(const RunRequest& request) {
     stackbeam::choose_contact_path(system, request.options);  // throws for a path the solver cannot take
     install_interrupt_handlers();
     const RunResult result = run(request, system);
-    const LoopFigures loop = loop_figures(request, result);
     if (result.signal == 0) {
-        print_summary(request, system, result, loop);
+        print_summary(request, system, result);
         if (!request.plot.empty()) {
             std::string note;
-            const auto files = plot_run(request.out, request.plot, note, loop.fancher_loop);
+            const auto files = plot_run(request.out, request.plot, note, result.summary.loop.fancher_loop);
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
             if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)
@@ -74,7 +73,7 @@ int run_request(const RunRequest& request) {
         }
     }
     if (!request.summary.empty()) {
-        write_json_summary(request, model, result, loop);
+        write_json_summary(request, model, result);
         if (result.signal == 0) std::printf("summary                    %s\n", request.summary.c_str());
     }
     return result.signal != 0 ? 128 + result.signal : exit_ok;
@@ -82,7 +81,7 @@ int run_request(const RunRequest& request) {
 
 
 int run_simulate(const SimulateArgs& args) {
-    const RunRequest request = make_request(args);  // every argument checked before any work
+    const SimulateRequest request = make_request(args);  // every argument checked before any work
     try {
         return run_request(request);
     } catch (const stackbeam::InputError& e) {

@@ -12,6 +12,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/io/scenario.hpp"
+#include "stackbeam/run/run.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/option_table.hpp"
 
@@ -195,8 +196,8 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
 }
 
-RunRequest make_request(const SimulateArgs& a) {
-    RunRequest r;
+SimulateRequest make_request(const SimulateArgs& a) {
+    SimulateRequest r;
     r.out = a.out;
     r.events = a.events;
     r.summary = a.summary;
@@ -226,7 +227,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         apply_interface(contact, r.spec);
-        r.setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
+        r.setup = scenario_setup(a.scenario, scenario.description);
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
         const PaperCase pcase = parse_paper_case(a.case_name, "--case");
@@ -239,8 +240,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         apply_interface(contact, r.spec);
-        r.setup = std::string("case ") + to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
-                  " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+        r.setup = case_setup(pcase, example);
     }
     if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
         throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "

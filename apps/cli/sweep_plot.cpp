@@ -68,7 +68,7 @@ bool log_scale(const SweepAxis& axis) {
 std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpec& spec,
                                     const SweepPoints& points, const std::vector<PointResult>& results,
                                     std::string& note) {
-    using namespace stackbeam::demo;
+    using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
     const fs::path dir = fs::path(directory) / "figures";

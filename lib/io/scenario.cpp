@@ -26,6 +26,16 @@
 
 namespace stackbeam {
 
+template <>
+const std::vector<EnumWord<InterfaceLawWord>>& enum_words<InterfaceLawWord>() {
+    static const std::vector<EnumWord<InterfaceLawWord>> words = {
+        {InterfaceLawWord::coulomb, "coulomb"},
+        {InterfaceLawWord::frictionless, "frictionless"},
+        {InterfaceLawWord::bonded, "bonded"},
+    };
+    return words;
+}
+
 namespace {
 
 const char* type_name(const toml::value& v) {
@@ -204,17 +214,14 @@ private:
     std::vector<std::string> allowed_;
 };
 
-/// A keyword value out of `choices` (text -> enum).
+/// A keyword value out of the enum's word table (words.hpp); `fallback` when the key is absent
+/// (nullptr: required).
 template <class E>
-E choice(const Table& t, const std::string& key, const std::vector<std::pair<std::string, E>>& choices,
-         const E* fallback) {
-    std::vector<std::string> names;
-    for (const auto& c : choices) names.push_back("'" + c.first + "'");
-    const std::string what = "one of " + join(names);
+E choice(const Table& t, const std::string& key, const E* fallback) {
+    const std::string what = "one of " + word_list<E>("'");
     if (!t.has(key) && fallback) return *fallback;
     const std::string text = t.string(key, what);
-    for (const auto& c : choices)
-        if (c.first == text) return c.second;
+    if (const auto value = find_word<E>(text)) return *value;
     t.context().fail(child(t.path(), key), "value '" + text + "' is not allowed: must be " + what);
 }
 
@@ -249,10 +256,6 @@ std::string file_path_of(const std::string& field) {
     ctx.fail(file_path_of(e.field()), message);
 }
 
-
-const std::vector<std::pair<std::string, SupportKind>> kSupports = {
-    {"free", SupportKind::free}, {"pinned", SupportKind::pinned}, {"fixed", SupportKind::fixed},
-    {"hinged", SupportKind::hinged}, {"shackle", SupportKind::shackle}, {"bushing", SupportKind::bushing}};
 
 /// [leaves.profile] and [leaves.left_end] / [leaves.right_end] (ranges: Model::build).
 void parse_profile_and_ends(const Table& t, LeafSpec& l) {
@@ -295,12 +298,7 @@ FatigueMaterial parse_material(const Table& parent, const std::string& key) {
     m.fatigue_strength_coefficient_pa = optional("fatigue_strength_coefficient_pa", "Basquin's sigma_f' [Pa], > 0");
     m.fatigue_strength_exponent = optional("fatigue_strength_exponent", "Basquin's exponent b [-], in (-1, 0)");
     const MeanStressCorrection goodman = MeanStressCorrection::goodman;
-    m.mean_stress_correction = choice<MeanStressCorrection>(t, "mean_stress_correction",
-                                                            {{"goodman", MeanStressCorrection::goodman},
-                                                             {"gerber", MeanStressCorrection::gerber},
-                                                             {"soderberg", MeanStressCorrection::soderberg},
-                                                             {"morrow", MeanStressCorrection::morrow}},
-                                                            &goodman);
+    m.mean_stress_correction = choice<MeanStressCorrection>(t, "mean_stress_correction", &goodman);
     return m;
 }
 
@@ -324,8 +322,8 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
         l.density_kg_per_m3 = t.number_or("density_kg_per_m3", "density [kg/m^3], >= 0", 0.0);
         l.poisson_ratio = t.number_or("poisson_ratio", "Poisson's ratio [-], in (-1, 0.5)", LeafSpec{}.poisson_ratio);
         const SupportKind free = SupportKind::free;
-        l.left_support = choice(t, "left_support", kSupports, &free);
-        l.right_support = choice(t, "right_support", kSupports, &free);
+        l.left_support = choice(t, "left_support", &free);
+        l.right_support = choice(t, "right_support", &free);
         l.free_camber_m = t.number_or("free_camber_m", "the free arc height [m], + ends up (0: flat)", 0.0);
         l.free_radius_m = t.number_or("free_radius_m", "the free radius [m], + ends up (0: flat)", 0.0);
         if (t.has("material")) l.material = parse_material(t, "material");
@@ -347,29 +345,27 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
 void parse_interfaces(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("interfaces", "one [[interfaces]] table per pair of adjacent leaves", spec.leaves.size() > 1);
     if (!arr) return;
-    enum class Law { coulomb, frictionless, bonded };
-    const std::vector<std::pair<std::string, Law>> laws = {
-        {"coulomb", Law::coulomb}, {"frictionless", Law::frictionless}, {"bonded", Law::bonded}};
+    using Law = InterfaceLawWord;
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("interfaces", i),
                 {"law", "friction_coefficient", "initial_gap_m", "contact", "normal_stiffness_pa_per_m",
                  "tangential_stiffness_pa_per_m"});
         InterfaceSpec f;
-        const Law law = choice<Law>(t, "law", laws, nullptr);
+        const Law law = choice<Law>(t, "law", nullptr);
         if (law == Law::coulomb) {
             f.law = InterfaceLaw::coulomb;
             f.friction_coefficient = t.number("friction_coefficient", "the Coulomb coefficient mu [-], >= 0 (law 'coulomb')");
         } else {
             if (t.has("friction_coefficient"))
                 t.context().fail(child(t.path(), "friction_coefficient"),
-                                 std::string("is not allowed with law '") + (law == Law::bonded ? "bonded" : "frictionless") +
+                                 std::string("is not allowed with law '") + word_of(law) +
                                      "': only law 'coulomb' takes a friction coefficient");
             f.law = law == Law::bonded ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
             f.friction_coefficient = 0.0;
         }
         f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], finite; < 0 an interference, closed by the assembly", 0.0);
         if (t.has("contact")) {
-            const std::string text = t.string("contact", "one of 'rigid', 'elastic'");
+            const std::string text = t.string("contact", "one of " + word_list<InterfaceContact>("'"));
             try {
                 f.contact = parse_interface_contact(text, child(t.path(), "contact"));
             } catch (const InputError& e) {
@@ -442,9 +438,7 @@ TimeFunction parse_time_function(const Table& parent, const std::string& key, co
     const Table t = parent.table(key, {"shape", "mean", "amplitude", "frequency_hz", "phase_rad", "times_s", "values"});
     using S = TimeFunction::Shape;
     TimeFunction f;
-    f.shape = choice<S>(t, "shape",
-                        {{"constant", S::constant}, {"harmonic", S::harmonic}, {"triangle", S::triangle}, {"table", S::table}},
-                        nullptr);
+    f.shape = choice<S>(t, "shape", nullptr);
     auto only = [&](const std::string& k, bool allowed) {
         if (t.has(k) && !allowed)
             t.context().fail(child(t.path(), k), "is not used by shape '" + std::string(to_string(f.shape)) +
@@ -476,12 +470,7 @@ Loading parse_loading(const Table& top, ModelSpec& spec) {
     const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s", "gravity_m_per_s2",
                                           "force_n", "displacement_m"});
     Loading l;
-    l.kind = choice<LoadingKind>(t, "kind",
-                                 {{"initial-conditions", LoadingKind::initial_conditions},
-                                  {"applied-force", LoadingKind::applied_force},
-                                  {"prescribed-displacement", LoadingKind::prescribed_displacement},
-                                  {"base-excitation", LoadingKind::base_excitation}},
-                                 nullptr);
+    l.kind = choice<LoadingKind>(t, "kind", nullptr);
     spec.rigid_body.initial_displacement_m = t.number_or("initial_displacement_m", "w(0) [m]", 0.0);
     spec.rigid_body.initial_velocity_m_per_s = t.number_or("initial_velocity_m_per_s", "dw/dt(0) [m/s]", 0.0);
     l.gravity_m_per_s2 = t.number_or("gravity_m_per_s2", "g [m/s^2], >= 0, acting in -y", 0.0);
@@ -503,7 +492,7 @@ void parse_mesh(const Table& top, ModelSpec& spec) {
     const Table t = top.table("mesh", {"element_length_m", "symmetry"});
     spec.mesh.element_length_m = t.number("element_length_m", "the largest element length [m], > 0");
     const Symmetry full = Symmetry::full;
-    spec.symmetry = choice<Symmetry>(t, "symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}}, &full);
+    spec.symmetry = choice<Symmetry>(t, "symmetry", &full);
 }
 
 void parse_probe(const Table& top, ModelSpec& spec) {

@@ -181,9 +181,9 @@ std::string to_toml(const Scenario& s) {
         out << "\n[[interfaces]]\n";
         Lines l(out);
         if (f.law == InterfaceLaw::bonded) {
-            l.word("law", "bonded");  // its friction coefficient is not used (the reader sets 0)
+            l.word("law", word_of(InterfaceLawWord::bonded));  // its friction coefficient is not used (the reader sets 0)
         } else {
-            l.word("law", "coulomb");
+            l.word("law", word_of(InterfaceLawWord::coulomb));
             l.num("friction_coefficient", f.friction_coefficient);
         }
         l.num("initial_gap_m", f.initial_gap_m);
@@ -231,7 +231,7 @@ std::string to_toml(const Scenario& s) {
 
     out << "\n[mesh]\n";
     top.num("element_length_m", m.mesh.element_length_m);
-    top.word("symmetry", m.symmetry == Symmetry::half ? "half" : "full");
+    top.word("symmetry", word_of(m.symmetry));
 
     if (m.probe) {
         out << "\n[probe]\n";

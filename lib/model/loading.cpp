@@ -29,25 +29,30 @@ void require_finite(const std::string& field, double v, const std::string& what)
 
 }  // namespace
 
-const char* to_string(TimeFunction::Shape shape) {
-    switch (shape) {
-        case TimeFunction::Shape::constant: return "constant";
-        case TimeFunction::Shape::harmonic: return "harmonic";
-        case TimeFunction::Shape::triangle: return "triangle";
-        case TimeFunction::Shape::table: return "table";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>() {
+    static const std::vector<EnumWord<TimeFunction::Shape>> words = {
+        {TimeFunction::Shape::constant, "constant"},
+        {TimeFunction::Shape::harmonic, "harmonic"},
+        {TimeFunction::Shape::triangle, "triangle"},
+        {TimeFunction::Shape::table, "table"},
+    };
+    return words;
 }
 
-const char* to_string(LoadingKind kind) {
-    switch (kind) {
-        case LoadingKind::initial_conditions: return "initial-conditions";
-        case LoadingKind::applied_force: return "applied-force";
-        case LoadingKind::prescribed_displacement: return "prescribed-displacement";
-        case LoadingKind::base_excitation: return "base-excitation";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>() {
+    static const std::vector<EnumWord<LoadingKind>> words = {
+        {LoadingKind::initial_conditions, "initial-conditions"},
+        {LoadingKind::applied_force, "applied-force"},
+        {LoadingKind::prescribed_displacement, "prescribed-displacement"},
+        {LoadingKind::base_excitation, "base-excitation"},
+    };
+    return words;
 }
+
+const char* to_string(TimeFunction::Shape shape) { return word_of(shape); }
+const char* to_string(LoadingKind kind) { return word_of(kind); }
 
 void TimeFunction::validate(const std::string& field, bool smooth) const {
     require_finite(field + ".mean", mean, "the mean");

@@ -11,30 +11,55 @@
 
 namespace stackbeam {
 
-const char* to_string(SupportKind kind) {
-    switch (kind) {
-        case SupportKind::free: return "free";
-        case SupportKind::pinned: return "pinned";
-        case SupportKind::fixed: return "fixed";
-        case SupportKind::hinged: return "hinged";
-        case SupportKind::shackle: return "shackle";
-        case SupportKind::bushing: return "bushing";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>() {
+    static const std::vector<EnumWord<SupportKind>> words = {
+        {SupportKind::free, "free"},
+        {SupportKind::pinned, "pinned"},
+        {SupportKind::fixed, "fixed"},
+        {SupportKind::hinged, "hinged"},
+        {SupportKind::shackle, "shackle"},
+        {SupportKind::bushing, "bushing"},
+    };
+    return words;
 }
 
-const char* to_string(InterfaceContact contact) {
-    switch (contact) {
-        case InterfaceContact::rigid: return "rigid";
-        case InterfaceContact::elastic: return "elastic";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>() {
+    static const std::vector<EnumWord<InterfaceContact>> words = {
+        {InterfaceContact::rigid, "rigid"},
+        {InterfaceContact::elastic, "elastic"},
+    };
+    return words;
 }
+
+template <>
+const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>() {
+    static const std::vector<EnumWord<Symmetry>> words = {
+        {Symmetry::full, "full"},
+        {Symmetry::half, "half"},
+    };
+    return words;
+}
+
+template <>
+const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>() {
+    static const std::vector<EnumWord<MeanStressCorrection>> words = {
+        {MeanStressCorrection::goodman, "goodman"},
+        {MeanStressCorrection::gerber, "gerber"},
+        {MeanStressCorrection::soderberg, "soderberg"},
+        {MeanStressCorrection::morrow, "morrow"},
+    };
+    return words;
+}
+
+const char* to_string(SupportKind kind) { return word_of(kind); }
+const char* to_string(InterfaceContact contact) { return word_of(contact); }
+const char* to_string(MeanStressCorrection correction) { return word_of(correction); }
 
 InterfaceContact parse_interface_contact(const std::string& text, const std::string& field) {
-    if (text == "rigid") return InterfaceContact::rigid;
-    if (text == "elastic") return InterfaceContact::elastic;
-    throw InputError(field, "value '" + text + "' is not allowed: must be 'rigid' or 'elastic'");
+    if (const auto contact = find_word<InterfaceContact>(text)) return *contact;
+    throw InputError(field, "value '" + text + "' is not allowed: must be " + word_list<InterfaceContact>("'", ", ", " or "));
 }
 
 namespace {
@@ -185,16 +210,6 @@ void validate_end(SupportKind kind, const LeafEndSpec& e, std::size_t i, const c
 }
 
 }  // namespace
-
-const char* to_string(MeanStressCorrection correction) {
-    switch (correction) {
-        case MeanStressCorrection::goodman: return "goodman";
-        case MeanStressCorrection::gerber: return "gerber";
-        case MeanStressCorrection::soderberg: return "soderberg";
-        case MeanStressCorrection::morrow: return "morrow";
-    }
-    return "?";
-}
 
 void validate_fatigue_material(const FatigueMaterial& m, const std::string& path) {
     const std::string pre = path + ".";

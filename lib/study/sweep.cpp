@@ -24,8 +24,7 @@
 
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/model/model.hpp"
-#include "stackbeam/post/fancher.hpp"
-#include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/run/run.hpp"
 
 namespace stackbeam {
 
@@ -524,49 +523,50 @@ const std::vector<std::string>& point_figure_columns() {
     return columns;
 }
 
-std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
-                                  std::string& note) {
+namespace {
+
+/// The point figures (point_figure_columns) of a run's loop figures and its largest |energy
+/// balance error| [J] (NaN for a run without records), as simulate's summary
+/// ("hysteresis", "fancher", "balance_error_max_abs").
+std::vector<double> figures_of(const LoopFigures& loop, long records, double max_abs_balance_j, std::string& note) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     std::vector<double> f(point_figure_columns().size(), nan);
-    note.clear();
-    const double period = options.loading.period_s();
-    if (period > 0.0) {
-        try {
-            const auto cycle = last_cycle(records, period);
-            const HysteresisMetrics m = hysteresis_metrics(records, cycle.first, cycle.second);
-            f[0] = m.loop_area_j;
-            f[1] = m.dissipated_j;
-            f[2] = m.secant_stiffness_n_per_m;
-            f[3] = m.dynamic_rate_n_per_m;
-            f[4] = m.loss_factor;
-            f[5] = m.equivalent_damping_ratio;
-            f[6] = m.force_min_n;
-            f[7] = m.force_max_n;
-            f[8] = m.w_min_m;
-            f[9] = m.w_max_m;
-            // the call simulate's summary makes (apps/cli/summary.cpp): the same figures
-            try {
-                const FancherFit fit = fit_fancher_loop(records, m.t_start_s, m.t_end_s).fit;
-                f[10] = fit.parameters.upper_rate_n_per_m;
-                f[11] = fit.parameters.upper_offset_n;
-                f[12] = fit.parameters.lower_rate_n_per_m;
-                f[13] = fit.parameters.lower_offset_n;
-                f[14] = fit.parameters.beta_m;
-                f[15] = fit.rms_error_relative;
-            } catch (const InputError& e) {
-                note = std::string("no Fancher fit: ") + e.what();
-            }
-        } catch (const InputError& e) {
-            note = e.what();
-        }
-    } else {
-        note = "no periodic loading: no steady cycle";
+    note = loop.note;
+    if (const auto& m = loop.metrics) {
+        f[0] = m->loop_area_j;
+        f[1] = m->dissipated_j;
+        f[2] = m->secant_stiffness_n_per_m;
+        f[3] = m->dynamic_rate_n_per_m;
+        f[4] = m->loss_factor;
+        f[5] = m->equivalent_damping_ratio;
+        f[6] = m->force_min_n;
+        f[7] = m->force_max_n;
+        f[8] = m->w_min_m;
+        f[9] = m->w_max_m;
     }
-    // the largest |energy balance error| over the run, as simulate's summary (balance_error_max_abs)
+    if (const auto& fit = loop.fancher) {
+        f[10] = fit->parameters.upper_rate_n_per_m;
+        f[11] = fit->parameters.upper_offset_n;
+        f[12] = fit->parameters.lower_rate_n_per_m;
+        f[13] = fit->parameters.lower_offset_n;
+        f[14] = fit->parameters.beta_m;
+        f[15] = fit->rms_error_relative;
+    } else if (!loop.fancher_note.empty()) {
+        note = "no Fancher fit: " + loop.fancher_note;
+    }
+    f[16] = records > 0 ? max_abs_balance_j : nan;
+    return f;
+}
+
+}  // namespace
+
+std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
+                                  std::string& note) {
+    // the loop figures of simulate's summary, from the same function (run/loop_figures.hpp)
     double balance = 0.0;
     for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
-    f[16] = records.empty() ? nan : balance;
-    return f;
+    return figures_of(loop_figures(records, options.loading.period_s()), static_cast<long>(records.size()), balance,
+                      note);
 }
 
 PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
@@ -578,18 +578,17 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     std::vector<StepRecord> records;
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
     try {
-        // as `stackbeam simulate --scenario` (apps/cli/main.cpp): build, system, contact path, simulate
+        // the library's run, as `stackbeam simulate --scenario` (run/run.hpp): build, system, run
         const Model model = Model::build(point.scenario.model);
         const System system(model);
-        choose_contact_path(system, point.scenario.simulation);
-        auto on_step = [&](const StepRecord&) {
-            if (stop && stop->load(std::memory_order_relaxed)) throw SweepStopped();
-        };
-        // the stop flag also inside an output interval (mode cvode polls it every 64 steps)
-        SimulationOptions options = point.scenario.simulation;
-        if (stop) options.stop_requested = [stop] { return stop->load(std::memory_order_relaxed); };
-        records = simulate(system, options, on_step);
-        result.figures = point_figures(records, point.scenario.simulation, result.message);
+        RunRequest run;
+        run.options = point.scenario.simulation;
+        // the stop flag before each record and inside an output interval (mode cvode polls it every 64 steps)
+        if (stop) run.stop = [stop] { return stop->load(std::memory_order_relaxed); };
+        RunSummary summary = run_scenario(system, run);
+        if (summary.interrupted) throw SweepStopped();
+        records = std::move(summary.records);
+        result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
         result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +
@@ -599,8 +598,6 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         result.message = e.what();
     } catch (const SweepStopped&) {
         throw;
-    } catch (const RunStopped&) {  // the stop flag seen inside an output interval
-        throw SweepStopped();
     } catch (const std::exception& e) {  // any other failure of this run (e.g. out of memory)
         result.status = PointStatus::failed;
         result.message = e.what();

@@ -24,16 +24,16 @@
 #include <thread>
 #include <vector>
 
-#include "run.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/model/paper_example.hpp"
+#include "stackbeam/run/run.hpp"
+#include "stackbeam/run/summary_json.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
 #include "stackbeam/time/option_table.hpp"
 #include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/stepper.hpp"
-#include "summary.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -122,15 +122,12 @@ struct OptionsView {
     std::string prefix;  ///< "" or "cvode." etc.
 };
 
-/// `text` as one of `words`; InputError naming `field` with the allowed words otherwise.
+/// `text` as a word of E's table (stackbeam/words.hpp); InputError naming `field` with the
+/// allowed words otherwise.
 template <class E>
-E parse_word(const std::string& text, const std::string& field, const std::vector<std::pair<const char*, E>>& words) {
-    std::string allowed;
-    for (const auto& [w, e] : words) {
-        if (text == w) return e;
-        allowed += (allowed.empty() ? "'" : ", '") + std::string(w) + "'";
-    }
-    throw InputError(field, "value '" + text + "' is not allowed: must be one of " + allowed);
+E parse_word(const std::string& text, const std::string& field) {
+    if (const auto value = find_word<E>(text)) return *value;
+    throw InputError(field, "value '" + text + "' is not allowed: must be one of " + word_list<E>("'"));
 }
 
 // --- Python values checked (checks.cpp) ------------------------------------------------------

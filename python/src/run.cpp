@@ -62,64 +62,54 @@ private:
     PyObject* traceback_ = nullptr;
 };
 
+/// The pairs and nodes of a run, kept as the --pairs and --nodes columns (the run layer's sink).
+struct TableSink : RunSink {
+    PairTable pairs;
+    NodeTable nodes;
+    void on_pairs(double t_s, const std::vector<PairRecord>& prs) override { pairs.add(t_s, prs); }
+    void on_nodes(double t_s, const std::vector<LeafNodes>& leaves) override { nodes.add(t_s, leaves); }
+};
+
 /// simulate(scenario, options, pairs) -> dict(columns, pairs, events, report, summary):
-/// the run of the command line (same records, same JSON summary), the GIL released while it steps.
+/// the library's run (run_scenario, as the command line: same records, same JSON summary), the
+/// GIL released while it steps.
 py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, const py::object& pairs_arg, const py::object& nodes_arg) {
-    const bool want_pairs = bool_arg(pairs_arg, "pairs"), want_nodes = bool_arg(nodes_arg, "nodes");
+    RunRequest request;
+    request.outputs.pairs = bool_arg(pairs_arg, "pairs");
+    request.outputs.nodes = bool_arg(nodes_arg, "nodes");
     // the run's own copy: another thread may change the scenario while this one runs without the GIL
     const auto copy = std::make_shared<PyScenario>(*scenario_arg(scenario, "scenario"));
     copy->synced();
     const std::shared_ptr<const PyScenario> ps = copy;
     SignalPoll signals;  // Ctrl-C: KeyboardInterrupt within about 20 ms of the stop check's polls
-    SimulationOptions options = options_with(*ps, overrides);
-    options.stop_requested = signals.stop_check();
-    const Model model = build_checked(*ps, options);
-    const auto t0 = std::chrono::steady_clock::now();
-    cli::RunResult result;
-    PairTable pairs;
-    NodeTable nodes;
+    request.options = options_with(*ps, overrides);
+    request.stop = signals.stop_check();
+    request.setup = ps->setup;
+    const Model model = build_checked(*ps, request.options);
+    TableSink tables;
+    request.sink = &tables;
+    RunSummary summary;
     std::chrono::steady_clock::time_point released, reacquired;  // the stepping without the GIL
-    bool stopped = false;
     {
         py::gil_scoped_release release;
         released = std::chrono::steady_clock::now();
         const System system(model);
-        try {
-            in_scenario(*ps, [&] {
-            choose_contact_path(system, options);  // as the command line: a path the solver cannot take
-            PairObserver on_pairs;
-            if (want_pairs) on_pairs = [&](double t, const std::vector<PairRecord>& prs) { pairs.add(t, prs); };
-            NodeObserver on_nodes;
-            if (want_nodes) on_nodes = [&](double t, const std::vector<LeafNodes>& leaves) { nodes.add(t, leaves); };
-            result.records = simulate(system, options, [&](const StepRecord& r) { result.stats.add(r); }, &result.report,
-                                      on_pairs, on_nodes);
-            return 0;
-            });
-        } catch (const RunStopped&) {  // the stop check saw a signal: its exception below, with the GIL
-            stopped = true;
-        }
+        summary = in_scenario(*ps, [&] { return run_scenario(system, request); });
         reacquired = std::chrono::steady_clock::now();
     }
-    if (stopped) signals.raise_pending();
-    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-    cli::RunRequest request;
-    request.spec = ps->scenario.model;
-    request.options = options;
-    request.setup = ps->setup;
-    const cli::LoopFigures loop = cli::loop_figures(request, result);
+    if (summary.interrupted) signals.raise_pending();  // the stop check saw a signal: its exception
 
     py::dict out;
-    out["columns"] = records_dict(result.records);
-    out["pairs"] = want_pairs ? py::object(pairs.to_dict()) : py::object(py::none());
-    out["nodes"] = want_nodes ? py::object(nodes.to_dict()) : py::object(py::none());
-    out["events"] = options.mode == Mode::cvode ? py::object(events_dict(result.report.events)) : py::object(py::none());
-    py::dict report = report_dict(result.report);
+    out["columns"] = records_dict(summary.records);
+    out["pairs"] = request.outputs.pairs ? py::object(tables.pairs.to_dict()) : py::object(py::none());
+    out["nodes"] = request.outputs.nodes ? py::object(tables.nodes.to_dict()) : py::object(py::none());
+    out["events"] = summary.stepper.cvode_stats ? py::object(events_dict(summary.report.events)) : py::object(py::none());
+    py::dict report = report_dict(summary.report);
     // when the run held no GIL, on the clock of Python's time.monotonic() (CLOCK_MONOTONIC, as steady_clock)
     report["without_gil_s"] = py::make_tuple(std::chrono::duration<double>(released.time_since_epoch()).count(),
                                             std::chrono::duration<double>(reacquired.time_since_epoch()).count());
     out["report"] = report;
-    out["summary"] = cli::json_summary(request, model, result, loop);
+    out["summary"] = summary_json(summary, model);
     return out;
 }
 /// A stepper for co-simulation: the model, the options and the mode's Stepper, one record at a time.
@@ -135,7 +125,8 @@ public:
           options_(with_stop_check(options_with(*ps_, overrides), *signals_)),
           system_(std::make_unique<System>(build_checked(*ps_, options_))),
           stepper_(in_scenario(*ps_, [&] { return make_stepper(*system_, options_); })),
-          n_(static_cast<long>(std::ceil(options_.t_end_s / options_.dt_s - 1e-9))) {}
+          n_(static_cast<long>(std::ceil(options_.t_end_s / options_.dt_s - 1e-9))),
+          cvode_stats_(describe_stepper(*system_, options_).cvode_stats) {}
 
     py::dict advance() {
         Busy busy(busy_, "advance");
@@ -185,7 +176,7 @@ public:
         idle("report");
         const RunReport r = stepper_->report();
         py::dict d = report_dict(r);
-        if (r.mode == Mode::cvode) d["event_log"] = events_dict(r.events);
+        if (cvode_stats_) d["event_log"] = events_dict(r.events);
         return d;
     }
 
@@ -216,6 +207,7 @@ private:
     std::unique_ptr<System> system_;
     std::unique_ptr<Stepper> stepper_;
     long n_;
+    bool cvode_stats_;  ///< the stepper keeps an event log (its registry row)
     std::atomic<bool> busy_{false};
 };
 

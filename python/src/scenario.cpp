@@ -6,31 +6,12 @@ namespace stackbeam_py {
 
 namespace {
 
-const std::vector<std::pair<const char*, SupportKind>> kSupports = {
-    {"free", SupportKind::free},       {"pinned", SupportKind::pinned},   {"fixed", SupportKind::fixed},
-    {"hinged", SupportKind::hinged},   {"shackle", SupportKind::shackle}, {"bushing", SupportKind::bushing}};
-const std::vector<std::pair<const char*, LoadingKind>> kLoadingKinds = {
-    {"initial-conditions", LoadingKind::initial_conditions},
-    {"applied-force", LoadingKind::applied_force},
-    {"prescribed-displacement", LoadingKind::prescribed_displacement},
-    {"base-excitation", LoadingKind::base_excitation}};
-const std::vector<std::pair<const char*, TimeFunction::Shape>> kShapes = {{"constant", TimeFunction::Shape::constant},
-                                                                          {"harmonic", TimeFunction::Shape::harmonic},
-                                                                          {"triangle", TimeFunction::Shape::triangle},
-                                                                          {"table", TimeFunction::Shape::table}};
-
-
-/// A string property for an enum member, parsed by `words`, the field named `name`.
+/// A string property for an enum member, by the enum's word table (words.hpp), the field named `name`.
 template <class Cls, class C, class E>
-void enum_property(Cls& cls, const char* name, E C::*member, const std::vector<std::pair<const char*, E>>& words) {
+void enum_property(Cls& cls, const char* name, E C::*member) {
     cls.def_property(
-        name,
-        [member, words](const C& c) {
-            for (const auto& [w, e] : words)
-                if (e == c.*member) return std::string(w);
-            return std::string("?");
-        },
-        [member, words, name](C& c, const py::object& text) { c.*member = parse_word(string_arg(text, name), name, words); });
+        name, [member](const C& c) { return std::string(word_of(c.*member)); },
+        [member, name](C& c, const py::object& text) { c.*member = parse_word<E>(string_arg(text, name), name); });
 }
 
 }  // namespace
@@ -119,7 +100,7 @@ ScenarioPtr make_scenario(Scenario s, std::string setup) { return std::make_shar
 
 /// The command line's summary line for a scenario file.
 std::string file_setup(const Scenario& s) {
-    return "scenario " + s.source + (s.description.empty() ? "" : " (" + s.description + ")") + "\n";
+    return scenario_setup(s.source, s.description);
 }
 void bind_scenario(py::module_& m) {
     // --- the model's entries: attributes named as the scenario file's keys
@@ -149,18 +130,21 @@ void bind_scenario(py::module_& m) {
         .def_property("right_end", getter(&LeafSpec::right_end), setter(&LeafSpec::right_end, "Leaf.right_end"))
         .def_property("free_camber_m", getter(&LeafSpec::free_camber_m), setter(&LeafSpec::free_camber_m, "Leaf.free_camber_m"))
         .def_property("free_radius_m", getter(&LeafSpec::free_radius_m), setter(&LeafSpec::free_radius_m, "Leaf.free_radius_m"));
-    enum_property(leaf, "left_support", &LeafSpec::left_support, kSupports);
-    enum_property(leaf, "right_support", &LeafSpec::right_support, kSupports);
+    enum_property(leaf, "left_support", &LeafSpec::left_support);
+    enum_property(leaf, "right_support", &LeafSpec::right_support);
 
     py::class_<InterfaceSpec, std::shared_ptr<InterfaceSpec>> interface(m, "Interface", "[[interfaces]]: between leaves i and i+1");
     interface.def(py::init<>())
         .def_property(
-            "law", [](const InterfaceSpec& f) { return std::string(f.law == InterfaceLaw::bonded ? "bonded" : "coulomb"); },
+            "law",
+            [](const InterfaceSpec& f) {
+                return std::string(word_of(f.law == InterfaceLaw::bonded ? InterfaceLawWord::bonded : InterfaceLawWord::coulomb));
+            },
             [](InterfaceSpec& f, const py::object& text) {
                 // 'frictionless' as in the file: coulomb with mu = 0
-                const int law = parse_word<int>(string_arg(text, "Interface.law"), "law", {{"coulomb", 0}, {"frictionless", 1}, {"bonded", 2}});
-                f.law = law == 2 ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
-                if (law != 0) f.friction_coefficient = 0.0;
+                const auto law = parse_word<InterfaceLawWord>(string_arg(text, "Interface.law"), "law");
+                f.law = law == InterfaceLawWord::bonded ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
+                if (law != InterfaceLawWord::coulomb) f.friction_coefficient = 0.0;
             })
         .def_property("friction_coefficient", getter(&InterfaceSpec::friction_coefficient), setter(&InterfaceSpec::friction_coefficient, "Interface.friction_coefficient"))
         .def_property("initial_gap_m", getter(&InterfaceSpec::initial_gap_m), setter(&InterfaceSpec::initial_gap_m, "Interface.initial_gap_m"))
@@ -203,7 +187,7 @@ void bind_scenario(py::module_& m) {
         .def_property("phase_rad", getter(&TimeFunction::phase_rad), setter(&TimeFunction::phase_rad, "TimeFunction.phase_rad"))
         .def_property("times_s", getter(&TimeFunction::times_s), setter(&TimeFunction::times_s, "TimeFunction.times_s"))
         .def_property("values", getter(&TimeFunction::values), setter(&TimeFunction::values, "TimeFunction.values"));
-    enum_property(tf, "shape", &TimeFunction::shape, kShapes);
+    enum_property(tf, "shape", &TimeFunction::shape);
 
     py::bind_vector<Shared<LeafSpec>>(m, "LeafList");
     py::bind_vector<Shared<InterfaceSpec>>(m, "InterfaceList");
@@ -214,7 +198,7 @@ void bind_scenario(py::module_& m) {
         .def_property(
             "kind", [](const LoadingView& v) { return std::string(to_string(v.s->scenario.simulation.loading.kind)); },
             [](LoadingView& v, const py::object& text) {
-                v.s->scenario.simulation.loading.kind = parse_word(string_arg(text, "loading.kind"), "loading.kind", kLoadingKinds);
+                v.s->scenario.simulation.loading.kind = parse_word<LoadingKind>(string_arg(text, "loading.kind"), "loading.kind");
             })
         .def_property(
             "initial_displacement_m", [](const LoadingView& v) { return v.s->scenario.model.rigid_body.initial_displacement_m; },
@@ -251,9 +235,9 @@ void bind_scenario(py::module_& m) {
                 v.s->scenario.model.mesh.element_length_m = real_arg(x, "mesh.element_length_m");
             })
         .def_property(
-            "symmetry", [](const MeshView& v) { return std::string(v.s->scenario.model.symmetry == Symmetry::half ? "half" : "full"); },
+            "symmetry", [](const MeshView& v) { return std::string(word_of(v.s->scenario.model.symmetry)); },
             [](MeshView& v, const py::object& text) {
-                v.s->scenario.model.symmetry = parse_word<Symmetry>(string_arg(text, "mesh.symmetry"), "mesh.symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}});
+                v.s->scenario.model.symmetry = parse_word<Symmetry>(string_arg(text, "mesh.symmetry"), "mesh.symmetry");
             });
 
     const auto ref = py::return_value_policy::reference_internal;
@@ -342,10 +326,8 @@ void bind_scenario(py::module_& m) {
             s.source = std::string("paper_example(") + to_string(c) + ")";
             s.description = std::string("the paper's ") + to_string(c) + " case (Lee & Lim 1992, section 5)";
             s.model = paper_example(c, o);
-            // as `stackbeam simulate --case NAME` writes it
-            const std::string setup = std::string("case ") + to_string(c) + ", " + std::to_string(o.elements_per_half_leaf) +
-                                      " elements per half leaf (" + (full_model ? "full" : "half") + " model), ";
-            return make_scenario(s, setup);
+            // the summary line of `stackbeam simulate --case NAME` (case_setup)
+            return make_scenario(s, case_setup(c, o));
         },
         "case"_a, "elements_per_half_leaf"_a = PaperExampleOptions{}.elements_per_half_leaf, "full_model"_a = false);
 

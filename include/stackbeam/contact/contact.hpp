@@ -65,6 +65,8 @@ enum class SolverKind {
     exact,        ///< active-set direct solver, factorisation reused while the modes stay (default)
     block_jacobi, ///< eq. 17 with E = per-pair 2x2 block inverse of W, applied to all pairs at once
 };
+template <>
+const std::vector<EnumWord<SolverKind>>& enum_words<SolverKind>();
 const char* to_string(SolverKind kind);
 /// Parses "paper" | "accelerated" | "block-jacobi" | "exact"; throws InputError naming `field`.
 SolverKind parse_solver_kind(const std::string& text, const std::string& field);

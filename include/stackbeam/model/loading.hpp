@@ -43,6 +43,8 @@
 #include <string>
 #include <vector>
 
+#include "stackbeam/words.hpp"
+
 namespace stackbeam {
 
 /// Samples of a function of time supplied by the caller while the run goes: the seat
@@ -104,6 +106,8 @@ struct TimeFunction {
     std::shared_ptr<const ExternalSamples> external;
 };
 
+template <>
+const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>();
 const char* to_string(TimeFunction::Shape shape);
 
 enum class LoadingKind {
@@ -112,6 +116,8 @@ enum class LoadingKind {
     prescribed_displacement,  ///< w(t) imposed on R: the test-rig loop
     base_excitation,          ///< the supports move by y_b(t) (plus the initial conditions)
 };
+template <>
+const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>();
 const char* to_string(LoadingKind kind);
 
 struct Loading {

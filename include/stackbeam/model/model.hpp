@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stackbeam/contact/pair.hpp"  // PairKind: the contact layer is below the model
+#include "stackbeam/words.hpp"
 
 namespace stackbeam {
 
@@ -283,6 +284,14 @@ bool has_free_camber(const ModelSpec& spec);
 /// free camber, a rebound clip or an interference (an interface's initial_gap_m < 0).
 bool needs_assembly(const ModelSpec& spec);
 
+template <>
+const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>();
+template <>
+const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>();
+template <>
+const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>();
+template <>
+const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>();
 const char* to_string(SupportKind kind);
 const char* to_string(InterfaceContact contact);
 /// Parses "rigid" | "elastic"; throws InputError naming `field`.

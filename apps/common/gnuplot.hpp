@@ -1,13 +1,13 @@
 #pragma once
-// Small helpers of the demos and the command line for running gnuplot (the figures
-// are drawn by gnuplot from the CSV files; nothing here is part of the library).
+// Small helpers of the command line (apps/cli) and the demos (demos/) for running gnuplot: the
+// figures are drawn by gnuplot from the CSV files; nothing here is part of the library.
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <sstream>
 #include <string>
 
-namespace stackbeam::demo {
+namespace stackbeam::gnuplot {
 
 /// Single-quoted for /bin/sh.
 inline std::string shell_quote(const std::string& s) {
@@ -41,4 +41,4 @@ inline std::optional<std::string> png_terminal() {
     return std::nullopt;
 }
 
-}  // namespace stackbeam::demo
+}  // namespace stackbeam::gnuplot
