@@ -364,7 +364,8 @@ CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
     es.compliance = W;
     // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual compliance (its
     // entries are far smaller than C''s: most of the leaves' flexibility is in the retained modes)
-    es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * W.diagonal().maxCoeff();
+    // (a stack without contact rows, a single leaf, has no events: any positive tolerance)
+    es.event_tolerance_m = W.size() > 0 ? 1e-9 * es.scales.F_ref_n * W.diagonal().maxCoeff() : 1e-12;
     // the gap witnesses' margin: kMotionMargin, or ten times the decisions' displacement
     // resolution if that is coarser (a gap the contact iteration cannot see closing must not count as closed)
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
