@@ -311,9 +311,9 @@ void soak_seed(unsigned seed, const std::string& only_row = "") {
             o.dt_s = row.mode == Mode::cvode ? T / 20.0 : T / (row.massive_leaves ? 200.0 : 100.0);
             // the elastic layer's forces ~ k_n A x: its approach resolved to 1e-9 m (test_stepper_contract)
             if (elastic) o.solver.tolerance_m = 1e-9;
-            // A healthy run takes a few hundred to a few thousand CVODE steps a period here (the
-            // measured most: see the decision note); a stall creeps ~1e-12 s a step. The budget,
-            // 20,000 steps a period, a healthy run never nears but a stall reaches in seconds.
+            // A healthy run takes 170-180 CVODE steps a period here (measured on seeds 1-6; 430 on
+            // base_friction at 20x); a stall creeps ~1e-12 s a step. The budget, 20,000 steps a
+            // period (~100x), a healthy run never nears but a stall reaches in seconds.
             o.cvode.max_steps = static_cast<long>(20000.0 * o.t_end_s / T);
             o = options_for(row, o);
             // The whole massive stack resolves the elastic layer's own vibrations (~1e5 Hz: k_n
