@@ -396,6 +396,7 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
     es.stiff_max_order = 2;  // BDF order <= 2, Newton on newton_setup / newton_solve (file comment)
     es.events = this;  // contact events (ContactEventHooks)
+    es.pair_chatter_limit = true;  // its contact points vibrate on the layer (kMaxPairSwitches)
     this->start(start, es);
 }
 

@@ -177,6 +177,7 @@ void EventDriver::start(const InitialState& stage, const EventStart& s) {
     ev_ = s.events;
     scales_ = s.scales;
     gap_margin_ = s.gap_margin;
+    pair_chatter_limit_ = s.pair_chatter_limit;
     stats_.retained_modes = s.retained_modes;
     stats_.modal_cutoff_rad_per_s = s.modal_cutoff_rad_per_s;
     init_grid();  // as the closed-form mode's steps
@@ -445,6 +446,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         e.w_m = w;
         e.w_dot_m_per_s = wd;
         events_.push_back(std::move(e));
+        if (cause != "start" && pair_chatter_limit_) note_pair_switch(kk, te);
     }
     enter(rel, nm, tm);
     if (!decided) rebuild();
@@ -546,6 +548,24 @@ void EventDriver::note_event_time(double te) {
         events_at_this_time_ = 0;
     }
     ++stats_.events;
+}
+
+void EventDriver::note_pair_switch(int kk, double te) {
+    if (switch_times_.empty()) switch_times_.resize(static_cast<std::size_t>(np_));
+    std::deque<double>& times = switch_times_[static_cast<std::size_t>(kk)];
+    times.push_back(te);
+    if (static_cast<int>(times.size()) > kMaxPairSwitches) times.pop_front();
+    constexpr double kTwoPi = 6.283185307179586;
+    const double window = kChatterPeriods * kTwoPi / scales_.omega_rad_per_s;
+    if (static_cast<int>(times.size()) < kMaxPairSwitches || te - times.front() > window) return;
+    const ContactEvent& e = events_.back();
+    throw SolverError(who_ + ": pair " + std::to_string(kk) + " (interface " + std::to_string(e.interface_index) +
+                          ", x = " + format_value(e.x_m) + " m) changed modes " + std::to_string(kMaxPairSwitches) +
+                          " times within " + format_value(te - times.front()) + " s (a thousandth of the stack's period is " +
+                          format_value(window) + " s) up to t = " + format_value(te) + " s, the last " + e.from + " -> " +
+                          e.to + ": the contact chatters (a contact point vibrating on the elastic layer, each switch a "
+                          "restart); leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
+                      stats_.steps, te, 0.0);
 }
 
 /// The per-step check of an accepted step at state y; true when the modes hold there.
