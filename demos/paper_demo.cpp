@@ -181,9 +181,9 @@ std::string csv_name(PaperCase c, Mode m, const std::string& suffix = "") {
 
 // --- gnuplot -----------------------------------------------------------------------
 
-using stackbeam::demo::gnuplot_on_path;
-using stackbeam::demo::png_terminal;
-using stackbeam::demo::shell_quote;
+using stackbeam::gnuplot::gnuplot_on_path;
+using stackbeam::gnuplot::png_terminal;
+using stackbeam::gnuplot::shell_quote;
 
 /// A gnuplot script drawing the figures from the CSV files in the same directory,
 /// both modes overlaid (closed-form solid, cvode dashed).

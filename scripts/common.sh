@@ -2,8 +2,9 @@
 # packages the project needs, if missing, and configures and builds it in build/.
 
 # The packages every build needs (pkgconf: the test of the installed stackbeam.pc; ninja-build:
-# the builds' generator, generator_args below).
-STACKBEAM_BUILD_PACKAGES=(build-essential cmake ninja-build pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev)
+# the builds' generator, generator_args below; libceres-dev: stackbeam fit's bounded least squares,
+# docs/decisions/059-calibration.md; libzip-dev: the FMU archive, fmu/ and docs/fmu.md).
+STACKBEAM_BUILD_PACKAGES=(build-essential cmake ninja-build pkgconf libsundials-dev libeigen3-dev libsuitesparse-dev libboost-test-dev libcli11-dev libtoml11-dev nlohmann-json3-dev libceres-dev libzip-dev)
 # OpenMPI: `mpirun -n N stackbeam sweep` (optional: without it the sweep runs on threads only;
 # the tests then skip the MPI comparison).
 STACKBEAM_MPI_PACKAGES=(libopenmpi-dev openmpi-bin)

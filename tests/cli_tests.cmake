@@ -279,7 +279,7 @@ stackbeam_cli_test(NAME cli_scenario_override_by_flag
                    OUT ${_cli_out_dir}/cli_x_cli_scenario_override_by_flag.csv)
 stackbeam_cli_test(NAME cli_scenario_missing_file
                    ARGS simulate --scenario ${_cli_out_dir}/no_such_scenario.toml --out ${_cli_out_dir}/cli_x_cli_scenario_missing_file.csv
-                   EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: cannot open the scenario file" OUT ${_cli_out_dir}/cli_x_cli_scenario_missing_file.csv)
+                   EXPECT_RC 2 EXPECT_TEXT "no_such_scenario.toml: the scenario file" OUT ${_cli_out_dir}/cli_x_cli_scenario_missing_file.csv)
 stackbeam_cli_test(NAME cli_neither_case_nor_scenario
                    ARGS simulate --out ${_cli_out_dir}/cli_x_cli_neither_case_nor_scenario.csv
                    EXPECT_RC 2 EXPECT_TEXT "--case or --scenario: one of them is required" OUT ${_cli_out_dir}/cli_x_cli_neither_case_nor_scenario.csv)

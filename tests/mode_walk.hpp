@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "contact/sparse/mode_solver.hpp"
-#include "contact/sparse/sparse_path.hpp"
+#include "contact/sparse/linear/mode_solver.hpp"
+#include "contact/sparse/driver/sparse_path.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "test_support.hpp"

@@ -10,6 +10,10 @@
 #                                                        SIGINT), resumed: the full table, no point
 #                                                        twice; SIGINT stops cleanly; another spec's
 #                                                        directory refused; --restart
+#   sweep_cli_test.sh <stackbeam> <work dir> owner      issue 41: a second sweep on a directory in use
+#                                                        refused naming the holder (also with --restart);
+#                                                        resume after kill -9; a FIFO scenario and
+#                                                        --out DIR refused at once
 # "The same table": every column but the last (wall_time_s), compared as text (floats are
 # printed in the fewest digits that read back exactly, so equal text is equal doubles). No wall-clock threshold anywhere.
 set -u
@@ -99,18 +103,18 @@ resume)
     rc=$?
     [ $rc = 130 ] || fail "--stop-after 3: exit status $rc, expected 130 (as SIGINT)"
     grep -q "run the same command again to resume" "$dir/stop.err" || fail "no resume advice on stderr"
-    [ "$(($(wc -l < "$out/finished.csv") - 1))" = 3 ] || fail "finished.csv has not 3 rows after --stop-after 3"
+    [ "$(($(wc -l < "$out/finished.csv") - 2))" = 3 ] || fail "finished.csv has not 3 rows after --stop-after 3"
     # a cut last row (a crash while writing) is dropped on resume, its point runs again
     printf '7,0.02,2,0.5,ok,,0.0' >> "$out/finished.csv"
     "$cli" sweep "$spec" --out-dir "$out" --jobs 2 --no-plot > "$dir/resume.out" || fail "resume: exit status $?"
     grep -q "resuming .* 3 of 8 points finished" "$dir/resume.out" || fail "the resume does not say 3 of 8 finished"
     diff <(table "$ref") <(table "$out") || fail "the resumed table differs from an uninterrupted run's"
     # none twice: the journal has each point once (3 before the stop + 5 after)
-    [ "$(tail -n +2 "$out/finished.csv" | cut -d, -f1 | sort -n | uniq -d | wc -l)" = 0 ] || fail "a point ran twice"
-    [ "$(tail -n +2 "$out/finished.csv" | wc -l)" = 8 ] || fail "finished.csv has not 8 rows"
+    [ "$(tail -n +3 "$out/finished.csv" | cut -d, -f1 | sort -n | uniq -d | wc -l)" = 0 ] || fail "a point ran twice"
+    [ "$(tail -n +3 "$out/finished.csv" | wc -l)" = 8 ] || fail "finished.csv has not 8 rows"
     # a finished sweep run again runs nothing and writes the same table
     "$cli" sweep "$spec" --out-dir "$out" --no-plot >/dev/null || fail "rerun of a finished sweep: exit status $?"
-    [ "$(tail -n +2 "$out/finished.csv" | wc -l)" = 8 ] || fail "a rerun of a finished sweep ran points again"
+    [ "$(tail -n +3 "$out/finished.csv" | wc -l)" = 8 ] || fail "a rerun of a finished sweep ran points again"
     # another spec in the same directory: refused, the difference named; --restart starts over
     other=$dir/other_spec.toml
     sed 's/values = \[0.3, 0.5\]/values = [0.3, 0.4]/' "$spec" | sed "s|\"rig_small.toml\"|\"$src/sweep/rig_small.toml\"|" > "$other"
@@ -120,14 +124,14 @@ resume)
     grep -q 'axes\[2\] (interfaces\[\*\].friction_coefficient) had values \["0.3","0.5"\]' "$dir/other.err" ||
         fail "the refusal does not name the difference: $(cat "$dir/other.err")"
     "$cli" sweep "$other" --out-dir "$out" --no-plot --restart --jobs 2 >/dev/null || fail "--restart: exit status $?"
-    [ "$(tail -n +2 "$out/finished.csv" | wc -l)" = 8 ] || fail "--restart did not start over"
+    [ "$(tail -n +3 "$out/finished.csv" | wc -l)" = 8 ] || fail "--restart did not start over"
     # SIGINT: stops cleanly (130), the points finished so far kept, advice given
     slow=$src/sweep/slow_map.toml
     rm -rf "$dir/sigint" "$dir/sigint_ref"
     "$cli" sweep "$slow" --out-dir "$dir/sigint" --jobs 2 --no-plot 2>"$dir/sigint.err" &
     pid=$!
     for ((k = 0; k < 2400; ++k)); do  # until a first row is on disk (at most 120 s)
-        [ -f "$dir/sigint/finished.csv" ] && [ "$(wc -l < "$dir/sigint/finished.csv")" -ge 2 ] && break
+        [ -f "$dir/sigint/finished.csv" ] && [ "$(wc -l < "$dir/sigint/finished.csv")" -ge 3 ] && break
         sleep 0.05
     done
     kill -s INT $pid
@@ -138,10 +142,10 @@ resume)
     else
         [ $rc = 130 ] || fail "SIGINT: exit status $rc, expected 130"
         grep -q "run the same command again to resume" "$dir/sigint.err" || fail "SIGINT: no resume advice"
-        done=$(($(wc -l < "$dir/sigint/finished.csv") - 1))
+        done=$(($(wc -l < "$dir/sigint/finished.csv") - 2))
         [ $done -lt 40 ] || fail "SIGINT: every point finished, yet the exit status is $rc"
         "$cli" sweep "$slow" --out-dir "$dir/sigint" --no-plot >/dev/null || fail "resume after SIGINT: exit status $?"
-        [ "$(tail -n +2 "$dir/sigint/finished.csv" | cut -d, -f1 | sort -n | uniq -d | wc -l)" = 0 ] ||
+        [ "$(tail -n +3 "$dir/sigint/finished.csv" | cut -d, -f1 | sort -n | uniq -d | wc -l)" = 0 ] ||
             fail "a point ran twice after SIGINT"
         "$cli" sweep "$slow" --out-dir "$dir/sigint_ref" --no-plot >/dev/null || fail "reference of the slow map: exit status $?"
         diff <(table "$dir/sigint_ref") <(table "$dir/sigint") || fail "the table resumed after SIGINT differs"
@@ -161,6 +165,46 @@ failed)
     grep -q '^1,exact,ok,' "$out/points.csv" || fail "point 1 did not run to the end"
     grep -q '"failed": 1' "$out/sweep.json" || fail "sweep.json does not count 1 failed"
     echo "one point failed, the other ran"
+    ;;
+owner)
+    # two sweeps on one directory: the second is refused (exit 2) naming the holder, with or
+    # without --restart, and the holder's results are untouched
+    slow=$src/sweep/slow_map.toml out=$dir/owner
+    rm -rf "$out" "$dir/owner_ref"
+    "$cli" sweep "$slow" --out-dir "$out" --jobs 1 --no-plot >/dev/null 2>&1 &
+    pid=$!
+    for ((k = 0; k < 2400; ++k)); do  # until the holder has written its name and a first row
+        [ -f "$out/finished.csv" ] && [ "$(wc -l < "$out/finished.csv")" -ge 3 ] && break
+        sleep 0.05
+    done
+    for restart in "" --restart; do
+        "$cli" sweep "$spec" --out-dir "$out" --no-plot $restart 2>"$dir/owner.err"
+        rc=$?
+        [ $rc = 2 ] || fail "a second sweep ${restart:+($restart) }on a directory in use: exit status $rc, expected 2"
+        grep -q "is in use by another sweep (pid $pid on .*, spec $slow)" "$dir/owner.err" ||
+            fail "the refusal does not name the holder: $(cat "$dir/owner.err")"
+    done
+    grep -q "^# stackbeam sweep journal: spec [0-9a-f]\{16\} ($slow)" "$out/finished.csv" ||
+        fail "the holder's journal was touched: $(head -1 "$out/finished.csv")"
+    # the lock dies with its holder, even by SIGKILL: the same command resumes
+    kill -s KILL $pid
+    wait $pid 2>/dev/null
+    "$cli" sweep "$slow" --out-dir "$out" --jobs 2 --no-plot >"$dir/owner.out" 2>&1 || fail "resume after kill -9: exit status $?"
+    "$cli" sweep "$slow" --out-dir "$dir/owner_ref" --jobs 2 --no-plot >/dev/null || fail "reference: exit status $?"
+    diff <(table "$dir/owner_ref") <(table "$out") || fail "the table resumed after kill -9 differs"
+    # inputs refused at once by name: a FIFO (no writer: reading it would block for ever), a directory as --out
+    rm -f "$dir/fifo.toml"
+    mkfifo "$dir/fifo.toml" || fail "mkfifo"
+    "$cli" simulate --scenario "$dir/fifo.toml" --out "$dir/fifo.csv" 2>"$dir/fifo.err"
+    rc=$?
+    [ $rc = 2 ] || fail "a FIFO as scenario: exit status $rc, expected 2"
+    grep -q "is a FIFO (named pipe): a regular file is required" "$dir/fifo.err" || fail "FIFO: $(cat "$dir/fifo.err")"
+    "$cli" simulate --scenario "$src/sweep/rig_small.toml" --out "$dir" 2>"$dir/outdir.err"
+    rc=$?
+    [ $rc = 2 ] || fail "--out DIR: exit status $rc, expected 2"
+    grep -q -- "--out: value '$dir' is a directory: give a file name" "$dir/outdir.err" || fail "--out DIR: $(cat "$dir/outdir.err")"
+    [ ! -e "$dir.partial" ] || fail "--out DIR left $dir.partial (the run started)"
+    echo "one owner per directory; resumed after kill -9; a FIFO and --out DIR refused"
     ;;
 *) fail "unknown test '$what'" ;;
 esac

@@ -4,12 +4,14 @@
 #include <boost/test/unit_test.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "stackbeam/time/cvode_stepper.hpp"
 #include "stackbeam/errors.hpp"
 #include "test_support.hpp"
-#include "time/cvode/cvode_testing.hpp"
+#include "time/cvode/cvode_massless.hpp"
+#include "time/initial_state.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -37,13 +39,14 @@ Run run_cvode(PaperCase c, double t_end_s, double rtol, bool root_finding = true
         r.records = simulate(s, o, {}, &r.report);
         return r;
     }
-    detail::CvodeTesting testing;  // the per-step check alone (lib/time/cvode/cvode_testing.hpp)
-    testing.root_finding = false;
-    const detail::ScopedCvodeTesting scope(testing);
-    CvodeStepper st(s, o);
-    r.records.push_back(st.current());
-    while (st.record_index() < st.num_outputs()) r.records.push_back(st.advance());
-    r.report = st.report();
+    o.validate();
+    detail::InitialState start = detail::initial_state("cvode-massless", s, o);
+    start.root_finding = false;  // the per-step check alone (a test-only field of the set-up stage)
+    const std::unique_ptr<Stepper> st = CvodeStepperAccess::build(s, start);
+    const long n = std::lround(o.t_end_s / o.dt_s);
+    r.records.push_back(st->current());
+    while (st->record_index() < n) r.records.push_back(st->advance());
+    r.report = st->report();
     return r;
 }
 
@@ -317,4 +320,82 @@ BOOST_AUTO_TEST_CASE(a_cvode_failure_is_reported_with_time_and_steps) {
         BOOST_TEST(e.time_s() < 0.5);
         BOOST_TEST(std::string(e.what()).find("max_steps") != std::string::npos);
     }
+}
+
+namespace {
+/// Half the peak-to-peak of w over the records with t in [t0, t1) [m]: the amplitude envelope.
+double envelope_m(const std::vector<StepRecord>& r, double t0, double t1) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& x : r)
+        if (x.t_s >= t0 && x.t_s < t1) {
+            lo = std::min(lo, x.w_m);
+            hi = std::max(hi, x.w_m);
+        }
+    BOOST_REQUIRE(hi >= lo);
+    return 0.5 * (hi - lo);
+}
+
+/// The paper's friction case in mode cvode with the default (exact) solver, run to t_end with a
+/// step budget: a healthy run takes ~4,200 CVODE steps per simulated second here (127k to 30 s).
+Run run_friction_cvode_to(double t_end_s, long max_steps) {
+    const System s(Model::build(paper_example(PaperCase::friction)));
+    SimulationOptions o;
+    o.mode = Mode::cvode;
+    o.t_end_s = t_end_s;
+    o.cvode.max_steps = max_steps;
+    Run r;
+    r.records = simulate(s, o, {}, &r.report);
+    return r;
+}
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(friction_case_passes_the_small_amplitude_turning_points) {
+    // The run that stalled (issue 41): at t = 21.962 s, a turning point at ~0.05 mm amplitude, the
+    // look-ahead decided a slip reversal (slip- -> slip+) on a pair with a small normal force, whose
+    // force jump put a sticking pair's force past its cone by 1.4e-8 F_ref at the event's state; a
+    // restart there failed the next step's check at once and the run crept by 2e-12 s per restart
+    // until cvode.max_steps (10^7, 340 s of wall time). A missed event's modes are now settled at its
+    // state (docs/decisions/056). Budget: 3x a healthy run's steps, so a stall fails in seconds.
+    const Run r = run_friction_cvode_to(22.5, 300000);
+    BOOST_TEST(r.records.back().t_s == 22.5, tt::tolerance(1e-12));
+    BOOST_TEST(r.report.cvode.missed_events > 0);  // the settling path ran
+    // The energy balance closes as in the short runs (energy_balance_closes_to_within_rtol: the
+    // integrated dissipation's error ~ rtol x 40 J x the number of restarts' worth): 1e-4 J of 40 J.
+    double worst = 0.0;
+    for (const auto& x : r.records) worst = std::max(worst, std::abs(x.energy_balance_error_j));
+    BOOST_TEST(worst < 1e-4);
+    // Coulomb friction decays the amplitude: later windows are smaller.
+    BOOST_TEST(envelope_m(r.records, 21.0, 22.0) < 0.5 * envelope_m(r.records, 11.0, 12.0));
+}
+
+BOOST_AUTO_TEST_CASE(friction_case_comes_to_rest_as_the_closed_form_mode, *boost::unit_test::label("slow")) {
+    // 60 s under cvode against the closed-form mode at dt = 0.25 ms (its time error falls as dt^2:
+    // the amplitude envelope differs from cvode by 4 % at dt = 1 ms at t = 20 s, so by ~0.25 % at
+    // 0.25 ms; measured 0.06-0.3 % from 1 s to 30 s) with a contact tolerance of 1e-10 m. (The
+    // default 2e-6 m is the paper's, chosen for dt = 1 ms: at dt = 0.1 ms the per-step slip
+    // increments at this amplitude are below it and the run sticks at 1.1e-4 m amplitude from 20 s
+    // on instead of coming to rest; docs/decisions/056.) Tolerance 1 % on the envelope of every
+    // 1 s window up to 30 s: 4x the closed-form's expected dt^2 error. At rest (t >= 40 s) both
+    // keep a residual elastic oscillation on the stuck stack of ~8.5e-8 m (0.008 % of the first
+    // second's amplitude): within 5 % of each other (measured 1.7 %; its value is the last slip's
+    // remainder, sensitive to the time error of the closed-form mode).
+    const Run cv = run_friction_cvode_to(60.0, 1000000);
+    const System s(Model::build(paper_example(PaperCase::friction)));
+    SimulationOptions o;
+    o.t_end_s = 60.0;
+    o.dt_s = 2.5e-4;
+    o.solver.tolerance_m = 1e-10;
+    const std::vector<StepRecord> cf = simulate(s, o);
+    for (double t0 : {1.0, 5.0, 10.0, 15.0, 20.0, 25.0, 29.0})
+        BOOST_TEST(envelope_m(cv.records, t0, t0 + 1.0) == envelope_m(cf, t0, t0 + 1.0), tt::tolerance(0.01));
+    const double rest_cv = envelope_m(cv.records, 40.0, 60.0), rest_cf = envelope_m(cf, 40.0, 60.0);
+    BOOST_TEST(rest_cv < 1e-4 * envelope_m(cv.records, 1.0, 2.0));
+    BOOST_TEST(rest_cv == rest_cf, tt::tolerance(0.05));
+    // No slip at rest, and the dissipated energy agrees to the closed-form's time error (1.9e-3 J at
+    // dt = 1 ms, so ~1.2e-4 J at 0.25 ms; measured 9.5e-5 J): 3e-4 J.
+    BOOST_TEST(cv.records.back().dissipated_energy_j == cv.records[40000].dissipated_energy_j, tt::tolerance(1e-9));
+    BOOST_TEST(std::abs(cv.records.back().dissipated_energy_j - cf.back().dissipated_energy_j) < 3e-4);
+    double worst = 0.0;
+    for (const auto& x : cv.records) worst = std::max(worst, std::abs(x.energy_balance_error_j));
+    BOOST_TEST(worst < 1e-4);
 }

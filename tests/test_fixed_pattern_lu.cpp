@@ -1,4 +1,4 @@
-// The fixed-pattern LU of the sparse path's large held sets (lib/contact/sparse/fixed_saddle.cpp,
+// The fixed-pattern LU of the sparse path's large held sets (lib/contact/sparse/linear/fixed_pattern_lu.cpp,
 // docs/decisions/031 and 035), checked against the sparse LU of each set's own saddle-point
 // system ordered from scratch over long random sequences of mode changes on a stack with
 // slipping pairs and broad contact (tests/mode_walk.hpp).
@@ -10,7 +10,7 @@
 using namespace stackbeam;
 using namespace stackbeam::testing::mode_walk;
 
-// ---- The fixed-pattern LU (lib/contact/sparse/fixed_saddle.cpp, docs/decisions/031): held
+// ---- The fixed-pattern LU (lib/contact/sparse/linear/fixed_pattern_lu.cpp, docs/decisions/031): held
 // sets above the Schur way's limit factorised on one pattern holding every contact row (a
 // row not held an identity row, its G entries explicit zeros), ordered once per (K, G),
 // one numeric factorisation per set. Against the sparse LU of each set's own saddle-point

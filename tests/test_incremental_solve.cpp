@@ -1,4 +1,4 @@
-// The sparse path's incremental solve of a set of modes (lib/contact/sparse/mode_solver.cpp,
+// The sparse path's incremental solve of a set of modes (lib/contact/sparse/linear/mode_solver.cpp,
 // ModeSolverTuning::schur_updates): the Schur complement of a new held set copied from the
 // base's where it stays and the base's dense LU updated by the changed rows and columns
 // (slip couplings included), z by one solve with K's factor. Checked against the same
@@ -98,7 +98,7 @@ BOOST_AUTO_TEST_CASE(incremental_solve_does_not_drift_over_ten_thousand_updates,
     BOOST_TEST(worst < 1.0);
 }
 
-// ---- The primal route (lib/contact/sparse/primal_solver.cpp): large held sets of elastic
+// ---- The primal route (lib/contact/sparse/linear/primal_cholmod.cpp): large held sets of elastic
 // interface rows, K_zz + G_S^T C^-1 G_S factorised by CHOLMOD once, then rank-k
 // cholmod_updown as rows enter and leave the held set; slip coupling by GMRES
 // preconditioned by the symmetric factor; rigid clamp rows as multipliers.

@@ -1,5 +1,5 @@
 // The parametric (homotopy) active-set transition of the sparse path, behind
-// Switches::path_following (lib/contact/sparse/path_following.cpp, docs/decisions/040): it
+// SparsePathMethods::path_following (lib/contact/sparse/transitions/path_following.cpp, docs/decisions/040): it
 // follows the solution from the previous step's problem to this step's along the straight
 // line between their data, its modes confirmed by the active-set passes. Its answers must be
 // the default method's: both are the exact solver's solution of the same problem (the passes
@@ -14,9 +14,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "contact/sparse/switches.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/switches.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "test_support.hpp"
 
 using namespace stackbeam;
@@ -33,11 +33,14 @@ struct Replay {
     int unconverged = 0;
 };
 
-/// Solves `problems` in order with one solver constructed under `sw`, each warm-started
-/// from its own previous forces as in a run.
-Replay replay(const std::vector<SparseContactProblem>& problems, const SolverOptions& options, const sp::Switches& sw) {
-    const sp::ScopedSwitches scoped(sw);
-    SparseContactSolver solver(options);
+/// Solves `problems` in order with one solver constructed with the methods `sw` (and the
+/// observer `trace`, if any), each warm-started from its own previous forces as in a run.
+Replay replay(const std::vector<SparseContactProblem>& problems, const SolverOptions& options,
+              const SparsePathMethods& sw, SparsePathObserver* trace = nullptr) {
+    SparsePathTuning tuning;
+    tuning.methods = sw;
+    tuning.observer = trace;
+    SparseContactSolver solver(options, tuning);
     Replay out;
     Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
     for (const auto& pr : problems) {
@@ -101,8 +104,8 @@ struct Agreement {
 };
 
 /// The switches of the homotopy before decision 042's repairs.
-sp::Switches before_042() {
-    sp::Switches sw;
+SparsePathMethods before_042() {
+    SparsePathMethods sw;
     sw.path_clamp_slip = false;
     sw.path_max_pair_switches = 6;
     sw.path_fold_ends = true;
@@ -118,13 +121,12 @@ BOOST_AUTO_TEST_CASE(homotopy_transitions_give_the_default_answers) {
     // elastic interfaces with the derived layer, 2 m/s from rest)
     const auto problems = sparse_step_problems(with_elastic_interfaces(graduated_stack(50, 6)), 60);
     const SolverOptions options;
-    sp::Switches newton;  // the Newton methods after the pass from the previous modes, without the homotopy
+    SparsePathMethods newton;  // the Newton methods after the pass from the previous modes, without the homotopy
     newton.path_following = 0;
     const Replay def = replay(problems, options, newton);
     sp::TransitionTrace trace;
-    sp::Switches sw;  // the default: the homotopy after the pass, then (where it fails) the Newton methods
-    sw.trace = &trace;
-    const Replay hom = replay(problems, options, sw);
+    SparsePathMethods sw;  // the default: the homotopy after the pass, then (where it fails) the Newton methods
+    const Replay hom = replay(problems, options, sw, &trace);
     BOOST_TEST(def.unconverged == 0);
     BOOST_TEST(hom.unconverged == 0);
     const PathRuns path(trace);
@@ -144,7 +146,7 @@ BOOST_AUTO_TEST_CASE(homotopy_transitions_give_the_default_answers) {
 }
 
 BOOST_AUTO_TEST_CASE(repaired_homotopy_settles_where_it_fell_back) {
-    // Decision 042's repairs of the homotopy (Switches::path_clamp_slip, path_max_pair_switches,
+    // Decision 042's repairs of the homotopy (SparsePathMethods::path_clamp_slip, path_max_pair_switches,
     // path_fold_ends), on two problem sequences where the homotopy of decision 040 fell back to
     // the Newton methods (measured: graduated 10 x 50, 100 steps: 5 of 62 runs, 4 ends not
     // confirmed after a clamp stuck at once on taking friction again, 1 pair switching 7 times;
@@ -156,15 +158,13 @@ BOOST_AUTO_TEST_CASE(repaired_homotopy_settles_where_it_fell_back) {
     const double accept_m = 1e-3 * options.tolerance_m;
     for (const int leaves : {10, 6}) {
         const auto problems = sparse_step_problems(with_elastic_interfaces(graduated_stack(50, leaves)), 100);
-        sp::Switches newton;
+        SparsePathMethods newton;
         newton.path_following = 0;
         const Replay def = replay(problems, options, newton);
         sp::TransitionTrace before_trace, trace;
-        sp::Switches before = before_042(), sw;
-        before.trace = &before_trace;
-        sw.trace = &trace;
-        const Replay old = replay(problems, options, before);
-        const Replay hom = replay(problems, options, sw);
+        SparsePathMethods before = before_042(), sw;
+        const Replay old = replay(problems, options, before, &before_trace);
+        const Replay hom = replay(problems, options, sw, &trace);
         const PathRuns path_before(before_trace), path(trace);
         const Agreement ag(problems, def, hom), ag_before(problems, def, old);
         BOOST_TEST_MESSAGE(leaves << " leaves: before 042 " << path_before.settled << " of " << path_before.runs
@@ -191,7 +191,7 @@ BOOST_AUTO_TEST_CASE(repaired_homotopy_settles_where_it_fell_back) {
 }
 
 BOOST_AUTO_TEST_CASE(kept_base_solves_are_the_from_scratch_solves) {
-    // Decision 045 (Switches::path_keep_base): the confirming passes of the homotopy's end modes
+    // Decision 045 (SparsePathMethods::path_keep_base): the confirming passes of the homotopy's end modes
     // and the next step's first pass solve a set of modes near the path's base on the base's
     // factorisation and its columns (the bordered form, refined against the set's own system)
     // instead of factorising it. Over a run's real steps (graduated 6 x 50, 60 steps), every such
@@ -207,16 +207,15 @@ BOOST_AUTO_TEST_CASE(kept_base_solves_are_the_from_scratch_solves) {
     // the Newton methods' as for the homotopy without it (Agreement), and the kept base must be used.
     const auto problems = sparse_step_problems(with_elastic_interfaces(graduated_stack(50, 6)), 60);
     const SolverOptions options;
-    sp::Switches newton;
+    SparsePathMethods newton;
     newton.path_following = 0;
     const Replay def = replay(problems, options, newton);
     sp::TransitionTrace trace;
     trace.check_kept = true;
-    sp::Switches sw;
+    SparsePathMethods sw;
     sw.path_keep_base = 1;  // (the default keeps it from 10,000 unknowns on: this stack has fewer)
-    sw.trace = &trace;
-    const Replay kept = replay(problems, options, sw);
-    sp::Switches off;
+    const Replay kept = replay(problems, options, sw, &trace);
+    SparsePathMethods off;
     off.path_keep_base = 0;
     const Replay before = replay(problems, options, off);
     const Agreement ag(problems, def, kept), ag_off(problems, before, kept);

@@ -1,5 +1,5 @@
 // The sparse path's step from rest by the homotopy from a covering start
-// (Switches::rest_path_violations, lib/contact/sparse/covering_start.cpp and
+// (SparsePathMethods::rest_path_violations, lib/contact/sparse/transitions/covering_start.cpp and
 // SparseContactSolver::Impl::rest_transition; docs/decisions/041): the semismooth Newton method
 // from rest hands its iterate over once few laws are violated; that iterate's modes M0 are made
 // valid by moving the step's data (b, d) -> (b0, d0), and path_following takes the solution from
@@ -11,10 +11,10 @@
 #include <random>
 #include <vector>
 
-#include "contact/sparse/common.hpp"
-#include "contact/sparse/switches.hpp"
-#include "contact/sparse/trace.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/driver/common.hpp"
+#include "contact/sparse/driver/switches.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "test_support.hpp"
 
 using namespace stackbeam;
@@ -38,7 +38,7 @@ BOOST_AUTO_TEST_CASE(covering_start_makes_any_modes_a_solution_of_the_moved_data
     layered.d = problems.front().d;
     layered.pairs = problems.front().pairs;
     const SolverOptions options;
-    sp::SparsePath path(options, sp::ModeSolverTuning{}, sp::Switches{});
+    sp::SparsePath path(options, sp::ModeSolverTuning{}, SparsePathMethods{});
     path.reset(layered);
     const int np = static_cast<int>(layered.pairs.size());
     const int m = layered.size();
@@ -108,11 +108,10 @@ BOOST_AUTO_TEST_CASE(a_step_from_rest_gives_the_answer_of_the_way_before) {
     const SparseContactProblem& pr = problems.front();
     const SolverOptions options;
     auto solve = [&](int violations, sp::TransitionTrace* trace, SolveResult& r) {
-        sp::Switches sw;
-        sw.rest_path_violations = violations;
-        sw.trace = trace;
-        const sp::ScopedSwitches scoped(sw);
-        SparseContactSolver solver(options);
+        SparsePathTuning tuning;
+        tuning.methods.rest_path_violations = violations;
+        tuning.observer = trace;
+        SparseContactSolver solver(options, tuning);
         Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
         r = solver.solve(pr, p, z);
         return p;
@@ -120,7 +119,7 @@ BOOST_AUTO_TEST_CASE(a_step_from_rest_gives_the_answer_of_the_way_before) {
     SolveResult before, after;
     const Eigen::VectorXd p_before = solve(0, nullptr, before);
     sp::TransitionTrace trace;
-    const Eigen::VectorXd p_after = solve(sp::Switches{}.rest_path_violations, &trace, after);
+    const Eigen::VectorXd p_after = solve(SparsePathMethods{}.rest_path_violations, &trace, after);
     BOOST_TEST(before.converged);
     BOOST_TEST(after.converged);
     BOOST_REQUIRE(trace.steps.size() == 1u);
@@ -148,7 +147,7 @@ BOOST_AUTO_TEST_CASE(a_step_from_rest_gives_the_answer_of_the_way_before) {
 }
 
 BOOST_AUTO_TEST_CASE(the_first_solve_from_rest_takes_no_pass_from_the_rest_modes) {
-    // Switches::rest_first_pass (docs/decisions/046): the run's first solve from rest goes to the
+    // SparsePathMethods::rest_first_pass (docs/decisions/046): the run's first solve from rest goes to the
     // Newton methods without the active-set pass from the rest modes (every pair closed and
     // sticking, every contact row held: the run's largest factorisation), whose solution no
     // Newton method starts from (from rest the semismooth method starts from the open modes'
@@ -164,11 +163,10 @@ BOOST_AUTO_TEST_CASE(the_first_solve_from_rest_takes_no_pass_from_the_rest_modes
     const SparseContactProblem& pr = problems.front();
     const SolverOptions options;
     auto solve = [&](bool first_pass, sp::TransitionTrace& trace, SolveResult& r, SolveResult* again) {
-        sp::Switches sw;
-        sw.rest_first_pass = first_pass;
-        sw.trace = &trace;
-        const sp::ScopedSwitches scoped(sw);
-        SparseContactSolver solver(options);
+        SparsePathTuning tuning;
+        tuning.methods.rest_first_pass = first_pass;
+        tuning.observer = &trace;
+        SparseContactSolver solver(options, tuning);
         Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
         r = solver.solve(pr, p, z);
         if (again) {

@@ -16,7 +16,7 @@
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/fe/system.hpp"
-#include "contact/sparse/switches.hpp"
+#include "contact/sparse/driver/switches.hpp"
 #include "fe/system_internal.hpp"
 #include "test_support.hpp"
 
@@ -234,7 +234,7 @@ BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
 
 BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
     // The sparse path's diagonal of W = G K^-1 G^T (selected inverse of K without the
-    // rigid body's DOFs plus a rank-h correction for them, contact/sparse/sparse_solver.cpp) against the
+    // rigid body's DOFs plus a rank-h correction for them, contact/sparse/driver/sparse_solver.cpp) against the
     // dense W of to_dense() (m full solves). Both are exact up to round-off: the entries
     // are sums of a few products of O(1) coefficients with entries of K^-1 whose relative
     // error is about cond(K) x 1e-16 (cond ~ 1e8-1e10 here: EA/L against EI/L^3 and the
@@ -277,7 +277,7 @@ BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
     check(five);
 }
 
-/// The answers of one SparseContactSolver (made with `tuning`, under `switches`) to
+/// The answers of one SparseContactSolver (made with `tuning` and the methods `methods`) to
 /// `problems` in order, each solve from the last answer (as the stepper does), with its counts;
 /// checks that every solve converged (error vector below the tolerance: the exact solver's answer).
 struct Replay {
@@ -286,8 +286,8 @@ struct Replay {
     Eigen::VectorXd w;               ///< W's diagonal [m/N] at the end
 };
 Replay replay_sparse(const std::vector<SparseContactProblem>& problems, const SolverOptions& options,
-                     const SparsePathTuning& tuning = {}, const detail::sparse::Switches& switches = {}) {
-    const detail::sparse::ScopedSwitches scoped(switches);
+                     SparsePathTuning tuning = {}, const SparsePathMethods& methods = {}) {
+    tuning.methods = methods;
     SparseContactSolver solver(options, tuning);
     Replay out;
     Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
@@ -412,7 +412,7 @@ BOOST_AUTO_TEST_CASE(sparse_equals_dense_on_a_finer_stack) {
 namespace {
 
 /// Replays the sparse problems of `steps` closed-form steps of `spec` (recorded from a
-/// sparse run) with the semismooth Newton method alone (detail::sparse::Switches::newton_first:
+/// sparse run) with the semismooth Newton method alone (SparsePathMethods::newton_first:
 /// every solve starts with it from the previous forces, the passes only confirm its
 /// modes) and with the dense exact solver on to_dense(), each warm-started from its own
 /// previous forces, and compares the forces step by step. Also checks the contact
@@ -425,12 +425,11 @@ void newton_equals_dense(const ModelSpec& spec, int steps, double rel,
     SimulationOptions so;
     so.solver.tolerance_m = kTol;
     const std::vector<SparseContactProblem> problems = testing::sparse_step_problems(spec, steps, so);
-    detail::sparse::Switches switches;
-    switches.newton_first = true;
-    switches.transition = method;
-    if (tresca) switches.box_qp = detail::sparse::BoxQpMethod::interior_point;
-    const detail::sparse::ScopedSwitches scoped(switches);
-    SparseContactSolver newton(so.solver);
+    SparsePathTuning tuning;
+    tuning.methods.newton_first = true;
+    tuning.methods.transition = method;
+    if (tresca) tuning.methods.box_qp = SparseBoxQpMethod::interior_point;
+    SparseContactSolver newton(so.solver, tuning);
     const auto dense_solver = make_solver(so.solver);
     Eigen::VectorXd pn = Eigen::VectorXd::Zero(problems.front().size()), pd = pn, z;
     double scale = 0.0, diff = 0.0, worst_natural = 0.0;
@@ -555,10 +554,9 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack, *boo
         problems.push_back(st.last_sparse_problem());
         reference.push_back(st.contact_forces());
     }
-    detail::sparse::Switches tresca;
-    tresca.transition = TransitionMethod::tresca;
-    const detail::sparse::ScopedSwitches scoped(tresca);
-    SparseContactSolver solver(so.solver);
+    SparsePathTuning tresca;
+    tresca.methods.transition = TransitionMethod::tresca;
+    SparseContactSolver solver(so.solver, tresca);
     BOOST_TEST(so.solver.tresca_anderson_depth > 0);
     Eigen::VectorXd p = Eigen::VectorXd::Zero(problems.front().size()), z;
     double scale = 0.0, diff = 0.0, worst_natural = 0.0;
@@ -620,7 +618,7 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
         st.advance();
         problems.push_back(st.last_sparse_problem());
     }
-    detail::sparse::Switches tresca;
+    SparsePathMethods tresca;
     tresca.transition = TransitionMethod::tresca;
     const Replay ra = replay_sparse(problems, so.solver);
     const Replay rt = replay_sparse(problems, so.solver, {}, tresca);
@@ -644,8 +642,8 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
 BOOST_AUTO_TEST_CASE(transition_method_of_decision_037_keeps_the_answers) {
     // The transition steps' method of decision 037 (one active-set pass before the semismooth
     // Newton method, the first pass's start without an extrapolation, the creep limit, the
-    // nonmonotone line search; detail::sparse::Switches' defaults) against the way before
-    // (Switches::before_037) on the same problems: a graduated 10-leaf spring, 100 elements per
+    // nonmonotone line search; SparsePathMethods' defaults) against the way before
+    // (SparsePathMethods::before_037) on the same problems: a graduated 10-leaf spring, 100 elements per
     // half leaf, elastic interfaces, the first 30 steps from rest at 2 m/s (the first step a
     // transition of most pairs, later ones of tens). Both confirm their final modes by the
     // active-set passes, so both answers are the exact solver's: error vector below the
@@ -669,7 +667,7 @@ BOOST_AUTO_TEST_CASE(transition_method_of_decision_037_keeps_the_answers) {
         problems.push_back(st.last_sparse_problem());
     }
     const Replay ra = replay_sparse(problems, so.solver);
-    const Replay rb = replay_sparse(problems, so.solver, {}, detail::sparse::Switches::before_037());
+    const Replay rb = replay_sparse(problems, so.solver, {}, SparsePathMethods::before_037());
     const auto &a = ra.p, &b = rb.p;
     const Eigen::VectorXd& w = ra.w;  // W's diagonal [m/N] (the same for every problem: one K and G)
     const int n_now = ra.newton, n_before = rb.newton;

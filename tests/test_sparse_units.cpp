@@ -15,13 +15,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "contact/box_qp.hpp"
-#include "contact/sparse/box_qp_methods.hpp"
-#include "contact/sparse/selected_inverse.hpp"
-#include "contact/sparse/transitions.hpp"
+#include "contact/sparse/qp/box_qp_methods.hpp"
+#include "contact/sparse/linear/selected_inverse.hpp"
+#include "contact/sparse/driver/trace.hpp"
+#include "contact/sparse/transitions/transitions.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
@@ -376,18 +378,34 @@ BOOST_AUTO_TEST_CASE(each_transition_method_alone_equals_the_dense_exact_solver)
     }
 }
 
-BOOST_AUTO_TEST_CASE(switches_are_scoped) {
-    // The test-only switches: a solver takes those live at its construction; the previous
-    // ones come back at the end of the scope.
-    BOOST_TEST(static_cast<int>(sp::current_switches().transition) == static_cast<int>(sp::TransitionMethod::newton));
-    {
-        sp::Switches sw;
-        sw.transition = sp::TransitionMethod::tresca;
-        sw.newton_first = true;
-        const sp::ScopedSwitches scoped(sw);
-        BOOST_TEST(static_cast<int>(sp::current_switches().transition) == static_cast<int>(sp::TransitionMethod::tresca));
-        BOOST_TEST(sp::current_switches().newton_first);
+BOOST_AUTO_TEST_CASE(methods_are_per_solver) {
+    // The methods are a solver's own (SparsePathTuning::methods, taken at its construction): two
+    // solvers made one after the other on one thread keep theirs, and the observer goes with them.
+    // A bad field is an InputError naming it.
+    const SolverOptions options;
+    SparsePathMethods tresca;
+    tresca.transition = sp::TransitionMethod::tresca;
+    tresca.newton_first = true;
+    SparsePathObserver trace;
+    const sp::SparsePath a(options, sp::ModeSolverTuning{}, tresca, &trace);
+    const sp::SparsePath b(options, sp::ModeSolverTuning{}, SparsePathMethods{});
+    BOOST_TEST(static_cast<int>(a.switches.transition) == static_cast<int>(sp::TransitionMethod::tresca));
+    BOOST_TEST(a.switches.newton_first);
+    BOOST_TEST(a.observer == &trace);
+    BOOST_TEST(static_cast<int>(b.switches.transition) == static_cast<int>(sp::TransitionMethod::newton));
+    BOOST_TEST(!b.switches.newton_first);
+    BOOST_TEST(b.observer == nullptr);
+    for (const int fixed : {-1, 5}) {
+        SparsePathTuning bad;
+        bad.methods.fixed_pattern = fixed;
+        try {
+            SparseContactSolver solver(options, bad);
+            BOOST_TEST(false, "fixed_pattern " << fixed << " accepted");
+        } catch (const InputError& e) {
+            BOOST_TEST(std::string(e.what()).find("tuning.methods.fixed_pattern") != std::string::npos);
+        }
     }
-    BOOST_TEST(static_cast<int>(sp::current_switches().transition) == static_cast<int>(sp::TransitionMethod::newton));
-    BOOST_TEST(!sp::current_switches().newton_first);
+    SparsePathTuning bad;
+    bad.methods.newton_passes = -1;
+    BOOST_CHECK_THROW(SparseContactSolver(options, bad), InputError);
 }

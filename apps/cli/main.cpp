@@ -36,6 +36,7 @@
 #include <sstream>
 #include <string>
 
+#include "fmu.hpp"
 #include "options.hpp"
 #include "plot.hpp"
 #include "run.hpp"
@@ -43,12 +44,13 @@
 #include "stackbeam/model/model.hpp"
 #include "summary.hpp"
 #include "sweep.hpp"
+#include "fit.hpp"
 
 namespace {
 
 using namespace stackbeam::cli;
 
-int run_request(const RunRequest& request) {
+int run_request(const SimulateRequest& request) {
     const stackbeam::Model model = stackbeam::Model::build(request.spec);
     const stackbeam::System system(model);
     if (const std::string advice = stackbeam::friction_mesh_advice(model); !advice.empty())
@@ -56,12 +58,11 @@ int run_request(const RunRequest& request) {
     stackbeam::choose_contact_path(system, request.options);  // throws for a path the solver cannot take
     install_interrupt_handlers();
     const RunResult result = run(request, system);
-    const LoopFigures loop = loop_figures(request, result);
     if (result.signal == 0) {
-        print_summary(request, system, result, loop);
+        print_summary(request, system, result);
         if (!request.plot.empty()) {
             std::string note;
-            const auto files = plot_run(request.out, request.plot, note, loop.fancher_loop);
+            const auto files = plot_run(request.out, request.plot, note, result.summary.loop.fancher_loop);
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
             if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)
@@ -72,7 +73,7 @@ int run_request(const RunRequest& request) {
         }
     }
     if (!request.summary.empty()) {
-        write_json_summary(request, model, result, loop);
+        write_json_summary(request, model, result);
         if (result.signal == 0) std::printf("summary                    %s\n", request.summary.c_str());
     }
     return result.signal != 0 ? 128 + result.signal : exit_ok;
@@ -80,7 +81,7 @@ int run_request(const RunRequest& request) {
 
 
 int run_simulate(const SimulateArgs& args) {
-    const RunRequest request = make_request(args);  // every argument checked before any work
+    const SimulateRequest request = make_request(args);  // every argument checked before any work
     try {
         return run_request(request);
     } catch (const stackbeam::InputError& e) {
@@ -137,6 +138,13 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
                   "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
     add_sweep_options(*sweep, sweep_args);
 
+    FitArgs fit_args;
+    CLI::App* fit = app.add_subcommand("fit", "Fit scenario keys (friction, interface stiffness, preload, ...) to measured "
+                                              "force-displacement loops (docs/calibration.md)");
+    add_fit_options(*fit, fit_args);
+    FmuArgs fmu_args;
+    CLI::App* fmu = add_fmu_command(app, fmu_args);  // `stackbeam fmu SCENARIO.toml --out spring.fmu` (fmu.hpp)
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -159,6 +167,8 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
     try {
         if (sim->parsed()) return run_simulate(args);
         if (sweep->parsed()) return run_sweep_command(sweep_args, world);
+        if (fit->parsed()) return run_fit_command(fit_args);
+        if (fmu->parsed()) return run_fmu_command(fmu_args);
         return exit_other;
     } catch (const ArgumentError& e) {
         return fail(exit_input, e.what());

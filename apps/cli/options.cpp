@@ -1,19 +1,43 @@
 // `stackbeam simulate`'s arguments -> ModelSpec + SimulationOptions + output files.
 #include "options.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/io/scenario.hpp"
+#include "stackbeam/run/run.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/option_table.hpp"
 
 namespace stackbeam::cli {
 
 namespace {
+
+/// Refuses an output file that cannot be written, before any run: a directory, or a file
+/// in a folder that does not exist or cannot be written (the system's reason). `name`: the
+/// flag, or the scenario key that gave the path.
+void check_output_file(const std::string& name, const std::string& path) {
+    if (path.empty()) return;
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+        throw ArgumentError(name + ": value '" + path + "' is a directory: give a file name");
+    const auto cut = path.find_last_of('/');
+    const std::string folder = cut == std::string::npos ? "." : cut == 0 ? "/" : path.substr(0, cut);
+    if (::stat(folder.c_str(), &st) != 0)
+        throw ArgumentError(name + ": value '" + path + "': its folder '" + folder + "' cannot be used: " +
+                            std::strerror(errno));
+    if (!S_ISDIR(st.st_mode))
+        throw ArgumentError(name + ": value '" + path + "': '" + folder + "' is not a directory");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw ArgumentError(name + ": value '" + path + "': cannot write in '" + folder + "': " + std::strerror(errno));
+}
 
 /// Parses all of `text` as a number for `spec` given as `flag`, or throws naming the flag,
 /// the text as written and what the option table allows.
@@ -172,8 +196,8 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
 }
 
-RunRequest make_request(const SimulateArgs& a) {
-    RunRequest r;
+SimulateRequest make_request(const SimulateArgs& a) {
+    SimulateRequest r;
     r.out = a.out;
     r.events = a.events;
     r.summary = a.summary;
@@ -203,7 +227,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         apply_interface(contact, r.spec);
-        r.setup = "scenario " + a.scenario + (scenario.description.empty() ? "" : " (" + scenario.description + ")") + "\n";
+        r.setup = scenario_setup(a.scenario, scenario.description);
     } else {
         if (a.case_name.empty()) throw ArgumentError("--case or --scenario: one of them is required");
         const PaperCase pcase = parse_paper_case(a.case_name, "--case");
@@ -216,8 +240,7 @@ RunRequest make_request(const SimulateArgs& a) {
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         apply_interface(contact, r.spec);
-        r.setup = std::string("case ") + to_string(pcase) + ", " + std::to_string(example.elements_per_half_leaf) +
-                  " elements per half leaf (" + (a.full_model ? "full" : "half") + " model), ";
+        r.setup = case_setup(pcase, example);
     }
     if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
         throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "
@@ -234,6 +257,15 @@ RunRequest make_request(const SimulateArgs& a) {
                 throw ArgumentError(what + ": value '" + r.nodes + "' is also the " + other +
                                     " file: give the nodal displacements a file of their own");
     }
+    // every output checked before the run: a bad path is found in a moment, not after the simulation
+    auto name = [&](const std::string& flag, const std::string& given, const char* key) {
+        return given.empty() && !a.scenario.empty() ? std::string("outputs.") + key + " (file " + a.scenario + ")" : flag;
+    };
+    check_output_file(name("--out", a.out, "csv_path"), r.out);
+    check_output_file(name("--events", a.events, "events_path"), r.events);
+    check_output_file(name("--summary", a.summary, "summary_path"), r.summary);
+    check_output_file(name("--pairs", a.pairs, "pairs_path"), r.pairs);
+    check_output_file(name("--nodes", a.nodes, "nodes_path"), r.nodes);
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }

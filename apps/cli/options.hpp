@@ -46,7 +46,7 @@ struct SimulateArgs {
 void add_simulate_options(CLI::App& sim, SimulateArgs& args);
 
 /// One run, ready to go: everything checked.
-struct RunRequest {
+struct SimulateRequest {
     ModelSpec spec;
     SimulationOptions options;
     std::string out, events, summary, pairs, nodes, plot;  ///< files ("" = none); out is required
@@ -57,6 +57,6 @@ struct RunRequest {
 
 /// Reads the arguments (and the scenario file): throws ArgumentError naming the flag,
 /// or InputError naming the scenario's key, line and column, before any work.
-RunRequest make_request(const SimulateArgs& args);
+SimulateRequest make_request(const SimulateArgs& args);
 
 }  // namespace stackbeam::cli

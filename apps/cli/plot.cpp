@@ -1,4 +1,4 @@
-// --plot: PNG figures of a run with gnuplot (demos/gnuplot.hpp) from its CSV.
+// --plot: PNG figures of a run with gnuplot (apps/common/gnuplot.hpp) from its CSV.
 #include "plot.hpp"
 
 #include <algorithm>
@@ -30,7 +30,7 @@ int column_of(const std::string& name) {
 }  // namespace
 
 std::optional<std::string> plot_terminal(std::string& note) {
-    using namespace stackbeam::demo;
+    using namespace stackbeam::gnuplot;
     if (!gnuplot_on_path()) {
         note = "gnuplot is not on PATH: no figures (install gnuplot-nox)";
         return std::nullopt;
@@ -42,7 +42,7 @@ std::optional<std::string> plot_terminal(std::string& note) {
 
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
                                   const std::vector<std::pair<double, double>>& fitted_loop) {
-    using namespace stackbeam::demo;
+    using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
     const std::string script_path = prefix + "_figures.gp";
@@ -120,7 +120,7 @@ double drawn_axis_m(const LeafNodes& leaf, double height_m, double scale, double
 
 std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
                                     std::string& note) {
-    using namespace stackbeam::demo;
+    using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
     const Model& model = system.model();

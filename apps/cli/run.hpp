@@ -11,26 +11,17 @@
 /// (the library hands it over at the end of a run). The --summary is written, marked
 /// "interrupted", with the time reached and the energies of the last whole record.
 /// The exit status is then 128 + the signal: 130 (SIGINT), 143 (SIGTERM).
+///
+/// The run itself is the library's (stackbeam/run/run.hpp, run_scenario); this file is its
+/// sink: the rows to the files, the progress line, the stack at the extreme deflections.
 #include <string>
 #include <vector>
 
 #include "options.hpp"
 #include "stackbeam/fe/system.hpp"
-#include "stackbeam/time/cvode_stepper.hpp"
+#include "stackbeam/run/run.hpp"
 
 namespace stackbeam::cli {
-
-/// What the summary needs of the records, gathered one record at a time (also
-/// complete for an interrupted run, whose records the library never returns).
-struct RunStats {
-    StepRecord first, last;
-    long records = 0;
-    long contact_iterations = 0;  ///< sum over the records
-    int max_contact_iterations = 0;
-    double max_abs_balance_j = 0.0;
-    double w_min_m = 0.0, w_max_m = 0.0, force_min_n = 0.0, force_max_n = 0.0;
-    void add(const StepRecord& r);
-};
 
 /// The stack at one record: every leaf's nodes and every pair (the deformed stack figure).
 struct StackSnapshot {
@@ -40,11 +31,8 @@ struct StackSnapshot {
 };
 
 struct RunResult {
-    RunStats stats;
-    std::vector<StepRecord> records;  ///< every record (empty when interrupted)
-    RunReport report;                 ///< the library's counters (default when interrupted)
+    RunSummary summary;               ///< the library's: stats, records, report, loop figures, stepper
     int signal = 0;                   ///< the signal that stopped the run, 0 if it finished
-    double wall_s = 0.0;              ///< wall time of the build and the run [s]
     std::string csv_file;             ///< where the rows are (FILE, or FILE.partial when interrupted)
     std::string pairs_file;           ///< likewise for --pairs ("" none)
     std::string nodes_file;           ///< likewise for --nodes ("" none)
@@ -60,6 +48,6 @@ void install_interrupt_handlers();
 void install_stop_handlers(void (*handler)(int));
 
 /// Runs `request` on `system`, writing the CSV, --pairs and --events files.
-RunResult run(const RunRequest& request, const System& system);
+RunResult run(const SimulateRequest& request, const System& system);
 
 }  // namespace stackbeam::cli

@@ -1,86 +1,30 @@
 // The results of a run: the text summary on stdout and the --summary JSON file.
 #include "summary.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
-#include <vector>
 
 #include "stackbeam/errors.hpp"
 
 namespace stackbeam::cli {
 
-namespace {
-
-/// The initial energy: the body's, and the leaves' in mode newmark (the first record).
-double initial_energy(const RunStats& s) { return s.first.kinetic_energy_j + s.first.strain_energy_j; }
-
-/// The contact law of every interface; for an elastic one the layer used (interface_layer):
-/// k_n, k_t [Pa/m] and the decay length l [m].
-nlohmann::json interfaces_json(const Model& model) {
-    nlohmann::json list = nlohmann::json::array();
-    const ModelSpec& spec = model.spec();
-    for (std::size_t i = 0; i < spec.interfaces.size(); ++i) {
-        const InterfaceContact contact = spec.interfaces[i].contact;
-        nlohmann::json f = {{"index", i}, {"contact", to_string(contact)}};
-        if (contact == InterfaceContact::elastic) {
-            const InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
-            f["normal_stiffness_pa_per_m"] = layer.normal_stiffness_pa_per_m;
-            f["tangential_stiffness_pa_per_m"] = layer.tangential_stiffness_pa_per_m;
-            f["decay_length_m"] = layer.decay_length_m;
-        }
-        list.push_back(f);
-    }
-    return list;
-}
-
-}  // namespace
-
-LoopFigures loop_figures(const RunRequest& request, const RunResult& result) {
-    LoopFigures loop;
-    const double period = request.options.loading.period_s();
-    if (result.signal != 0) {
-        loop.note = "interrupted run: no loop figures";
-    } else if (period > 0.0) {
-        try {
-            const auto cyc = last_cycle(result.records, period);
-            loop.metrics = hysteresis_metrics(result.records, cyc.first, cyc.second);
-        } catch (const InputError& e) {
-            loop.note = e.what();
-        }
-        if (const auto& m = loop.metrics) {
-            // the records hysteresis_metrics read (t in [t_start, t_end]); the sweep's point
-            // figures (lib/study/sweep.cpp) make the same call
-            try {
-                const FancherLoopFit fit = fit_fancher_loop(result.records, m->t_start_s, m->t_end_s);
-                loop.fancher = fit.fit;
-                for (std::size_t i = 0; i < fit.w_m.size(); ++i) loop.fancher_loop.emplace_back(fit.w_m[i], fit.model_force_n[i]);
-            } catch (const InputError& e) {
-                loop.fancher_note = e.what();
-            }
-        }
-    } else {
-        loop.note = "no periodic loading: no steady cycle";
-    }
-    return loop;
-}
-
-void print_summary(const RunRequest& request, const System& system, const RunResult& result, const LoopFigures& loop) {
-    const SimulationOptions& options = request.options;
-    const RunStats& s = result.stats;
+void print_summary(const SimulateRequest& request, const System& system, const RunResult& result) {
+    const RunSummary& summary = result.summary;
+    const SimulationOptions& options = summary.options;
+    const RunStats& s = summary.stats;
+    const LoopFigures& loop = summary.loop;
     const StepRecord& last = s.last;
     const long steps = s.records - 1;  // the first record is the initial state
     std::printf("%smode %s, solver %s, dt %g s, t_end %g s\n", request.setup.c_str(), to_string(options.mode),
                 to_string(options.solver.kind), options.dt_s, options.t_end_s);
-    if (options.mode == Mode::cvode) {
-        const auto& cs = result.report.cvode;
+    if (summary.stepper.cvode_stats) {
+        const auto& cs = summary.report.cvode;
         std::printf("cvode                      rtol %g, atol %g m; %ld steps, %ld RHS evaluations, %ld root evaluations\n",
                     options.cvode.rtol, options.cvode.atol_m, cs.steps, cs.rhs_evaluations, cs.root_evaluations);
         std::printf("events                     %ld event times (%ld found by the per-step check), %zu transitions, "
                     "%ld restarts, %ld mode factorisations\n",
-                    cs.events, cs.missed_events, result.report.events.size(), cs.restarts, cs.mode_factorizations);
+                    cs.events, cs.missed_events, summary.report.events.size(), cs.restarts, cs.mode_factorizations);
         if (cs.retained_modes > 0)
             std::printf("leaf inertia               %d modes up to %g rad/s carry it, the rest quasi-static "
                         "(massless contact layer)\n",
@@ -88,7 +32,7 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
         std::printf("outputs                    %ld (every %g s)\n", steps, options.dt_s);
     } else {
         std::printf("contact path               %s (%d contact components)\n",
-                    to_string(choose_contact_path(system, options)), system.num_components());
+                    to_string(summary.contact_path), summary.contact_components);
         std::printf("steps                      %ld\n", steps);
     }
     const ModelSpec& spec = system.model().spec();
@@ -108,7 +52,7 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
                     : "");
     std::printf("energy balance error       %.3e J at the end, %.3e J largest (initial energy %.6g J, external work %.6g J, "
                 "dissipated %.6g J)\n",
-                last.energy_balance_error_j, s.max_abs_balance_j, initial_energy(s), last.external_work_j,
+                last.energy_balance_error_j, s.max_abs_balance_j, s.initial_energy_j(), last.external_work_j,
                 last.dissipated_energy_j);
     if (const auto& m = loop.metrics) {
         std::printf("loop                       t %.6g to %.6g s: area %.6g J per cycle (friction work %.6g J), secant stiffness %.6g N/m,\n"
@@ -128,116 +72,34 @@ void print_summary(const RunRequest& request, const System& system, const RunRes
     } else if (!loop.fancher_note.empty()) {
         std::printf("fancher fit                none (%s)\n", loop.fancher_note.c_str());
     }
-    if (options.mode == Mode::newmark)
+    if (summary.stepper.impact_loss)
         std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",
                     last.impact_loss_j, last.leaf_kinetic_energy_j);
-    std::printf("wall time                  %.3f s\n", result.wall_s);
+    std::printf("wall time                  %.3f s\n", summary.wall_s);
     std::printf("output                     %s\n", result.csv_file.c_str());
     if (!result.events_file.empty()) std::printf("event log                  %s\n", result.events_file.c_str());
     if (!result.pairs_file.empty()) std::printf("pairs                      %s\n", result.pairs_file.c_str());
     if (!result.nodes_file.empty()) std::printf("nodes                      %s\n", result.nodes_file.c_str());
 }
 
-std::string json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
-    const SimulationOptions& options = request.options;
-    const RunStats& s = result.stats;
-    const StepRecord& last = s.last;
-    const bool cvode = options.mode == Mode::cvode;
-    nlohmann::json j;
-    j["setup"] = request.setup;
-    j["interrupted"] = result.signal != 0;
-    if (result.signal != 0) {
-        j["signal"] = result.signal;
-        j["interrupted_note"] = "stopped by a signal at t_reached_s: the rows up to it are in the .partial files "
-                                "(kept under that name: not a complete run); no event log";
-    }
-    j["t_reached_s"] = last.t_s;
-    j["mode"] = to_string(options.mode);
-    j["solver"] = to_string(options.solver.kind);
-    j["dt_s"] = options.dt_s;
-    j["t_end_s"] = options.t_end_s;
-    const FrictionMeshRatio kappa = friction_mesh_ratio(model);
-    j["friction_mesh_ratio"] = {{"kappa", kappa.ratio},
-                                {"interface", kappa.interface_index},
-                                {"pair_spacing_m", kappa.pair_spacing_m},
-                                {"spacing_for_kappa_one_m", kappa.spacing_for_one_m},
-                                {"decay_length_m", kappa.decay_length_m},
-                                {"elastic", kappa.elastic}};
-    j["interfaces"] = interfaces_json(model);
-    j["loading"] = {{"kind", to_string(options.loading.kind)},
-                    {"gravity_m_per_s2", options.loading.gravity_m_per_s2},
-                    {"period_s", options.loading.period_s()}};
-    const RunReport& report = result.report;
-    j["counts"] = {{"records", s.records},
-                   {"steps", result.signal != 0 ? s.records - 1 : report.steps},
-                   {"contact_iterations", result.signal != 0 ? s.contact_iterations : report.contact_iterations},
-                   {"factorizations", report.factorizations},
-                   {"events", report.events.size()}};
-    if (cvode && result.signal == 0)
-        j["cvode"] = {{"rtol", options.cvode.rtol},          {"atol_m", options.cvode.atol_m},
-                      {"steps", report.cvode.steps},         {"rhs_evaluations", report.cvode.rhs_evaluations},
-                      {"event_times", report.cvode.events},  {"missed_events", report.cvode.missed_events},
-                      {"restarts", report.cvode.restarts}};
-    if (cvode && report.cvode.retained_modes > 0) {
-        j["cvode"]["retained_modes"] = report.cvode.retained_modes;
-        j["cvode"]["modal_cutoff_rad_per_s"] = report.cvode.modal_cutoff_rad_per_s;
-    }
-    j["extremes"] = {{"w_min_m", s.w_min_m},
-                     {"w_max_m", s.w_max_m},
-                     {"spring_force_min_n", s.force_min_n},
-                     {"spring_force_max_n", s.force_max_n}};
-    j["final"] = {{"t_s", last.t_s}, {"w_m", last.w_m}, {"w_dot_m_per_s", last.w_dot_m_per_s}};
-    j["energy_j"] = {{"initial", initial_energy(s)},
-                     {"external_work", last.external_work_j},
-                     {"dissipated", last.dissipated_energy_j},
-                     {"kinetic", last.kinetic_energy_j},
-                     {"strain", last.strain_energy_j},
-                     {"balance_error_final", last.energy_balance_error_j},
-                     {"balance_error_max_abs", s.max_abs_balance_j}};
-    if (const auto& m = loop.metrics) {
-        j["hysteresis"] = {{"t_start_s", m->t_start_s},
-                           {"t_end_s", m->t_end_s},
-                           {"loop_area_j", m->loop_area_j},
-                           {"friction_work_j", m->dissipated_j},
-                           {"secant_stiffness_n_per_m", m->secant_stiffness_n_per_m},
-                           {"dynamic_rate_n_per_m", m->dynamic_rate_n_per_m},
-                           {"loss_factor", m->loss_factor},
-                           {"energy_loss_factor", m->energy_loss_factor},
-                           {"equivalent_damping_ratio", m->equivalent_damping_ratio},
-                           {"w_min_m", m->w_min_m},
-                           {"w_max_m", m->w_max_m},
-                           {"force_min_n", m->force_min_n},
-                           {"force_max_n", m->force_max_n}};
-    } else {
-        j["hysteresis"] = nullptr;
-        j["hysteresis_note"] = loop.note;
-    }
-    if (const auto& fit = loop.fancher) {
-        const FancherParameters& p = fit->parameters;
-        j["fancher"] = {{"upper_rate_n_per_m", p.upper_rate_n_per_m},
-                        {"upper_offset_n", p.upper_offset_n},
-                        {"lower_rate_n_per_m", p.lower_rate_n_per_m},
-                        {"lower_offset_n", p.lower_offset_n},
-                        {"beta_m", p.beta_m},
-                        {"start_force_n", fit->start_force_n},
-                        {"rms_error_n", fit->rms_error_n},
-                        {"rms_error_relative", fit->rms_error_relative},
-                        {"iterations", fit->iterations},
-                        {"converged", fit->converged}};
-    } else {
-        j["fancher"] = nullptr;
-        if (!loop.fancher_note.empty()) j["fancher_note"] = loop.fancher_note;
-    }
-    j["wall_time_s"] = result.wall_s;
-    j["outputs"] = {{"csv", result.csv_file}, {"events", result.events_file}, {"pairs", result.pairs_file}, {"nodes", result.nodes_file}};
-    return j.dump(2);
+SummaryContext summary_context(const RunResult& result) {
+    SummaryContext c;
+    c.csv_file = result.csv_file;
+    c.events_file = result.events_file;
+    c.pairs_file = result.pairs_file;
+    c.nodes_file = result.nodes_file;
+    c.signal = result.signal;
+    if (result.signal != 0)
+        c.interrupted_note = "stopped by a signal at t_reached_s: the rows up to it are in the .partial files "
+                             "(kept under that name: not a complete run); no event log";
+    return c;
 }
 
-void write_json_summary(const RunRequest& request, const Model& model, const RunResult& result, const LoopFigures& loop) {
+void write_json_summary(const SimulateRequest& request, const Model& model, const RunResult& result) {
     const std::string partial = request.summary + ".partial";
     std::ofstream out(partial, std::ios::out | std::ios::trunc);
     if (!out) throw ArgumentError("--summary: cannot open '" + partial + "' for writing");
-    out << json_summary(request, model, result, loop) << "\n";
+    out << summary_json(result.summary, model, summary_context(result)) << "\n";
     out.close();
     if (out.fail()) throw std::runtime_error("writing '" + partial + "' failed");
     if (std::rename(partial.c_str(), request.summary.c_str()) != 0)

@@ -95,8 +95,26 @@ void add_sweep_options(CLI::App& sweep, SweepArgs& a) {
 int run_sweep_command(const SweepArgs& a, MpiWorld world) {
     const auto t0 = std::chrono::steady_clock::now();
     // every point's scenario is read and checked before any run (and before DIR is touched)
-    const SweepSpec spec = load_sweep_spec(a.spec);
-    const std::vector<SweepPoint> points = expand_points(spec);
+    const SweepSpec spec = load_sweep_spec(a.spec);  // refuses more than max_sweep_points points, with the size
+    const SweepPoints points(spec);                 // made one at a time: memory does not grow with the count
+    const bool show = world.rank == 0 && (a.progress || isatty(fileno(stderr)) != 0);
+    {
+        // every point made and checked in turn (none kept), with progress from the start
+        const bool terminal = isatty(fileno(stderr)) != 0;
+        const int total = points.size();
+        auto last = std::chrono::steady_clock::now();
+        if (show)
+            std::fprintf(stderr, "%ssweep: checking %d points%s", terminal ? "\r" : "", total, terminal ? "" : "\n");
+        points.check_all([&](int checked) {
+            if (!show || !terminal) return;
+            const auto now = std::chrono::steady_clock::now();
+            if (checked < total && now - last < std::chrono::milliseconds(200)) return;
+            last = now;
+            std::fprintf(stderr, "\rsweep: checking points: %d of %d", checked, total);
+            std::fflush(stderr);
+        });
+        if (show && terminal) std::fprintf(stderr, "\n");
+    }
     const std::string directory = !a.out_dir.empty() ? a.out_dir : spec.output_directory;
     if (directory.empty())
         throw ArgumentError("--out-dir: a results directory is required (none given, and " + a.spec +
@@ -115,8 +133,9 @@ int run_sweep_command(const SweepArgs& a, MpiWorld world) {
         return g_signal != 0 ? 128 + g_signal : exit_ok;
     }
 
-    SweepDirectory out(directory, spec, points, a.restart, a.keep_series);
-    const int total = static_cast<int>(points.size());
+    SweepDirectory out(directory, points, a.restart, a.keep_series);  // locked: a second sweep there is refused
+    for (const std::string& note : out.notes()) std::fprintf(stderr, "stackbeam: note: %s\n", note.c_str());
+    const int total = points.size();
     const int before = out.finished_count();
     if (before > 0 && before < total)
         std::printf("resuming                   %d of %d points finished in %s\n", before, total, directory.c_str());

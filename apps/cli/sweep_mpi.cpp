@@ -138,7 +138,7 @@ void mpi_abort(const MpiWorld& world, int status) {
 }
 
 #ifdef STACKBEAM_WITH_MPI
-void mpi_serve(const MpiWorld& world, const std::vector<SweepPoint>& points, const std::vector<int>& pending,
+void mpi_serve(const MpiWorld& world, const SweepPoints& points, const std::vector<int>& pending,
                const std::atomic<bool>& stop, const std::function<void(const PointResult&)>& record_local,
                const std::function<void(const std::string&)>& record_remote) {
     std::atomic<std::size_t> cursor{0};
@@ -154,7 +154,7 @@ void mpi_serve(const MpiWorld& world, const std::vector<SweepPoint>& points, con
         try {
             for (int i; (i = next()) >= 0 && !abandon.load();) {
                 try {
-                    run_point(points.at(static_cast<std::size_t>(i)), &abandon, [&](const PointResult& r) {
+                    run_point(points.point(i), &abandon, [&](const PointResult& r) {
                         std::lock_guard<std::mutex> lock(record);
                         record_local(r);
                     });
@@ -206,7 +206,7 @@ void mpi_serve(const MpiWorld& world, const std::vector<SweepPoint>& points, con
     if (local_error) std::rethrow_exception(local_error);
 }
 
-void mpi_work(const MpiWorld& world, const std::vector<SweepPoint>& points, const std::string& directory,
+void mpi_work(const MpiWorld& world, const SweepPoints& points, const std::string& directory,
               bool keep_series, const std::atomic<bool>& stop) {
     mpi_ready(world);
     std::string row;  // the last finished point's row, not sent yet
@@ -228,10 +228,10 @@ void mpi_work(const MpiWorld& world, const std::vector<SweepPoint>& points, cons
             std::this_thread::sleep_for(std::chrono::microseconds(100));
         }
         if (index < 0) return;
-        const SweepPoint& point = points.at(static_cast<std::size_t>(index));
+        const SweepPoint point = points.point(index);
         try {
             const PointResult r = run_point(point, &stop, [&](const PointResult& with_records) {
-                write_point_files(directory, point, with_records, keep_series);
+                write_point_files(directory, point, with_records, keep_series, points.spec().source);
             });
             row = format_point_row(point, r);
         } catch (const SweepStopped&) {

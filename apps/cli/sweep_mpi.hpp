@@ -50,13 +50,13 @@ void mpi_finish(const MpiWorld& world);
 /// `record_local` (this rank's results, records attached) and `record_remote` (another rank's
 /// row) from the calling thread or its worker, one at a time. Returns when every point ran
 /// or `stop` was set and the ranks have been told.
-void mpi_serve(const MpiWorld& world, const std::vector<SweepPoint>& points, const std::vector<int>& pending,
+void mpi_serve(const MpiWorld& world, const SweepPoints& points, const std::vector<int>& pending,
                const std::atomic<bool>& stop, const std::function<void(const PointResult&)>& record_local,
                const std::function<void(const std::string&)>& record_remote);
 
 /// Any other rank: asks rank 0 for points until told none is left (or `stop`), runs them,
 /// writes their files in `directory`, sends their rows back.
-void mpi_work(const MpiWorld& world, const std::vector<SweepPoint>& points, const std::string& directory,
+void mpi_work(const MpiWorld& world, const SweepPoints& points, const std::string& directory,
               bool keep_series, const std::atomic<bool>& stop);
 
 }  // namespace stackbeam::cli

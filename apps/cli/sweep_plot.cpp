@@ -66,9 +66,9 @@ bool log_scale(const SweepAxis& axis) {
 }  // namespace
 
 std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpec& spec,
-                                    const std::vector<SweepPoint>& points, const std::vector<PointResult>& results,
+                                    const SweepPoints& points, const std::vector<PointResult>& results,
                                     std::string& note) {
-    using namespace stackbeam::demo;
+    using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
     const fs::path dir = fs::path(directory) / "figures";
@@ -125,11 +125,12 @@ std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpe
         std::string curves;
         fitted = false;
         int k_curve = 0;
-        for (const SweepPoint& p : points) {
-            if (!has_loop(p.index)) continue;
+        for (int i = 0; i < points.size(); ++i) {
+            if (!has_loop(i)) continue;
+            const std::vector<AxisValue> values = points.values(i);
             std::string title;
-            for (std::size_t a = 0; a < n_axes; ++a) title += (a ? ", " : "") + to_string(p.values[a]);
-            curves += (curves.empty() ? "" : ", ") + loop_curve(p.index, k_curve++, title);
+            for (std::size_t a = 0; a < n_axes; ++a) title += (a ? ", " : "") + to_string(values[a]);
+            curves += (curves.empty() ? "" : ", ") + loop_curve(i, k_curve++, title);
         }
         if (!curves.empty()) {
             files.push_back((dir / "loops.png").string());

@@ -13,7 +13,7 @@ namespace stackbeam::cli {
 /// Draws the figures from DIR/loops/ and the results; returns the PNG files written, or
 /// none and why in `note`.
 std::vector<std::string> plot_sweep(const std::string& directory, const SweepSpec& spec,
-                                    const std::vector<SweepPoint>& points, const std::vector<PointResult>& results,
+                                    const SweepPoints& points, const std::vector<PointResult>& results,
                                     std::string& note);
 
 }  // namespace stackbeam::cli

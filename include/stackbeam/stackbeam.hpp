@@ -9,7 +9,8 @@
 ///             and its natural frequencies
 ///   time/     the time-stepping modes (closed-form, cvode, newmark) and simulate()
 ///   io/       scenario files (TOML) and CSV output
-///   post/     hysteresis-loop figures of a run, the Fancher model fitted to a loop
+///   post/     hysteresis-loop figures of a run, the Fancher model fitted to a loop,
+///             fatigue of the leaves from stress histories (rainflow, S-N, Miner)
 ///   study/    sweeps: a base scenario at many points, on threads; the results directory
 #include "stackbeam/conventions.hpp"
 #include "stackbeam/errors.hpp"
@@ -31,6 +32,9 @@
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
+#include "stackbeam/post/fatigue.hpp"
+#include "stackbeam/post/fibre.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/post/stresses.hpp"
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"

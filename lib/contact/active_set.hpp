@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the active-set algorithms on the modes (stackbeam/contact/modes.hpp) shared by the
-// dense `exact` solver (contact/exact.cpp) and the sparse path (contact/sparse/sparse_solver.cpp):
+// dense `exact` solver (contact/exact.cpp) and the sparse path (contact/sparse/driver/sparse_solver.cpp):
 // the passes (block principal pivoting, Murty's rule), Anderson mixing and the Tresca fixed
 // point. What is path-specific is only how a set of modes' linear problem is solved and how
 // s = W p + q is evaluated: this file needs s and the diagonal of W, never W itself.

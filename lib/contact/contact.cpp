@@ -30,22 +30,22 @@ const char* to_string(PairState state) {
     return "?";
 }
 
-const char* to_string(SolverKind kind) {
-    switch (kind) {
-        case SolverKind::paper: return "paper";
-        case SolverKind::accelerated: return "accelerated";
-        case SolverKind::exact: return "exact";
-        case SolverKind::block_jacobi: return "block-jacobi";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<SolverKind>>& enum_words<SolverKind>() {
+    static const std::vector<EnumWord<SolverKind>> words = {
+        {SolverKind::exact, "exact"},
+        {SolverKind::accelerated, "accelerated"},
+        {SolverKind::block_jacobi, "block-jacobi"},
+        {SolverKind::paper, "paper"},
+    };
+    return words;
 }
 
+const char* to_string(SolverKind kind) { return word_of(kind); }
+
 SolverKind parse_solver_kind(const std::string& text, const std::string& field) {
-    if (text == "paper") return SolverKind::paper;
-    if (text == "accelerated") return SolverKind::accelerated;
-    if (text == "exact") return SolverKind::exact;
-    if (text == "block-jacobi") return SolverKind::block_jacobi;
-    throw InputError(field, "value '" + text + "' is not a solver: allowed paper, accelerated, block-jacobi, exact");
+    if (const auto kind = find_word<SolverKind>(text)) return *kind;
+    throw InputError(field, "value '" + text + "' is not a solver: allowed " + word_list<SolverKind>());
 }
 
 void ContactProblem::validate() const {

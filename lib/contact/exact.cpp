@@ -23,7 +23,7 @@
 // if even that fails, Gauss-Seidel sweeps finish the job and say so.
 //
 // The modes, their linear problem and the switching rules are shared with the
-// sparse path (active_set.hpp, contact/sparse/sparse_solver.cpp).
+// sparse path (active_set.hpp, contact/sparse/driver/sparse_solver.cpp).
 #include <Eigen/LU>
 #include <cmath>
 #include <algorithm>

@@ -7,20 +7,21 @@
 
 namespace stackbeam {
 
-const char* to_string(ContactPath path) {
-    switch (path) {
-        case ContactPath::automatic: return "auto";
-        case ContactPath::dense: return "dense";
-        case ContactPath::sparse: return "sparse";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<ContactPath>>& enum_words<ContactPath>() {
+    static const std::vector<EnumWord<ContactPath>> words = {
+        {ContactPath::automatic, "auto"},
+        {ContactPath::dense, "dense"},
+        {ContactPath::sparse, "sparse"},
+    };
+    return words;
 }
 
+const char* to_string(ContactPath path) { return word_of(path); }
+
 ContactPath parse_contact_path(const std::string& text, const std::string& field) {
-    if (text == "auto") return ContactPath::automatic;
-    if (text == "dense") return ContactPath::dense;
-    if (text == "sparse") return ContactPath::sparse;
-    throw InputError(field, "value '" + text + "' is not a contact path: allowed auto, dense, sparse");
+    if (const auto path = find_word<ContactPath>(text)) return *path;
+    throw InputError(field, "value '" + text + "' is not a contact path: allowed " + word_list<ContactPath>());
 }
 
 ContactPath resolve_contact_path(ContactPath requested, int rows, SolverKind kind) {

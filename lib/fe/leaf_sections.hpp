@@ -7,6 +7,7 @@
 // 5-point Gauss-Legendre is exact to degree 9.
 #include <Eigen/Sparse>
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "stackbeam/model/model.hpp"
@@ -38,6 +39,22 @@ void integrate_profiled(const LeafSpec& leaf, double x1, double x2, F&& f) {
 constexpr int kBendingDofs[4] = {1, 2, 4, 5};
 constexpr int kAxialDofs[2] = {0, 3};
 
+/// Bernoulli-Euler 2-node element of a uniform leaf, DOFs (u1, v1, th1, u2, v2, th2): axial EA/L
+/// and bending EI/L^3 [12 6L -12 6L; 6L 4L^2 -6L 2L^2; ...], exact for end loads.
+inline ElementMatrix uniform_stiffness(double EA, double EI, double L) {
+    ElementMatrix k{};
+    k[0][0] = k[3][3] = EA / L;
+    k[0][3] = k[3][0] = -EA / L;
+    const double c = EI / (L * L * L);
+    const double kb[4][4] = {{12 * c, 6 * L * c, -12 * c, 6 * L * c},
+                             {6 * L * c, 4 * L * L * c, -6 * L * c, 2 * L * L * c},
+                             {-12 * c, -6 * L * c, 12 * c, -6 * L * c},
+                             {6 * L * c, 2 * L * L * c, -6 * L * c, 4 * L * L * c}};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) k[kBendingDofs[i]][kBendingDofs[j]] = kb[i][j];
+    return k;
+}
+
 /// Stiffness of an element of a profiled leaf: int EA N_a' N_a' dx (axial), int EI B B dx (bending).
 inline ElementMatrix profiled_stiffness(const LeafSpec& leaf, double x1, double x2) {
     ElementMatrix k{};
@@ -52,6 +69,14 @@ inline ElementMatrix profiled_stiffness(const LeafSpec& leaf, double x1, double 
     return k;
 }
 
+/// The stiffness of element [x1, x2] of `leaf` (uniform or profiled), as System assembles it.
+inline ElementMatrix element_stiffness(const LeafSpec& leaf, double x1, double x2) {
+    if (!leaf.profile.x_m.empty()) return profiled_stiffness(leaf, x1, x2);
+    const double EA = leaf.youngs_modulus_pa * leaf.width_m * leaf.height_m;
+    const double EI = leaf.youngs_modulus_pa * leaf.width_m * std::pow(leaf.height_m, 3) / 12.0;
+    return uniform_stiffness(EA, EI, x2 - x1);
+}
+
 /// Consistent mass of an element of a profiled leaf: int rho b t N N dx (axial and bending shapes).
 inline ElementMatrix profiled_mass(const LeafSpec& leaf, double x1, double x2) {
     ElementMatrix m{};
@@ -63,6 +88,29 @@ inline ElementMatrix profiled_mass(const LeafSpec& leaf, double x1, double x2) {
             for (int j = 0; j < 4; ++j) m[kBendingDofs[i]][kBendingDofs[j]] += dx * rho_a * N[i] * N[j];
     });
     return m;
+}
+
+/// Consistent mass of a Bernoulli-Euler 2-node element of a uniform leaf, m = rho A L [kg], DOFs
+/// (u1, v1, th1, u2, v2, th2): axial m/6 [2 1; 1 2]; bending (cubic Hermite shapes, rotary inertia
+/// neglected as in the stiffness) m/420 [156 22L 54 -13L; 22L 4L^2 13L -3L^2; ...].
+inline ElementMatrix uniform_mass(double m, double L) {
+    ElementMatrix me{};
+    me[0][0] = me[3][3] = m / 3.0;
+    me[0][3] = me[3][0] = m / 6.0;
+    const double c = m / 420.0;
+    const double mb[4][4] = {{156 * c, 22 * L * c, 54 * c, -13 * L * c},
+                             {22 * L * c, 4 * L * L * c, 13 * L * c, -3 * L * L * c},
+                             {54 * c, 13 * L * c, 156 * c, -22 * L * c},
+                             {-13 * L * c, -3 * L * L * c, -22 * L * c, 4 * L * L * c}};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) me[kBendingDofs[i]][kBendingDofs[j]] = mb[i][j];
+    return me;
+}
+
+/// The consistent mass of element [x1, x2] of `leaf` (uniform or profiled), as System assembles it.
+inline ElementMatrix element_mass(const LeafSpec& leaf, double x1, double x2) {
+    if (!leaf.profile.x_m.empty()) return profiled_mass(leaf, x1, x2);
+    return uniform_mass(leaf.density_kg_per_m3 * leaf.width_m * leaf.height_m * (x2 - x1), x2 - x1);
 }
 
 /// Adds a 6 x 6 element matrix over nodes a, b (full DOF offsets / 3): its nonzero entries.

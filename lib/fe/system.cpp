@@ -25,26 +25,6 @@ namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-/// Bernoulli-Euler 2-node element, DOFs (u1, v1, th1, u2, v2, th2): axial EA/L
-/// and bending EI/L^3 [12 6L -12 6L; 6L 4L^2 -6L 2L^2; ...], exact for end loads.
-void add_element(Triplets& t, int a, int b, double EA, double EI, double L) {
-    const int d[6] = {3 * a, 3 * a + 1, 3 * a + 2, 3 * b, 3 * b + 1, 3 * b + 2};
-    double k[6][6] = {};
-    k[0][0] = k[3][3] = EA / L;
-    k[0][3] = k[3][0] = -EA / L;
-    const double c = EI / (L * L * L);
-    const double kb[4][4] = {{12 * c, 6 * L * c, -12 * c, 6 * L * c},
-                             {6 * L * c, 4 * L * L * c, -6 * L * c, 2 * L * L * c},
-                             {-12 * c, -6 * L * c, 12 * c, -6 * L * c},
-                             {6 * L * c, 2 * L * L * c, -6 * L * c, 4 * L * L * c}};
-    const int bi[4] = {1, 2, 4, 5};
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) k[bi[i]][bi[j]] = kb[i][j];
-    for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j)
-            if (k[i][j] != 0.0) t.emplace_back(d[i], d[j], k[i][j]);
-}
-
 /// Whether an end support holds the stack axially through its eye (then the seat does not).
 bool holds_axially(SupportKind s, const LeafEndSpec& e) {
     return s == SupportKind::hinged || (s == SupportKind::shackle && e.shackle_angle_rad != 0.0) ||
@@ -79,13 +59,8 @@ System::System(const Model& model) : model_(model) {
 
     Triplets kt;
     for (int l = 0; l < nleaf; ++l) {
-        const auto& leaf = spec.leaves[l];
-        const double EA = leaf.youngs_modulus_pa * leaf.width_m * leaf.height_m;
-        const double EI = leaf.youngs_modulus_pa * leaf.width_m * std::pow(leaf.height_m, 3) / 12.0;
-        for (int j = model_.first_node(l); j < model_.last_node(l); ++j) {
-            if (leaf.profile.x_m.empty()) add_element(kt, node_dof(l, j), node_dof(l, j + 1), EA, EI, xs[j + 1] - xs[j]);
-            else detail::add_matrix(kt, node_dof(l, j), node_dof(l, j + 1), detail::profiled_stiffness(leaf, xs[j], xs[j + 1]));
-        }
+        for (int j = model_.first_node(l); j < model_.last_node(l); ++j)
+            detail::add_matrix(kt, node_dof(l, j), node_dof(l, j + 1), detail::element_stiffness(spec.leaves[l], xs[j], xs[j + 1]));
     }
 
     // --- constraints: each full DOF = sum of coef * master ------------------------
@@ -341,6 +316,13 @@ Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w
 
 Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
     return P_ * reduced_displacements(p, w);
+}
+
+Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& z) const {
+    if (z.size() != P_.cols())
+        throw InputError("z", "has " + std::to_string(z.size()) + " entries: System::leaf_displacements needs one per reduced DOF, " +
+                                  std::to_string(P_.cols()) + " (num_reduced_dofs())");
+    return P_ * z;
 }
 
 std::vector<LeafNodes> System::leaf_nodes(const Eigen::VectorXd& z) const {

@@ -5,7 +5,13 @@
 
 #include <toml.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -19,6 +25,16 @@
 #include "stackbeam/time/option_table.hpp"
 
 namespace stackbeam {
+
+template <>
+const std::vector<EnumWord<InterfaceLawWord>>& enum_words<InterfaceLawWord>() {
+    static const std::vector<EnumWord<InterfaceLawWord>> words = {
+        {InterfaceLawWord::coulomb, "coulomb"},
+        {InterfaceLawWord::frictionless, "frictionless"},
+        {InterfaceLawWord::bonded, "bonded"},
+    };
+    return words;
+}
 
 namespace {
 
@@ -198,17 +214,14 @@ private:
     std::vector<std::string> allowed_;
 };
 
-/// A keyword value out of `choices` (text -> enum).
+/// A keyword value out of the enum's word table (words.hpp); `fallback` when the key is absent
+/// (nullptr: required).
 template <class E>
-E choice(const Table& t, const std::string& key, const std::vector<std::pair<std::string, E>>& choices,
-         const E* fallback) {
-    std::vector<std::string> names;
-    for (const auto& c : choices) names.push_back("'" + c.first + "'");
-    const std::string what = "one of " + join(names);
+E choice(const Table& t, const std::string& key, const E* fallback) {
+    const std::string what = "one of " + word_list<E>("'");
     if (!t.has(key) && fallback) return *fallback;
     const std::string text = t.string(key, what);
-    for (const auto& c : choices)
-        if (c.first == text) return c.second;
+    if (const auto value = find_word<E>(text)) return *value;
     t.context().fail(child(t.path(), key), "value '" + text + "' is not allowed: must be " + what);
 }
 
@@ -244,10 +257,6 @@ std::string file_path_of(const std::string& field) {
 }
 
 
-const std::vector<std::pair<std::string, SupportKind>> kSupports = {
-    {"free", SupportKind::free}, {"pinned", SupportKind::pinned}, {"fixed", SupportKind::fixed},
-    {"hinged", SupportKind::hinged}, {"shackle", SupportKind::shackle}, {"bushing", SupportKind::bushing}};
-
 /// [leaves.profile] and [leaves.left_end] / [leaves.right_end] (ranges: Model::build).
 void parse_profile_and_ends(const Table& t, LeafSpec& l) {
     if (t.has("profile")) {
@@ -269,12 +278,36 @@ void parse_profile_and_ends(const Table& t, LeafSpec& l) {
     }
 }
 
+/// A fatigue material table, [material] or [leaves.material] (model.hpp, FatigueMaterial;
+/// ranges: validate_fatigue_material). A strength given as 0 is refused here: 0 stands for
+/// "not given" in the spec, so the file says that by leaving the key out.
+FatigueMaterial parse_material(const Table& parent, const std::string& key) {
+    const Table t = parent.table(key, {"ultimate_strength_pa", "yield_strength_pa", "endurance_limit_pa",
+                                       "fatigue_strength_coefficient_pa", "fatigue_strength_exponent",
+                                       "mean_stress_correction"});
+    auto optional = [&](const char* k, const char* what) {
+        const double v = t.number_or(k, what, 0.0);
+        if (t.has(k) && v == 0.0)
+            t.context().fail(child(t.path(), k), std::string("value 0 is not allowed: ") + what + " (leave the key out when not given)");
+        return v;
+    };
+    FatigueMaterial m;
+    m.ultimate_strength_pa = t.number("ultimate_strength_pa", "the ultimate tensile strength S_u [Pa], > 0");
+    m.yield_strength_pa = optional("yield_strength_pa", "the yield strength S_y [Pa], > 0");
+    m.endurance_limit_pa = optional("endurance_limit_pa", "the endurance limit S_e [Pa], > 0");
+    m.fatigue_strength_coefficient_pa = optional("fatigue_strength_coefficient_pa", "Basquin's sigma_f' [Pa], > 0");
+    m.fatigue_strength_exponent = optional("fatigue_strength_exponent", "Basquin's exponent b [-], in (-1, 0)");
+    const MeanStressCorrection goodman = MeanStressCorrection::goodman;
+    m.mean_stress_correction = choice<MeanStressCorrection>(t, "mean_stress_correction", &goodman);
+    return m;
+}
+
 void parse_leaves(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("leaves", "the leaves, [[leaves]] tables from the top of the stack down", true);
     const std::vector<std::string> keys = {"length_m",         "x_start_m",    "height_m",     "width_m",
                                            "youngs_modulus_pa", "density_kg_per_m3", "poisson_ratio", "left_support",
                                            "right_support", "profile", "left_end", "right_end", "free_camber_m",
-                                           "free_radius_m"};
+                                           "free_radius_m", "material"};
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("leaves", i), keys);
         LeafSpec l;
@@ -289,40 +322,50 @@ void parse_leaves(const Table& top, ModelSpec& spec) {
         l.density_kg_per_m3 = t.number_or("density_kg_per_m3", "density [kg/m^3], >= 0", 0.0);
         l.poisson_ratio = t.number_or("poisson_ratio", "Poisson's ratio [-], in (-1, 0.5)", LeafSpec{}.poisson_ratio);
         const SupportKind free = SupportKind::free;
-        l.left_support = choice(t, "left_support", kSupports, &free);
-        l.right_support = choice(t, "right_support", kSupports, &free);
+        l.left_support = choice(t, "left_support", &free);
+        l.right_support = choice(t, "right_support", &free);
         l.free_camber_m = t.number_or("free_camber_m", "the free arc height [m], + ends up (0: flat)", 0.0);
         l.free_radius_m = t.number_or("free_radius_m", "the free radius [m], + ends up (0: flat)", 0.0);
+        if (t.has("material")) l.material = parse_material(t, "material");
         spec.leaves.push_back(l);
     }
+    // [material]: the leaves' shared fatigue strength, for every leaf without its own
+    // [leaves.material] (which replaces it whole); checked here, under the key path as written
+    if (!top.has("material")) return;
+    const FatigueMaterial shared = parse_material(top, "material");
+    try {
+        validate_fatigue_material(shared, "material");
+    } catch (const InputError& e) {
+        rethrow_in_file(top.context(), e);
+    }
+    for (LeafSpec& l : spec.leaves)
+        if (!l.material) l.material = shared;
 }
 
 void parse_interfaces(const Table& top, ModelSpec& spec) {
     const auto* arr = top.array("interfaces", "one [[interfaces]] table per pair of adjacent leaves", spec.leaves.size() > 1);
     if (!arr) return;
-    enum class Law { coulomb, frictionless, bonded };
-    const std::vector<std::pair<std::string, Law>> laws = {
-        {"coulomb", Law::coulomb}, {"frictionless", Law::frictionless}, {"bonded", Law::bonded}};
+    using Law = InterfaceLawWord;
     for (std::size_t i = 0; i < arr->size(); ++i) {
         Table t(top.context(), (*arr)[i], element("interfaces", i),
                 {"law", "friction_coefficient", "initial_gap_m", "contact", "normal_stiffness_pa_per_m",
                  "tangential_stiffness_pa_per_m"});
         InterfaceSpec f;
-        const Law law = choice<Law>(t, "law", laws, nullptr);
+        const Law law = choice<Law>(t, "law", nullptr);
         if (law == Law::coulomb) {
             f.law = InterfaceLaw::coulomb;
             f.friction_coefficient = t.number("friction_coefficient", "the Coulomb coefficient mu [-], >= 0 (law 'coulomb')");
         } else {
             if (t.has("friction_coefficient"))
                 t.context().fail(child(t.path(), "friction_coefficient"),
-                                 std::string("is not allowed with law '") + (law == Law::bonded ? "bonded" : "frictionless") +
+                                 std::string("is not allowed with law '") + word_of(law) +
                                      "': only law 'coulomb' takes a friction coefficient");
             f.law = law == Law::bonded ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
             f.friction_coefficient = 0.0;
         }
         f.initial_gap_m = t.number_or("initial_gap_m", "the initial normal gap [m], finite; < 0 an interference, closed by the assembly", 0.0);
         if (t.has("contact")) {
-            const std::string text = t.string("contact", "one of 'rigid', 'elastic'");
+            const std::string text = t.string("contact", "one of " + word_list<InterfaceContact>("'"));
             try {
                 f.contact = parse_interface_contact(text, child(t.path(), "contact"));
             } catch (const InputError& e) {
@@ -395,9 +438,7 @@ TimeFunction parse_time_function(const Table& parent, const std::string& key, co
     const Table t = parent.table(key, {"shape", "mean", "amplitude", "frequency_hz", "phase_rad", "times_s", "values"});
     using S = TimeFunction::Shape;
     TimeFunction f;
-    f.shape = choice<S>(t, "shape",
-                        {{"constant", S::constant}, {"harmonic", S::harmonic}, {"triangle", S::triangle}, {"table", S::table}},
-                        nullptr);
+    f.shape = choice<S>(t, "shape", nullptr);
     auto only = [&](const std::string& k, bool allowed) {
         if (t.has(k) && !allowed)
             t.context().fail(child(t.path(), k), "is not used by shape '" + std::string(to_string(f.shape)) +
@@ -429,12 +470,7 @@ Loading parse_loading(const Table& top, ModelSpec& spec) {
     const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s", "gravity_m_per_s2",
                                           "force_n", "displacement_m"});
     Loading l;
-    l.kind = choice<LoadingKind>(t, "kind",
-                                 {{"initial-conditions", LoadingKind::initial_conditions},
-                                  {"applied-force", LoadingKind::applied_force},
-                                  {"prescribed-displacement", LoadingKind::prescribed_displacement},
-                                  {"base-excitation", LoadingKind::base_excitation}},
-                                 nullptr);
+    l.kind = choice<LoadingKind>(t, "kind", nullptr);
     spec.rigid_body.initial_displacement_m = t.number_or("initial_displacement_m", "w(0) [m]", 0.0);
     spec.rigid_body.initial_velocity_m_per_s = t.number_or("initial_velocity_m_per_s", "dw/dt(0) [m/s]", 0.0);
     l.gravity_m_per_s2 = t.number_or("gravity_m_per_s2", "g [m/s^2], >= 0, acting in -y", 0.0);
@@ -456,7 +492,7 @@ void parse_mesh(const Table& top, ModelSpec& spec) {
     const Table t = top.table("mesh", {"element_length_m", "symmetry"});
     spec.mesh.element_length_m = t.number("element_length_m", "the largest element length [m], > 0");
     const Symmetry full = Symmetry::full;
-    spec.symmetry = choice<Symmetry>(t, "symmetry", {{"full", Symmetry::full}, {"half", Symmetry::half}}, &full);
+    spec.symmetry = choice<Symmetry>(t, "symmetry", &full);
 }
 
 void parse_probe(const Table& top, ModelSpec& spec) {
@@ -637,7 +673,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source_name)
     s.source = source_name;
     const Table top(ctx, root, "",
                     {"description", "leaves", "interfaces", "clamps", "rigid_body", "loading", "mesh", "probe",
-                     "integrator", "outputs", "clips"});
+                     "integrator", "outputs", "clips", "material"});
     s.description = top.string_or("description", "free text", "");
     parse_leaves(top, s.model);
     parse_interfaces(top, s.model);
@@ -666,13 +702,50 @@ void rethrow_in_scenario(const Scenario& scenario, const InputError& e) {
     rethrow_in_file(Context(scenario.source, scenario.key_locations), e);
 }
 
+std::string detail::read_input_file(const std::string& path, const std::string& what, const std::string& field,
+                                   const std::string& location, long long max_bytes) {
+    auto refuse = [&](const std::string& why) -> InputError {
+        const std::string message = what + " '" + path + "' " + why;
+        return location.empty() ? InputError(field, message) : InputError(field, message, location);
+    };
+    // O_NONBLOCK: opening a FIFO with no writer would wait for one; the type is checked before any read
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) throw refuse(std::string("cannot be opened: ") + std::strerror(errno));
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) throw refuse(std::string("cannot be examined: ") + std::strerror(errno));
+    if (!S_ISREG(st.st_mode)) {
+        const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
+                           : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                           : S_ISCHR(st.st_mode)  ? "a character device"
+                           : S_ISBLK(st.st_mode)  ? "a block device"
+                           : S_ISSOCK(st.st_mode) ? "a socket"
+                                                  : "not a regular file";
+        throw refuse(std::string("is ") + kind + ": a regular file is required");
+    }
+    if (st.st_size > max_bytes)
+        throw refuse("has " + std::to_string(static_cast<long long>(st.st_size)) + " bytes: at most " +
+                     std::to_string(max_bytes) + " are read");
+    std::string text;
+    char buffer[65536];
+    for (;;) {  // read to the end (the file may grow meanwhile: the cap holds for what is read)
+        const ssize_t n = ::read(fd, buffer, sizeof buffer);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw refuse(std::string("cannot be read: ") + std::strerror(errno));
+        if (n == 0) break;
+        text.append(buffer, static_cast<std::size_t>(n));
+        if (static_cast<long long>(text.size()) > max_bytes)
+            throw refuse("has more than " + std::to_string(max_bytes) + " bytes: at most " + std::to_string(max_bytes) +
+                         " are read");
+    }
+    return text;
+}
+
 Scenario load_scenario(const std::string& path) {
-    std::ifstream in(path, std::ios::in | std::ios::binary);
-    if (!in) throw InputError(path, "cannot open the scenario file for reading");
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (in.bad()) throw InputError(path, "cannot read the scenario file");
-    return parse_scenario(text.str(), path);
+    return parse_scenario(detail::read_input_file(path, "the scenario file", path), path);
 }
 
 }  // namespace stackbeam

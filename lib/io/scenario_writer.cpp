@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stackbeam/io/scenario.hpp"
@@ -81,6 +82,19 @@ void write_end(std::ostringstream& out, const char* name, const LeafEndSpec& e) 
     l.num("bushing_x_n_per_m", e.bushing_x_n_per_m);
     l.num("bushing_y_n_per_m", e.bushing_y_n_per_m);
     l.num("bushing_rotation_n_m_per_rad", e.bushing_rotation_n_m_per_rad);
+}
+
+/// [leaves.material]: the given strengths (0: not given, left out) and the correction.
+void write_material(std::ostringstream& out, const FatigueMaterial& m) {
+    out << "[leaves.material]\n";
+    Lines l(out);
+    l.num("ultimate_strength_pa", m.ultimate_strength_pa);
+    for (const auto& [key, value] : {std::pair<const char*, double>{"yield_strength_pa", m.yield_strength_pa},
+                                     {"endurance_limit_pa", m.endurance_limit_pa},
+                                     {"fatigue_strength_coefficient_pa", m.fatigue_strength_coefficient_pa},
+                                     {"fatigue_strength_exponent", m.fatigue_strength_exponent}})
+        if (value != 0.0) l.num(key, value);
+    l.word("mean_stress_correction", to_string(m.mean_stress_correction));
 }
 
 void write_time_function(std::ostringstream& out, const std::string& table, const TimeFunction& f) {
@@ -161,14 +175,15 @@ std::string to_toml(const Scenario& s) {
         }
         write_end(out, "left_end", leaf.left_end);
         write_end(out, "right_end", leaf.right_end);
+        if (leaf.material) write_material(out, *leaf.material);  // a shared [material] is written per leaf
     }
     for (const InterfaceSpec& f : m.interfaces) {
         out << "\n[[interfaces]]\n";
         Lines l(out);
         if (f.law == InterfaceLaw::bonded) {
-            l.word("law", "bonded");  // its friction coefficient is not used (the reader sets 0)
+            l.word("law", word_of(InterfaceLawWord::bonded));  // its friction coefficient is not used (the reader sets 0)
         } else {
-            l.word("law", "coulomb");
+            l.word("law", word_of(InterfaceLawWord::coulomb));
             l.num("friction_coefficient", f.friction_coefficient);
         }
         l.num("initial_gap_m", f.initial_gap_m);
@@ -216,7 +231,7 @@ std::string to_toml(const Scenario& s) {
 
     out << "\n[mesh]\n";
     top.num("element_length_m", m.mesh.element_length_m);
-    top.word("symmetry", m.symmetry == Symmetry::half ? "half" : "full");
+    top.word("symmetry", word_of(m.symmetry));
 
     if (m.probe) {
         out << "\n[probe]\n";

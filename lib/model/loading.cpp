@@ -29,25 +29,30 @@ void require_finite(const std::string& field, double v, const std::string& what)
 
 }  // namespace
 
-const char* to_string(TimeFunction::Shape shape) {
-    switch (shape) {
-        case TimeFunction::Shape::constant: return "constant";
-        case TimeFunction::Shape::harmonic: return "harmonic";
-        case TimeFunction::Shape::triangle: return "triangle";
-        case TimeFunction::Shape::table: return "table";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>() {
+    static const std::vector<EnumWord<TimeFunction::Shape>> words = {
+        {TimeFunction::Shape::constant, "constant"},
+        {TimeFunction::Shape::harmonic, "harmonic"},
+        {TimeFunction::Shape::triangle, "triangle"},
+        {TimeFunction::Shape::table, "table"},
+    };
+    return words;
 }
 
-const char* to_string(LoadingKind kind) {
-    switch (kind) {
-        case LoadingKind::initial_conditions: return "initial-conditions";
-        case LoadingKind::applied_force: return "applied-force";
-        case LoadingKind::prescribed_displacement: return "prescribed-displacement";
-        case LoadingKind::base_excitation: return "base-excitation";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>() {
+    static const std::vector<EnumWord<LoadingKind>> words = {
+        {LoadingKind::initial_conditions, "initial-conditions"},
+        {LoadingKind::applied_force, "applied-force"},
+        {LoadingKind::prescribed_displacement, "prescribed-displacement"},
+        {LoadingKind::base_excitation, "base-excitation"},
+    };
+    return words;
 }
+
+const char* to_string(TimeFunction::Shape shape) { return word_of(shape); }
+const char* to_string(LoadingKind kind) { return word_of(kind); }
 
 void TimeFunction::validate(const std::string& field, bool smooth) const {
     require_finite(field + ".mean", mean, "the mean");
@@ -110,7 +115,37 @@ void TimeFunction::prepare(bool smooth) {
     for (std::size_t i = n - 1; i-- > 0;) spline_m2[i] = (r[i] - c[i] * spline_m2[i + 1]) / b[i];
 }
 
+void ExternalSamples::set(double t, double v, double d, double dd) {
+    const auto keep = static_cast<std::size_t>(std::lower_bound(times_s.begin(), times_s.end(), t) - times_s.begin());
+    times_s.resize(keep);
+    values.resize(keep);
+    derivatives.resize(keep);
+    second_derivatives.resize(keep);
+    times_s.push_back(t);
+    values.push_back(v);
+    derivatives.push_back(d);
+    second_derivatives.push_back(dd);
+}
+
+namespace {
+/// The first-order hold of ExternalSamples: ys at the samples' times exactly, linear between.
+double hold(const std::vector<double>& ts, const std::vector<double>& ys, double t) {
+    if (ts.empty()) return 0.0;
+    if (t <= ts.front()) return ys.front();
+    if (t >= ts.back()) return ys.back();
+    const std::size_t i = interval(ts, t);
+    if (t == ts[i]) return ys[i];
+    const double h = ts[i + 1] - ts[i];
+    return (ys[i] * (ts[i + 1] - t) + ys[i + 1] * (t - ts[i])) / h;
+}
+}  // namespace
+
+double ExternalSamples::value(double t) const { return hold(times_s, values, t); }
+double ExternalSamples::derivative(double t) const { return hold(times_s, derivatives, t); }
+double ExternalSamples::second_derivative(double t) const { return hold(times_s, second_derivatives, t); }
+
 double TimeFunction::value(double t) const {
+    if (external) return external->value(t);
     switch (shape) {
         case Shape::constant: return mean;
         case Shape::harmonic: return mean + amplitude * std::sin(kTwoPi * frequency_hz * t + phase_rad);
@@ -134,6 +169,7 @@ double TimeFunction::value(double t) const {
 }
 
 double TimeFunction::derivative(double t) const {
+    if (external) return external->derivative(t);
     switch (shape) {
         case Shape::constant: return 0.0;
         case Shape::harmonic:
@@ -156,6 +192,7 @@ double TimeFunction::derivative(double t) const {
 }
 
 double TimeFunction::second_derivative(double t) const {
+    if (external) return external->second_derivative(t);
     switch (shape) {
         case Shape::constant:
         case Shape::triangle: return 0.0;  // triangle: impulses at the turning points (refused where it matters)

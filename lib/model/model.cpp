@@ -11,30 +11,55 @@
 
 namespace stackbeam {
 
-const char* to_string(SupportKind kind) {
-    switch (kind) {
-        case SupportKind::free: return "free";
-        case SupportKind::pinned: return "pinned";
-        case SupportKind::fixed: return "fixed";
-        case SupportKind::hinged: return "hinged";
-        case SupportKind::shackle: return "shackle";
-        case SupportKind::bushing: return "bushing";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>() {
+    static const std::vector<EnumWord<SupportKind>> words = {
+        {SupportKind::free, "free"},
+        {SupportKind::pinned, "pinned"},
+        {SupportKind::fixed, "fixed"},
+        {SupportKind::hinged, "hinged"},
+        {SupportKind::shackle, "shackle"},
+        {SupportKind::bushing, "bushing"},
+    };
+    return words;
 }
 
-const char* to_string(InterfaceContact contact) {
-    switch (contact) {
-        case InterfaceContact::rigid: return "rigid";
-        case InterfaceContact::elastic: return "elastic";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>() {
+    static const std::vector<EnumWord<InterfaceContact>> words = {
+        {InterfaceContact::rigid, "rigid"},
+        {InterfaceContact::elastic, "elastic"},
+    };
+    return words;
 }
+
+template <>
+const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>() {
+    static const std::vector<EnumWord<Symmetry>> words = {
+        {Symmetry::full, "full"},
+        {Symmetry::half, "half"},
+    };
+    return words;
+}
+
+template <>
+const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>() {
+    static const std::vector<EnumWord<MeanStressCorrection>> words = {
+        {MeanStressCorrection::goodman, "goodman"},
+        {MeanStressCorrection::gerber, "gerber"},
+        {MeanStressCorrection::soderberg, "soderberg"},
+        {MeanStressCorrection::morrow, "morrow"},
+    };
+    return words;
+}
+
+const char* to_string(SupportKind kind) { return word_of(kind); }
+const char* to_string(InterfaceContact contact) { return word_of(contact); }
+const char* to_string(MeanStressCorrection correction) { return word_of(correction); }
 
 InterfaceContact parse_interface_contact(const std::string& text, const std::string& field) {
-    if (text == "rigid") return InterfaceContact::rigid;
-    if (text == "elastic") return InterfaceContact::elastic;
-    throw InputError(field, "value '" + text + "' is not allowed: must be 'rigid' or 'elastic'");
+    if (const auto contact = find_word<InterfaceContact>(text)) return *contact;
+    throw InputError(field, "value '" + text + "' is not allowed: must be " + word_list<InterfaceContact>("'", ", ", " or "));
 }
 
 namespace {
@@ -186,6 +211,44 @@ void validate_end(SupportKind kind, const LeafEndSpec& e, std::size_t i, const c
 
 }  // namespace
 
+void validate_fatigue_material(const FatigueMaterial& m, const std::string& path) {
+    const std::string pre = path + ".";
+    require_positive(pre + "ultimate_strength_pa", m.ultimate_strength_pa, "[Pa]");
+    // the optional strengths: 0 is "not given", anything else finite and > 0
+    for (const auto& [key, value] : {std::pair<const char*, double>{"yield_strength_pa", m.yield_strength_pa},
+                                     {"endurance_limit_pa", m.endurance_limit_pa},
+                                     {"fatigue_strength_coefficient_pa", m.fatigue_strength_coefficient_pa}})
+        if (value != 0.0) require_positive(pre + key, value, "[Pa] (0 or absent: not given)");
+    const double b = m.fatigue_strength_exponent;
+    if (b != 0.0 && !(std::isfinite(b) && b > -1.0 && b < 0.0))
+        throw InputError(pre + "fatigue_strength_exponent",
+                         "value " + format_value(b) + " is not allowed: Basquin's exponent b must be in (-1, 0) [-] (steels about -0.05 to -0.12)");
+    if ((b != 0.0) != (m.fatigue_strength_coefficient_pa != 0.0)) {
+        const bool has_b = b != 0.0;
+        throw InputError(pre + (has_b ? "fatigue_strength_coefficient_pa" : "fatigue_strength_exponent"),
+                         std::string("required key is missing: the S-N curve sigma_a = sigma_f' (2N)^b needs both ") +
+                             "fatigue_strength_coefficient_pa and fatigue_strength_exponent (" +
+                             (has_b ? "fatigue_strength_exponent" : "fatigue_strength_coefficient_pa") + " is given)");
+    }
+    if (m.yield_strength_pa > m.ultimate_strength_pa)
+        throw InputError(pre + "yield_strength_pa", "value " + format_value(m.yield_strength_pa) +
+                                                        " is not allowed: must be <= ultimate_strength_pa (" +
+                                                        format_value(m.ultimate_strength_pa) + " Pa)");
+    if (m.endurance_limit_pa >= m.ultimate_strength_pa)
+        throw InputError(pre + "endurance_limit_pa", "value " + format_value(m.endurance_limit_pa) +
+                                                         " is not allowed: must be < ultimate_strength_pa (" +
+                                                         format_value(m.ultimate_strength_pa) + " Pa)");
+    if (m.endurance_limit_pa == 0.0 && !has_sn_curve(m))
+        throw InputError(pre + "endurance_limit_pa",
+                         "required key is missing: a fatigue material needs an endurance limit (endurance_limit_pa) or "
+                         "an S-N curve (fatigue_strength_coefficient_pa and fatigue_strength_exponent), or both");
+    if (m.mean_stress_correction == MeanStressCorrection::soderberg && m.yield_strength_pa == 0.0)
+        throw InputError(pre + "yield_strength_pa", "required key is missing: mean_stress_correction 'soderberg' needs the yield strength");
+    if (m.mean_stress_correction == MeanStressCorrection::morrow && m.fatigue_strength_coefficient_pa == 0.0)
+        throw InputError(pre + "fatigue_strength_coefficient_pa",
+                         "required key is missing: mean_stress_correction 'morrow' needs the fatigue strength coefficient sigma_f'");
+}
+
 bool Model::leaf_has_node(int leaf, int node) const {
     return node >= first_node_[leaf] && node <= last_node_[leaf];
 }
@@ -210,6 +273,7 @@ Model Model::build(ModelSpec spec) {
         if (!std::isfinite(l.poisson_ratio) || l.poisson_ratio <= -1.0 || l.poisson_ratio >= 0.5)
             throw InputError(idx("leaves", i, "poisson_ratio"),
                              "value " + format_value(l.poisson_ratio) + " is not allowed: must be in (-1, 0.5) [-]");
+        if (l.material) validate_fatigue_material(*l.material, idx("leaves", i, "material"));
         x_min = std::min(x_min, l.x_start_m);
         x_max = std::max(x_max, leaf_end(l));
     }

@@ -10,20 +10,21 @@ constexpr double kLength = 0.5, kWidth = 0.05, kHeight = 0.005;
 constexpr int kLeaves = 3;
 }  // namespace
 
-const char* to_string(PaperCase c) {
-    switch (c) {
-        case PaperCase::bonded: return "bonded";
-        case PaperCase::friction: return "friction";
-        case PaperCase::frictionless: return "frictionless";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<PaperCase>>& enum_words<PaperCase>() {
+    static const std::vector<EnumWord<PaperCase>> words = {
+        {PaperCase::bonded, "bonded"},
+        {PaperCase::friction, "friction"},
+        {PaperCase::frictionless, "frictionless"},
+    };
+    return words;
 }
 
+const char* to_string(PaperCase c) { return word_of(c); }
+
 PaperCase parse_paper_case(const std::string& text, const std::string& field) {
-    if (text == "bonded") return PaperCase::bonded;
-    if (text == "friction") return PaperCase::friction;
-    if (text == "frictionless") return PaperCase::frictionless;
-    throw InputError(field, "value '" + text + "' is not a case: allowed bonded, friction, frictionless");
+    if (const auto c = find_word<PaperCase>(text)) return *c;
+    throw InputError(field, "value '" + text + "' is not a case: allowed " + word_list<PaperCase>());
 }
 
 ModelSpec paper_example(PaperCase c, const PaperExampleOptions& o) {

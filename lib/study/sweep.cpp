@@ -12,17 +12,19 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <optional>
+#include <system_error>
 #include <thread>
 
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/model/model.hpp"
-#include "stackbeam/post/fancher.hpp"
-#include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/run/run.hpp"
 
 namespace stackbeam {
 
@@ -71,6 +73,9 @@ std::vector<PathPart> split_key(const std::string& key, const std::string& locat
                 if (inside.empty() || inside.find_first_not_of("0123456789") != std::string::npos)
                     bad("index '[" + inside + "]' is neither a number nor *");
                 p.index = PathPart::Index::one;
+                // no array in a scenario has a million elements: a longer index is refused by name
+                // here, before std::stoul would throw its bare "stoul" on 20 digits
+                if (inside.size() > 6) bad("index '[" + inside + "]' is too large (at most 999999)");
                 p.element = static_cast<std::size_t>(std::stoul(inside));
             }
             i = close + 1;
@@ -148,11 +153,7 @@ bool key_covers(const std::string& key, const std::string& field) {
 
 std::string read_file(const std::string& path, const std::string& field, const std::string& location,
                       const std::string& what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(field, "cannot read " + what + " '" + path + "'", location);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return detail::read_input_file(path, what, field, location);
 }
 
 std::string directory_of(const std::string& path) {
@@ -224,7 +225,13 @@ const char* to_string(PointStatus status) {
 }
 
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
-    return parse_sweep_spec(text, source_name, [](const std::string& path, const std::string& location) {
+    return parse_sweep_spec(text, source_name, [&](const std::string& path, const std::string& location) {
+        // the spec named as its own base scenario would be read as a scenario with unknown keys
+        std::error_code ec;
+        if (std::filesystem::equivalent(path, source_name, ec))
+            throw InputError("scenario", "value '" + path + "' is the sweep spec itself: the base scenario is another "
+                                         "file (a scenario, docs/model-and-scenarios.md)",
+                             location);
         return read_file(path, "scenario", location, "the base scenario file");
     });
 }
@@ -386,6 +393,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
 int point_count(const SweepSpec& spec) {
     if (spec.axes.empty()) throw InputError("axes", "at least one axis is required", spec.source);
     long long n = spec.combine == Combine::zip ? -1 : 1;
+    double product = 1.0;  // the product's size for the message (exact below 2^53)
     for (std::size_t a = 0; a < spec.axes.size(); ++a) {
         const SweepAxis& axis = spec.axes[a];
         const std::string field = "axes[" + std::to_string(a) + "]";
@@ -401,68 +409,104 @@ int point_count(const SweepSpec& spec) {
                                  where);
             n = len;
         } else {
+            product *= static_cast<double>(len);
             n *= len;
-            if (n > 10000000) throw InputError("axes", "more than 10 million points", spec.source);
+            if (n > max_sweep_points) n = max_sweep_points + 1;  // refused below; no overflow however many axes
         }
+    }
+    if (n > max_sweep_points) {
+        std::string sizes;
+        for (const SweepAxis& axis : spec.axes)
+            sizes += (sizes.empty() ? "" : spec.combine == Combine::zip ? ", " : " x ") + std::to_string(axis.values.size());
+        throw InputError("axes", "the spec has " +
+                                     (spec.combine == Combine::zip ? std::to_string(n) : format_value(product)) +
+                                     " points (" + to_string(spec.combine) + " of " + sizes +
+                                     " values): at most " + std::to_string(max_sweep_points) +
+                                     " points in one sweep; split it into several specs",
+                         spec.source);
     }
     return static_cast<int>(n);
 }
 
-std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
-    const int n = point_count(spec);
-    Document base;
+struct SweepPoints::Impl {
+    Document base;                          // the base scenario without [outputs]
+    std::vector<std::vector<PathPart>> paths;  // each axis' key, split
+};
+
+SweepPoints::SweepPoints(const SweepSpec& spec) : spec_(&spec), count_(point_count(spec)) {
+    auto impl = std::make_shared<Impl>();
     try {
         detail::check_toml_text(spec.scenario_text, spec.scenario_path);
         std::istringstream in(spec.scenario_text);
-        base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
+        impl->base = toml::parse<toml::discard_comments, std::map>(in, spec.scenario_path);
     } catch (const std::exception& e) {
         throw InputError("scenario", "the base scenario '" + spec.scenario_path + "' is not a valid TOML file: " + e.what(),
                          spec.scenario_location.empty() ? spec.source : spec.scenario_location);
     }
-    if (base.is_table()) base.as_table().erase("outputs");  // the sweep writes its own
-    std::vector<std::vector<PathPart>> paths;
+    if (impl->base.is_table()) impl->base.as_table().erase("outputs");  // the sweep writes its own
     for (std::size_t a = 0; a < spec.axes.size(); ++a)
-        paths.push_back(split_key(spec.axes[a].key, spec.axes[a].location, "axes[" + std::to_string(a) + "].key"));
+        impl->paths.push_back(split_key(spec.axes[a].key, spec.axes[a].location, "axes[" + std::to_string(a) + "].key"));
+    impl_ = std::move(impl);
+}
 
-    std::vector<SweepPoint> points;
-    points.reserve(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        SweepPoint point;
-        point.index = i;
-        // product: the last axis varies fastest
-        int rest = i;
-        point.values.resize(spec.axes.size());
-        for (std::size_t a = spec.axes.size(); a-- > 0;) {
-            const auto& vals = spec.axes[a].values;
-            const int len = static_cast<int>(vals.size());
-            point.values[a] = spec.combine == Combine::zip ? vals[static_cast<std::size_t>(i)] : vals[static_cast<std::size_t>(rest % len)];
-            if (spec.combine == Combine::product) rest /= len;
-        }
-        const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
-        Document doc = base;
-        for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-            try {
-                set_at(doc, paths[a], 0, to_document(point.values[a]), "");
-            } catch (const std::invalid_argument& e) {
-                throw InputError(spec.axes[a].key, at_point + ": " + e.what() + " (axis " + std::to_string(a) + ")",
-                                 spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
-            }
-        }
-        point.scenario_text = toml::format(doc, 0, std::numeric_limits<double>::max_digits10);
-        const std::string name = spec.scenario_path + " at point " + std::to_string(i);
-        try {
-            point.scenario = parse_scenario(point.scenario_text, name);
-        } catch (const InputError& e) {
-            for (std::size_t a = 0; a < spec.axes.size(); ++a)
-                if (key_covers(spec.axes[a].key, e.field()))
-                    throw InputError(e.field(), at_point + ": " + bare_message(e) + " (axis " + spec.axes[a].key + ")",
-                                     spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
-            throw InputError(e.field(), at_point + ": " + bare_message(e) + " (a key of the base scenario " +
-                                            spec.scenario_path + ", with the point's values)",
-                             spec.scenario_location.empty() ? spec.source : spec.scenario_location);
-        }
-        points.push_back(std::move(point));
+std::vector<AxisValue> SweepPoints::values(int i) const {
+    const SweepSpec& spec = *spec_;
+    if (i < 0 || i >= count_) throw std::out_of_range("sweep point " + std::to_string(i) + " of " + std::to_string(count_));
+    std::vector<AxisValue> values(spec.axes.size());
+    // product: the last axis varies fastest
+    int rest = i;
+    for (std::size_t a = spec.axes.size(); a-- > 0;) {
+        const auto& vals = spec.axes[a].values;
+        const int len = static_cast<int>(vals.size());
+        values[a] = spec.combine == Combine::zip ? vals[static_cast<std::size_t>(i)] : vals[static_cast<std::size_t>(rest % len)];
+        if (spec.combine == Combine::product) rest /= len;
     }
+    return values;
+}
+
+SweepPoint SweepPoints::point(int i) const {
+    const SweepSpec& spec = *spec_;
+    SweepPoint point;
+    point.index = i;
+    point.values = values(i);
+    const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
+    Document doc = impl_->base;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+        try {
+            set_at(doc, impl_->paths[a], 0, to_document(point.values[a]), "");
+        } catch (const std::invalid_argument& e) {
+            throw InputError(spec.axes[a].key, at_point + ": " + e.what() + " (axis " + std::to_string(a) + ")",
+                             spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+        }
+    }
+    point.scenario_text = toml::format(doc, 0, std::numeric_limits<double>::max_digits10);
+    const std::string name = spec.scenario_path + " at point " + std::to_string(i);
+    try {
+        point.scenario = parse_scenario(point.scenario_text, name);
+    } catch (const InputError& e) {
+        for (std::size_t a = 0; a < spec.axes.size(); ++a)
+            if (key_covers(spec.axes[a].key, e.field()))
+                throw InputError(e.field(), at_point + ": " + bare_message(e) + " (axis " + spec.axes[a].key + ")",
+                                 spec.axes[a].location.empty() ? spec.source : spec.axes[a].location);
+        throw InputError(e.field(), at_point + ": " + bare_message(e) + " (a key of the base scenario " +
+                                        spec.scenario_path + ", with the point's values)",
+                         spec.scenario_location.empty() ? spec.source : spec.scenario_location);
+    }
+    return point;
+}
+
+void SweepPoints::check_all(const std::function<void(int checked)>& progress) const {
+    for (int i = 0; i < count_; ++i) {
+        point(i);  // built, checked and dropped: memory does not grow with the count
+        if (progress) progress(i + 1);
+    }
+}
+
+std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
+    const SweepPoints generator(spec);
+    std::vector<SweepPoint> points;
+    points.reserve(static_cast<std::size_t>(generator.size()));
+    for (int i = 0; i < generator.size(); ++i) points.push_back(generator.point(i));
     return points;
 }
 
@@ -479,49 +523,50 @@ const std::vector<std::string>& point_figure_columns() {
     return columns;
 }
 
-std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
-                                  std::string& note) {
+namespace {
+
+/// The point figures (point_figure_columns) of a run's loop figures and its largest |energy
+/// balance error| [J] (NaN for a run without records), as simulate's summary
+/// ("hysteresis", "fancher", "balance_error_max_abs").
+std::vector<double> figures_of(const LoopFigures& loop, long records, double max_abs_balance_j, std::string& note) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     std::vector<double> f(point_figure_columns().size(), nan);
-    note.clear();
-    const double period = options.loading.period_s();
-    if (period > 0.0) {
-        try {
-            const auto cycle = last_cycle(records, period);
-            const HysteresisMetrics m = hysteresis_metrics(records, cycle.first, cycle.second);
-            f[0] = m.loop_area_j;
-            f[1] = m.dissipated_j;
-            f[2] = m.secant_stiffness_n_per_m;
-            f[3] = m.dynamic_rate_n_per_m;
-            f[4] = m.loss_factor;
-            f[5] = m.equivalent_damping_ratio;
-            f[6] = m.force_min_n;
-            f[7] = m.force_max_n;
-            f[8] = m.w_min_m;
-            f[9] = m.w_max_m;
-            // the call simulate's summary makes (apps/cli/summary.cpp): the same figures
-            try {
-                const FancherFit fit = fit_fancher_loop(records, m.t_start_s, m.t_end_s).fit;
-                f[10] = fit.parameters.upper_rate_n_per_m;
-                f[11] = fit.parameters.upper_offset_n;
-                f[12] = fit.parameters.lower_rate_n_per_m;
-                f[13] = fit.parameters.lower_offset_n;
-                f[14] = fit.parameters.beta_m;
-                f[15] = fit.rms_error_relative;
-            } catch (const InputError& e) {
-                note = std::string("no Fancher fit: ") + e.what();
-            }
-        } catch (const InputError& e) {
-            note = e.what();
-        }
-    } else {
-        note = "no periodic loading: no steady cycle";
+    note = loop.note;
+    if (const auto& m = loop.metrics) {
+        f[0] = m->loop_area_j;
+        f[1] = m->dissipated_j;
+        f[2] = m->secant_stiffness_n_per_m;
+        f[3] = m->dynamic_rate_n_per_m;
+        f[4] = m->loss_factor;
+        f[5] = m->equivalent_damping_ratio;
+        f[6] = m->force_min_n;
+        f[7] = m->force_max_n;
+        f[8] = m->w_min_m;
+        f[9] = m->w_max_m;
     }
-    // the largest |energy balance error| over the run, as simulate's summary (balance_error_max_abs)
+    if (const auto& fit = loop.fancher) {
+        f[10] = fit->parameters.upper_rate_n_per_m;
+        f[11] = fit->parameters.upper_offset_n;
+        f[12] = fit->parameters.lower_rate_n_per_m;
+        f[13] = fit->parameters.lower_offset_n;
+        f[14] = fit->parameters.beta_m;
+        f[15] = fit->rms_error_relative;
+    } else if (!loop.fancher_note.empty()) {
+        note = "no Fancher fit: " + loop.fancher_note;
+    }
+    f[16] = records > 0 ? max_abs_balance_j : nan;
+    return f;
+}
+
+}  // namespace
+
+std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
+                                  std::string& note) {
+    // the loop figures of simulate's summary, from the same function (run/loop_figures.hpp)
     double balance = 0.0;
     for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
-    f[16] = records.empty() ? nan : balance;
-    return f;
+    return figures_of(loop_figures(records, options.loading.period_s()), static_cast<long>(records.size()), balance,
+                      note);
 }
 
 PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
@@ -533,15 +578,17 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     std::vector<StepRecord> records;
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
     try {
-        // as `stackbeam simulate --scenario` (apps/cli/main.cpp): build, system, contact path, simulate
+        // the library's run, as `stackbeam simulate --scenario` (run/run.hpp): build, system, run
         const Model model = Model::build(point.scenario.model);
         const System system(model);
-        choose_contact_path(system, point.scenario.simulation);
-        auto on_step = [&](const StepRecord&) {
-            if (stop && stop->load(std::memory_order_relaxed)) throw SweepStopped();
-        };
-        records = simulate(system, point.scenario.simulation, on_step);
-        result.figures = point_figures(records, point.scenario.simulation, result.message);
+        RunRequest run;
+        run.options = point.scenario.simulation;
+        // the stop flag before each record and inside an output interval (mode cvode polls it every 64 steps)
+        if (stop) run.stop = [stop] { return stop->load(std::memory_order_relaxed); };
+        RunSummary summary = run_scenario(system, run);
+        if (summary.interrupted) throw SweepStopped();
+        records = std::move(summary.records);
+        result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
         result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +
@@ -558,13 +605,20 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     result.wall_s = elapsed();
     if (with_records) {
         result.records = &records;
+        result.point = &point;
         with_records(result);
         result.records = nullptr;
+        result.point = nullptr;
     }
     return result;
 }
 
-int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+namespace {
+
+/// run_sweep over `count` points, point i given by point_at(i) (a stored point, or one made now).
+template <class PointAt>
+int run_sweep_with(std::size_t count, const PointAt& point_at, const SweepRunOptions& opts,
+                   const PointCallback& on_point_done) {
     int jobs = opts.jobs > 0 ? opts.jobs : static_cast<int>(std::thread::hardware_concurrency());
     if (jobs < 1) jobs = 1;
     std::mutex hand_out, report;
@@ -577,14 +631,14 @@ int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts
         std::lock_guard<std::mutex> lock(hand_out);
         if (stopped()) return -1;
         if (opts.next_point) return opts.next_point();
-        while (next < points.size() && next < opts.skip.size() && opts.skip[next]) ++next;
-        return next < points.size() ? static_cast<int>(next++) : -1;
+        while (next < count && next < opts.skip.size() && opts.skip[next]) ++next;
+        return next < count ? static_cast<int>(next++) : -1;
     };
     std::atomic<bool> abort{false};  // opts.stop, or a callback's exception
     auto worker = [&] {
         for (int i; (i = take()) >= 0;) {
             try {
-                run_point(points.at(static_cast<std::size_t>(i)), &abort, [&](const PointResult& r) {
+                run_point(point_at(i), &abort, [&](const PointResult& r) {
                     std::lock_guard<std::mutex> lock(report);
                     if (failed) return;
                     try {
@@ -609,20 +663,55 @@ int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts
     };
     // a watcher turns the caller's stop flag into `abort`, which the runs poll
     std::atomic<bool> done{false};
-    std::thread watcher([&] {
-        while (!done.load()) {
-            if (opts.stop && opts.stop->load()) abort = true;
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-    });
+    // a thread the system refuses (std::system_error: the process's thread or memory limit,
+    // e.g. `ulimit -u` / `ulimit -v`) stops the threads started and throws std::system_error
+    // naming the thread and the jobs asked for, never std::terminate on a joinable thread
+    auto refused = [&](const std::system_error& e, const std::string& which) {
+        return std::system_error(e.code(), "could not start " + which + " (jobs = " + std::to_string(jobs) +
+                                               "): the system's thread or memory limit; give fewer jobs");
+    };
     std::vector<std::thread> threads;
-    for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
-    worker();
+    threads.reserve(static_cast<std::size_t>(jobs));  // no allocation between the starts below
+    std::thread watcher;
+    try {
+        watcher = std::thread([&] {
+            while (!done.load()) {
+                if (opts.stop && opts.stop->load()) abort = true;
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            }
+        });
+    } catch (const std::system_error& e) {
+        throw refused(e, "the sweep's watcher thread");
+    }
+    std::optional<std::system_error> start_error;
+    for (int j = 1; j < jobs && !start_error; ++j) try {
+            threads.emplace_back(worker);
+        } catch (const std::system_error& e) {
+            start_error.emplace(refused(e, "the sweep's thread " + std::to_string(j + 1) + " of " + std::to_string(jobs)));
+            std::lock_guard<std::mutex> lock(hand_out);
+            failed = true;  // no more points handed out; the points in flight stop at their next check
+            abort = true;
+        }
+    if (!start_error) worker();
     for (auto& t : threads) t.join();
     done = true;
     watcher.join();
+    if (start_error) throw *start_error;
     if (error) std::rethrow_exception(error);
     return run;
+}
+
+}  // namespace
+
+int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+    return run_sweep_with(
+        points.size(), [&](int i) -> const SweepPoint& { return points.at(static_cast<std::size_t>(i)); }, opts,
+        on_point_done);
+}
+
+int run_sweep(const SweepPoints& points, const SweepRunOptions& opts, const PointCallback& on_point_done) {
+    return run_sweep_with(
+        static_cast<std::size_t>(points.size()), [&](int i) { return points.point(i); }, opts, on_point_done);
 }
 
 }  // namespace stackbeam

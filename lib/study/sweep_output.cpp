@@ -3,11 +3,16 @@
 #include "stackbeam/study/sweep_output.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <ctime>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +21,11 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <optional>
 #include <stdexcept>
+#include <tuple>
+
+#include "../io/toml_text.hpp"
 
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
@@ -123,27 +132,80 @@ std::string spec_difference(const nlohmann::json& old_spec, const nlohmann::json
     return "";
 }
 
-void write_whole(const std::string& path, const std::string& text) {
-    const std::string partial = path + ".partial";
-    {
-        std::ofstream out(partial, std::ios::out | std::ios::trunc | std::ios::binary);
-        if (!out) throw std::runtime_error("cannot open '" + partial + "' for writing");
-        out << text;
-        out.close();
-        if (out.fail()) throw std::runtime_error("writing '" + partial + "' failed");
+std::string system_reason() { return std::strerror(errno); }
+
+/// Writes all of `text` to `fd`; false with errno set on failure.
+bool write_all(int fd, const std::string& text) {
+    std::size_t written = 0;
+    while (written < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            if (n == 0) errno = EIO;
+            return false;
+        }
+        written += static_cast<std::size_t>(n);
     }
-    if (std::rename(partial.c_str(), path.c_str()) != 0)
-        throw std::runtime_error("cannot rename '" + partial + "' to '" + path + "'");
+    return true;
 }
 
+/// Writes `text` to PATH.partial, syncs it and renames it to PATH: PATH is the old file or
+/// the whole new one. Failures name the file and the system's reason (the partial removed).
+void write_whole(const std::string& path, const std::string& text) {
+    const std::string partial = path + ".partial";
+    const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error("cannot open '" + partial + "' for writing: " + system_reason());
+    if (!write_all(fd, text) || ::fsync(fd) != 0) {
+        const std::string why = system_reason();
+        ::close(fd);
+        ::unlink(partial.c_str());
+        throw std::runtime_error("writing '" + partial + "' failed: " + why);
+    }
+    if (::close(fd) != 0) {
+        const std::string why = system_reason();
+        ::unlink(partial.c_str());
+        throw std::runtime_error("writing '" + partial + "' failed: " + why);
+    }
+    if (std::rename(partial.c_str(), path.c_str()) != 0) {
+        const std::string why = system_reason();
+        ::unlink(partial.c_str());
+        throw std::runtime_error("cannot rename '" + partial + "' to '" + path + "': " + why);
+    }
+}
+
+/// The largest journal read back: 256 MiB (100,000 rows of ~0.4 kB are 40 MB).
+constexpr long long max_journal_bytes = 256LL * 1024 * 1024;
+
 std::string read_text(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return detail::read_input_file(path, "the sweep file", "--out-dir", "", max_journal_bytes);
 }
 
 const char* kJournal = "finished.csv";
+const char* kJournalId = "# stackbeam sweep journal: spec ";
+
+/// A row's axis cell as format_point_row writes the value (text_cell, unquoted by split_row).
+std::string axis_cell(const AxisValue& v) {
+    std::string s = to_string(v);
+    for (char& c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    return s;
+}
+
+/// parse_point_row that also hands back the axis cells.
+PointResult parse_row(const SweepSpec& spec, const std::string& row, std::vector<std::string>* axis_cells);
+
+/// The index of a per-point file's name "point-NNNN..." (-1 if it is not one).
+long long point_index_of(const std::string& name) {
+    if (name.rfind("point-", 0) != 0) return -1;
+    std::size_t i = 6, digits = 0;
+    long long index = 0;
+    while (i < name.size() && std::isdigit(static_cast<unsigned char>(name[i])) && digits < 12) {
+        index = index * 10 + (name[i] - '0');
+        ++i;
+        ++digits;
+    }
+    return digits == 0 ? -1 : index;
+}
 
 }  // namespace
 
@@ -163,14 +225,34 @@ std::string point_table_header(const SweepSpec& spec) {
 }
 
 std::string format_point_row(const SweepPoint& point, const PointResult& r) {
+    return format_point_row(point.values, r);
+}
+
+std::string format_point_row(const std::vector<AxisValue>& values, const PointResult& r) {
     std::string row = std::to_string(r.index);
-    for (const AxisValue& v : point.values) row += "," + text_cell(to_string(v));
+    for (const AxisValue& v : values) row += "," + text_cell(to_string(v));
     row += std::string(",") + to_string(r.status) + "," + text_cell(r.message);
     for (double f : r.figures) row += "," + number_cell(f);
     return row + "," + number_cell(r.wall_s);
 }
 
-PointResult parse_point_row(const SweepSpec& spec, const std::string& row) {
+std::string sweep_spec_id(const SweepSpec& spec) {
+    const std::string text = spec_json(spec).dump();
+    std::uint64_t h = 14695981039346656037ULL;  // FNV-1a, 64 bits
+    for (unsigned char c : text) {
+        h ^= c;
+        h *= 1099511628211ULL;
+    }
+    char id[17];
+    std::snprintf(id, sizeof id, "%016llx", static_cast<unsigned long long>(h));
+    return id;
+}
+
+PointResult parse_point_row(const SweepSpec& spec, const std::string& row) { return parse_row(spec, row, nullptr); }
+
+namespace {
+
+PointResult parse_row(const SweepSpec& spec, const std::string& row, std::vector<std::string>* axis_cells) {
     const auto cells = split_row(row);
     const std::size_t figures = point_figure_columns().size();
     const std::size_t expected = 1 + spec.axes.size() + 2 + figures + 1;
@@ -181,7 +263,9 @@ PointResult parse_point_row(const SweepSpec& spec, const std::string& row) {
     const std::string& index = cells[k++];
     if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos)
         throw std::invalid_argument("point '" + index + "' is not an index");
+    if (index.size() > 9) throw std::invalid_argument("point '" + index + "' is not an index");
     r.index = std::stoi(index);
+    if (axis_cells) axis_cells->assign(cells.begin() + 1, cells.begin() + 1 + static_cast<std::ptrdiff_t>(spec.axes.size()));
     k += spec.axes.size();
     const std::string& status = cells[k++];
     if (status == "ok") r.status = PointStatus::ok;
@@ -194,22 +278,98 @@ PointResult parse_point_row(const SweepSpec& spec, const std::string& row) {
     return r;
 }
 
+/// Throws when a row's axis cells are not point `index`'s values: `where` names the row.
+void check_row_values(const SweepSpec& spec, const std::vector<AxisValue>& values, const std::vector<std::string>& cells,
+                      int index, const std::string& where) {
+    for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        if (cells[a] != axis_cell(values[a]))
+            throw InputError("--out-dir", where + ": the row of point " + std::to_string(index) + " has " +
+                                              spec.axes[a].key + " = " + cells[a] + ", but point " +
+                                              std::to_string(index) + " of this spec has " + spec.axes[a].key + " = " +
+                                              axis_cell(values[a]) +
+                                              ": the journal holds another spec's results (never reused); use "
+                                              "another directory, or --restart to discard them");
+}
+
+}  // namespace
+
 SweepDirectory::SweepDirectory(std::string directory, const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                bool restart, bool keep_series)
-    : directory_(std::move(directory)), spec_(spec), points_(points), keep_series_(keep_series) {
-    finished_.assign(points.size(), false);
-    results_.resize(points.size());
+    : directory_(std::move(directory)), spec_(spec), count_(static_cast<int>(points.size())), keep_series_(keep_series) {
+    values_at_ = [&points](int i) { return points.at(static_cast<std::size_t>(i)).values; };
+    point_at_ = [&points](int i) { return points.at(static_cast<std::size_t>(i)); };
+    open(restart);
+}
+
+SweepDirectory::SweepDirectory(std::string directory, const SweepPoints& points, bool restart, bool keep_series)
+    : directory_(std::move(directory)), spec_(points.spec()), count_(points.size()), keep_series_(keep_series) {
+    values_at_ = [&points](int i) { return points.values(i); };
+    point_at_ = [&points](int i) { return points.point(i); };
+    open(restart);
+}
+
+SweepDirectory::~SweepDirectory() {
+    if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the flock
+}
+
+void SweepDirectory::open(bool restart) {
+    const std::size_t count = static_cast<std::size_t>(count_);
+    finished_.assign(count, false);
+    results_.resize(count);
     const fs::path dir(directory_);
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir))
         throw InputError("--out-dir", "cannot create the directory '" + directory_ + "'" + (ec ? ": " + ec.message() : ""));
-    const nlohmann::json now = spec_json(spec);
+
+    // the owner: an advisory lock on DIR/lock, held until this object goes (or the process dies)
+    const std::string lock_path = (dir / "lock").string();
+    lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0)
+        throw InputError("--out-dir", "cannot open the lock file '" + lock_path + "': " + system_reason());
+    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+        const std::string why = errno == EWOULDBLOCK ? "" : system_reason();
+        std::string holder;
+        char buffer[1024];
+        const ssize_t n = ::pread(lock_fd_, buffer, sizeof buffer - 1, 0);
+        if (n > 0) holder.assign(buffer, static_cast<std::size_t>(n));
+        while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+        ::close(lock_fd_);
+        lock_fd_ = -1;
+        if (!why.empty()) throw InputError("--out-dir", "cannot lock '" + lock_path + "': " + why);
+        throw InputError("--out-dir", "'" + directory_ + "' is in use by another sweep (" +
+                                          (holder.empty() ? std::string("its holder has not written its name yet") : holder) +
+                                          "): wait for it to end or stop it, or use another directory");
+    }
+    {
+        char host[256] = "?";
+        ::gethostname(host, sizeof host - 1);
+        host[sizeof host - 1] = '\0';
+        char when[32] = "?";
+        const std::time_t now = std::time(nullptr);
+        std::tm utc{};
+        if (::gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &utc);
+        const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + ", started " + when + ", spec " +
+                               spec_.source + "\n";
+        if (::ftruncate(lock_fd_, 0) != 0 || ::pwrite(lock_fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size()))
+            throw InputError("--out-dir", "cannot write the lock file '" + lock_path + "': " + system_reason());
+    }
+
+    const nlohmann::json now = spec_json(spec_);
     const fs::path spec_file = dir / "spec.json";
     const fs::path journal = dir / kJournal;
+    const std::string id_line = kJournalId + sweep_spec_id(spec_) + " (" + spec_.source + ")";
     if (restart) {
-        for (const char* f : {"spec.json", kJournal, "points.csv", "sweep.json"}) fs::remove(dir / f, ec);
-        for (const char* d : {"scenarios", "loops", "series", "figures"}) fs::remove_all(dir / d, ec);
+        auto remove = [&](const fs::path& path, bool tree) {
+            std::error_code rec;
+            if (tree) fs::remove_all(path, rec);
+            else fs::remove(path, rec);
+            if (rec)
+                throw InputError("--restart", "cannot delete '" + path.string() + "': " + rec.message() +
+                                                  " (nothing was run; the old results are still there)");
+        };
+        for (const char* f : {kJournal, "spec.json", "points.csv", "sweep.json"}) remove(dir / f, false);
+        for (const char* d : {"scenarios", "loops", "series", "figures"}) remove(dir / d, true);
     } else if (fs::exists(spec_file)) {
         nlohmann::json old_spec;
         try {
@@ -225,53 +385,88 @@ SweepDirectory::SweepDirectory(std::string directory, const SweepSpec& spec, con
         throw InputError("--out-dir", "'" + directory_ + "' holds sweep results without spec.json: use another "
                                       "directory, or --restart to discard them");
     }
-    const std::string header = point_table_header(spec);
+    const std::string header = point_table_header(spec_);
     if (fs::exists(journal)) {
-        // the finished points: every whole row (a line cut by a crash is dropped, its point runs again)
-        std::string text = read_text(journal.string());
-        std::size_t start = 0, kept = 0;
-        bool first = true;
-        while (start < text.size()) {
+        // the finished points: every whole row whose values are its point's; a damaged row is
+        // dropped (named by line) and the rows after it kept; a line cut by a crash is dropped
+        const std::string text = read_text(journal.string());
+        const std::string where = journal.string();
+        std::string kept = id_line + "\n" + header + "\n";
+        bool repaired = false, header_seen = false;
+        std::size_t start = 0;
+        for (long line_no = 1; start < text.size(); ++line_no) {
             const std::size_t end = text.find('\n', start);
-            if (end == std::string::npos) break;  // no newline: cut
-            const std::string line = text.substr(start, end - start);
-            if (first) {
-                if (line != header)
-                    throw InputError("--out-dir", "'" + journal.string() + "' has other columns than this program "
-                                                  "writes (another version?): use --restart to start over");
-                first = false;
-            } else {
-                PointResult r;
-                try {
-                    r = parse_point_row(spec, line);
-                } catch (const std::invalid_argument&) {
-                    break;  // a damaged row: the rest runs again
-                }
-                if (r.index < 0 || r.index >= static_cast<int>(points.size())) break;
-                finished_[static_cast<std::size_t>(r.index)] = true;
-                results_[static_cast<std::size_t>(r.index)] = r;
+            if (end == std::string::npos) {  // no newline: cut by a crash
+                notes_.push_back(where + " line " + std::to_string(line_no) +
+                                 ": a row cut short (the run was stopped while writing it) was dropped; its point runs again");
+                repaired = true;
+                break;
             }
+            const std::string line = text.substr(start, end - start);
             start = end + 1;
-            kept = start;
+            if (!header_seen) {
+                if (line.rfind(kJournalId, 0) == 0) {
+                    if (line_no != 1 || line.rfind(kJournalId + sweep_spec_id(spec_), 0) != 0)
+                        throw InputError("--out-dir", where + " line " + std::to_string(line_no) + " says '" + line +
+                                                          "', this spec is " + sweep_spec_id(spec_) + " (" + spec_.source +
+                                                          "): the journal holds another spec's results; use another "
+                                                          "directory, or --restart to discard them");
+                    continue;
+                }
+                if (line != header)
+                    throw InputError("--out-dir", "'" + where + "' has other columns than this program "
+                                                  "writes (another version?): use --restart to start over");
+                header_seen = true;
+                if (line_no == 1) repaired = true;  // a journal of an older version: its id line is added
+                continue;
+            }
+            PointResult r;
+            std::vector<std::string> cells;
+            try {
+                r = parse_row(spec_, line, &cells);
+                if (r.index < 0 || r.index >= count_)
+                    throw std::invalid_argument("point " + std::to_string(r.index) + " does not exist (the spec has " +
+                                                std::to_string(count_) + ")");
+            } catch (const std::invalid_argument& e) {
+                notes_.push_back(where + " line " + std::to_string(line_no) + ": a damaged row was dropped (" + e.what() +
+                                 "); the rows after it are kept, its point runs again");
+                repaired = true;
+                continue;
+            }
+            check_row_values(spec_, values_at_(r.index), cells, r.index, where + " line " + std::to_string(line_no));
+            finished_[static_cast<std::size_t>(r.index)] = true;
+            results_[static_cast<std::size_t>(r.index)] = r;
+            kept += line + "\n";
         }
-        if (kept < text.size()) {  // drop the damaged tail so that new rows follow whole ones
-            fs::resize_file(journal, kept, ec);
-            if (ec) throw std::runtime_error("cannot truncate '" + journal.string() + "': " + ec.message());
-        }
-        if (first) append(header);
+        if (!header_seen) repaired = true;  // empty, or only the id line
+        // a repaired journal is replaced whole (renamed over), so that new rows follow whole ones
+        if (repaired) write_whole(journal.string(), kept);
     } else {
         write_whole(spec_file.string(), now.dump(2) + "\n");
-        append(header);
+        write_whole(journal.string(), id_line + "\n" + header + "\n");
     }
     if (!fs::exists(spec_file)) write_whole(spec_file.string(), now.dump(2) + "\n");
-    fs::create_directories(dir / "scenarios", ec);
-    fs::create_directories(dir / "loops", ec);
-    if (keep_series_) fs::create_directories(dir / "series", ec);
-    for (const SweepPoint& p : points) {
-        const std::string file = point_file(directory_, "scenarios", p.index, "toml");
-        if (!fs::exists(file))
-            write_whole(file, "# point " + std::to_string(p.index) + " of the sweep " + spec.source +
-                                  " (stackbeam simulate --scenario FILE --out OUT.csv runs it)\n" + p.scenario_text);
+    // the files of points without a row are another run's: removed, never reused
+    for (const char* kind : {"scenarios", "loops", "series"}) {
+        const fs::path folder = dir / kind;
+        if (!fs::is_directory(folder, ec)) continue;
+        for (const auto& entry : fs::directory_iterator(folder, ec)) {
+            const long long index = point_index_of(entry.path().filename().string());
+            if (index >= 0 && index < count_ && finished_[static_cast<std::size_t>(index)]) continue;
+            std::error_code rec;
+            fs::remove(entry.path(), rec);
+            if (rec)
+                throw InputError("--out-dir", "cannot delete the stale file '" + entry.path().string() +
+                                                  "' (no row of this sweep owns it): " + rec.message());
+        }
+    }
+    for (const char* kind : {"scenarios", "loops"}) {
+        fs::create_directories(dir / kind, ec);
+        if (ec) throw InputError("--out-dir", "cannot create '" + (dir / kind).string() + "': " + ec.message());
+    }
+    if (keep_series_) {
+        fs::create_directories(dir / "series", ec);
+        if (ec) throw InputError("--out-dir", "cannot create '" + (dir / "series").string() + "': " + ec.message());
     }
 }
 
@@ -283,25 +478,33 @@ int SweepDirectory::finished_count() const {
 
 void SweepDirectory::append(const std::string& row) {
     const std::string path = (fs::path(directory_) / kJournal).string();
-    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT, 0644);
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0) throw std::runtime_error("cannot open '" + path + "': " + std::strerror(errno));
-    const std::string line = row + "\n";
-    std::size_t written = 0;
-    while (written < line.size()) {
-        const ssize_t n = ::write(fd, line.data() + written, line.size() - written);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            ::close(fd);
-            throw std::runtime_error("writing '" + path + "' failed: " + std::strerror(errno));
-        }
-        written += static_cast<std::size_t>(n);
+    struct stat before {};
+    const bool sized = ::fstat(fd, &before) == 0;
+    if (!write_all(fd, row + "\n")) {
+        // a row written in part (a full disk) is cut back off: the journal ends on whole rows
+        const std::string why = system_reason();
+        if (sized) (void)::ftruncate(fd, before.st_size);
+        ::close(fd);
+        throw std::runtime_error("writing '" + path + "' failed: " + why);
     }
     const bool synced = ::fsync(fd) == 0;
     ::close(fd);
     if (!synced) throw std::runtime_error("fsync of '" + path + "' failed: " + std::strerror(errno));
 }
 
-void write_point_files(const std::string& directory, const SweepPoint& point, const PointResult& r, bool keep_series) {
+void write_point_files(const std::string& directory, const SweepPoint& point, const PointResult& r, bool keep_series,
+                       const std::string& spec_source) {
+    write_whole(point_file(directory, "scenarios", r.index, "toml"),
+                "# point " + std::to_string(r.index) + " of the sweep " + (spec_source.empty() ? "" : spec_source + " ") +
+                    "(stackbeam simulate --scenario FILE --out OUT.csv runs it)\n" + point.scenario_text);
+    // an older run's files of this point go first: those written below are this row's
+    for (const auto& [kind, ext, suffix] : {std::tuple<const char*, const char*, const char*>{"loops", "csv", ""},
+                                            {"loops", "csv", "-fancher"}, {"series", "csv", ""}}) {
+        std::error_code ec;
+        fs::remove(point_file(directory, kind, r.index, ext, suffix), ec);
+    }
     if (r.records && r.status == PointStatus::ok) {
         const auto& records = *r.records;
         const double period = point.scenario.simulation.loading.period_s();
@@ -355,8 +558,11 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
 }
 
 void SweepDirectory::record(const PointResult& r) {
-    const SweepPoint& point = points_.at(static_cast<std::size_t>(r.index));
-    write_point_files(directory_, point, r, keep_series_);
+    if (r.index < 0 || r.index >= count_) throw std::invalid_argument("record: no point " + std::to_string(r.index));
+    std::optional<SweepPoint> made;
+    if (!r.point) made = point_at_(r.index);
+    const SweepPoint& point = r.point ? *r.point : *made;
+    write_point_files(directory_, point, r, keep_series_, spec_.source);
     append(format_point_row(point, r));  // last: a point is finished once its row is on disk
     finished_[static_cast<std::size_t>(r.index)] = true;
     results_[static_cast<std::size_t>(r.index)] = r;
@@ -364,9 +570,11 @@ void SweepDirectory::record(const PointResult& r) {
 }
 
 void SweepDirectory::record_row(const std::string& row) {
-    const PointResult r = parse_point_row(spec_, row);
-    if (r.index < 0 || r.index >= static_cast<int>(points_.size()))
+    std::vector<std::string> cells;
+    const PointResult r = parse_row(spec_, row, &cells);
+    if (r.index < 0 || r.index >= count_)
         throw std::invalid_argument("row of point " + std::to_string(r.index) + ": no such point");
+    check_row_values(spec_, values_at_(r.index), cells, r.index, "a row sent by another process");
     append(row);
     finished_[static_cast<std::size_t>(r.index)] = true;
     results_[static_cast<std::size_t>(r.index)] = r;
@@ -376,13 +584,13 @@ void SweepDirectory::finish(const SweepTotals& totals) {
     std::string table = point_table_header(spec_) + "\n";
     int ok = 0, failed = 0, input = 0, missing = 0;
     double point_wall = 0.0;
-    for (std::size_t i = 0; i < points_.size(); ++i) {
+    for (std::size_t i = 0; i < finished_.size(); ++i) {
         if (!finished_[i]) {
             ++missing;
             continue;
         }
         const PointResult& r = results_[i];
-        table += format_point_row(points_[i], r) + "\n";
+        table += format_point_row(values_at_(static_cast<int>(i)), r) + "\n";
         point_wall += r.wall_s;
         (r.status == PointStatus::ok ? ok : r.status == PointStatus::failed ? failed : input) += 1;
     }
@@ -392,7 +600,7 @@ void SweepDirectory::finish(const SweepTotals& totals) {
     j["spec"] = spec_json(spec_);
     j["spec"]["source"] = spec_.source;
     j["spec"]["description"] = spec_.description;
-    j["counts"] = {{"points", points_.size()}, {"ok", ok}, {"failed", failed}, {"input_error", input}, {"not_run", missing}};
+    j["counts"] = {{"points", count_}, {"ok", ok}, {"failed", failed}, {"input_error", input}, {"not_run", missing}};
     j["complete"] = missing == 0;
     j["wall_time_s"] = totals.wall_s;
     j["points_wall_time_s"] = point_wall;

@@ -22,6 +22,7 @@ struct ClosedFormStepper::Impl {
     const StepRecord& advance();
     std::vector<PairRecord> pairs() const;
     std::vector<LeafNodes> nodes() const;
+    Eigen::VectorXd displacements_now() const;
     std::vector<PairState> pair_states() const;
 
     const System& system_;
@@ -64,6 +65,7 @@ const StepRecord& ClosedFormStepper::current() const noexcept { return impl_->re
 long ClosedFormStepper::record_index() const noexcept { return impl_->step_; }
 std::vector<PairRecord> ClosedFormStepper::pairs() const { return impl_->pairs(); }
 std::vector<LeafNodes> ClosedFormStepper::nodes() const { return impl_->nodes(); }
+Stresses ClosedFormStepper::stresses() const { return compute_stresses(impl_->system_, impl_->displacements_now(), pairs()); }
 RunReport ClosedFormStepper::report() const { return impl_->report_; }
 const Eigen::VectorXd& ClosedFormStepper::contact_forces() const noexcept { return impl_->p_; }
 const Eigen::VectorXd& ClosedFormStepper::relative_positions() const noexcept { return impl_->rel_; }
@@ -179,8 +181,12 @@ std::vector<PairRecord> ClosedFormStepper::Impl::pairs() const {
     return detail::pair_records(system_, problem_, p_, rel_);
 }
 
+Eigen::VectorXd ClosedFormStepper::Impl::displacements_now() const {
+    return op_->has_displacements() ? z_ : system_.reduced_displacements(p_, w_);
+}
+
 std::vector<LeafNodes> ClosedFormStepper::Impl::nodes() const {
-    return system_.leaf_nodes(op_->has_displacements() ? z_ : system_.reduced_displacements(p_, w_));
+    return system_.leaf_nodes(displacements_now());
 }
 
 const StepRecord& ClosedFormStepper::Impl::advance() {

@@ -31,6 +31,10 @@ struct InitialState {
     bool rig = false;           ///< R's motion prescribed (LoadingKind::prescribed_displacement)
     bool pre_stressed = false;  ///< a static step ran (assembly or gravity)
     SolveResult solve;          ///< the last contact solve of the stage (converged when none ran)
+    /// Event steppers: locate transitions by CVODE's root-finding (the method). false, for tests
+    /// only (no option or scenario key): the per-step contact check alone finds them, by bisection
+    /// on the dense output, to test that safety net (tests/test_cvode.cpp).
+    bool root_finding = true;
 };
 
 /// The stage for `stepper`: check_capabilities, then the state before t = 0 by the row's

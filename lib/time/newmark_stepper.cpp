@@ -87,6 +87,12 @@ const StepRecord& NewmarkStepper::current() const noexcept { return impl_->recor
 long NewmarkStepper::record_index() const noexcept { return impl_->step_; }
 std::vector<PairRecord> NewmarkStepper::pairs() const { return impl_->pairs(); }
 std::vector<LeafNodes> NewmarkStepper::nodes() const { return impl_->system_.leaf_nodes(impl_->z_); }
+Stresses NewmarkStepper::stresses() const {
+    if (!impl_->massive_leaves_) return compute_stresses(impl_->system_, impl_->z_, pairs());
+    // the leaves' distributed loads at t (decision 061): a and v of the step's update (M a = G^T p - K z - C v + q)
+    const double a_frame = impl_->options_.loading.gravity_m_per_s2 + impl_->load_.base_acceleration(impl_->t_);
+    return compute_stresses(impl_->system_, impl_->z_, pairs(), LeafMotion{impl_->a_, impl_->v_, a_frame, impl_->options_.damping});
+}
 RunReport NewmarkStepper::report() const { return impl_->report_; }
 const Eigen::VectorXd& NewmarkStepper::displacements() const noexcept { return impl_->z_; }
 const Eigen::VectorXd& NewmarkStepper::velocities() const noexcept { return impl_->v_; }

@@ -23,12 +23,31 @@ std::string number_text(double v) {
     return buf;
 }
 
-const char* to_word(TauRule rule) { return rule == TauRule::current ? "current" : "previous-step"; }
+}  // namespace
+
+template <>
+const std::vector<EnumWord<TauRule>>& enum_words<TauRule>() {
+    static const std::vector<EnumWord<TauRule>> words = {
+        {TauRule::current, "current"},
+        {TauRule::previous_step, "previous-step"},
+    };
+    return words;
+}
+
+namespace {
+
+const char* to_word(TauRule rule) { return word_of(rule); }
 
 TauRule parse_tau_rule(const std::string& text, const std::string& field) {
-    if (text == "current") return TauRule::current;
-    if (text == "previous-step") return TauRule::previous_step;
-    throw InputError(field, "value '" + text + "' is not a tau rule: allowed current, previous-step");
+    if (const auto rule = find_word<TauRule>(text)) return *rule;
+    throw InputError(field, "value '" + text + "' is not a tau rule: allowed " + word_list<TauRule>());
+}
+
+/// A keyword option's choices for the table and --help: "a | b | c" from the enum's word table.
+template <class E>
+const char* choices_of() {
+    static const std::string text = word_list<E>("", " | ");
+    return text.c_str();
 }
 
 // Builders of the rows: a number, an integer, a keyword.
@@ -55,7 +74,7 @@ std::vector<OptionSpec> make_table() {
                 "time stepping: closed-form (the paper's exact step, fixed dt), cvode (SUNDIALS CVODE, root-finding "
                 "on every stick-slip and open-close transition), newmark (leaves with mass, --beam-density; "
                 "average-acceleration Newmark, fixed dt)",
-                "closed-form | cvode | newmark", [](const O& o) { return std::string(to_string(o.mode)); },
+                choices_of<Mode>(), [](const O& o) { return std::string(to_string(o.mode)); },
                 [](O& o, S t, S f) { o.mode = parse_mode(t, f); }),
         real("dt_s", "integrator.dt_s", "--dt", "", "s", "time step (mode cvode: the output interval)", 0.0, true, kInf,
              false, "", [](const O& o) { return o.dt_s; }, [](O& o, double v) { o.dt_s = v; }),
@@ -63,7 +82,7 @@ std::vector<OptionSpec> make_table() {
              [](const O& o) { return o.t_end_s; }, [](O& o, double v) { o.t_end_s = v; }),
         keyword("tau_rule", "integrator.tau_rule", "--tau-rule",
                 "friction limit of a step: from the step's own normal forces (current) or the previous step's",
-                "current | previous-step", [](const O& o) { return std::string(to_word(o.tau_rule)); },
+                choices_of<TauRule>(), [](const O& o) { return std::string(to_word(o.tau_rule)); },
                 [](O& o, S t, S f) { o.tau_rule = parse_tau_rule(t, f); }),
         real("restitution", "integrator.restitution", "--restitution", "", "-",
              "mode newmark with massive leaves: the impact law's normal restitution coefficient", 0.0, false, 1.0,
@@ -72,12 +91,12 @@ std::vector<OptionSpec> make_table() {
         keyword("contact_path", "integrator.contact_path", "--contact-path",
                 "contact problem: auto (dense below kSparsePathMinComponents = 150 contact components, else "
                 "sparse), dense, sparse (exact solver only; not in mode cvode)",
-                "auto | dense | sparse", [](const O& o) { return std::string(to_string(o.contact_path)); },
+                choices_of<ContactPath>(), [](const O& o) { return std::string(to_string(o.contact_path)); },
                 [](O& o, S t, S f) { o.contact_path = parse_contact_path(t, f); }),
         keyword("solver.kind", "integrator.solver.kind", "--solver",
                 "contact solver (every mode; in mode cvode the per-step check): exact (active set), accelerated "
                 "(eq. 17, E = per-pair block inverse), block-jacobi, paper (eq. 17, E = I)",
-                "exact | accelerated | block-jacobi | paper",
+                choices_of<SolverKind>(),
                 [](const O& o) { return std::string(to_string(o.solver.kind)); },
                 [](O& o, S t, S f) { o.solver.kind = parse_solver_kind(t, f); }),
         real("solver.tolerance_m", "integrator.solver.tolerance_m", "--tolerance", "--tol", "m",
@@ -115,7 +134,7 @@ std::vector<OptionSpec> make_table() {
                 "mode cvode, massive leaves with friction: the whole massive stack (needs an elastic layer on every "
                 "contact row), the stack's modes below the cut with a massless contact layer, or auto (massive "
                 "where every row is elastic, else modal) (docs/time-integration.md)",
-                "auto | massive | modal", [](const O& o) { return std::string(to_string(o.cvode.leaf_inertia)); },
+                choices_of<LeafInertia>(), [](const O& o) { return std::string(to_string(o.cvode.leaf_inertia)); },
                 [](O& o, S t, S f) { o.cvode.leaf_inertia = parse_leaf_inertia(t, f); }),
         real("damping.rayleigh_alpha_per_s", "integrator.damping.rayleigh_alpha_per_s", "--rayleigh-alpha", "", "1/s",
              "structural damping C = alpha M + beta K of the leaves, mass coefficient (mode cvode, massive stack)", 0.0,

@@ -43,36 +43,37 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.damping_energy_j};
 }
 
-const char* to_string(Mode m) {
-    switch (m) {
-        case Mode::closed_form: return "closed-form";
-        case Mode::cvode: return "cvode";
-        case Mode::newmark: return "newmark";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<Mode>>& enum_words<Mode>() {
+    static const std::vector<EnumWord<Mode>> words = {
+        {Mode::closed_form, "closed-form"},
+        {Mode::cvode, "cvode"},
+        {Mode::newmark, "newmark"},
+    };
+    return words;
 }
+
+template <>
+const std::vector<EnumWord<LeafInertia>>& enum_words<LeafInertia>() {
+    static const std::vector<EnumWord<LeafInertia>> words = {
+        {LeafInertia::automatic, "auto"},
+        {LeafInertia::massive, "massive"},
+        {LeafInertia::modal, "modal"},
+    };
+    return words;
+}
+
+const char* to_string(Mode m) { return word_of(m); }
+const char* to_string(LeafInertia kind) { return word_of(kind); }
 
 Mode parse_mode(const std::string& text, const std::string& field) {
-    if (text == "closed-form") return Mode::closed_form;
-    if (text == "cvode") return Mode::cvode;
-    if (text == "newmark") return Mode::newmark;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed closed-form, cvode, newmark");
-}
-
-const char* to_string(LeafInertia kind) {
-    switch (kind) {
-        case LeafInertia::automatic: return "auto";
-        case LeafInertia::massive: return "massive";
-        case LeafInertia::modal: return "modal";
-    }
-    return "?";
+    if (const auto mode = find_word<Mode>(text)) return *mode;
+    throw InputError(field, "value '" + text + "' is not a mode: allowed " + word_list<Mode>());
 }
 
 LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field) {
-    if (text == "auto") return LeafInertia::automatic;
-    if (text == "massive") return LeafInertia::massive;
-    if (text == "modal") return LeafInertia::modal;
-    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed auto, massive, modal");
+    if (const auto kind = find_word<LeafInertia>(text)) return *kind;
+    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed " + word_list<LeafInertia>());
 }
 
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {

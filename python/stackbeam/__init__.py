@@ -18,6 +18,8 @@ from collections.abc import Mapping as _Mapping
 
 from ._core import (
     InputError,
+    InputTypeError,
+    ThreadStartError,
     SolverError,
     Scenario,
     Leaf,
@@ -32,14 +34,15 @@ from ._core import (
     paper_example,
     option_table,
     step_record_columns,
+    export_fmu,
 )
 from . import _core
 
 __all__ = [
-    "InputError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
+    "InputError", "InputTypeError", "ThreadStartError", "SolverError", "Scenario", "Leaf", "LeafProfile", "LeafEnd", "Interface", "Clamp", "Clip",
     "Probe", "TimeFunction", "load_scenario", "paper_example", "option_table", "simulate", "make_stepper",
-    "sweep", "SweepResult",
-    "Result", "Stepper",
+    "sweep", "SweepResult", "MAX_SWEEP_JOBS", "fit",
+    "Result", "Stepper", "export_fmu",
 ]
 
 
@@ -71,12 +74,25 @@ Scenario.__repr__ = lambda s: "<stackbeam.Scenario %s: %d leaves, mode %s, t_end
     s.source, len(s.model.leaves), s.simulation.mode, s.simulation.t_end_s)
 
 
-def _input_error(field, message):
-    """An InputError raised from Python, as the C++ ones: ``field`` the name given, ``location`` empty."""
-    error = InputError("%s: %s" % (field, message))
+def _input_error(field, message, kind=InputError):
+    """An InputError (or InputTypeError) raised from Python, as the C++ ones: ``field`` the name
+    given, ``location`` empty."""
+    error = kind("%s: %s" % (field, message))
     error.field = field
     error.location = ""
     return error
+
+
+def _check_bool(name, value):
+    if not isinstance(value, bool):
+        raise _input_error(name, "value %r is not allowed: must be True or False" % (value,), InputTypeError)
+
+
+def _check_path(name, value):
+    if not isinstance(value, (str, _os.PathLike)):
+        raise _input_error(name, "value %r is not allowed: must be a path (a str or an os.PathLike)" % (value,),
+                           InputTypeError)
+    return _os.fspath(value)
 
 
 def _flatten_options(options, prefix=""):
@@ -153,11 +169,15 @@ def simulate(scenario, *, pairs=False, nodes=False, **options):
     N records on a mesh of n nodes keeps 5 N n numbers).
 
     The GIL is released while the run steps, so runs on Python threads run in parallel;
-    Ctrl-C raises KeyboardInterrupt at the first record after about 20 ms (the run is dropped)."""
+    Ctrl-C raises KeyboardInterrupt within about 20 ms of the run's next stop check (before every
+    record, and every 64 internal steps of mode cvode; the run is dropped)."""
     flat = _flatten_options(options)
+    if not isinstance(scenario, Scenario):
+        raise _input_error("scenario", "value %r is not allowed: must be a stackbeam.Scenario" % (scenario,), InputTypeError)
     for name, value in (("pairs", pairs), ("nodes", nodes)):
         if not isinstance(value, bool):
-            raise _input_error(name, "value %r is not a bool: give True to keep them, False (the default) not to" % (value,))
+            raise _input_error(name, "value %r is not a bool: give True to keep them, False (the default) not to" % (value,),
+                               InputTypeError)
     raw = _core._run(scenario, flat, pairs, nodes)
     return Result(raw, scenario.copy(), flat)
 
@@ -187,18 +207,23 @@ def sweep(spec, *, jobs=None, out_dir=None, restart=False, keep_series=False):
     """Runs the sweep spec file `spec` (docs/sweep.md) as `stackbeam sweep` does and returns its
     points table (a SweepResult), figure for figure the command line's points.csv.
 
-    ``jobs``: threads (default: the machine's cores). Every point's scenario is read and checked
+    ``jobs``: threads (default None: the machine's cores), an int from 1 to MAX_SWEEP_JOBS (1024);
+    a thread the system refuses (its thread or memory limit) raises ThreadStartError. Every point's scenario is read and checked
     before any run: a bad spec raises InputError naming the spec file's line, the key and the
     point. ``out_dir``: also keep the results in that directory as the command line does
     (journal, points.csv, sweep.json, loops; ``keep_series`` the records; an interrupted sweep
     is resumed by the same call, ``restart=True`` starts over); without it nothing is written.
     The GIL is released while the points run; Ctrl-C stops the sweep (KeyboardInterrupt)."""
-    raw = _core._sweep(_os.fspath(spec), int(jobs or 0), _os.fspath(out_dir) if out_dir else "", bool(restart),
-                       bool(keep_series))
+    spec = _check_path("spec", spec)
+    out_dir = "" if out_dir is None else _check_path("out_dir", out_dir)
+    _check_bool("restart", restart)
+    _check_bool("keep_series", keep_series)
+    raw = _core._sweep(spec, jobs, out_dir, restart, keep_series)
     return SweepResult(raw)
 
 
 Stepper = _core.Stepper  # advance(), pairs(), nodes(), report(), current, record_index, records, dt_s
+MAX_SWEEP_JOBS = _core.MAX_SWEEP_JOBS
 
 
 def _stepper_iter(self):
@@ -214,5 +239,19 @@ def make_stepper(scenario, **options):
     """A run of `scenario` one record at a time (co-simulation loops), options as in simulate():
     ``advance()`` returns the next record (a dict of the CSV's columns), ``pairs()`` the contact
     pairs at the current one, ``nodes()`` every leaf's nodes there, ``current`` the current record, ``record_index``, ``records``
-    (to t_end_s), ``dt_s``, ``report()``. Iterating over it advances to the end."""
+    (to t_end_s), ``dt_s``, ``report()``. Iterating over it advances to the end; advance() past
+    the last record raises InputError (field "advance"). Ctrl-C inside advance() raises
+    KeyboardInterrupt and leaves the stepper at its last record."""
+    if not isinstance(scenario, Scenario):
+        raise _input_error("scenario", "value %r is not allowed: must be a stackbeam.Scenario" % (scenario,), InputTypeError)
     return Stepper(scenario, _flatten_options(options))
+
+
+def fit(spec, *, jobs=None):
+    """Fits the scenario keys of the fit spec file `spec` (docs/calibration.md) to its measured
+    loops, as `stackbeam fit` does, and returns a dict: ``parameters`` (key, value,
+    standard_error, identifiable, note, ...), ``correlation``, ``warnings``, ``cost``,
+    ``runs``, ``loops`` (name, w_m, measured_force_n, fitted_force_n, branch as numpy arrays;
+    the loop areas), ``history`` and ``fitted_scenario`` (TOML text). Writes no file; the GIL
+    is released while the runs go on ``jobs`` threads (None: the machine's cores)."""
+    return _core._fit(str(spec), jobs)

@@ -67,6 +67,21 @@ def loop(result, ax=None):
     return _finish(ax, "force-deflection loop", "w [mm]", "spring force [N]", legend=False)
 
 
+def fit_loops(fit_result, ax=None):
+    """The measured loops (points) and the fitted ones (lines, each branch on its own) of
+    stackbeam.fit's result, against w [mm]."""
+    ax = _axes(ax)
+    for loop in fit_result["loops"]:
+        w = 1000 * _np.asarray(loop["w_m"])
+        line = ax.plot(w, loop["measured_force_n"], ".", ms=3, label=f"{loop['name']} measured")[0]
+        for b in (1, -1):
+            sel = _np.asarray(loop["branch"]) == b
+            order = _np.argsort(w[sel])
+            ax.plot(w[sel][order], _np.asarray(loop["fitted_force_n"])[sel][order], "-", color=line.get_color(), lw=1,
+                    label=f"{loop['name']} fitted" if b == 1 else None)
+    return _finish(ax, "measured and fitted loops", "w [mm]", "spring force [N]")
+
+
 FIGURES = {"displacement": displacement, "force": force, "friction": friction, "loop": loop}
 
 

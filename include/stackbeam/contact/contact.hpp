@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "stackbeam/contact/pair.hpp"
+#include "stackbeam/contact/sparse_methods.hpp"
 
 namespace stackbeam {
 
@@ -64,6 +65,8 @@ enum class SolverKind {
     exact,        ///< active-set direct solver, factorisation reused while the modes stay (default)
     block_jacobi, ///< eq. 17 with E = per-pair 2x2 block inverse of W, applied to all pairs at once
 };
+template <>
+const std::vector<EnumWord<SolverKind>>& enum_words<SolverKind>();
 const char* to_string(SolverKind kind);
 /// Parses "paper" | "accelerated" | "block-jacobi" | "exact"; throws InputError naming `field`.
 SolverKind parse_solver_kind(const std::string& text, const std::string& field);
@@ -174,7 +177,7 @@ struct SparseContactProblem {
 /// same way). If all that fails, a problem of at most 4000 rows is
 /// finished by the dense exact solver on to_dense() (SolveResult::fell_back); a larger
 /// one returns converged = false with a message. (The units: lib/contact/sparse/; tests force
-/// each transition and box-QP method alone through lib/contact/sparse/switches.hpp.)
+/// each transition and box-QP method alone through SparsePathTuning::methods.)
 ///
 /// How SparseContactSolver solves the linear problem of a set of modes (the defaults
 /// are the measured choices, docs/decisions/002-sparse-contact-path.md; tests set them to force each way; the three
@@ -201,6 +204,13 @@ struct SparsePathTuning {
     /// another of the modes within the threshold, e.g. 1.03e-9 J against 0.70e-9 J of
     /// energy-balance round-off on the paper example with steel leaves)
     int newton_min_rows = 200;
+    /// The transition, box-QP and linear-route methods (sparse_methods.hpp): the defaults are
+    /// the measured choices; tests and benchmarks/ set a field to check or measure one way alone.
+    SparsePathMethods methods;
+    /// Where not null, the solver records its transition steps there (counters per route and
+    /// phase, per-step traces: a study aid, docs/decisions/036). The caller owns it; it must
+    /// outlive the solver. nullptr (default): nothing recorded and nothing costs.
+    SparsePathObserver* observer = nullptr;
 };
 
 class SparseContactSolver {

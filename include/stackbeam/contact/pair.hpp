@@ -3,6 +3,7 @@
 /// The contact laws of one pair and how its friction limit is taken: the vocabulary the
 /// contact layer (the ground numerics layer: Eigen only) shares with the model above it.
 /// Sign convention: conventions.hpp.
+#include "stackbeam/words.hpp"
 
 namespace stackbeam {
 
@@ -29,5 +30,7 @@ enum class TauRule {
     current,        ///< tau from the current normal force p_n^j: Coulomb exactly
     previous_step,  ///< tau from the converged previous step (the paper's fallback)
 };
+template <>
+const std::vector<EnumWord<TauRule>>& enum_words<TauRule>();
 
 }  // namespace stackbeam

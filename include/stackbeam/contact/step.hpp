@@ -30,6 +30,8 @@ enum class ContactPath {
     dense,      ///< ContactProblem: the dense W (O(m^2) memory, O(m^3) set-up); every solver
     sparse,     ///< SparseContactProblem on the banded stiffness, near-linear in the elements; exact solver only
 };
+template <>
+const std::vector<EnumWord<ContactPath>>& enum_words<ContactPath>();
 const char* to_string(ContactPath path);
 /// Parses "auto" | "dense" | "sparse"; throws InputError naming `field`.
 ContactPath parse_contact_path(const std::string& text, const std::string& field);

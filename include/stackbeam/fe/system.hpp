@@ -105,6 +105,10 @@ public:
     /// Displacements (u, v, theta) of every leaf node [m, m, rad] for contact forces p
     /// and rigid-body displacement w: index 3*node_dof(leaf, node) + {0,1,2}.
     Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
+    /// Displacements (u, v, theta) of every leaf node [m, m, rad] for reduced displacements
+    /// z = [z_r; w] (num_reduced_dofs() entries), indexed as leaf_displacements(p, w); from the
+    /// leaves' free shapes. InputError naming z when it has the wrong size.
+    Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& z) const;
     /// Offset of (leaf, node) in leaf_displacements() / 3, or -1 if the leaf has no such node.
     int node_dof(int leaf, int node) const;
     /// Every leaf's nodes (x, v, theta) for reduced displacements z = [z_r; w] (w last,

@@ -29,6 +29,12 @@ struct ScenarioOutputs {
     std::string plot_prefix;  ///< `[outputs] plot_prefix`: PNG figures PREFIX_*.png (gnuplot), optional
 };
 
+/// The words of `[[interfaces]] law` (and of the Python module's Interface.law): coulomb,
+/// frictionless (InterfaceLaw::coulomb with friction_coefficient 0), bonded.
+enum class InterfaceLawWord { coulomb, frictionless, bonded };
+template <>
+const std::vector<EnumWord<InterfaceLawWord>>& enum_words<InterfaceLawWord>();
+
 /// A parsed, validated scenario.
 struct Scenario {
     std::string source;        ///< the file name (or the name given to parse_scenario)

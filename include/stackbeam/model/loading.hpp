@@ -39,10 +39,32 @@
 /// cell between R and the spring reads lambda - m w_p'' (the leaves' inertia included), and
 /// w(t) must then be smooth (validate(true): a triangle is refused, a table splined).
 /// Energy balance of every loading: E(0) + W_ext(t) = kinetic + strain + dissipated.
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "stackbeam/words.hpp"
+
 namespace stackbeam {
+
+/// Samples of a function of time supplied by the caller while the run goes: the seat
+/// displacement an FMU's importer sets at each communication point (docs/fmu.md). At a
+/// sample's time the function and its two derivatives are the sample's values exactly;
+/// between two samples each of the three is interpolated linearly (a first-order hold);
+/// before the first sample the first, after the last the last. Units: those of the
+/// function it stands for ([m], [m/s], [m/s^2] for a displacement).
+struct ExternalSamples {
+    std::vector<double> times_s;             ///< strictly increasing [s]
+    std::vector<double> values;              ///< f(t_i)
+    std::vector<double> derivatives;         ///< f'(t_i) [unit/s]
+    std::vector<double> second_derivatives;  ///< f''(t_i) [unit/s^2]
+    /// Appends a sample at t_s; a sample at the last sample's time (or earlier) replaces
+    /// the samples from there on (a caller that steps back). Values are not checked here.
+    void set(double t_s, double value, double derivative, double second_derivative);
+    double value(double t_s) const;
+    double derivative(double t_s) const;
+    double second_derivative(double t_s) const;
+};
 
 /// A scalar function of time, in the unit of what it describes ([N] or [m]).
 struct TimeFunction {
@@ -78,8 +100,14 @@ struct TimeFunction {
 
     /// Spline second derivatives at the table's points (smooth tables; filled by prepare()).
     std::vector<double> spline_m2;
+    /// When set, value(), derivative() and second_derivative() are the caller's samples
+    /// (ExternalSamples, filled while the run goes, e.g. by an FMU) whatever the shape: the
+    /// steppers copy the TimeFunction and share the samples. Not written to scenario files.
+    std::shared_ptr<const ExternalSamples> external;
 };
 
+template <>
+const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>();
 const char* to_string(TimeFunction::Shape shape);
 
 enum class LoadingKind {
@@ -88,6 +116,8 @@ enum class LoadingKind {
     prescribed_displacement,  ///< w(t) imposed on R: the test-rig loop
     base_excitation,          ///< the supports move by y_b(t) (plus the initial conditions)
 };
+template <>
+const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>();
 const char* to_string(LoadingKind kind);
 
 struct Loading {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stackbeam/contact/pair.hpp"  // PairKind: the contact layer is below the model
+#include "stackbeam/words.hpp"
 
 namespace stackbeam {
 
@@ -64,6 +65,39 @@ enum class InterfaceContact {
 /// at the rigid body's attachment (u = 0 and theta = 0 on every leaf there).
 enum class Symmetry { full, half };
 
+/// How a fatigue cycle's mean stress is allowed for (include/stackbeam/post/fatigue.hpp;
+/// docs/stresses-and-fatigue.md, "Fatigue"): each a line or curve in the (mean, amplitude) plane
+/// through the endurance limit at zero mean.
+enum class MeanStressCorrection {
+    goodman,    ///< straight to the ultimate strength (the default)
+    gerber,     ///< a parabola to the ultimate strength
+    soderberg,  ///< straight to the yield strength (needs yield_strength_pa)
+    morrow,     ///< straight to the fatigue strength coefficient sigma_f' (needs it)
+};
+
+/// A leaf's fatigue strength (optional: without it a leaf has no fatigue figures). Stresses
+/// in Pa, tension positive; 0 means "not given" for every optional strength. At least an
+/// endurance limit or a Basquin S-N curve sigma_a = sigma_f' (2N)^b (both its constants);
+/// validated by Model::build (validate_fatigue_material).
+struct FatigueMaterial {
+    double ultimate_strength_pa = 0.0;             ///< S_u [Pa], > 0 (required)
+    double yield_strength_pa = 0.0;                ///< S_y [Pa], in (0, S_u]; 0: not given (Soderberg needs it)
+    double endurance_limit_pa = 0.0;               ///< S_e [Pa]: the fully reversed amplitude of infinite life, in (0, S_u); 0: not given
+    double fatigue_strength_coefficient_pa = 0.0;  ///< sigma_f' [Pa], > 0; 0: not given (the S-N curve and Morrow need it)
+    double fatigue_strength_exponent = 0.0;        ///< Basquin's b [-], in (-1, 0); 0: not given (with sigma_f' or neither)
+    MeanStressCorrection mean_stress_correction = MeanStressCorrection::goodman;
+};
+
+/// Whether the material has a Basquin S-N curve (sigma_f' and b given).
+inline bool has_sn_curve(const FatigueMaterial& m) {
+    return m.fatigue_strength_coefficient_pa != 0.0 && m.fatigue_strength_exponent != 0.0;
+}
+/// Checks a fatigue material: every given strength finite and > 0, b in (-1, 0), S_y <= S_u,
+/// S_e < S_u, an endurance limit or an S-N curve, the correction's strength given. Throws
+/// InputError naming `path` + "." + the key, e.g. "leaves[2].material.ultimate_strength_pa".
+void validate_fatigue_material(const FatigueMaterial& material, const std::string& path);
+const char* to_string(MeanStressCorrection correction);
+
 /// One leaf (beam) of the stack.
 struct LeafSpec {
     double length_m = 0.0;                  ///< leaf length [m], > 0
@@ -88,6 +122,8 @@ struct LeafSpec {
     /// Free camber as the radius R [m] of the arc instead (curvature 1/R, v0 = (x - x_R)^2 / (2 R)):
     /// R > 0 ends up, R < 0 ends down, 0: flat (no radius given). |R| >= 1.25 L (arc height <= L/10).
     double free_radius_m = 0.0;
+    /// Fatigue strength (absent: no fatigue figures for this leaf; nothing of the run uses it).
+    std::optional<FatigueMaterial> material;
 };
 
 /// Thickness and width of a leaf at x [m] (absolute x; the profile, or height_m / width_m).
@@ -248,6 +284,14 @@ bool has_free_camber(const ModelSpec& spec);
 /// free camber, a rebound clip or an interference (an interface's initial_gap_m < 0).
 bool needs_assembly(const ModelSpec& spec);
 
+template <>
+const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>();
+template <>
+const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>();
+template <>
+const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>();
+template <>
+const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>();
 const char* to_string(SupportKind kind);
 const char* to_string(InterfaceContact contact);
 /// Parses "rigid" | "elastic"; throws InputError naming `field`.

@@ -16,6 +16,8 @@ enum class PaperCase {
     friction,      ///< mu = 0.5, clamp force 1000 N
     frictionless,  ///< mu = 0: one beam 0.15 x 0.005 m (k = 12,000 N/m)
 };
+template <>
+const std::vector<EnumWord<PaperCase>>& enum_words<PaperCase>();
 const char* to_string(PaperCase c);
 /// Parses "bonded" | "friction" | "frictionless"; throws InputError naming `field`.
 PaperCase parse_paper_case(const std::string& text, const std::string& field);

@@ -20,6 +20,7 @@
 /// directory (points.csv, resume) is study/sweep_output.hpp.
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -97,6 +98,40 @@ struct SweepPoint {
     Scenario scenario;                ///< parse_scenario(scenario_text): Model::build and validate() succeed
 };
 
+/// The most points one sweep may have (docs/sweep.md, "Limits"). A sweep directory keeps
+/// one row per point in memory (~0.3 kB) and checking a point before the run takes ~1 ms
+/// (the rig scenario, docs/decisions/051), so 100,000 points cost ~30 MB and ~2 min of
+/// checking (shown as progress) before the first run; a larger map is several specs. A
+/// spec with more points is refused by parse_sweep_spec / point_count, with its size.
+constexpr long long max_sweep_points = 100000;
+
+/// The points of a spec made one at a time, when asked for: memory does not grow with
+/// the number of points. point(i) is expand_points(spec)[i], figure for figure. Keeps a
+/// reference to `spec` (it must outlive this); const member functions may be called from
+/// several threads at once.
+class SweepPoints {
+public:
+    /// Reads the base scenario's TOML and the axes' key paths; throws InputError as
+    /// expand_points for a bad base document, key path, empty axis, unequal zip or a spec
+    /// of more than max_sweep_points points.
+    explicit SweepPoints(const SweepSpec& spec);
+    int size() const noexcept { return count_; }
+    const SweepSpec& spec() const noexcept { return *spec_; }
+    /// Point i's axis values (cheap: no scenario is made).
+    std::vector<AxisValue> values(int index) const;
+    /// Point i, its scenario parsed and validated; throws InputError as expand_points.
+    SweepPoint point(int index) const;
+    /// Makes and checks every point in turn, keeping none (the check before any run);
+    /// `progress` (may be empty) is called after each with the number checked.
+    void check_all(const std::function<void(int checked)>& progress = {}) const;
+
+private:
+    struct Impl;
+    const SweepSpec* spec_;
+    int count_;
+    std::shared_ptr<const Impl> impl_;
+};
+
 /// Every point of `spec` in table order, each scenario parsed and validated. Throws
 /// InputError on the first bad one: "spec.toml:LINE: point N (key = value, ...): <key>:
 /// <what is wrong>", naming the axis whose key or value is wrong (and its line) when the
@@ -136,6 +171,8 @@ struct PointResult {
     /// The point's records (only during the on_point_done call that reports it; empty after
     /// a row is read back from a file)
     const std::vector<StepRecord>* records = nullptr;
+    /// The point run (only during the on_point_done call, as records)
+    const SweepPoint* point = nullptr;
 };
 
 /// Thrown by run_point when `stop` was set during the run (the point is not finished).
@@ -147,7 +184,7 @@ struct SweepStopped : std::runtime_error {
 /// model, options and results, figure for figure) and computes its figures. A SolverError
 /// or an InputError at the start of the run is returned as a failed / input-error row.
 /// `stop` (may be null) is polled at every record: when set, throws SweepStopped. Calls
-/// `with_records` (if set) with the records before they are dropped.
+/// `with_records` (if set) with the records (and result.point) before they are dropped.
 PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop = nullptr,
                       const std::function<void(const PointResult&)>& with_records = {});
 
@@ -172,5 +209,9 @@ using PointCallback = std::function<void(const PointResult&)>;
 /// (records valid during the call). Returns the number of points run (stop: fewer). An
 /// exception thrown by the callback stops the sweep and is rethrown here.
 int run_sweep(const std::vector<SweepPoint>& points, const SweepRunOptions& opts, const PointCallback& on_point_done);
+
+/// run_sweep over points made when they start (SweepPoints::point): memory bounded
+/// whatever the number of points. The same rows, figure for figure.
+int run_sweep(const SweepPoints& points, const SweepRunOptions& opts, const PointCallback& on_point_done);
 
 }  // namespace stackbeam

@@ -48,6 +48,8 @@ public:
     /// The leaves' nodes: z of the sparse path, or of the forces and w on the dense path
     /// (System::reduced_displacements: the massless leaves are in equilibrium with p and w).
     std::vector<LeafNodes> nodes() const override;
+    /// The stresses of the z nodes() uses and of pairs() (compute_stresses).
+    Stresses stresses() const override;
     /// Steps, and the contact iterations and factorisations summed over the records.
     RunReport report() const override;
 

@@ -80,6 +80,8 @@ public:
     /// The leaves' nodes at the last output time, of its forces and w (the massless leaves are
     /// in equilibrium with them: System::reduced_displacements).
     std::vector<LeafNodes> nodes() const override;
+    /// The stresses of the z nodes() uses and of pairs() (compute_stresses).
+    Stresses stresses() const override;
     /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
     RunReport report() const override;
     /// Number of output intervals to t_end, as in the closed-form mode.

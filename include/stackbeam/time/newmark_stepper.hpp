@@ -91,6 +91,8 @@ public:
     std::vector<PairRecord> pairs() const override;
     /// The leaves' nodes of displacements() (System::leaf_nodes).
     std::vector<LeafNodes> nodes() const override;
+    /// The stresses of displacements() and pairs() (compute_stresses).
+    Stresses stresses() const override;
     /// Steps, and the contact iterations and factorisations summed over the records.
     RunReport report() const override;
 

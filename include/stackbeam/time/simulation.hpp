@@ -59,6 +59,8 @@ enum class Mode {
     cvode,        ///< SUNDIALS CVODE between events, root-finding on every contact transition (massless leaves)
     newmark,      ///< leaves with mass: average-acceleration Newmark, fixed dt (newmark_stepper.hpp)
 };
+template <>
+const std::vector<EnumWord<Mode>>& enum_words<Mode>();
 const char* to_string(Mode m);
 Mode parse_mode(const std::string& text, const std::string& field);
 
@@ -71,6 +73,8 @@ enum class LeafInertia {
     massive,    ///< every DOF of the stack in CVODE (BDF); needs elastic contact everywhere
     modal,      ///< the stack's modes below CvodeOptions::modal_cutoff_rad_per_s, a massless contact layer
 };
+template <>
+const std::vector<EnumWord<LeafInertia>>& enum_words<LeafInertia>();
 const char* to_string(LeafInertia kind);
 /// Parses "auto" | "massive" | "modal"; throws InputError naming `field`.
 LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field);

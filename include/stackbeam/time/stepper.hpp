@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "stackbeam/fe/system.hpp"
+#include "stackbeam/post/stresses.hpp"
 #include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -37,6 +38,10 @@ public:
     /// displacement v [m] and rotation [rad], whole leaves (the half model mirrored),
     /// System::leaf_nodes. The node at R's attachment on a tied leaf moves by the record's w_m.
     virtual std::vector<LeafNodes> nodes() const = 0;
+    /// Every leaf's stress resultants and fibre stresses and every pair's pressure at the current
+    /// record (compute_stresses of the z that nodes() uses and of pairs(); stresses.hpp): computed
+    /// on each call, so a run that does not ask pays nothing.
+    virtual Stresses stresses() const = 0;
     /// The counters so far (steps, contact iterations, factorisations; mode cvode: its
     /// CvodeStats and event log).
     virtual RunReport report() const = 0;

@@ -180,6 +180,16 @@ struct CvodeHeldStepper::Impl final : EventDriver {
         }
     }
 
+    /// The motion at an output for the stresses (event_driver.hpp): a = N Phi (g - Omega^2 xi), as
+    /// make_record's (G^T p = M a + K z - f_L); no loading, no damping here.
+    LeafMotion leaf_motion(double, const State& Y, const Vec&) const override {
+        Eigen::VectorXd xi, xid;
+        modal(Y, xi, xid);
+        LeafMotion m;
+        m.acceleration = NPhi * Eigen::VectorXd(g - om.cwiseProduct(om).cwiseProduct(xi));
+        return m;
+    }
+
     /// z = z_p + N Phi xi.
     Vec displacements(const State& Y, const Vec&) const override {
         Eigen::VectorXd xi, xid;

@@ -197,6 +197,18 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         return a;
     }
 
+    /// The motion at an output for the stresses (event_driver.hpp): z'' of the current modes at
+    /// (t, z, v), the frame's g + y_b''(t), the structural damping.
+    LeafMotion leaf_motion(double t_s, const State& y, const Vec&) const override {
+        const int nd = ndof();
+        LeafMotion m;
+        m.velocity = y.segment(nd, nd);
+        m.acceleration = acceleration(t_s, y.head(nd), y.segment(nd, nd));
+        m.frame_acceleration_m_per_s2 = options().loading.gravity_m_per_s2 + load->base_acceleration(t_s);
+        m.damping = options().damping;
+        return m;
+    }
+
     /// The external power [W, meshed part] at (t, v) with acceleration-side rig force lambda.
     double external_power(double t_s, const Eigen::Ref<const Eigen::VectorXd>& v, double lambda) const {
         if (rig) return lambda * v[w_dof()];

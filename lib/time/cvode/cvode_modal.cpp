@@ -274,6 +274,19 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
     /// retained modes' motion plus the quasi-static response of the modes above the cut to the
     /// contact forces and the loading (modal_load.hpp; its row w is make_record's w). K's factor
     /// is made on the first call (only a run that asks for the nodes pays for it).
+    /// The motion at an output for the stresses (event_driver.hpp): the modes' part Phi eta'' alone.
+    /// With z = Phi eta + R f (f = G^T p + B u, R = K^-1 - Phi Omega^-2 Phi^T, mass-normalised modes),
+    /// K z = M Phi Omega^2 eta + f - M Phi Phi^T f = f - M Phi eta'': M (Phi eta'') + K z = f holds
+    /// exactly, the quasi-static rest R f carrying no inertia. f's B u = -(g + y_b'') l + e_w F/f:
+    /// the frame's acceleration is -u_0.
+    LeafMotion leaf_motion(double, const State& Y, const Vec&) const override {
+        LeafMotion m;
+        const ModalLoad::Values u = u_of(Y);
+        m.acceleration = Phi * modal_acceleration(Y.head(r), u.u);
+        m.frame_acceleration_m_per_s2 = -u.u[0];
+        return m;
+    }
+
     Vec displacements(const State& Y, const Vec& p) const override {
         if (!stiffness_factor)
             stiffness_factor = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(system().stiffness_reduced());

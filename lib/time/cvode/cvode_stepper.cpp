@@ -245,6 +245,7 @@ std::vector<PairRecord> CvodeStepper::pairs() const {
     return s.pair_records_at(p.size() > 0 ? Eigen::VectorXd(s.C * p + s.c * s.current().w_m) : Eigen::VectorXd());
 }
 std::vector<LeafNodes> CvodeStepper::nodes() const { return impl_->nodes_at_output(); }
+Stresses CvodeStepper::stresses() const { return compute_stresses(impl_->system(), impl_->displacements_at_output(), pairs()); }
 RunReport CvodeStepper::report() const { return impl_->report(); }
 const Eigen::VectorXd& CvodeStepper::contact_forces() const noexcept { return impl_->contact_forces(); }
 const std::vector<ContactEvent>& CvodeStepper::events() const noexcept { return impl_->events(); }

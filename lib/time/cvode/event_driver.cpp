@@ -11,7 +11,6 @@
 #include "model/mesh_note.hpp"
 #include "stackbeam/errors.hpp"
 #include "time/contact_state.hpp"
-#include "time/cvode/cvode_testing.hpp"
 #include "time/record.hpp"
 
 namespace stackbeam::detail {
@@ -63,7 +62,7 @@ EventDriver::EventDriver(const System& system, const SimulationOptions& options,
       f_(system.model().whole_spring_factor()),
       m_body_(system.model().spec().rigid_body.mass_kg),
       d_(system.initial_offsets_m()),
-      root_finding_(cvode_testing().root_finding) {}
+      root_finding_(true) {}
 
 EventDriver::~EventDriver() = default;
 
@@ -173,6 +172,7 @@ SolverError EventDriver::failure(const std::string& what) const {
 }
 
 void EventDriver::start(const InitialState& stage, const EventStart& s) {
+    root_finding_ = stage.root_finding;
     nstate_ = s.nstate;
     ev_ = s.events;
     scales_ = s.scales;
@@ -701,6 +701,10 @@ const StepRecord& EventStepper::current() const noexcept { return driver_->curre
 long EventStepper::record_index() const noexcept { return driver_->record_index(); }
 std::vector<PairRecord> EventStepper::pairs() const { return driver_->pair_records(); }
 std::vector<LeafNodes> EventStepper::nodes() const { return driver_->nodes_at_output(); }
+Stresses EventStepper::stresses() const {
+    return compute_stresses(driver_->system(), driver_->displacements_at_output(), pairs(), driver_->leaf_motion_at_output());
+}
+LeafMotion EventDriver::leaf_motion(double, const State&, const Vec&) const { return {}; }
 RunReport EventStepper::report() const { return driver_->report(); }
 const CvodeStats& EventStepper::stats() const noexcept { return driver_->stats(); }
 const std::vector<ContactEvent>& EventStepper::events() const noexcept { return driver_->events(); }

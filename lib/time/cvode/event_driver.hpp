@@ -176,7 +176,11 @@ public:
     /// The pairs at the current output with the relative positions of its record.
     std::vector<PairRecord> pair_records() const { return pair_records_at(rel_out_); }
     /// Every leaf's nodes at the current output (Stepper::nodes()): displacements() at its state.
-    std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements(y_out_, p_out_)); }
+    std::vector<LeafNodes> nodes_at_output() const { return sys_.leaf_nodes(displacements_at_output()); }
+    /// z at the current output (displacements() at its state): Stepper::nodes() and stresses().
+    Vec displacements_at_output() const { return displacements(y_out_, p_out_); }
+    /// The leaves' motion at the current output for their distributed loads (Stepper::stresses()).
+    LeafMotion leaf_motion_at_output() const { return leaf_motion(record_.t_s, y_out_, p_out_); }
     RunReport report() const;
     const CvodeStats& stats() const noexcept { return stats_; }
     const std::vector<ContactEvent>& events() const noexcept { return events_; }
@@ -270,6 +274,11 @@ protected:
     /// The reduced displacements z = [z_r; w] [m, rad] at state y with the forces p [N] of its
     /// record (System::leaf_nodes makes the nodes of them).
     virtual Vec displacements(const State& y, const Vec& p) const = 0;
+    /// The leaves' accelerations z'' (relative to the supports), velocities (damped) and the frame's
+    /// acceleration g + y_b'' at time t_s, state y with the forces p of its record, such that
+    /// M z'' + C z' + K z = G^T p + e_w F - (g + y_b'') l holds on the leaves' DOFs (compute_stresses
+    /// takes the elements' distributed loads off with them; decision 061). Default: none.
+    virtual LeafMotion leaf_motion(double t_s, const State& y, const Vec& p) const;
 
 private:
     using Clock = std::chrono::steady_clock;
@@ -299,7 +308,7 @@ private:
     Vec p_out_, rel_out_, y_out_;
     double e0_ = 0.0;
     double jump_dissipation_ = 0.0;
-    bool root_finding_ = true;     // off only in tests (cvode_testing.hpp)
+    bool root_finding_ = true;     // off only in tests (InitialState::root_finding)
     long iters_since_ = 0, facts_since_ = 0;
     long steps_at_stop_check_ = 0; // CVODE's steps at the last stop check
     double last_check_residual_ = 0.0;
@@ -366,6 +375,8 @@ public:
     std::vector<PairRecord> pairs() const override;
     /// The leaves' nodes at the last output (EventDriver::displacements at its state).
     std::vector<LeafNodes> nodes() const override;
+    /// The stresses at the last output (compute_stresses of nodes()' z and pairs()).
+    Stresses stresses() const override;
     /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
     RunReport report() const override;
     const CvodeStats& stats() const noexcept;

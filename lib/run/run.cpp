@@ -1,0 +1,102 @@
+// The run layer (run/run.hpp): a run's record loop, its stats and its summary's figures.
+#include "stackbeam/run/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/time/stepper.hpp"
+#include "time/stepper_registry.hpp"
+
+namespace stackbeam {
+
+std::string case_setup(PaperCase c, const PaperExampleOptions& options) {
+    return std::string("case ") + to_string(c) + ", " + std::to_string(options.elements_per_half_leaf) +
+           " elements per half leaf (" + word_of(options.symmetry) + " model), ";
+}
+
+std::string scenario_setup(const std::string& source, const std::string& description) {
+    return "scenario " + source + (description.empty() ? "" : " (" + description + ")") + "\n";
+}
+
+void RunStats::add(const StepRecord& r) {
+    if (records == 0) {
+        first = r;
+        w_min_m = w_max_m = r.w_m;
+        force_min_n = force_max_n = r.spring_force_n;
+    }
+    last = r;
+    ++records;
+    contact_iterations += r.contact_iterations;
+    max_contact_iterations = std::max(max_contact_iterations, r.contact_iterations);
+    max_abs_balance_j = std::max(max_abs_balance_j, std::abs(r.energy_balance_error_j));
+    w_min_m = std::min(w_min_m, r.w_m);
+    w_max_m = std::max(w_max_m, r.w_m);
+    force_min_n = std::min(force_min_n, r.spring_force_n);
+    force_max_n = std::max(force_max_n, r.spring_force_n);
+}
+
+StepperDescription describe_stepper(const System& system, const SimulationOptions& options) {
+    const detail::StepperCapabilities& row = detail::choose_stepper(system, options);
+    StepperDescription d;
+    d.name = row.name;
+    d.description = row.description;
+    d.mode = row.mode;
+    d.cvode_stats = row.cvode_stats;
+    d.impact_loss = row.impact_loss;
+    d.leaf_kinetic_energy = row.leaf_kinetic_energy;
+    return d;
+}
+
+namespace {
+
+/// Thrown inside the record loop when the stop check answers true between records.
+struct StopSeen {};
+
+}  // namespace
+
+RunSummary run_scenario(const System& system, const RunRequest& request) {
+    const auto t0 = std::chrono::steady_clock::now();
+    RunSummary summary;
+    summary.setup = request.setup;
+    summary.options = request.options;
+    summary.options.stop_requested = nullptr;
+    SimulationOptions options = request.options;
+    if (request.stop) options.stop_requested = request.stop;
+    const std::function<bool()>& stop = options.stop_requested;
+    summary.contact_path = choose_contact_path(system, options);
+    summary.contact_components = system.num_components();
+    RunSink none;
+    RunSink& sink = request.sink ? *request.sink : none;
+    const RunOutputs& out = request.outputs;
+    try {
+        // the loop of simulate() (simulation.cpp), with the stop check before each record is handed over
+        const std::unique_ptr<Stepper> stepper = make_stepper(system, options);  // validates the options
+        summary.stepper = describe_stepper(system, options);
+        const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
+        if (out.keep_records) summary.records.reserve(static_cast<std::size_t>(n) + 1);
+        for (long i = 0; i <= n; ++i) {
+            const StepRecord& r = i == 0 ? stepper->current() : stepper->advance();
+            if (stop && stop()) throw StopSeen{};  // the record in progress is dropped
+            if (out.keep_records) summary.records.push_back(r);
+            summary.stats.add(r);
+            sink.on_record(r);
+            if (out.pairs) sink.on_pairs(r.t_s, stepper->pairs());
+            if (out.nodes) sink.on_nodes(r.t_s, stepper->nodes());
+            if (out.stresses) sink.on_stresses(r.t_s, stepper->stresses());
+        }
+        summary.report = stepper->report();
+        summary.loop = loop_figures(summary.records, options.loading.period_s());
+    } catch (const StopSeen&) {
+        summary.interrupted = true;
+    } catch (const RunStopped&) {  // the stop check seen within a step
+        summary.interrupted = true;
+    }
+    if (summary.interrupted) summary.loop.note = "interrupted run: no loop figures";
+    summary.t_reached_s = summary.stats.last.t_s;
+    summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return summary;
+}
+
+}  // namespace stackbeam

@@ -1,0 +1,145 @@
+// The run layer (stackbeam/run/): run_scenario gives simulate()'s records, its stats and loop
+// figures are those of the records, a stop ends it cleanly, the JSON summary carries them; the
+// enums' word tables (stackbeam/words.hpp) read back what they write.
+#define BOOST_TEST_MODULE run_layer
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/run/run.hpp"
+#include "stackbeam/run/summary_json.hpp"
+#include "stackbeam/study/sweep.hpp"
+
+using namespace stackbeam;
+
+namespace {
+
+/// The rig scenario (three leaves, triangle stroke of 1 Hz), shortened to two periods so that
+/// the last cycle is a whole one after a first.
+Scenario rig() {
+    Scenario s = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/rig_friction.toml");
+    s.simulation.t_end_s = 2.0;
+    return s;
+}
+
+bool same(const StepRecord& a, const StepRecord& b) {
+    const auto x = step_record_values(a), y = step_record_values(b);
+    return std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+}
+
+struct CountingSink : RunSink {
+    long records = 0, pair_calls = 0, pairs = 0;
+    double last_t_s = -1.0;
+    void on_record(const StepRecord& r) override {
+        ++records;
+        last_t_s = r.t_s;
+    }
+    void on_pairs(double, const std::vector<PairRecord>& prs) override {
+        ++pair_calls;
+        pairs += static_cast<long>(prs.size());
+    }
+};
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(run_scenario_is_simulate_with_its_figures) {
+    const Scenario s = rig();
+    const System system(Model::build(s.model));
+    // the reference: simulate(), the library's plain loop; the run layer steps the same stepper,
+    // so the records must be bitwise equal (no tolerance: the same arithmetic)
+    const std::vector<StepRecord> reference = simulate(system, s.simulation);
+    CountingSink sink;
+    RunRequest request;
+    request.options = s.simulation;
+    request.outputs.pairs = true;
+    request.sink = &sink;
+    const RunSummary summary = run_scenario(system, request);
+    BOOST_TEST(!summary.interrupted);
+    BOOST_REQUIRE_EQUAL(summary.records.size(), reference.size());
+    for (std::size_t i = 0; i < reference.size(); ++i) BOOST_TEST_REQUIRE(same(summary.records[i], reference[i]), "record " << i);
+    BOOST_TEST(sink.records == static_cast<long>(reference.size()));
+    BOOST_TEST(sink.pair_calls == sink.records);
+    BOOST_TEST(sink.pairs == sink.records * static_cast<long>(system.pairs().size()));
+    // the stats are the records' extremes and sums, exactly
+    double w_max = reference[0].w_m, balance = 0.0;
+    long iterations = 0;
+    for (const StepRecord& r : reference) {
+        w_max = std::max(w_max, r.w_m);
+        balance = std::max(balance, std::abs(r.energy_balance_error_j));
+        iterations += r.contact_iterations;
+    }
+    BOOST_TEST(summary.stats.records == static_cast<long>(reference.size()));
+    BOOST_TEST(summary.stats.w_max_m == w_max);
+    BOOST_TEST(summary.stats.max_abs_balance_j == balance);
+    BOOST_TEST(summary.stats.contact_iterations == iterations);
+    BOOST_TEST(summary.t_reached_s == reference.back().t_s);
+    // the loop figures: those of hysteresis_metrics over last_cycle and the Fancher fit over the
+    // same records, called directly (exactly equal: one computation)
+    BOOST_REQUIRE(summary.loop.metrics.has_value());
+    const auto cycle = last_cycle(reference, s.simulation.loading.period_s());
+    const HysteresisMetrics m = hysteresis_metrics(reference, cycle.first, cycle.second);
+    BOOST_TEST(summary.loop.metrics->loop_area_j == m.loop_area_j);
+    BOOST_TEST(summary.loop.metrics->secant_stiffness_n_per_m == m.secant_stiffness_n_per_m);
+    BOOST_REQUIRE(summary.loop.fancher.has_value());
+    const FancherFit fit = fit_fancher_loop(reference, m.t_start_s, m.t_end_s).fit;
+    BOOST_TEST(summary.loop.fancher->parameters.beta_m == fit.parameters.beta_m);
+    // the sweep's point figures come from the same function: the same numbers
+    std::string note;
+    const std::vector<double> f = point_figures(reference, s.simulation, note);
+    BOOST_TEST(f[0] == m.loop_area_j);
+    BOOST_TEST(f[14] == fit.parameters.beta_m);
+    BOOST_TEST(f[16] == balance);
+    // the stepper as the registry describes it: the closed-form mode keeps no event log
+    BOOST_TEST(summary.stepper.name == "closed-form");
+    BOOST_TEST(!summary.stepper.cvode_stats);
+    // the JSON summary has the figures and the setup
+    const std::string json = summary_json(summary, system.model());
+    BOOST_TEST(json.find("\"interrupted\": false") != std::string::npos);
+    BOOST_TEST(json.find("\"loop_area_j\"") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(a_stop_ends_the_run_at_a_whole_record) {
+    const Scenario s = rig();
+    const System system(Model::build(s.model));
+    CountingSink sink;
+    RunRequest request;
+    request.options = s.simulation;
+    request.sink = &sink;
+    // asked to stop once the sink has 10 records: the 11th is dropped (or not made), the run ends
+    request.stop = [&] { return sink.records >= 10; };
+    const RunSummary summary = run_scenario(system, request);
+    BOOST_TEST(summary.interrupted);
+    BOOST_TEST(sink.records == 10);
+    BOOST_TEST(summary.records.size() == 10u);
+    BOOST_TEST(summary.stats.records == 10);
+    BOOST_TEST(summary.t_reached_s == sink.last_t_s);
+    BOOST_TEST(!summary.loop.metrics.has_value());
+    BOOST_TEST(summary.loop.note == "interrupted run: no loop figures");
+    BOOST_TEST(summary.report.steps == 0);  // no report for an interrupted run (documented)
+    const std::string json = summary_json(summary, system.model());
+    BOOST_TEST(json.find("\"interrupted\": true") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {
+    for (const auto& w : enum_words<Mode>()) BOOST_TEST((parse_mode(to_string(w.value), "mode") == w.value));
+    for (const auto& w : enum_words<LeafInertia>())
+        BOOST_TEST((parse_leaf_inertia(to_string(w.value), "leaf_inertia") == w.value));
+    for (const auto& w : enum_words<PaperCase>()) BOOST_TEST((parse_paper_case(to_string(w.value), "case") == w.value));
+    for (const auto& w : enum_words<InterfaceContact>())
+        BOOST_TEST((parse_interface_contact(to_string(w.value), "contact") == w.value));
+    for (const auto& w : enum_words<SupportKind>()) BOOST_TEST(std::string(to_string(w.value)) == w.word);
+    for (const auto& w : enum_words<LoadingKind>()) BOOST_TEST(std::string(to_string(w.value)) == w.word);
+    BOOST_TEST(word_list<Mode>() == "closed-form, cvode, newmark");
+    BOOST_TEST(word_list<Symmetry>("'", ", ", " or ") == "'full' or 'half'");
+    BOOST_TEST(word_list<SolverKind>("", " | ") == "exact | accelerated | block-jacobi | paper");
+    BOOST_TEST(!find_word<Mode>("rk4").has_value());
+    try {
+        parse_mode("rk4", "--mode");
+        BOOST_FAIL("no error");
+    } catch (const InputError& e) {
+        BOOST_TEST(std::string(e.what()) == "--mode: value 'rk4' is not a mode: allowed closed-form, cvode, newmark");
+    }
+}
