@@ -17,7 +17,8 @@ struct ContactEvent {
     int interface_index = 0;     ///< interface i: leaf i above, leaf i+1 below
     double x_m = 0.0;            ///< position of the pair along the leaves [m]
     std::string from, to;        ///< pair modes: stick, slip+, slip-, open, closed (frictionless), released (clamp)
-    std::string cause;           ///< "start" (t = 0), "root" (CVODE root-finding) or "check" (found by the per-step check)
+    std::string cause;           ///< "start" (t = 0), "root" (CVODE root-finding), "check" (found by the per-step check) or
+                                 ///< "loading" (at a break of the loading: a table's point, the modal stepper)
     double w_m = 0.0;            ///< displacement of R at the event [m]
     double w_dot_m_per_s = 0.0;  ///< velocity of R at the event [m/s]
 

@@ -403,10 +403,12 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     es.scales = event_scales(system, leaf_mass_scale_inputs(system, options().loading));
     // the instantaneous compliance: only the layer (z is held by the leaves' inertia)
     es.compliance = cL.asDiagonal();
-    es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * cL.maxCoeff();
+    // (a stack without contact rows, a single leaf, has no events: any positive tolerance)
+    es.event_tolerance_m = cL.size() > 0 ? 1e-9 * es.scales.F_ref_n * cL.maxCoeff() : 1e-12;
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);
     es.stiff_max_order = 2;  // BDF order <= 2, Newton on newton_setup / newton_solve (file comment)
     es.events = this;  // contact events (ContactEventHooks)
+    es.pair_chatter_limit = true;  // its contact points vibrate on the layer (kMaxPairSwitches)
     this->start(start, es);
 }
 

@@ -224,6 +224,26 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         D[i_clock] = 1.0;
     }
 
+    /// A break of the loading (a table's point, ModalLoad::breaks): the next piece of u(t). Where
+    /// u jumps (the clamped base spline's y'' at its first and last points) q and q' are
+    /// continuous but the quasi-static rest R (G^T p + B u) jumps with u (and p with Pu u):
+    /// the rest is a massless linear spring, so the loading's work over the jump is exactly the
+    /// trapezoid (q- + q+)^T (z+ - z-) / 2 (its strain energy's change), i.e. the integral X of
+    /// q'^T z takes (q+ - q-)^T (z- + z+) / 2 (file comment: work = [q^T z] - X). A slipping
+    /// pair's slider jumps by Hsu du: its friction work, the trapezoid of its force, to D.
+    void cross_loading_break(double t_s, Vec& y) override {
+        if (i_clock < 0) return;
+        const auto q = y.head(r);
+        const ModalLoad::Values before = u_of(y);
+        const Vec p_before = forces(y);
+        load->enter_piece(t_s);
+        const ModalLoad::Values after = u_of(y);
+        const Vec p_after = forces(y);
+        const Eigen::Vector2d du = after.u - before.u;
+        y[i_work] += 0.5 * (load->q_dot_z(q, p_before, before.u, du) + load->q_dot_z(q, p_after, after.u, du));
+        for (int rt : slip_rows) y[2 * r] -= 0.5 * (p_before[rt] + p_after[rt]) * Hsu.row(rt).dot(du);
+    }
+
     /// q^T z at t = 0 (the loading's work, make_record) from the decided modes' forces.
     void started(const State& Y) override {
         const ModalLoad::Values u0 = u_of(Y);
@@ -369,6 +389,7 @@ CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
         i_work = 2 * r + 1;
         i_clock = 2 * r + 2;
         es.nstate = 2 * r + 3;
+        es.loading_breaks_s = load->breaks(options().t_end_s);  // CVODE stops at each (cross_loading_break)
     }
     // the initial state: the assembly and gravity's static state, R held at w(0), the leaves moving
     // with R in the tied shape (the shared stage, initial_state.hpp: whole_stack_static)
@@ -377,7 +398,8 @@ CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
     es.compliance = W;
     // forces resolved to the witnesses' margin, 1e-9 F_ref, through the residual compliance (its
     // entries are far smaller than C''s: most of the leaves' flexibility is in the retained modes)
-    es.event_tolerance_m = 1e-9 * es.scales.F_ref_n * W.diagonal().maxCoeff();
+    // (a stack without contact rows, a single leaf, has no events: any positive tolerance)
+    es.event_tolerance_m = W.size() > 0 ? 1e-9 * es.scales.F_ref_n * W.diagonal().maxCoeff() : 1e-12;
     // the gap witnesses' margin: kMotionMargin, or ten times the decisions' displacement
     // resolution if that is coarser (a gap the contact iteration cannot see closing must not count as closed)
     es.gap_margin = std::max(kMotionMargin, 10.0 * es.event_tolerance_m / es.scales.L_ref_m);

@@ -47,6 +47,15 @@ constexpr int kMaxEventsAtOneTime = 200;
 /// count together towards kMaxEventsAtOneTime (10x the missed-event bisection's 1e-13 plus
 /// margin; a genuine cascade of transitions at one contact front is ~1e-9 s or more apart).
 constexpr double kEventInstant = 1e-10;
+/// A pair of the massive stack (EventStart::pair_chatter_limit) that changes modes
+/// kMaxPairSwitches times within kChatterPeriods of the stack's period
+/// (2 pi / EventScales::omega_rad_per_s) chatters: a contact point vibrating on the undamped
+/// elastic layer at ~1e5 Hz (the massive stack), opening and closing every microsecond, each
+/// switch a restart that costs CVODE ~80 steps. The run stops with a named SolverError instead
+/// of running to cvode.max_steps. A stack's own dynamics switches a pair a few times a period
+/// (turning points, stick-slip): 100 switches within a thousandth of a period is 1e5 times that.
+constexpr int kMaxPairSwitches = 100;
+constexpr double kChatterPeriods = 1e-3;
 /// Passes of EventDriver::decide_modes that make the decided modes hold at the event's state.
 constexpr int kSettlePasses = 4;
 /// The event driver polls the caller's stop check (SimulationOptions::stop_requested) once

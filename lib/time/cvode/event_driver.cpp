@@ -118,7 +118,7 @@ void EventDriver::start_cvode(const EventStart& s) {
         cvode_->use_fixed_point();
     }
     cvode_->set_limits(opt_.cvode.max_step_s);
-    cvode_->set_stop_time(t_final_);
+    cvode_->set_stop_time(stop_time());
     if (root_finding_ && !slots_.empty()) cvode_->set_roots(static_cast<int>(slots_.size()), &EventDriver::roots_of);
 }
 
@@ -157,6 +157,7 @@ int EventDriver::newton_setup(double) { return -1; }
 int EventDriver::newton_solve(double, const double*, const double*, double*, double) const { return -1; }
 int EventDriver::band_jacobian(double, const State&, BandMatrixView) const { return -1; }
 void EventDriver::started(const State&) {}
+void EventDriver::cross_loading_break(double, Vec&) {}
 
 void EventDriver::rebuild() {
     ModeLinearization lin;
@@ -176,9 +177,12 @@ void EventDriver::start(const InitialState& stage, const EventStart& s) {
     ev_ = s.events;
     scales_ = s.scales;
     gap_margin_ = s.gap_margin;
+    pair_chatter_limit_ = s.pair_chatter_limit;
     stats_.retained_modes = s.retained_modes;
     stats_.modal_cutoff_rad_per_s = s.modal_cutoff_rad_per_s;
     init_grid();  // as the closed-form mode's steps
+    for (double tb : s.loading_breaks_s)
+        if (tb > 0.0 && tb < t_final_) breaks_.push_back(tb);
     init_problems(s.compliance, s.event_tolerance_m);
     d_ = stage.d;  // the anchors of the set-up stage (gravity's static step, R held at w(0))
     cvode_ = std::make_unique<CvodeSession>(who_, nstate_);
@@ -442,6 +446,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         e.w_m = w;
         e.w_dot_m_per_s = wd;
         events_.push_back(std::move(e));
+        if (cause != "start" && pair_chatter_limit_) note_pair_switch(kk, te);
     }
     enter(rel, nm, tm);
     if (!decided) rebuild();
@@ -486,6 +491,25 @@ void EventDriver::restart(double te, const Vec& y) {
     stats_.event_time_s += seconds_since(t0);
 }
 
+bool EventDriver::cross_break_at(double te, const Vec& y) {
+    if (next_break_ >= breaks_.size() || te < breaks_[next_break_]) return false;
+    // the records up to te are out (the loading's left limit); past te the next piece
+    Vec yb = y;
+    cross_loading_break(te, yb);
+    while (next_break_ < breaks_.size() && breaks_[next_break_] <= te) ++next_break_;
+    if (ev_) {
+        double residual = 0.0;
+        if (!modes_hold(yb, residual)) {
+            note_event_time(te);
+            decide_modes(te, yb, ev_->forces(yb), "loading");
+        }
+        reset_check_anchors(yb);
+    }
+    cvode_->set_stop_time(stop_time());
+    restart(te, yb);
+    return true;
+}
+
 /// Queues the records of the output times in (t, upto] (the current modes hold there).
 void EventDriver::emit_until(double upto) {
     long next = out_index_ + static_cast<long>(pending_.size()) + 1;
@@ -524,6 +548,24 @@ void EventDriver::note_event_time(double te) {
         events_at_this_time_ = 0;
     }
     ++stats_.events;
+}
+
+void EventDriver::note_pair_switch(int kk, double te) {
+    if (switch_times_.empty()) switch_times_.resize(static_cast<std::size_t>(np_));
+    std::deque<double>& times = switch_times_[static_cast<std::size_t>(kk)];
+    times.push_back(te);
+    if (static_cast<int>(times.size()) > kMaxPairSwitches) times.pop_front();
+    constexpr double kTwoPi = 6.283185307179586;
+    const double window = kChatterPeriods * kTwoPi / scales_.omega_rad_per_s;
+    if (static_cast<int>(times.size()) < kMaxPairSwitches || te - times.front() > window) return;
+    const ContactEvent& e = events_.back();
+    throw SolverError(who_ + ": pair " + std::to_string(kk) + " (interface " + std::to_string(e.interface_index) +
+                          ", x = " + format_value(e.x_m) + " m) changed modes " + std::to_string(kMaxPairSwitches) +
+                          " times within " + format_value(te - times.front()) + " s (a thousandth of the stack's period is " +
+                          format_value(window) + " s) up to t = " + format_value(te) + " s, the last " + e.from + " -> " +
+                          e.to + ": the contact chatters (a contact point vibrating on the elastic layer, each switch a "
+                          "restart); leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
+                      stats_.steps, te, 0.0);
 }
 
 /// The per-step check of an accepted step at state y; true when the modes hold there.
@@ -581,7 +623,7 @@ bool EventDriver::step_once() {
         std::vector<int> found(slots_.size(), 0);
         cvode_->root_info(found);
         decide_modes(tret, y, ev_->forces(y), "root", &found);
-        restart(tret, y);
+        if (!cross_break_at(tret, y)) restart(tret, y);
         return true;
     }
 
@@ -590,6 +632,7 @@ bool EventDriver::step_once() {
         emit_until(tret);
         t_ = tret;
         reset_check_anchors(y);
+        cross_break_at(tret, y);
         return tret < t_final_;
     }
 
@@ -611,7 +654,7 @@ bool EventDriver::step_once() {
     ++stats_.missed_events;
     note_event_time(hi);
     decide_modes(hi, ye, ev_->forces(ye), "check");
-    restart(hi, ye);
+    if (!cross_break_at(hi, ye)) restart(hi, ye);
     return true;
 }
 

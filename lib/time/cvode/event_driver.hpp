@@ -146,6 +146,15 @@ struct EventStart {
     int stiff_max_order = 0;             ///< 0: Adams with fixed point; else BDF to this order with Newton
     NewtonSolver newton = NewtonSolver::stepper;  ///< BDF's linear solver
     int band_upper = 0, band_lower = 0;  ///< the band solver's half-bandwidths (NewtonSolver::band)
+    /// The loading's breaks in (0, t_end) [s], sorted: times where the right-hand side is not smooth
+    /// (a table's points). CVODE stops at each (its stop time) and restarts past it after
+    /// cross_loading_break; the contact modes are decided again there when they do not hold.
+    std::vector<double> loading_breaks_s;
+    /// The per-pair chatter limit (kMaxPairSwitches): the massive stack, whose contact points carry
+    /// mass and vibrate on the elastic layer. Not the massless-layer steppers: near rest a pair
+    /// of theirs switches at every small turning point (paper_friction at 20x: 100 switches of
+    /// pair 22 within 8.5e-5 s at t = 22.3 s, a healthy run).
+    bool pair_chatter_limit = false;
     int retained_modes = 0;              ///< CvodeStats (modal stepper)
     double modal_cutoff_rad_per_s = 0.0; ///< CvodeStats (modal stepper)
 };
@@ -253,6 +262,10 @@ protected:
     virtual int band_jacobian(double t_s, const State& y, BandMatrixView J) const;
     /// Once the initial modes are decided, before the first record (default nothing).
     virtual void started(const State& y0);
+    /// CVODE stopped at the loading's break t_s (EventStart::loading_breaks_s) in state y, the
+    /// loading's left limit: the stepper enters the next piece of its loading and books in y what
+    /// jumps there (default nothing).
+    virtual void cross_loading_break(double t_s, Vec& y);
     /// CVODE's absolute tolerances at the initial state y0 into atol (nstate entries).
     virtual void tolerances(const State& y0, Eigen::Ref<Vec> atol) const = 0;
     /// The record at time tau of state y, with the forces p and (optional) relative positions rel;
@@ -304,6 +317,10 @@ private:
     std::deque<Output> pending_;
     double last_event_t_ = -1.0;
     int events_at_this_time_ = 0;
+    bool pair_chatter_limit_ = false;  // EventStart::pair_chatter_limit
+    std::vector<std::deque<double>> switch_times_;  // per pair, its last kMaxPairSwitches mode changes [s]
+    std::vector<double> breaks_;   // EventStart::loading_breaks_s
+    std::size_t next_break_ = 0;   // the first break not crossed yet
 
     void init_grid();
     void init_slots();
@@ -330,9 +347,16 @@ private:
     double output_time(long i) const { return i == n_out_ ? t_final_ : static_cast<double>(i) * dt_; }
     void emit_until(double upto);
     void note_event_time(double te);
+    /// Pair kk changed modes at te: a SolverError naming it when it chatters (kMaxPairSwitches).
+    void note_pair_switch(int kk, double te);
     void reset_check_anchors(const State& y);
     bool modes_hold(const State& y, double& residual, bool* witnesses_ok = nullptr);
     void restart(double te, const Vec& y);
+    /// CVODE's stop time: the next break of the loading or the run's end [s].
+    double stop_time() const { return next_break_ < breaks_.size() ? breaks_[next_break_] : t_final_; }
+    /// At a break (te at or past the next one): cross it (cross_loading_break), decide the modes
+    /// if they no longer hold, move the stop time on and restart CVODE there. True when it did.
+    bool cross_break_at(double te, const Vec& y);
     bool step_keeps_modes(const Vec& y);
     bool step_once();
     void check_stop();

@@ -31,30 +31,83 @@ ModalLoad::ModalLoad(const System& system, const Loading& prepared, const Eigen:
     Rqq = (0.5 * (Rqq + Rqq.transpose())).eval();
 }
 
+namespace {
+
+/// The piece of table `ts` that holds [t_s, next point): -1 before the first point, i on
+/// [t_i, t_i+1), n - 1 (the last index) from the last point on.
+long table_piece(const std::vector<double>& ts, double t_s) {
+    return static_cast<long>(std::upper_bound(ts.begin(), ts.end(), t_s) - ts.begin()) - 1;
+}
+
+}  // namespace
+
+std::vector<double> ModalLoad::breaks(double t_end_s) const {
+    std::vector<double> b;
+    if (none_) return b;
+    auto add = [&](const TimeFunction& F) {
+        if (F.shape != TimeFunction::Shape::table) return;
+        for (double t : F.times_s)
+            if (t > 0.0 && t < t_end_s) b.push_back(t);
+    };
+    if (load_.kind == LoadingKind::base_excitation) add(load_.displacement_m);
+    if (load_.kind == LoadingKind::applied_force) add(load_.force_n);
+    std::sort(b.begin(), b.end());
+    b.erase(std::unique(b.begin(), b.end()), b.end());
+    return b;
+}
+
 ModalLoad::Values ModalLoad::at(double t_s) const {
     Values v;
     if (none_) return v;
-    // channel 0: -(g + y_b''); its rates by central differences of y_b'' (TimeFunction gives up to
-    // the second derivative; y_b is C2 and smooth between a table's points). The steps balance
-    // truncation (h^2 y_b^(5) / 6) against round-off (eps y_b'' / h, eps y_b'' / h^2): at 8 Hz
-    // u' to ~1e-9 of itself (it enters the work and the witnesses' rates), u'' to ~1e-6 (only
-    // the record's m w'' uses it).
-    const bool base = load_.kind == LoadingKind::base_excitation;
     v.u[0] = -load_.gravity_m_per_s2;
-    if (base) {
+    if (load_.kind == LoadingKind::base_excitation) {
         const TimeFunction& y = load_.displacement_m;
-        const double h1 = 1e-6, h2 = 1e-4;  // [s]
-        const double a = y.second_derivative(t_s);
-        v.u[0] -= a;
-        v.ud[0] = -(y.second_derivative(t_s + h1) - y.second_derivative(t_s - h1)) / (2.0 * h1);
-        v.udd[0] = -(y.second_derivative(t_s + h2) - 2.0 * a + y.second_derivative(t_s - h2)) / (h2 * h2);
+        if (y.shape == TimeFunction::Shape::table) {
+            // channel 0 on the current piece: the clamped spline's y'' is linear on [t_i, t_i+1]
+            // (M_i, M_i+1 at its ends), y''' its slope, y'''' = 0; 0 before the first point and
+            // from the last on (y is constant there)
+            const std::vector<double>& ts = y.times_s;
+            const long i = table_piece(ts, piece_t_s_);
+            if (i >= 0 && i + 1 < static_cast<long>(ts.size())) {
+                const std::size_t k = static_cast<std::size_t>(i);
+                const double h = ts[k + 1] - ts[k], Mi = y.spline_m2[k], Mj = y.spline_m2[k + 1];
+                v.u[0] -= (Mi * (ts[k + 1] - t_s) + Mj * (t_s - ts[k])) / h;
+                v.ud[0] = -(Mj - Mi) / h;
+            }
+        } else {
+            // a harmonic (or constant) base: its rates by central differences of y_b''
+            // (TimeFunction gives up to the second derivative). The steps balance truncation
+            // (h^2 y_b^(5) / 6) against round-off (eps y_b'' / h, eps y_b'' / h^2): at 8 Hz u' to
+            // ~1e-9 of itself (it enters the work and the witnesses' rates), u'' to ~1e-6 (only
+            // the record's m w'' uses it).
+            const double h1 = 1e-6, h2 = 1e-4;  // [s]
+            const double a = y.second_derivative(t_s);
+            v.u[0] -= a;
+            v.ud[0] = -(y.second_derivative(t_s + h1) - y.second_derivative(t_s - h1)) / (2.0 * h1);
+            v.udd[0] = -(y.second_derivative(t_s + h2) - 2.0 * a + y.second_derivative(t_s - h2)) / (h2 * h2);
+        }
     }
-    // channel 1: F(t)/f
+    // channel 1: F(t)/f; a table (piecewise linear) as the line of the current piece
     if (load_.kind == LoadingKind::applied_force) {
         const TimeFunction& F = load_.force_n;
-        v.u[1] = F.value(t_s) / f_;
-        v.ud[1] = F.derivative(t_s) / f_;
-        v.udd[1] = F.second_derivative(t_s) / f_;
+        if (F.shape == TimeFunction::Shape::table) {
+            const std::vector<double>& ts = F.times_s;
+            const long i = table_piece(ts, piece_t_s_);
+            if (i < 0) {
+                v.u[1] = F.values.front() / f_;
+            } else if (i + 1 >= static_cast<long>(ts.size())) {
+                v.u[1] = F.values.back() / f_;
+            } else {
+                const std::size_t k = static_cast<std::size_t>(i);
+                const double slope = (F.values[k + 1] - F.values[k]) / (ts[k + 1] - ts[k]);
+                v.u[1] = (F.values[k] + slope * (t_s - ts[k])) / f_;
+                v.ud[1] = slope / f_;
+            }
+        } else {
+            v.u[1] = F.value(t_s) / f_;
+            v.ud[1] = F.derivative(t_s) / f_;
+            v.udd[1] = F.second_derivative(t_s) / f_;
+        }
     }
     return v;
 }

@@ -5,6 +5,7 @@
 // (docs/decisions/026-loaded-modal-stepper.md).
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <vector>
 
 #include "stackbeam/contact/contact.hpp"
 #include "stackbeam/fe/system.hpp"
@@ -39,7 +40,16 @@ public:
     struct Values {
         Eigen::Vector2d u = Eigen::Vector2d::Zero(), ud = Eigen::Vector2d::Zero(), udd = Eigen::Vector2d::Zero();
     };
+    /// u(t) on the current piece of the loading (enter_piece): between two breaks a table's channel
+    /// is one polynomial (the base spline's cubic, the force table's line), evaluated, extrapolated
+    /// past its ends, as that polynomial, so CVODE sees a smooth right-hand side up to a break.
     Values at(double t_s) const;
+    /// The breaks of the loading in (0, t_end_s) [s]: a table's points, where u or u' is not smooth
+    /// (the clamped base spline's y'' jumps from 0 to M_0 at its first point and from M_n to 0 at
+    /// its last, its y''' at every point; a force table's slope at every point). Sorted.
+    std::vector<double> breaks(double t_end_s) const;
+    /// Selects the piece of the loading that holds [t_s, next break) (the run starts on the piece of t = 0).
+    void enter_piece(double t_s) { piece_t_s_ = t_s; }
     /// True when q is zero at every t (initial conditions only).
     bool none() const noexcept { return none_; }
     /// The weight of the stack and R on the reduced DOFs, -g l [N per DOF, meshed part] (the static stage's load).
@@ -63,6 +73,7 @@ private:
     Eigen::VectorXd l_;
     double f_ = 1.0;
     bool none_ = true;
+    double piece_t_s_ = 0.0;  ///< a time on the current piece's left-closed interval [s]
 };
 
 }  // namespace stackbeam::detail

@@ -1,0 +1,464 @@
+// Soak tests (issue 41, "Prove"): every stepper of the registry runs to rest and beyond.
+//  - A random soak: small random stacks (1-4 leaves; lengths, thicknesses, widths of leaf springs
+//    and friction dampers; mu 0-0.6; clamp preloads; bonded, frictionless and Coulomb interfaces,
+//    rigid or elastic) under random loadings that end (initial conditions; an applied force, a rig
+//    stroke or a base motion that stops), drawn from std::mt19937 with fixed seeds, each run
+//    massless and with steel leaves under every registered stepper that takes it
+//    (lib/time/stepper_registry.hpp), for 30 periods of the stack after the loading ends: friction
+//    decays the amplitude linearly, so a frictional stack comes to rest within that and the run
+//    goes on at rest (where the CVODE stall of decision 056 lived).
+//  - The bundled scenarios (scenarios/*.toml) at 20x their length under every stepper that takes
+//    them.
+// Each run must complete without error, close its energy balance to the bound of its stepper
+// (soak_bound below: the integrator's own error over the run's step count, on the run's own energy
+// scale) and, under CVODE, stay within a step budget a healthy run never nears but a stall
+// (~1e-12 s per restart) reaches in seconds. The first tier runs a handful of seeds; the rest and
+// the scenarios carry the label "slow" (docs/decisions/057-soak-tests.md).
+#define BOOST_TEST_MODULE soak
+#include <boost/test/data/test_case.hpp>
+#include <boost/test/unit_test.hpp>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stackbeam/errors.hpp"
+#include "stackbeam/io/scenario.hpp"
+#include "stackbeam/time/run_report.hpp"
+#include "stackbeam/time/stepper.hpp"
+#include "time/stepper_registry.hpp"
+
+using namespace stackbeam;
+namespace bdata = boost::unit_test::data;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// The options that make choose_stepper pick registry row `row` (mode, leaf inertia).
+SimulationOptions options_for(const detail::StepperCapabilities& row, SimulationOptions o) {
+    o.mode = row.mode;
+    const std::string name = row.name;
+    if (name == "cvode-modal") o.cvode.leaf_inertia = LeafInertia::modal;
+    else if (name == "cvode-massive") o.cvode.leaf_inertia = LeafInertia::massive;
+    else o.cvode.leaf_inertia = LeafInertia::automatic;
+    return o;
+}
+
+/// Whether row `row` runs `system` under `o`: the options reach the row (choose_stepper) and the
+/// row takes what the system and loading ask (check_capabilities). A row that refuses is not a
+/// failure: the registry says which stepper takes what.
+bool takes(const detail::StepperCapabilities& row, const System& system, const SimulationOptions& o) {
+    if (std::string(detail::choose_stepper(system, o).name) != row.name) return false;
+    try {
+        detail::check_capabilities(row, system, o);
+    } catch (const InputError&) {
+        return false;
+    }
+    return true;
+}
+
+/// What one soak run did.
+struct Soak {
+    bool completed = false;
+    std::string error;          ///< the exception's message when it did not complete
+    double t_reached_s = 0.0;   ///< time of the last record
+    long steps = 0;             ///< closed-form / newmark steps or CVODE steps
+    long events = 0;            ///< CVODE events
+    double balance_j = 0.0;     ///< max |energy_balance_error_j| over the run [J]
+    double scale_j = 0.0;       ///< the run's energy scale [J] (energy_scale_j)
+    double final_kinetic_j = 0.0;
+    double max_kinetic_j = 0.0;
+    double dissipated_j = 0.0;
+};
+
+/// Runs `system` under `o` record by record (no records kept: a 20x scenario has up to 1e5).
+/// The energy scale is the sum of the magnitudes the balance adds up,
+///     S = E(0) + max |W_ext| + max (K + U) + D(end) + impact loss(end) + damping energy(end),
+/// so a balance error is measured against the largest energy it could be the error of.
+Soak soak_run(const System& system, const SimulationOptions& o) {
+    Soak s;
+    double max_ext = 0.0, max_ku = 0.0, e0 = 0.0;
+    auto take = [&](const StepRecord& r) {
+        s.t_reached_s = r.t_s;
+        s.balance_j = std::max(s.balance_j, std::abs(r.energy_balance_error_j));
+        max_ext = std::max(max_ext, std::abs(r.external_work_j));
+        max_ku = std::max(max_ku, r.kinetic_energy_j + r.strain_energy_j);
+        s.final_kinetic_j = r.kinetic_energy_j;
+        s.max_kinetic_j = std::max(s.max_kinetic_j, r.kinetic_energy_j);
+        s.dissipated_j = r.dissipated_energy_j;
+        s.scale_j = e0 + max_ext + max_ku + r.dissipated_energy_j + std::abs(r.impact_loss_j) + r.damping_energy_j;
+    };
+    std::unique_ptr<Stepper> stepper;
+    try {
+        stepper = make_stepper(system, o);
+        e0 = stepper->current().kinetic_energy_j + stepper->current().strain_energy_j;
+        take(stepper->current());
+        const long n = static_cast<long>(std::ceil(o.t_end_s / o.dt_s - 1e-9));
+        for (long i = 0; i < n; ++i) take(stepper->advance());
+        s.completed = true;
+    } catch (const std::exception& e) {
+        s.error = e.what();
+    }
+    if (stepper) {
+        const RunReport rep = stepper->report();
+        s.steps = rep.steps;
+        s.events = rep.cvode.events;
+    }
+    return s;
+}
+
+/// The balance bound of a run of row `row` with `steps` steps on the energy scale S [J]:
+///  - closed-form: eq. 16 is exact for the linear stack; the balance error comes from taking the
+///    contact forces linear over a step (eq. 14) and the trapezoidal friction work, O((omega dt)^2)
+///    relative to the energy moved (test_friction_case: halving dt quarters it; the paper's case
+///    measured 1e-4 E0 at omega dt = 0.073, i.e. 0.02 (omega dt)^2): bound (omega dt)^2 S, with
+///    omega the stack's frequency (omega_rad_per_s; 0 on a rig: quasi-static, only the
+///    trapezoidal friction and rig work, bound 1e-3 S as the scenarios' runs measure);
+///  - newmark: the step's energy identity is exact (newmark_stepper.hpp), the balance closes to
+///    round-off per step: 1e-13 S per step (test_stepper_contract measured 2.5e-14 E0 per step);
+///  - cvode: each step commits a local error ~ rtol of the state, the balance drifts by up to
+///    N rtol S over N steps (test_stepper_contract, test_loadings): bound 4 N rtol S, and at
+///    least the contact solver's tolerance's share (events decided to solver.tolerance_m: the
+///    work of a force jump across it, bounded by 1e-6 S).
+double soak_bound(const detail::StepperCapabilities& row, const SimulationOptions& o, long steps, double scale_j,
+                  double omega_rad_per_s) {
+    switch (row.mode) {
+        case Mode::closed_form: {
+            const double wdt = omega_rad_per_s * o.dt_s;
+            return (omega_rad_per_s > 0.0 ? wdt * wdt : 1e-3) * scale_j;
+        }
+        case Mode::newmark: return 1e-13 * static_cast<double>(std::max(steps, 1L)) * scale_j;
+        case Mode::cvode:
+            return std::max(4.0 * static_cast<double>(steps) * o.cvode.rtol, 1e-6) * scale_j;
+    }
+    return 0.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Random stacks and loadings
+
+/// One random case: the stack (massless; soak_case makes it massive), its loading and the run.
+struct RandomCase {
+    ModelSpec spec;
+    Loading loading;
+    double omega_rad_per_s = 0.0;  ///< sqrt(k_tied / m): the stack's frequency (the mass is drawn for it)
+    double t_load_end_s = 0.0;     ///< the loading is over by then (0: initial conditions)
+    std::string what;              ///< a one-line description for the messages
+};
+
+double uniform(std::mt19937& g, double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
+int pick(std::mt19937& g, int a, int b) { return std::uniform_int_distribution<int>(a, b)(g); }
+
+/// The case of seed `seed`. Steel leaves (E = 206 GPa): a leaf spring's or a friction damper's
+/// leaves, 0.3-1.0 m long, 3-10 mm thick, 30-80 mm wide, graduated below the top leaf (each lower
+/// leaf shorter, centred, free ends; the top leaf pinned at both ends), the seat at mid-span tying
+/// every leaf. Interfaces bonded (15 %), frictionless (15 %) or Coulomb with mu in 0.05-0.6;
+/// rigid, elastic or a mix. 0-2 clamp pairs with preloads 0-3 kN. The mass of R for a tied
+/// frequency of 3-12 Hz. Amplitudes of 2-20 mm. 4-7 elements per half leaf (the modal and massive
+/// steppers' cost grows fast with the mesh).
+RandomCase random_case(unsigned seed) {
+    std::mt19937 g(seed);
+    RandomCase c;
+    ModelSpec& s = c.spec;
+    std::ostringstream what;
+    const int n = pick(g, 1, 4);
+    const double L0 = uniform(g, 0.3, 1.0), grad = uniform(g, 0.08, 0.2);
+    const double t = uniform(g, 0.003, 0.010), b = uniform(g, 0.03, 0.08);
+    const int elastic_draw = pick(g, 0, 99);  // < 45 all elastic, < 85 all rigid, else mixed
+    for (int i = 0; i < n; ++i) {
+        LeafSpec l;
+        l.length_m = L0 * (1.0 - grad * i);
+        l.x_start_m = 0.5 * (L0 - l.length_m);
+        l.height_m = t * uniform(g, 0.8, 1.2);
+        l.width_m = b;
+        l.youngs_modulus_pa = 2.06e11;
+        l.left_support = l.right_support = i == 0 ? SupportKind::pinned : SupportKind::free;
+        s.leaves.push_back(l);
+    }
+    what << n << " leaves, L " << L0 << " m, t " << t << " m, b " << b << " m;";
+    for (int i = 0; i + 1 < n; ++i) {
+        InterfaceSpec f;
+        const int law = pick(g, 0, 99);
+        f.law = law < 15 ? InterfaceLaw::bonded : InterfaceLaw::coulomb;
+        f.friction_coefficient = law < 30 ? 0.0 : uniform(g, 0.05, 0.6);
+        f.contact = elastic_draw < 45 || (elastic_draw >= 85 && pick(g, 0, 1) == 0) ? InterfaceContact::elastic
+                                                                                    : InterfaceContact::rigid;
+        what << " if" << i << ' ' << (f.law == InterfaceLaw::bonded ? "bonded" : "mu=" + std::to_string(f.friction_coefficient))
+             << ' ' << to_string(f.contact) << ';';
+        s.interfaces.push_back(f);
+    }
+    if (n > 1) {
+        const double half_short = 0.5 * s.leaves.back().length_m;
+        for (int k = pick(g, 0, 2); k > 0; --k) {
+            const double d = half_short * uniform(g, 0.3, 0.85), preload = uniform(g, 0.0, 3000.0);
+            for (double x : {0.5 * L0 - d, 0.5 * L0 + d}) s.clamps.push_back({x, preload, 0.01});
+            what << " clamps at +-" << d << " m, " << preload << " N;";
+        }
+    }
+    s.rigid_body.x_m = 0.5 * L0;
+    s.rigid_body.mass_kg = 1.0;
+    s.mesh.element_length_m = 0.5 * L0 / pick(g, 4, 7);
+    // the mass for the drawn frequency
+    const double f_hz = uniform(g, 3.0, 12.0);
+    c.omega_rad_per_s = 2.0 * kPi * f_hz;
+    const double k = System(Model::build(s)).tied_stiffness_n_per_m();
+    s.rigid_body.mass_kg = k / (c.omega_rad_per_s * c.omega_rad_per_s);
+    const double T = 1.0 / f_hz, A = uniform(g, 0.002, 0.02);
+    what << " m " << s.rigid_body.mass_kg << " kg, f " << f_hz << " Hz;";
+
+    Loading& L = c.loading;
+    const int kind = pick(g, 0, 3);
+    if (kind == 0) {  // initial conditions: a velocity or a displacement of R
+        if (pick(g, 0, 1) == 0) s.rigid_body.initial_velocity_m_per_s = (pick(g, 0, 1) ? 1 : -1) * A * c.omega_rad_per_s;
+        else s.rigid_body.initial_displacement_m = (pick(g, 0, 1) ? 1 : -1) * A;
+        what << " initial conditions v0 " << s.rigid_body.initial_velocity_m_per_s << " m/s, w0 "
+             << s.rigid_body.initial_displacement_m << " m";
+    } else if (kind == 1) {  // a harmonic force for 2-5 cycles, then off (a table, 16 points a cycle)
+        L.kind = LoadingKind::applied_force;
+        const double fr = f_hz * uniform(g, 0.5, 1.5), F0 = k * A * uniform(g, 0.2, 0.6);
+        const int cycles = pick(g, 2, 5);
+        for (int i = 0; i <= 16 * cycles; ++i) {
+            const double ti = i / (16.0 * fr);
+            L.force_n.times_s.push_back(ti);
+            L.force_n.values.push_back(F0 * std::sin(2.0 * kPi * fr * ti));
+        }
+        L.force_n.shape = TimeFunction::Shape::table;
+        c.t_load_end_s = L.force_n.times_s.back();
+        what << " force " << F0 << " N at " << fr << " Hz, " << cycles << " cycles then off";
+    } else if (kind == 2) {  // a rig stroke: down to -A, up to +A, back to 0, then held
+        L.kind = LoadingKind::prescribed_displacement;
+        const double Ts = T * uniform(g, 2.0, 6.0);
+        L.displacement_m.shape = TimeFunction::Shape::table;
+        L.displacement_m.times_s = {0.0, 0.25 * Ts, 0.75 * Ts, Ts};
+        L.displacement_m.values = {0.0, -A, A, 0.0};
+        c.t_load_end_s = Ts;
+        what << " rig stroke +-" << A << " m over " << Ts << " s then held";
+    } else {  // a base motion: a few random points, back to rest (a C2 spline, zero slope at the ends)
+        L.kind = LoadingKind::base_excitation;
+        L.displacement_m.shape = TimeFunction::Shape::table;
+        const int pts = pick(g, 2, 5);
+        const double dt = T * uniform(g, 0.3, 1.0);
+        L.displacement_m.times_s.push_back(0.0);
+        L.displacement_m.values.push_back(0.0);
+        for (int i = 1; i <= pts; ++i) {
+            L.displacement_m.times_s.push_back(i * dt);
+            L.displacement_m.values.push_back(uniform(g, -A, A));
+        }
+        L.displacement_m.times_s.push_back((pts + 1) * dt);
+        L.displacement_m.values.push_back(0.0);
+        c.t_load_end_s = (pts + 1) * dt;
+        what << " base motion through " << pts << " points, +-" << A << " m, then still";
+    }
+    if (kind != 2 && pick(g, 0, 2) == 0) {
+        L.gravity_m_per_s2 = 9.81;
+        what << ", gravity";
+    }
+    c.what = what.str();
+    return c;
+}
+
+/// Periods of the stack run after the loading ends: a frictional stack's amplitude decays by
+/// 4 F_f / k a cycle (Coulomb), so the drawn amplitudes (2-20 mm, ~ k A of force) with the drawn
+/// friction limits stop within a few to tens of cycles; 30 take each run to rest and on at rest.
+constexpr double kPeriodsAfterLoading = 30.0;
+
+/// The failures the soak found in the library, kept as regression cases (the disabled cases at the
+/// end of this file run exactly these); soak_seed skips them so the rest of each seed still runs.
+struct KnownFailure {
+    unsigned seed;
+    const char* row;
+};
+const KnownFailure kKnownFailures[] = {
+    // 2 leaves, elastic interface mu = 0.27, two clamp pairs, base motion: the whole massive stack's
+    // contact points vibrate on the undamped elastic layer, switching modes every few microseconds;
+    // the run stops with the driver's named chatter error (seed_1_cvode_massive_chatter_is_named).
+    {1, "cvode-massive"},
+    // Open (issue 41; docs/decisions/062-soak-fixes.md lists each with its message). Each run is
+    // skipped here so that the tier guards every other seed and stepper; remove a line when fixed.
+    // The whole massive stack (cvode-massive): the same chatter, named (seeds 8, 17, 23); the step
+    // limit without a named chatter (27, 28, 31); the initial contact solve or an event's decision
+    // ending 1.01-3x above a tolerance of ~1e-16 m (14, 18, 25, 36).
+    {8, "cvode-massive"}, {14, "cvode-massive"}, {17, "cvode-massive"}, {18, "cvode-massive"},
+    {23, "cvode-massive"}, {25, "cvode-massive"}, {27, "cvode-massive"}, {28, "cvode-massive"},
+    {31, "cvode-massive"}, {36, "cvode-massive"},
+    // newmark: a fixed balance offset built up while the pairs start slipping (13, 20, 31), as on
+    // graduated_elastic.toml; the contact solve ending at 4x / 1.7x its tolerance (15).
+    {13, "newmark-massless"}, {13, "newmark-massive"}, {15, "newmark-massless"}, {15, "newmark-massive"},
+    {20, "newmark-massless"}, {20, "newmark-massive"}, {31, "newmark-massive"},
+    // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick).
+    {29, "cvode-modal"},
+};
+/// The bundled scenarios' known failures at 20x (as kKnownFailures).
+struct KnownScenarioFailure {
+    const char* file;
+    const char* row;
+};
+const KnownScenarioFailure kKnownScenarioFailures[] = {
+    {"base_steel_elastic.toml", "cvode-massive"},    // the step limit at t = 0.97 ms
+    {"graduated_elastic.toml", "newmark-massless"},  // the balance offset of seeds 13, 20, 31
+};
+bool known_failure(unsigned seed, const char* row) {
+    for (const KnownFailure& k : kKnownFailures)
+        if (k.seed == seed && std::string(k.row) == row) return true;
+    return false;
+}
+
+/// Runs seed `seed` (massless, then with steel leaves) under every registered stepper that takes
+/// it; every run must complete within the step budget and close its balance. `only_row`: that row
+/// alone (the regression cases); else every row but the known failures. `expect_error`: the run
+/// must instead stop with an error saying that, well within its step budget (a named refusal).
+void soak_seed(unsigned seed, const std::string& only_row = "", const std::string& expect_error = "") {
+    const RandomCase c = random_case(seed);
+    BOOST_TEST_MESSAGE("seed " << seed << ": " << c.what);
+    const double T = 2.0 * kPi / c.omega_rad_per_s;
+    for (const double density : {0.0, 7850.0}) {
+        ModelSpec spec = c.spec;
+        for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = density;
+        const System system(Model::build(spec));
+        const bool elastic = system.has_layer();
+        for (const detail::StepperCapabilities& row : detail::stepper_registry()) {
+            SimulationOptions o;
+            o.loading = c.loading;
+            o.t_end_s = c.t_load_end_s + kPeriodsAfterLoading * T;
+            // fixed-step: 100 steps a period (omega dt = 0.063); newmark with leaf mass 200 (its
+            // leaves' modes); cvode: records 20 a period (its steps are its own)
+            o.dt_s = row.mode == Mode::cvode ? T / 20.0 : T / (row.massive_leaves ? 200.0 : 100.0);
+            // the elastic layer's forces ~ k_n A x: its approach resolved to 1e-9 m (test_stepper_contract)
+            if (elastic) o.solver.tolerance_m = 1e-9;
+            // A healthy run takes 170-180 CVODE steps a period here (measured on seeds 1-6; 430 on
+            // base_friction at 20x); a stall creeps ~1e-12 s a step. The budget, 20,000 steps a
+            // period (~100x), a healthy run never nears but a stall reaches in seconds.
+            o.cvode.max_steps = static_cast<long>(20000.0 * o.t_end_s / T);
+            o = options_for(row, o);
+            // The whole massive stack resolves the elastic layer's own vibrations (~1e5 Hz: k_n
+            // over a node's mass; undamped, BDF follows them at ~40 steps a period, ~1e6 steps a
+            // simulated second): a light stiffness-proportional damping, beta = 1e-6 s, damps them
+            // (zeta = beta omega / 2 ~ 0.3 there) and leaves the stack's own motion undamped to
+            // zeta < 1e-4 (omega < 80 rad/s). Its energy is in the balance (damping_energy_j).
+            // Even so it takes ~3e5 steps a simulated second on these stacks (measured, seed 3), so
+            // it runs the first 0.05 s only (the loading's start, its first events), with a
+            // budget of 2e5 steps (~3x that window's need; a creeping stall reaches it in seconds).
+            if (std::string(row.name) == "cvode-massive") {
+                o.damping.rayleigh_beta_s = 1e-6;
+                o.t_end_s = std::min(o.t_end_s, 0.05);
+                o.dt_s = std::min(o.dt_s, 0.005);
+                o.cvode.max_steps = 200000;
+            }
+            if (!takes(row, system, o)) continue;
+            if (only_row.empty() ? known_failure(seed, row.name) : only_row != row.name) {
+                if (only_row.empty()) BOOST_TEST_MESSAGE("  " << row.name << ": skipped, a known failure (kKnownFailures)");
+                continue;
+            }
+            const Soak s = soak_run(system, o);
+            const double bound = soak_bound(row, o, s.steps, s.scale_j,
+                                            c.loading.kind == LoadingKind::prescribed_displacement ? 0.0 : c.omega_rad_per_s);
+            BOOST_TEST_MESSAGE("  " << row.name << ": t " << s.t_reached_s << " s of " << o.t_end_s << ", " << s.steps
+                                    << " steps, " << s.events << " events, balance " << s.balance_j / s.scale_j
+                                    << " S (bound " << bound / s.scale_j << " S), final K/max K "
+                                    << (s.max_kinetic_j > 0 ? s.final_kinetic_j / s.max_kinetic_j : 0.0));
+            if (!expect_error.empty()) {
+                BOOST_TEST(!s.completed, "seed " << seed << ", " << row.name << ": completed; expected \"" << expect_error << '"');
+                BOOST_TEST(s.error.find(expect_error) != std::string::npos, "seed " << seed << ", " << row.name << ": " << s.error);
+                BOOST_TEST(s.steps < o.cvode.max_steps / 4, "seed " << seed << ", " << row.name << ": " << s.steps << " steps");
+                continue;
+            }
+            BOOST_TEST(s.completed, "seed " << seed << ", " << row.name << " (density " << density << "): failed at t = "
+                                            << s.t_reached_s << " s: " << s.error);
+            if (!s.completed) continue;
+            BOOST_TEST(s.balance_j <= bound, "seed " << seed << ", " << row.name << ": balance error "
+                                                     << s.balance_j << " J > bound " << bound << " J (S " << s.scale_j << " J)");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The bundled scenarios at 20x their length
+
+std::vector<std::string> scenario_files() {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios"))
+        if (e.path().extension() == ".toml") files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+void soak_scenario(const std::string& file) {
+    const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/" + file);
+    const System system(Model::build(sc.model));
+    const double k = system.tied_stiffness_n_per_m(), m = sc.model.rigid_body.mass_kg;
+    const double omega = sc.simulation.loading.kind == LoadingKind::prescribed_displacement ? 0.0 : std::sqrt(k / m);
+    int runs = 0;
+    for (const detail::StepperCapabilities& row : detail::stepper_registry()) {
+        SimulationOptions o = options_for(row, sc.simulation);
+        o.t_end_s = 20.0 * sc.simulation.t_end_s;
+        // the whole massive stack: its first 0.05 s only, as in soak_seed (~1e6 steps a simulated
+        // second on base_steel_elastic; 20 s of it would take hours)
+        if (std::string(row.name) == "cvode-massive") {
+            o.t_end_s = std::min(o.t_end_s, 0.05);
+            o.dt_s = std::min(o.dt_s, 0.005);
+            o.cvode.max_steps = 200000;
+        }
+        if (!takes(row, system, o)) continue;
+        ++runs;
+        const bool known = std::any_of(std::begin(kKnownScenarioFailures), std::end(kKnownScenarioFailures),
+                                       [&](const KnownScenarioFailure& k) { return file == k.file && std::string(row.name) == k.row; });
+        if (known) {
+            BOOST_TEST_MESSAGE(file << ", " << row.name << ": skipped, a known failure (kKnownScenarioFailures)");
+            continue;
+        }
+        const Soak s = soak_run(system, o);
+        const double bound = soak_bound(row, o, s.steps, s.scale_j, omega);
+        BOOST_TEST_MESSAGE(file << ", " << row.name << ": t " << s.t_reached_s << " s of " << o.t_end_s << ", "
+                                << s.steps << " steps, " << s.events << " events, balance " << s.balance_j / s.scale_j
+                                << " S (bound " << bound / s.scale_j << " S)");
+        BOOST_TEST(s.completed, file << ", " << row.name << ": failed at t = " << s.t_reached_s << " s: " << s.error);
+        if (s.completed) BOOST_TEST(s.balance_j <= bound, file << ", " << row.name << ": balance error " << s.balance_j
+                                                                << " J > bound " << bound << " J");
+    }
+    BOOST_TEST(runs > 0, file << ": no stepper takes it");
+}
+
+std::vector<unsigned> seeds(unsigned first, unsigned count) {
+    std::vector<unsigned> v;
+    for (unsigned i = 0; i < count; ++i) v.push_back(first + i);
+    return v;
+}
+
+}  // namespace
+
+// The first tier: a handful of seeds (every stepper that takes them).
+BOOST_DATA_TEST_CASE(random_stacks_run_to_rest, bdata::make(seeds(1, 6)), seed) { soak_seed(seed); }
+
+// The full soak: many seeds.
+BOOST_TEST_DECORATOR(*boost::unit_test::label("slow"))
+BOOST_DATA_TEST_CASE(many_random_stacks_run_to_rest, bdata::make(seeds(7, 30)), seed) {
+    soak_seed(seed);
+}
+
+// Every bundled scenario at 20x its length.
+BOOST_TEST_DECORATOR(*boost::unit_test::label("slow"))
+BOOST_DATA_TEST_CASE(bundled_scenarios_at_twenty_times_their_length, bdata::make(scenario_files()), file) {
+    soak_scenario(file);
+}
+
+// The regression cases of the failures the soak found (docs/decisions/062-soak-fixes.md).
+// Seed 1 (2 leaves, elastic interface mu = 0.27, two clamp pairs, base motion), the whole massive
+// stack: contact points vibrate on the undamped elastic layer (pairs 0/15 open -> stick -> slip ->
+// open every ~11 us from the start, later pairs 5/10 open <-> slip every ~2 us), each switch a
+// restart of ~80 CVODE steps: it ran to cvode.max_steps = 200,000 at t = 3.5 ms after 2,433 events.
+// Now the driver's named chatter error (kMaxPairSwitches: pair 0, 100 switches within 2.6e-4 s,
+// under a thousandth of the stack's period) after 24,756 steps; the modal stepper (massless
+// layer) runs this seed to rest (first tier).
+BOOST_AUTO_TEST_CASE(seed_1_cvode_massive_chatter_is_named) {
+    soak_seed(1, "cvode-massive", "the contact chatters");
+}
+// Fixed (docs/decisions/062-soak-fixes.md): 1 leaf, base motion through a table then still,
+// gravity. The clamped base spline's y'' jumps at the table's first and last points; the modal
+// stepper's loading work, [q^T z] - int q'^T z dt, missed the jump's term (q+ - q-)^T z there:
+// balance error 0.088 S (0.48 J of 5.5 J). It now stops at every point of the table
+// (cross_loading_break): 9.8e-7 S measured against the bound 4 N rtol S = 6.7e-5 S.
+BOOST_AUTO_TEST_CASE(seed_5_cvode_modal_one_leaf_base_table) { soak_seed(5, "cvode-modal"); }
