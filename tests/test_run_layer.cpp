@@ -143,3 +143,76 @@ BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {
         BOOST_TEST(std::string(e.what()) == "--mode: value 'rk4' is not a mode: allowed closed-form, cvode, newmark");
     }
 }
+
+namespace {
+
+/// Keeps every record's stresses the run layer hands over.
+struct StressSink : RunSink {
+    std::vector<double> t_s;
+    std::vector<Stresses> stresses;
+    void on_stresses(double t, const Stresses& s) override {
+        t_s.push_back(t);
+        stresses.push_back(s);
+    }
+};
+
+}  // namespace
+
+// RunOutputs::stresses (issue 43 item 5): the run's StressSummary is the one a StressMonitor
+// gives when fed the same stresses by hand, and every interface's peak pressure is the largest
+// of the pressures handed to the sink; the records do not change (the flag only reads the state).
+// Exact comparisons: one computation, the same inputs.
+BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_monitors_summary) {
+    const Scenario s = rig();
+    const System system(Model::build(s.model));
+    RunRequest plain;
+    plain.options = s.simulation;
+    const RunSummary without = run_scenario(system, plain);
+    BOOST_TEST(!without.stresses.has_value());  // not asked: nothing made (and no note)
+    BOOST_TEST(without.stresses_note.empty());
+    BOOST_TEST(summary_json(without, system.model()).find("\"stresses\"") == std::string::npos);
+
+    StressSink sink;
+    RunRequest request = plain;
+    request.outputs.stresses = true;
+    request.sink = &sink;
+    const RunSummary with = run_scenario(system, request);
+    BOOST_REQUIRE_EQUAL(with.records.size(), without.records.size());
+    for (std::size_t i = 0; i < with.records.size(); ++i) BOOST_TEST_REQUIRE(same(with.records[i], without.records[i]), "record " << i);
+    BOOST_REQUIRE(with.stresses.has_value());
+    BOOST_REQUIRE_EQUAL(sink.stresses.size(), with.records.size());
+
+    // the reference: a monitor over the last period (the rig's loading is periodic, 1 s; the run 2 s)
+    StressMonitorOptions o;
+    o.period_s = s.simulation.loading.period_s();
+    o.t_end_s = with.records.back().t_s;
+    StressMonitor monitor(s.model, o);
+    for (std::size_t i = 0; i < sink.stresses.size(); ++i) monitor.add(sink.t_s[i], sink.stresses[i]);
+    const StressSummary ref = monitor.summary();
+    const StressSummary& got = with.stresses->summary;
+    BOOST_TEST(got.samples == ref.samples);
+    BOOST_TEST(got.cycle_samples == ref.cycle_samples);
+    BOOST_TEST(got.cycle_start_s == ref.cycle_start_s);
+    BOOST_REQUIRE_EQUAL(got.extremes.size(), s.model.leaves.size());
+    for (std::size_t l = 0; l < got.extremes.size(); ++l) {
+        BOOST_TEST(got.extremes[l].tension.stress_pa == ref.extremes[l].tension.stress_pa);
+        BOOST_TEST(got.extremes[l].compression.x_m == ref.extremes[l].compression.x_m);
+        BOOST_TEST(got.extremes[l].tension.stress_pa > 0.0);  // a loaded leaf bends: both signs somewhere
+        BOOST_TEST(got.extremes[l].compression.stress_pa < 0.0);
+    }
+    BOOST_TEST(got.largest_range.range_pa == ref.largest_range.range_pa);
+    BOOST_TEST(got.largest_range.range_pa > 0.0);
+    // the peaks: the largest pressure on each interface over every record handed over
+    BOOST_REQUIRE_EQUAL(with.stresses->interfaces.size(), s.model.interfaces.size());
+    for (std::size_t i = 0; i < with.stresses->interfaces.size(); ++i) {
+        double peak = 0.0;
+        for (const Stresses& st : sink.stresses) peak = std::max(peak, st.interfaces[i].pressure_pa);
+        BOOST_TEST(with.stresses->interfaces[i].peak.pressure_pa == peak);
+        BOOST_TEST(peak > 0.0);  // the leaves press on each other under load
+    }
+    // the JSON summary's section
+    const std::string json = summary_json(with, system.model());
+    BOOST_TEST(json.find("\"stresses\": {") != std::string::npos);
+    BOOST_TEST(json.find("\"largest_tension\"") != std::string::npos);
+    BOOST_TEST(json.find("\"peak_pressure_pa\"") != std::string::npos);
+}

@@ -96,11 +96,11 @@ void write_outputs(const FitSpec& spec, const FitResult& r, const fs::path& dir,
                               {"dynamic_rate_n_per_m", {{"measured", l.measured_dynamic_rate_n_per_m}, {"fitted", l.fitted_dynamic_rate_n_per_m}}}});
     std::ofstream(dir / "fit.json") << j.dump(2) << "\n";
     if (!plot) return;
-    if (!demo::gnuplot_on_path()) {
+    if (!gnuplot::gnuplot_on_path()) {
         std::printf("figure                     none: gnuplot not found (loops.csv has the loops)\n");
         return;
     }
-    const auto terminal = demo::png_terminal();
+    const auto terminal = gnuplot::png_terminal();
     if (!terminal) return;
     std::ofstream gp(dir / "loops.gp");
     gp << "set terminal " << *terminal << " size 900,650\nset output 'loops.png'\nset datafile separator ','\n"
@@ -113,7 +113,7 @@ void write_outputs(const FitSpec& spec, const FitResult& r, const fs::path& dir,
     }
     gp << "\n";
     gp.close();
-    const std::string command = "cd " + demo::shell_quote(dir.string()) + " && gnuplot loops.gp >/dev/null 2>&1";
+    const std::string command = "cd " + gnuplot::shell_quote(dir.string()) + " && gnuplot loops.gp >/dev/null 2>&1";
     if (std::system(command.c_str()) == 0) std::printf("figure                     %s\n", (dir / "loops.png").c_str());
 }
 
