@@ -224,6 +224,24 @@ stackbeam_cli_test(NAME cli_bad_nodes_is_out
                    ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_nodes_bad.csv
                         --nodes ${_cli_out_dir}/cli_nodes_bad.csv
                    EXPECT_RC 2 EXPECT_TEXT "--nodes: value" OUT ${_cli_out_dir}/cli_nodes_bad.csv)
+# --stresses (issue 43 item 5): the long-format file of every leaf's stresses at every record
+# (whole leaves: 3 leaves x 41 nodes x 6 records + the header), the summary's largest stress per
+# leaf, the JSON's stresses section, and a name of its own
+stackbeam_cli_test(NAME cli_ok_stresses
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stresses_run.csv
+                        --stresses ${_cli_out_dir}/cli_stresses.csv
+                   EXPECT_RC 0 EXPECT_TEXT "stress leaf 0" OUT ${_cli_out_dir}/cli_stresses.csv
+                   HEADER_PREFIX "t,leaf,x,sigma_top,sigma_bottom,axial_force,bending_moment,shear_force"
+                   MIN_LINES 739)
+# the JSON's samples: one per record (6 records: t = 0 .. 0.005 s every 0.001 s)
+stackbeam_cli_test(NAME cli_ok_stresses_json
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stresses_json.csv
+                        --stresses ${_cli_out_dir}/cli_stresses_json_s.csv --summary ${_cli_out_dir}/cli_stresses.json
+                   EXPECT_RC 0 JSON ${_cli_out_dir}/cli_stresses.json JSON_PATH "stresses|samples" JSON_RANGE "6|6")
+stackbeam_cli_test(NAME cli_bad_stresses_is_out
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stresses_bad.csv
+                        --stresses ${_cli_out_dir}/cli_stresses_bad.csv
+                   EXPECT_RC 2 EXPECT_TEXT "--stresses: value" OUT ${_cli_out_dir}/cli_stresses_bad.csv)
 stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
                    ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv

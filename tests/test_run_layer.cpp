@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/run/run.hpp"
@@ -142,4 +143,126 @@ BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {
     } catch (const InputError& e) {
         BOOST_TEST(std::string(e.what()) == "--mode: value 'rk4' is not a mode: allowed closed-form, cvode, newmark");
     }
+}
+
+namespace {
+
+/// Keeps every record's stresses the run layer hands over.
+struct StressSink : RunSink {
+    std::vector<double> t_s;
+    std::vector<Stresses> stresses;
+    void on_stresses(double t, const Stresses& s) override {
+        t_s.push_back(t);
+        stresses.push_back(s);
+    }
+};
+
+}  // namespace
+
+// RunOutputs::stresses (issue 43 item 5): the run's StressSummary is the one a StressMonitor
+// gives when fed the same stresses by hand, and every interface's peak pressure is the largest
+// of the pressures handed to the sink; the records do not change (the flag only reads the state).
+// Exact comparisons: one computation, the same inputs.
+BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_monitors_summary) {
+    const Scenario s = rig();
+    const System system(Model::build(s.model));
+    RunRequest plain;
+    plain.options = s.simulation;
+    const RunSummary without = run_scenario(system, plain);
+    BOOST_TEST(!without.stresses.has_value());  // not asked: nothing made (and no note)
+    BOOST_TEST(without.stresses_note.empty());
+    BOOST_TEST(summary_json(without, system.model()).find("\"stresses\"") == std::string::npos);
+
+    StressSink sink;
+    RunRequest request = plain;
+    request.outputs.stresses = true;
+    request.sink = &sink;
+    const RunSummary with = run_scenario(system, request);
+    BOOST_REQUIRE_EQUAL(with.records.size(), without.records.size());
+    for (std::size_t i = 0; i < with.records.size(); ++i) BOOST_TEST_REQUIRE(same(with.records[i], without.records[i]), "record " << i);
+    BOOST_REQUIRE(with.stresses.has_value());
+    BOOST_REQUIRE_EQUAL(sink.stresses.size(), with.records.size());
+
+    // the reference: a monitor over the last period (the rig's loading is periodic, 1 s; the run 2 s)
+    StressMonitorOptions o;
+    o.period_s = s.simulation.loading.period_s();
+    o.t_end_s = with.records.back().t_s;
+    StressMonitor monitor(s.model, o);
+    for (std::size_t i = 0; i < sink.stresses.size(); ++i) monitor.add(sink.t_s[i], sink.stresses[i]);
+    const StressSummary ref = monitor.summary();
+    const StressSummary& got = with.stresses->summary;
+    BOOST_TEST(got.samples == ref.samples);
+    BOOST_TEST(got.cycle_samples == ref.cycle_samples);
+    BOOST_TEST(got.cycle_start_s == ref.cycle_start_s);
+    BOOST_REQUIRE_EQUAL(got.extremes.size(), s.model.leaves.size());
+    for (std::size_t l = 0; l < got.extremes.size(); ++l) {
+        BOOST_TEST(got.extremes[l].tension.stress_pa == ref.extremes[l].tension.stress_pa);
+        BOOST_TEST(got.extremes[l].compression.x_m == ref.extremes[l].compression.x_m);
+        BOOST_TEST(got.extremes[l].tension.stress_pa > 0.0);  // a loaded leaf bends: both signs somewhere
+        BOOST_TEST(got.extremes[l].compression.stress_pa < 0.0);
+    }
+    BOOST_TEST(got.largest_range.range_pa == ref.largest_range.range_pa);
+    BOOST_TEST(got.largest_range.range_pa > 0.0);
+    // the peaks: the largest pressure on each interface over every record handed over
+    BOOST_REQUIRE_EQUAL(with.stresses->interfaces.size(), s.model.interfaces.size());
+    for (std::size_t i = 0; i < with.stresses->interfaces.size(); ++i) {
+        double peak = 0.0;
+        for (const Stresses& st : sink.stresses) peak = std::max(peak, st.interfaces[i].pressure_pa);
+        BOOST_TEST(with.stresses->interfaces[i].peak.pressure_pa == peak);
+        BOOST_TEST(peak > 0.0);  // the leaves press on each other under load
+    }
+    // the JSON summary's section
+    const std::string json = summary_json(with, system.model());
+    BOOST_TEST(json.find("\"stresses\": {") != std::string::npos);
+    BOOST_TEST(json.find("\"largest_tension\"") != std::string::npos);
+    BOOST_TEST(json.find("\"peak_pressure_pa\"") != std::string::npos);
+}
+
+// With a material on every leaf (S_u 1.6 GPa, S_e 600 MPa, Goodman) the run's fatigue figures are
+// the periodic path's: at every node and fibre one cycle of the last period, s_a = (max - min) / 2,
+// s_m = (max + min) / 2, n = 1 / (s_a / S_e + s_m / S_u) for s_m > 0 and S_e / s_a otherwise
+// (Shigley, 10th ed., table 6-7), recomputed here from the stresses handed to the sink; the least
+// n over the leaf agrees to round-off (1e-12 relative: a few operations on numbers of one size).
+BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_fatigue_figures) {
+    Scenario s = rig();
+    FatigueMaterial steel;
+    steel.ultimate_strength_pa = 1.6e9;
+    steel.endurance_limit_pa = 6e8;
+    for (LeafSpec& l : s.model.leaves) l.material = steel;
+    const System system(Model::build(s.model));
+    StressSink sink;
+    RunRequest request;
+    request.options = s.simulation;
+    request.outputs.stresses = true;
+    request.sink = &sink;
+    const RunSummary summary = run_scenario(system, request);
+    BOOST_REQUIRE(summary.stresses.has_value());
+    const StressSummary& got = summary.stresses->summary;
+    BOOST_TEST((got.counting == CycleCounting::periodic));
+    const double t_last = sink.t_s.back(), period = s.simulation.loading.period_s();
+    for (std::size_t l = 0; l < s.model.leaves.size(); ++l) {
+        const std::size_t nodes = sink.stresses[0].leaves[l].x_m.size();
+        double least = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < nodes; ++i)
+            for (int fibre = 0; fibre < 2; ++fibre) {
+                double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+                for (std::size_t k = 0; k < sink.t_s.size(); ++k) {
+                    if (sink.t_s[k] < t_last - period - 1e-9) continue;
+                    const LeafStresses& ls = sink.stresses[k].leaves[l];
+                    const double v = fibre == 0 ? ls.top_stress_pa[i] : ls.bottom_stress_pa[i];
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+                const double sa = 0.5 * (hi - lo), sm = 0.5 * (hi + lo);
+                const double n = sm > 0.0 ? 1.0 / (sa / steel.endurance_limit_pa + sm / steel.ultimate_strength_pa)
+                                          : steel.endurance_limit_pa / sa;
+                least = std::min(least, n);
+            }
+        BOOST_REQUIRE(got.fatigue[l].has_material);
+        BOOST_REQUIRE(got.fatigue[l].fatigue.has_safety_factor);
+        BOOST_TEST(got.fatigue[l].fatigue.least_safety_factor == least, boost::test_tools::tolerance(1e-12));
+        BOOST_TEST(least > 1.0);  // the rig's 50 MPa amplitudes are far below S_e
+    }
+    const std::string json = summary_json(summary, system.model());
+    BOOST_TEST(json.find("\"least_safety_factor\"") != std::string::npos);
 }

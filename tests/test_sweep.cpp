@@ -6,12 +6,14 @@
 #define BOOST_TEST_MODULE sweep
 #include <boost/test/unit_test.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
 
 #include "stackbeam/study/sweep.hpp"
 #include "stackbeam/study/sweep_output.hpp"
+#include "stackbeam/run/run.hpp"
 
 using namespace stackbeam;
 
@@ -169,5 +171,46 @@ BOOST_AUTO_TEST_CASE(cvode_runs_on_threads) {
     for (std::size_t i = 0; i < points.size(); ++i) {
         BOOST_TEST(status[i] == "ok", "point " << i);
         BOOST_TEST(same(serial[i], threaded[i]), "point " << i);
+    }
+}
+
+// [outputs] stresses = true (issue 43 item 5): the points' stress columns are the run layer's
+// figures (the largest |fibre stress| over the leaves' extremes, the same numbers: one
+// computation); without it they are NaN and the other figures do not change (the flag only
+// reads the state); a value not a bool is refused with its line.
+BOOST_AUTO_TEST_CASE(stress_columns) {
+    const std::string axes = "[[axes]]\nkey = \"interfaces[*].friction_coefficient\"\nvalues = [0.3]\n";
+    const SweepSpec on = parse_sweep_spec("scenario = \"rig_small.toml\"\n[outputs]\nstresses = true\n" + axes, kSource);
+    const SweepSpec off = parse_sweep_spec("scenario = \"rig_small.toml\"\n" + axes, kSource);
+    BOOST_TEST(on.stresses);
+    BOOST_TEST(!off.stresses);
+    const auto& columns = point_figure_columns();
+    BOOST_REQUIRE_EQUAL(columns.size(), 19u);
+    BOOST_TEST(columns[17] == "stress_max_abs_pa");
+    BOOST_TEST(columns[18] == "fatigue_least_safety_factor");
+    const SweepPoint p_on = expand_points(on)[0], p_off = expand_points(off)[0];
+    const PointResult with = run_point(p_on), without = run_point(p_off);
+    BOOST_REQUIRE(with.status == PointStatus::ok);
+    BOOST_TEST(std::isnan(without.figures[17]));
+    BOOST_TEST(std::isnan(without.figures[18]));
+    for (std::size_t i = 0; i < 17; ++i) BOOST_TEST(same({with.figures[i]}, {without.figures[i]}), "figure " << i);
+    // the reference: the run layer's summary of the same scenario
+    const System system(Model::build(p_on.scenario.model));
+    RunRequest request;
+    request.options = p_on.scenario.simulation;
+    request.outputs.stresses = true;
+    const RunSummary summary = run_scenario(system, request);
+    double largest = 0.0;
+    for (const LeafExtremes& e : summary.stresses->summary.extremes)
+        largest = std::max({largest, std::abs(e.tension.stress_pa), std::abs(e.compression.stress_pa)});
+    BOOST_TEST(with.figures[17] == largest);
+    BOOST_TEST(largest > 0.0);
+    BOOST_TEST(std::isnan(with.figures[18]));  // rig_small's leaves have no material
+    try {
+        parse_sweep_spec("scenario = \"rig_small.toml\"\n[outputs]\nstresses = \"yes\"\n" + axes, kSource);
+        BOOST_FAIL("stresses = \"yes\" was accepted");
+    } catch (const InputError& e) {
+        BOOST_TEST(e.field() == "outputs.stresses");
+        BOOST_TEST(e.location() == kSource + ":3");
     }
 }

@@ -191,6 +191,11 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
                    "write every leaf's nodal displacements (t, leaf, x, w, theta; the half model mirrored to whole "
                    "leaves) at every output time (file key outputs.nodes_path)")
         ->type_name("FILE.csv");
+    sim.add_option("--stresses", a.stresses,
+                   "write every leaf's stresses and resultants (t, leaf, x, sigma_top, sigma_bottom [Pa], axial_force, "
+                   "shear_force [N], bending_moment [N m]; whole leaves) at every output time; the summary then has "
+                   "the largest stress per leaf")
+        ->type_name("FILE.csv");
     sim.add_option("--plot", a.plot, "draw PNG figures with gnuplot: PREFIX_*.png (file key outputs.plot_prefix)")
         ->type_name("PREFIX");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
@@ -203,6 +208,7 @@ SimulateRequest make_request(const SimulateArgs& a) {
     r.summary = a.summary;
     r.pairs = a.pairs;
     r.nodes = a.nodes;
+    r.stresses = a.stresses;
     r.plot = a.plot;
     r.quiet = a.quiet;
     const bool density_given = a.given.count("--beam-density") > 0;
@@ -257,6 +263,12 @@ SimulateRequest make_request(const SimulateArgs& a) {
                 throw ArgumentError(what + ": value '" + r.nodes + "' is also the " + other +
                                     " file: give the nodal displacements a file of their own");
     }
+    if (!r.stresses.empty())  // the stresses' rows would overwrite (or interleave with) another output
+        for (const auto& [other, file] : {std::pair<const char*, const std::string*>{"--out", &r.out}, {"--pairs", &r.pairs},
+                                          {"--nodes", &r.nodes}, {"--events", &r.events}, {"--summary", &r.summary}})
+            if (*file == r.stresses)
+                throw ArgumentError("--stresses: value '" + r.stresses + "' is also the " + other +
+                                    " file: give the stresses a file of their own");
     // every output checked before the run: a bad path is found in a moment, not after the simulation
     auto name = [&](const std::string& flag, const std::string& given, const char* key) {
         return given.empty() && !a.scenario.empty() ? std::string("outputs.") + key + " (file " + a.scenario + ")" : flag;
@@ -266,6 +278,7 @@ SimulateRequest make_request(const SimulateArgs& a) {
     check_output_file(name("--summary", a.summary, "summary_path"), r.summary);
     check_output_file(name("--pairs", a.pairs, "pairs_path"), r.pairs);
     check_output_file(name("--nodes", a.nodes, "nodes_path"), r.nodes);
+    check_output_file("--stresses", r.stresses);
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }

@@ -36,7 +36,7 @@ struct SimulateArgs {
     bool full_model = false;
     std::string beam_density;  ///< "" = the leaves' own density (the case's: 0, massless)
     std::string interface;     ///< --interface: "" = the case's or the file's contact law (rigid | elastic)
-    std::string out, events, summary, pairs, nodes, plot;
+    std::string out, events, summary, pairs, nodes, stresses, plot;
     bool quiet = false;
     std::map<std::string, std::string> table_text;  ///< flag (or alias) of the option table -> text
     std::set<std::string> given;                     ///< the flags given on the command line
@@ -49,7 +49,7 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& args);
 struct SimulateRequest {
     ModelSpec spec;
     SimulationOptions options;
-    std::string out, events, summary, pairs, nodes, plot;  ///< files ("" = none); out is required
+    std::string out, events, summary, pairs, nodes, stresses, plot;  ///< files ("" = none); out is required
     std::string setup;                              ///< the summary's first line: the case or the scenario
     bool quiet = false;
     std::optional<Scenario> scenario;  ///< the file read, for --scenario (its keys' locations)

@@ -155,18 +155,24 @@ class FileSink : public RunSink {
 public:
     FileSink(const SimulateRequest& request, RunResult& result)
         : csv(request.out, "--out"), pairs_csv(request.pairs, "--pairs"), nodes_csv(request.nodes, "--nodes"),
+          stresses_csv(request.stresses, "--stresses"),
           progress(!request.quiet, request.options.t_end_s), snapshots_(!request.plot.empty()), result_(result) {
         write_csv_header(csv.stream());
         if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
         pairs_csv.stream().precision(17);
         if (nodes_csv.active()) nodes_csv.stream() << "t,leaf,x,w,theta\n";
         nodes_csv.stream().precision(17);
+        // SI units: x [m], stresses [Pa] (tension positive), N and V [N], M [N m] (post/stresses.hpp's signs)
+        if (stresses_csv.active())
+            stresses_csv.stream() << "t,leaf,x,sigma_top,sigma_bottom,axial_force,bending_moment,shear_force\n";
+        stresses_csv.stream().precision(17);
     }
     /// What the run hands over: pairs and nodes for their files or the stack figure.
     RunOutputs outputs() const {
         RunOutputs o;
         o.pairs = pairs_csv.active() || snapshots_;
         o.nodes = nodes_csv.active() || snapshots_;
+        o.stresses = stresses_csv.active();
         return o;
     }
     void on_record(const StepRecord& r) override {
@@ -174,6 +180,7 @@ public:
         csv.check();  // a write error (a full disk) stops the run at once, with the system's reason
         pairs_csv.check();
         nodes_csv.check();
+        stresses_csv.check();
         // --plot: a new max or min of w marks the record; its pairs and nodes follow in on_pairs, on_nodes
         marked_.clear();
         if (snapshots_) {
@@ -206,7 +213,16 @@ public:
                 o << t << ',' << leaf.leaf << ',' << leaf.x_m[j] << ',' << leaf.w_m[j] << ',' << leaf.theta_rad[j] << '\n';
     }
 
-    PartialFile csv, pairs_csv, nodes_csv;
+    /// Stepper::stresses() gives whole leaves (the half model mirrored): one row per node.
+    void on_stresses(double t, const Stresses& stresses) override {
+        auto& o = stresses_csv.stream();
+        for (const LeafStresses& l : stresses.leaves)
+            for (std::size_t j = 0; j < l.x_m.size(); ++j)
+                o << t << ',' << l.leaf << ',' << l.x_m[j] << ',' << l.top_stress_pa[j] << ',' << l.bottom_stress_pa[j] << ','
+                  << l.axial_force_n[j] << ',' << l.bending_moment_n_m[j] << ',' << l.shear_force_n[j] << '\n';
+    }
+
+    PartialFile csv, pairs_csv, nodes_csv, stresses_csv;
     Progress progress;
 
 private:
@@ -239,12 +255,14 @@ RunResult run(const SimulateRequest& request, const System& system) {
         sink.csv.discard();
         sink.pairs_csv.discard();
         sink.nodes_csv.discard();
+        sink.stresses_csv.discard();
         throw;
     } catch (...) {
         sink.progress.finish();
         sink.csv.keep_whole_rows();
         sink.pairs_csv.keep_whole_rows();
         sink.nodes_csv.keep_whole_rows();
+        sink.stresses_csv.keep_whole_rows();
         std::cerr << "stackbeam: note: " << request.out << " was not written; the rows up to the failure are in "
                   << sink.csv.partial() << "\n";
         throw;
@@ -255,9 +273,11 @@ RunResult run(const SimulateRequest& request, const System& system) {
         sink.csv.close();
         sink.pairs_csv.close();
         sink.nodes_csv.close();
+        sink.stresses_csv.close();
         result.csv_file = sink.csv.partial();
         if (sink.pairs_csv.active()) result.pairs_file = sink.pairs_csv.partial();
         if (sink.nodes_csv.active()) result.nodes_file = sink.nodes_csv.partial();
+        if (sink.stresses_csv.active()) result.stresses_file = sink.stresses_csv.partial();
         std::cerr << "stackbeam: interrupted by signal " << result.signal << " at t = " << result.summary.t_reached_s
                   << " s; the rows up to it are in " << sink.csv.partial() << "\n";
         return result;
@@ -271,9 +291,11 @@ RunResult run(const SimulateRequest& request, const System& system) {
     sink.csv.commit();
     sink.pairs_csv.commit();
     sink.nodes_csv.commit();
+    sink.stresses_csv.commit();
     result.csv_file = request.out;
     result.pairs_file = request.pairs;
     result.nodes_file = request.nodes;
+    result.stresses_file = request.stresses;
     return result;
 }
 

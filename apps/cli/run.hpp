@@ -6,7 +6,7 @@
 /// Interruption: the signal handler only sets a flag (async-signal-safe); the run
 /// checks it before writing each record (simulate's per-record callback), drops the
 /// record in progress and stops. Every file then ends on a whole row: the CSV, the
-/// --pairs and the --nodes files hold the records before it, and they keep their .partial names, so
+/// --pairs, --nodes and --stresses files hold the records before it, and they keep their .partial names, so
 /// that nobody mistakes them for a complete run. The --events log is not written
 /// (the library hands it over at the end of a run). The --summary is written, marked
 /// "interrupted", with the time reached and the energies of the last whole record.
@@ -36,6 +36,7 @@ struct RunResult {
     std::string csv_file;             ///< where the rows are (FILE, or FILE.partial when interrupted)
     std::string pairs_file;           ///< likewise for --pairs ("" none)
     std::string nodes_file;           ///< likewise for --nodes ("" none)
+    std::string stresses_file;        ///< likewise for --stresses ("" none)
     /// With --plot: the stack at the records of the largest and the smallest w (the first such record).
     StackSnapshot stack_at_w_max, stack_at_w_min;
     std::string events_file;          ///< the event log written ("" none)

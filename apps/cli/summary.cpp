@@ -75,11 +75,20 @@ void print_summary(const SimulateRequest& request, const System& system, const R
     if (summary.stepper.impact_loss)
         std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",
                     last.impact_loss_j, last.leaf_kinetic_energy_j);
+    if (const auto& rs = summary.stresses)  // stresses [Pa], tension positive; x [m], t [s]
+        for (const LeafExtremes& e : rs->summary.extremes)
+            std::printf("stress leaf %-2d             largest tension %.6g Pa (x %.4g m, t %.6g s, %s fibre), "
+                        "largest compression %.6g Pa (x %.4g m, t %.6g s, %s fibre)\n",
+                        e.leaf, e.tension.stress_pa, e.tension.x_m, e.tension.t_s, to_string(e.tension.fibre),
+                        e.compression.stress_pa, e.compression.x_m, e.compression.t_s, to_string(e.compression.fibre));
+    else if (!summary.stresses_note.empty())
+        std::printf("stresses                   none (%s)\n", summary.stresses_note.c_str());
     std::printf("wall time                  %.3f s\n", summary.wall_s);
     std::printf("output                     %s\n", result.csv_file.c_str());
     if (!result.events_file.empty()) std::printf("event log                  %s\n", result.events_file.c_str());
     if (!result.pairs_file.empty()) std::printf("pairs                      %s\n", result.pairs_file.c_str());
     if (!result.nodes_file.empty()) std::printf("nodes                      %s\n", result.nodes_file.c_str());
+    if (!result.stresses_file.empty()) std::printf("stresses                   %s\n", result.stresses_file.c_str());
 }
 
 SummaryContext summary_context(const RunResult& result) {
@@ -88,6 +97,7 @@ SummaryContext summary_context(const RunResult& result) {
     c.events_file = result.events_file;
     c.pairs_file = result.pairs_file;
     c.nodes_file = result.nodes_file;
+    c.stresses_file = result.stresses_file;
     c.signal = result.signal;
     if (result.signal != 0)
         c.interrupted_note = "stopped by a signal at t_reached_s: the rows up to it are in the .partial files "

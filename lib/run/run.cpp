@@ -54,6 +54,29 @@ namespace {
 /// Thrown inside the record loop when the stop check answers true between records.
 struct StopSeen {};
 
+/// The monitor's options for a run of `options` ending at t_last_s [s]: periodic when the run
+/// lasts at least one period of a periodic loading, else the whole run (rainflow).
+StressMonitorOptions monitor_options(const SimulationOptions& options, double t_last_s) {
+    StressMonitorOptions o;
+    const double period_s = options.loading.period_s();
+    if (period_s > 0.0 && t_last_s >= period_s) o.period_s = period_s;
+    o.t_end_s = t_last_s;  // the cycle's end (the whole run's without a period)
+    return o;
+}
+
+/// Keeps each interface's largest pressure over the run and its time.
+void add_peaks(std::vector<InterfaceRunPeak>& peaks, double t_s, const Stresses& s) {
+    if (peaks.empty()) peaks.resize(s.interfaces.size());
+    for (std::size_t i = 0; i < s.interfaces.size() && i < peaks.size(); ++i) {
+        const InterfacePeak& p = s.interfaces[i];
+        if (p.pair >= 0 && (std::isnan(peaks[i].t_s) || p.pressure_pa > peaks[i].peak.pressure_pa)) {
+            peaks[i].peak = p;
+            peaks[i].t_s = t_s;
+        }
+        peaks[i].peak.interface_index = p.interface_index;
+    }
+}
+
 }  // namespace
 
 RunSummary run_scenario(const System& system, const RunRequest& request) {
@@ -76,6 +99,9 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
         summary.stepper = describe_stepper(system, options);
         const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
         if (out.keep_records) summary.records.reserve(static_cast<std::size_t>(n) + 1);
+        std::optional<StressMonitor> monitor;  // only when asked: no cost otherwise
+        std::vector<InterfaceRunPeak> peaks;
+        if (out.stresses) monitor.emplace(system.model().spec(), monitor_options(options, static_cast<double>(n) * options.dt_s));
         for (long i = 0; i <= n; ++i) {
             const StepRecord& r = i == 0 ? stepper->current() : stepper->advance();
             if (stop && stop()) throw StopSeen{};  // the record in progress is dropped
@@ -84,16 +110,23 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
             sink.on_record(r);
             if (out.pairs) sink.on_pairs(r.t_s, stepper->pairs());
             if (out.nodes) sink.on_nodes(r.t_s, stepper->nodes());
-            if (out.stresses) sink.on_stresses(r.t_s, stepper->stresses());
+            if (out.stresses) {
+                const Stresses st = stepper->stresses();
+                monitor->add(r.t_s, st);
+                add_peaks(peaks, r.t_s, st);
+                sink.on_stresses(r.t_s, st);
+            }
         }
         summary.report = stepper->report();
         summary.loop = loop_figures(summary.records, options.loading.period_s());
+        if (monitor) summary.stresses = RunStresses{monitor->summary(), std::move(peaks)};
     } catch (const StopSeen&) {
         summary.interrupted = true;
     } catch (const RunStopped&) {  // the stop check seen within a step
         summary.interrupted = true;
     }
     if (summary.interrupted) summary.loop.note = "interrupted run: no loop figures";
+    if (out.stresses && summary.interrupted) summary.stresses_note = "interrupted run: no stress figures";
     summary.t_reached_s = summary.stats.last.t_s;
     summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return summary;

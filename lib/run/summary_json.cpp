@@ -1,6 +1,8 @@
 // A run's JSON summary (run/summary_json.hpp), with nlohmann-json (private to the library).
 #include "stackbeam/run/summary_json.hpp"
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 namespace stackbeam {
@@ -24,6 +26,74 @@ nlohmann::json interfaces_json(const Model& model) {
         list.push_back(f);
     }
     return list;
+}
+
+/// A number, null when it is not one (NaN), "infinite" for +infinity (a life without damage).
+nlohmann::json number_json(double v) {
+    if (std::isnan(v)) return nullptr;
+    if (std::isinf(v)) return v > 0 ? "infinite" : "-infinite";
+    return v;
+}
+
+nlohmann::json extreme_json(const StressExtreme& e) {
+    return {{"stress_pa", number_json(e.stress_pa)}, {"x_m", number_json(e.x_m)}, {"t_s", number_json(e.t_s)}, {"fibre", to_string(e.fibre)}};
+}
+
+nlohmann::json spot_json(const FatigueSpot& s) {
+    return {{"x_m", s.x_m}, {"fibre", to_string(s.fibre)}, {"amplitude_pa", s.amplitude_pa}, {"mean_pa", s.mean_pa}};
+}
+
+/// The stresses section (RunSummary::stresses): per leaf its extremes, the cycle's largest range
+/// and, with a material, the least fatigue safety factor and the shortest life; per interface
+/// the peak pressure. Stresses [Pa], x [m], t [s].
+nlohmann::json stresses_json(const RunStresses& rs) {
+    const StressSummary& s = rs.summary;
+    nlohmann::json leaves = nlohmann::json::array();
+    for (std::size_t l = 0; l < s.extremes.size(); ++l) {
+        nlohmann::json leaf = {{"leaf", s.extremes[l].leaf},
+                               {"largest_tension", extreme_json(s.extremes[l].tension)},
+                               {"largest_compression", extreme_json(s.extremes[l].compression)}};
+        if (l < s.cycle.size()) {  // the leaf's largest range over its nodes and fibres
+            const LeafCycle& c = s.cycle[l];
+            LargestRange r;
+            r.leaf = c.leaf;
+            for (std::size_t i = 0; i < c.x_m.size(); ++i)
+                for (const Fibre f : {Fibre::top, Fibre::bottom}) {
+                    const FibreCycle& fc = f == Fibre::top ? c.top[i] : c.bottom[i];
+                    if (fc.range_pa > r.range_pa || std::isnan(r.x_m)) r = {c.leaf, c.x_m[i], f, fc.range_pa, fc.mean_pa};
+                }
+            leaf["cycle_largest_range"] = {{"range_pa", r.range_pa}, {"mean_pa", number_json(r.mean_pa)},
+                                           {"x_m", number_json(r.x_m)}, {"fibre", to_string(r.fibre)}};
+        }
+        nlohmann::json fatigue = nullptr;
+        if (l < s.fatigue.size() && s.fatigue[l].has_material) {
+            const LeafFatigue& f = s.fatigue[l].fatigue;
+            fatigue = {{"least_safety_factor", f.has_safety_factor ? number_json(f.least_safety_factor) : nullptr},
+                       {"shortest_life_repetitions", f.has_life ? number_json(f.shortest_life_repetitions) : nullptr},
+                       {"damage_per_repetition", f.has_life ? number_json(f.damage_per_repetition) : nullptr}};
+            if (f.has_safety_factor) fatigue["safety_spot"] = spot_json(f.safety_spot);
+            if (f.has_life) fatigue["life_spot"] = spot_json(f.life_spot);
+        }
+        leaf["fatigue"] = fatigue;
+        leaves.push_back(leaf);
+    }
+    nlohmann::json interfaces = nlohmann::json::array();
+    for (const InterfaceRunPeak& p : rs.interfaces)
+        interfaces.push_back({{"interface", p.peak.interface_index},
+                              {"peak_pressure_pa", p.peak.pressure_pa},
+                              {"line_load_n_per_m", p.peak.line_load_n_per_m},
+                              {"x_m", number_json(p.peak.x_m)},
+                              {"t_s", number_json(p.t_s)}});
+    const LargestRange& r = s.largest_range;
+    return {{"samples", s.samples},
+            {"cycle", {{"t_start_s", s.cycle_start_s},
+                       {"t_end_s", s.cycle_end_s},
+                       {"samples", s.cycle_samples},
+                       {"counting", s.counting == CycleCounting::periodic ? "periodic" : "rainflow"},
+                       {"largest_range", {{"leaf", r.leaf}, {"x_m", number_json(r.x_m)}, {"fibre", to_string(r.fibre)},
+                                          {"range_pa", r.range_pa}, {"mean_pa", number_json(r.mean_pa)}}}}},
+            {"leaves", leaves},
+            {"interfaces", interfaces}};
 }
 
 }  // namespace
@@ -117,11 +187,17 @@ std::string summary_json(const RunSummary& summary, const Model& model, const Su
         j["fancher"] = nullptr;
         if (!loop.fancher_note.empty()) j["fancher_note"] = loop.fancher_note;
     }
+    if (summary.stresses) j["stresses"] = stresses_json(*summary.stresses);
+    else if (!summary.stresses_note.empty()) {  // asked, none made
+        j["stresses"] = nullptr;
+        j["stresses_note"] = summary.stresses_note;
+    }
     j["wall_time_s"] = summary.wall_s;
     j["outputs"] = {{"csv", context.csv_file},
                     {"events", context.events_file},
                     {"pairs", context.pairs_file},
                     {"nodes", context.nodes_file}};
+    if (!context.stresses_file.empty()) j["outputs"]["stresses"] = context.stresses_file;
     return j.dump(2);
 }
 

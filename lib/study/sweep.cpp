@@ -283,8 +283,16 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
         const auto& o = top.at("outputs");
         if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
         for (const auto& kv : o.as_table()) {
+            if (kv.first == "stresses") {
+                if (!kv.second.is_boolean())
+                    throw InputError("outputs.stresses", "value " + toml::format(kv.second) +
+                                                             " is not allowed: must be true or false",
+                                     line_of(source_name, kv.second));
+                spec.stresses = kv.second.as_boolean();
+                continue;
+            }
             if (kv.first != "directory")
-                throw InputError("outputs." + kv.first, "unknown key: [outputs] has directory",
+                throw InputError("outputs." + kv.first, "unknown key: [outputs] has directory and stresses",
                                  line_of(source_name, kv.second));
             if (!kv.second.is_string() || kv.second.as_string().str.empty())
                 throw InputError("outputs.directory", "must be a directory name (a string)", line_of(source_name, kv.second));
@@ -468,6 +476,7 @@ SweepPoint SweepPoints::point(int i) const {
     const SweepSpec& spec = *spec_;
     SweepPoint point;
     point.index = i;
+    point.stresses = spec.stresses;
     point.values = values(i);
     const std::string at_point = "at point " + std::to_string(i) + " (" + point_values_text(spec, point.values) + ")";
     Document doc = impl_->base;
@@ -519,6 +528,9 @@ const std::vector<std::string>& point_figure_columns() {
         "fancher_upper_rate_n_per_m", "fancher_upper_offset_n", "fancher_lower_rate_n_per_m",
         "fancher_lower_offset_n", "fancher_beta_m", "fancher_rms_error_relative",
         "energy_balance_error_j",
+        // the stresses ([outputs] stresses = true, RunOutputs::stresses): the largest |fibre stress| of
+        // any leaf over the run [Pa] and the least fatigue safety factor over the leaves with a material
+        "stress_max_abs_pa", "fatigue_least_safety_factor",
     };
     return columns;
 }
@@ -558,6 +570,20 @@ std::vector<double> figures_of(const LoopFigures& loop, long records, double max
     return f;
 }
 
+/// The stress columns (point_figure_columns 17, 18) from a run's stress figures; NaN where none
+/// (not asked, or no leaf with a material whose endurance limit gives a safety factor).
+void add_stress_figures(const std::optional<RunStresses>& stresses, std::vector<double>& f) {
+    if (!stresses) return;
+    double largest = 0.0, least = std::numeric_limits<double>::quiet_NaN();
+    for (const LeafExtremes& e : stresses->summary.extremes)
+        largest = std::max({largest, std::abs(e.tension.stress_pa), std::abs(e.compression.stress_pa)});
+    for (const LeafFatigueResult& r : stresses->summary.fatigue)
+        if (r.has_material && r.fatigue.has_safety_factor && !(r.fatigue.least_safety_factor >= least))
+            least = r.fatigue.least_safety_factor;
+    f[17] = largest;
+    f[18] = least;
+}
+
 }  // namespace
 
 std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
@@ -585,10 +611,12 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         run.options = point.scenario.simulation;
         // the stop flag before each record and inside an output interval (mode cvode polls it every 64 steps)
         if (stop) run.stop = [stop] { return stop->load(std::memory_order_relaxed); };
+        run.outputs.stresses = point.stresses;  // only when asked: a solve per record in the massless modes
         RunSummary summary = run_scenario(system, run);
         if (summary.interrupted) throw SweepStopped();
         records = std::move(summary.records);
         result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
+        add_stress_figures(summary.stresses, result.figures);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
         result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +

@@ -62,19 +62,69 @@ private:
     PyObject* traceback_ = nullptr;
 };
 
-/// The pairs and nodes of a run, kept as the --pairs and --nodes columns (the run layer's sink).
+/// Every leaf's stresses at every record, per leaf as (records x nodes) arrays: Result.stresses.
+/// SI units: sigma [Pa] (tension positive), N and V [N], M [N m] (post/stresses.hpp's signs).
+struct StressTable {
+    struct Leaf {
+        int leaf = 0;
+        std::vector<double> x, top, bottom, n, m, v;  // x: one per node; the rest row by row
+    };
+    std::vector<double> t;
+    std::vector<Leaf> leaves;
+    void add(double t_s, const Stresses& s) {
+        if (leaves.empty())
+            for (const LeafStresses& l : s.leaves) leaves.push_back({l.leaf, l.x_m, {}, {}, {}, {}, {}});
+        t.push_back(t_s);
+        for (std::size_t i = 0; i < s.leaves.size() && i < leaves.size(); ++i) {
+            const LeafStresses& l = s.leaves[i];
+            Leaf& k = leaves[i];
+            k.top.insert(k.top.end(), l.top_stress_pa.begin(), l.top_stress_pa.end());
+            k.bottom.insert(k.bottom.end(), l.bottom_stress_pa.begin(), l.bottom_stress_pa.end());
+            k.n.insert(k.n.end(), l.axial_force_n.begin(), l.axial_force_n.end());
+            k.m.insert(k.m.end(), l.bending_moment_n_m.begin(), l.bending_moment_n_m.end());
+            k.v.insert(k.v.end(), l.shear_force_n.begin(), l.shear_force_n.end());
+        }
+    }
+    py::list to_list() const {
+        py::list out;
+        for (const Leaf& k : leaves) {
+            const auto rows = static_cast<py::ssize_t>(t.size()), cols = static_cast<py::ssize_t>(k.x.size());
+            auto grid = [&](const std::vector<double>& v) {
+                return py::array_t<double>(std::vector<py::ssize_t>{rows, cols}, v.data());
+            };
+            py::dict d;
+            d["leaf"] = k.leaf;
+            d["t"] = py::array_t<double>(t.size(), t.data());
+            d["x"] = py::array_t<double>(k.x.size(), k.x.data());
+            d["sigma_top"] = grid(k.top);
+            d["sigma_bottom"] = grid(k.bottom);
+            d["N"] = grid(k.n);
+            d["M"] = grid(k.m);
+            d["V"] = grid(k.v);
+            out.append(d);
+        }
+        return out;
+    }
+};
+
+/// The pairs, nodes and stresses of a run, kept as the --pairs, --nodes and --stresses columns
+/// (the run layer's sink).
 struct TableSink : RunSink {
     PairTable pairs;
     NodeTable nodes;
+    StressTable stresses;
     void on_pairs(double t_s, const std::vector<PairRecord>& prs) override { pairs.add(t_s, prs); }
     void on_nodes(double t_s, const std::vector<LeafNodes>& leaves) override { nodes.add(t_s, leaves); }
+    void on_stresses(double t_s, const Stresses& s) override { stresses.add(t_s, s); }
 };
 
 /// simulate(scenario, options, pairs) -> dict(columns, pairs, events, report, summary):
 /// the library's run (run_scenario, as the command line: same records, same JSON summary), the
 /// GIL released while it steps.
-py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, const py::object& pairs_arg, const py::object& nodes_arg) {
+py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, const py::object& pairs_arg, const py::object& nodes_arg,
+             const py::object& stresses_arg) {
     RunRequest request;
+    request.outputs.stresses = bool_arg(stresses_arg, "stresses");
     request.outputs.pairs = bool_arg(pairs_arg, "pairs");
     request.outputs.nodes = bool_arg(nodes_arg, "nodes");
     // the run's own copy: another thread may change the scenario while this one runs without the GIL
@@ -103,6 +153,7 @@ py::dict run(const ScenarioPtr& scenario, const py::dict& overrides, const py::o
     out["columns"] = records_dict(summary.records);
     out["pairs"] = request.outputs.pairs ? py::object(tables.pairs.to_dict()) : py::object(py::none());
     out["nodes"] = request.outputs.nodes ? py::object(tables.nodes.to_dict()) : py::object(py::none());
+    out["stresses"] = request.outputs.stresses ? py::object(tables.stresses.to_list()) : py::object(py::none());
     out["events"] = summary.stepper.cvode_stats ? py::object(events_dict(summary.report.events)) : py::object(py::none());
     py::dict report = report_dict(summary.report);
     // when the run held no GIL, on the clock of Python's time.monotonic() (CLOCK_MONOTONIC, as steady_clock)
@@ -214,7 +265,7 @@ private:
 }  // namespace
 
 void bind_run(py::module_& m) {
-    m.def("_run", &run, "scenario"_a, "options"_a, "pairs"_a, "nodes"_a);
+    m.def("_run", &run, "scenario"_a, "options"_a, "pairs"_a, "nodes"_a, "stresses"_a);
     m.def(
         "_stack_geometry", [](const ScenarioPtr& scenario) { return stack_geometry(scenario_arg(scenario, "scenario")); },
         "scenario"_a);

@@ -136,7 +136,11 @@ class Result(_Columns):
     --pairs CSV's columns; None unless simulate(..., pairs=True)), ``nodes`` (every leaf's
     nodal displacements at every record, a dict of arrays with the --nodes CSV's columns t,
     leaf, x, w, theta, the half model mirrored to whole leaves; None unless
-    simulate(..., nodes=True)), ``events`` (the event
+    simulate(..., nodes=True)), ``stresses`` (every leaf's stresses at every record: a list
+    with one dict per leaf of ``leaf``, ``t`` (records), ``x`` (nodes, whole leaf [m]) and
+    (records x nodes) arrays ``sigma_top``, ``sigma_bottom`` [Pa, tension positive], ``N`` [N],
+    ``M`` [N m], ``V`` [N]; None unless simulate(..., stresses=True), which also puts the run's
+    stress figures in ``summary["stresses"]``), ``events`` (the event
     log of mode cvode, the --events CSV's columns; None in the other modes), ``summary``
     (the command line's JSON summary as a dict), ``report`` (the run's counters, and
     ``without_gil_s``: when the run stepped without the GIL, on time.monotonic()'s clock),
@@ -146,6 +150,7 @@ class Result(_Columns):
         self._columns = raw["columns"]
         self.pairs = raw["pairs"]
         self.nodes = raw["nodes"]
+        self.stresses = raw["stresses"]
         self.events = raw["events"]
         self.report = raw["report"]
         self.summary = _json.loads(raw["summary"])
@@ -158,7 +163,7 @@ class Result(_Columns):
             n, self._columns["t"][-1] if n else 0.0, ", ".join(self._columns))
 
 
-def simulate(scenario, *, pairs=False, nodes=False, **options):
+def simulate(scenario, *, pairs=False, nodes=False, stresses=False, **options):
     """Runs `scenario` (a Scenario) from t = 0 to t_end_s and returns a Result.
 
     ``options``: SimulationOptions members over the scenario's, e.g. ``t_end_s=1.0,
@@ -166,7 +171,10 @@ def simulate(scenario, *, pairs=False, nodes=False, **options):
     (``**{"cvode.rtol": 1e-9}``). Each is checked by the option table: InputError naming
     the member. ``pairs=True`` keeps every pair at every record (Result.pairs); ``nodes=True``
     every leaf's nodal displacements at every record (Result.nodes; off by default: a run of
-    N records on a mesh of n nodes keeps 5 N n numbers).
+    N records on a mesh of n nodes keeps 5 N n numbers); ``stresses=True`` every leaf's stresses
+    at every record (Result.stresses) and the run's stress figures (Result.summary["stresses"]:
+    extremes, the cycle's range, fatigue where a leaf has a material, the interfaces' peak
+    pressures; in the massless modes a solve per record).
 
     The GIL is released while the run steps, so runs on Python threads run in parallel;
     Ctrl-C raises KeyboardInterrupt within about 20 ms of the run's next stop check (before every
@@ -174,11 +182,11 @@ def simulate(scenario, *, pairs=False, nodes=False, **options):
     flat = _flatten_options(options)
     if not isinstance(scenario, Scenario):
         raise _input_error("scenario", "value %r is not allowed: must be a stackbeam.Scenario" % (scenario,), InputTypeError)
-    for name, value in (("pairs", pairs), ("nodes", nodes)):
+    for name, value in (("pairs", pairs), ("nodes", nodes), ("stresses", stresses)):
         if not isinstance(value, bool):
             raise _input_error(name, "value %r is not a bool: give True to keep them, False (the default) not to" % (value,),
                                InputTypeError)
-    raw = _core._run(scenario, flat, pairs, nodes)
+    raw = _core._run(scenario, flat, pairs, nodes, stresses)
     return Result(raw, scenario.copy(), flat)
 
 

@@ -10,6 +10,9 @@ The deformed stack (each leaf's deflected axis, every pair coloured by its state
 nodes and the pairs of the run: simulate(..., nodes=True, pairs=True), then
 deformed_stack(result, times=[...]) or animate_stack(result, "run.gif").
 
+The stresses along each leaf (top and bottom fibre at chosen times, and the cycle's envelope)
+need simulate(..., stresses=True), then stresses(result, times=[...]).
+
 Units on the axes: mm for displacements, N for forces, s for time (the columns are SI).
 """
 import math as _math
@@ -307,3 +310,45 @@ def animate_stack(result, path, scale=None, fps=25, every=1, dpi=80):
     anim.save(path, writer=writer, dpi=dpi)
     plt.close(fig)
     return path
+
+
+def stresses(result, times=None, ax=None):
+    """The fibre stresses along each leaf [MPa, tension positive] at the records nearest to
+    `times` [s] (default: the last record), top fibre solid and bottom dashed, over the envelope
+    (the least and the greatest stress of either fibre at each node) over the cycle of
+    Result.summary["stresses"] (the loading's last period, else the whole run), shaded. One
+    Axes per leaf, stacked; `ax` (a one-leaf stack only) draws on that Axes. Needs
+    simulate(..., stresses=True). Returns the Figure."""
+    leaves = getattr(result, "stresses", None)
+    if leaves is None:
+        raise _error("result.stresses", "is None: run simulate(..., stresses=True)")
+    t = leaves[0]["t"]
+    if times is None:
+        records = [len(t) - 1]
+    else:
+        records = [int(_np.argmin(_np.abs(t - float(ti)))) for ti in _np.atleast_1d(times)]
+    if not records:
+        raise _error("times", "is empty: give at least one time")
+    if ax is not None and len(leaves) != 1:
+        raise _error("ax", "is given with %d leaves: give one leaf per Axes" % len(leaves))
+    cycle = result.summary["stresses"]["cycle"]
+    in_cycle = (t >= cycle["t_start_s"] - 1e-9 * max(1.0, abs(cycle["t_end_s"]))) & (t <= cycle["t_end_s"] + 1e-9 * max(1.0, abs(cycle["t_end_s"])))
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, axs = plt.subplots(len(leaves), 1, figsize=(9, 2.8 * len(leaves)), squeeze=False, sharex=True)
+        axs = axs[:, 0]
+    else:
+        fig, axs = ax.figure, [ax]
+    for a, leaf in zip(axs, leaves):
+        x_mm = 1000 * leaf["x"]
+        both = _np.concatenate([leaf["sigma_top"][in_cycle], leaf["sigma_bottom"][in_cycle]])
+        if len(both):
+            a.fill_between(x_mm, both.min(axis=0) / 1e6, both.max(axis=0) / 1e6, color="0.85", label="cycle envelope")
+        for i in records:
+            line, = a.plot(x_mm, leaf["sigma_top"][i] / 1e6, lw=1.5, label="top, t = %.4g s" % t[i])
+            a.plot(x_mm, leaf["sigma_bottom"][i] / 1e6, lw=1.5, ls="--", color=line.get_color(),
+                   label="bottom, t = %.4g s" % t[i])
+        _finish(a, "leaf %d" % leaf["leaf"], "x [mm]", "fibre stress [MPa]")
+    fig.tight_layout()
+    return fig

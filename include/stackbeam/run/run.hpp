@@ -16,6 +16,8 @@
 /// exception: RunSummary::interrupted, the records handed over so far (the record in progress
 /// is dropped), no loop figures and a default RunReport.
 #include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,7 +35,9 @@ namespace stackbeam {
 struct RunOutputs {
     bool pairs = false;         ///< RunSink::on_pairs (Stepper::pairs())
     bool nodes = false;         ///< RunSink::on_nodes (Stepper::nodes())
-    bool stresses = false;      ///< RunSink::on_stresses (Stepper::stresses(), post/stresses.hpp)
+    /// RunSink::on_stresses (Stepper::stresses(), post/stresses.hpp) and RunSummary::stresses (a
+    /// StressMonitor fed every record, the interfaces' peak pressures)
+    bool stresses = false;
     bool keep_records = true;   ///< RunSummary::records holds every record (the loop figures need them)
 };
 
@@ -98,6 +102,21 @@ struct StepperDescription {
 /// make_stepper for a combination no stepper takes.
 StepperDescription describe_stepper(const System& system, const SimulationOptions& options);
 
+/// One interface's largest pressure over the run (clamps included, clips not): InterfacePeak
+/// at the time t_s [s] it was reached (NaN: no pair on the interface).
+struct InterfaceRunPeak {
+    InterfacePeak peak;
+    double t_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// A run's stress figures (RunOutputs::stresses): the StressMonitor's summary over the records
+/// (the cycle: the loading's last period [t_last - period, t_last] when the run lasts a period,
+/// else the whole run) and every interface's peak pressure.
+struct RunStresses {
+    StressSummary summary;
+    std::vector<InterfaceRunPeak> interfaces;  ///< one per interface (ModelSpec::interfaces order)
+};
+
 /// The result of run_scenario: what every front-end formats.
 struct RunSummary {
     std::string setup;               ///< RunRequest::setup
@@ -109,6 +128,9 @@ struct RunSummary {
     std::vector<StepRecord> records; ///< every record (RunOutputs::keep_records), also when interrupted
     RunReport report;                ///< the stepper's counters and event log (default when interrupted)
     LoopFigures loop;                ///< the last cycle's figures (none when interrupted)
+    /// RunOutputs::stresses: the stress figures (none when not asked; when interrupted: stresses_note says)
+    std::optional<RunStresses> stresses;
+    std::string stresses_note;
     bool interrupted = false;        ///< the stop check ended the run
     double t_reached_s = 0.0;        ///< the last record's time [s]
     double wall_s = 0.0;             ///< wall time of the run [s] (the set-up of the stepper and the steps)

@@ -13,7 +13,7 @@ namespace stackbeam {
 /// What the front-end knows beyond the RunSummary: its files ("outputs"; "" none) and, for an
 /// interrupted run, the signal ("signal", 0: not written) and a note ("interrupted_note").
 struct SummaryContext {
-    std::string csv_file, events_file, pairs_file, nodes_file;
+    std::string csv_file, events_file, pairs_file, nodes_file, stresses_file;
     int signal = 0;
     std::string interrupted_note;
 };

@@ -70,6 +70,9 @@ struct SweepSpec {
     std::vector<SweepAxis> axes;
     Combine combine = Combine::product;
     std::string output_directory;    ///< `[outputs] directory` ("" not given), relative to the working directory
+    /// `[outputs] stresses = true`: every point's run feeds a StressMonitor (RunOutputs::stresses),
+    /// for the stress columns of point_figure_columns() (NaN without; in the massless modes a solve per record)
+    bool stresses = false;
 };
 
 /// Parses sweep spec TOML `text` (docs/sweep.md); `source_name` names it in messages and
@@ -96,6 +99,7 @@ struct SweepPoint {
     std::vector<AxisValue> values;    ///< one per axis
     std::string scenario_text;        ///< the point's scenario file (the base with the values set; no [outputs])
     Scenario scenario;                ///< parse_scenario(scenario_text): Model::build and validate() succeed
+    bool stresses = false;            ///< SweepSpec::stresses: the run makes the stress columns
 };
 
 /// The most points one sweep may have (docs/sweep.md, "Limits"). A sweep directory keeps
