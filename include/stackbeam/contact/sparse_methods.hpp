@@ -9,12 +9,10 @@
 
 namespace stackbeam {
 
-namespace detail::sparse {
-struct TransitionTrace;  // lib/contact/sparse/driver/trace.hpp (a study aid, docs/decisions/036)
-}  // namespace detail::sparse
 /// The observer of a SparseContactSolver's transition steps: counters per route and phase,
-/// per-step traces (lib/contact/sparse/driver/trace.hpp). The caller owns it and reads it.
-using SparsePathObserver = detail::sparse::TransitionTrace;
+/// per-step traces (defined in lib/contact/sparse/driver/trace.hpp, a study aid: tests and
+/// benchmarks include it). The caller owns it and reads it.
+struct SparsePathObserver;
 
 /// How the sparse path solves a transition that the active-set passes from the previous
 /// modes do not settle (SparseContactSolver::solve, step 2).

@@ -140,7 +140,18 @@ struct StepTrace {
     int path_confirm_solves = 0;    ///< mode-set solves of the passes after it
 };
 
-struct TransitionTrace {
+}  // namespace stackbeam::detail::sparse
+
+namespace stackbeam {
+
+/// The sparse path's observer (SparsePathTuning::observer; public by name only: the public header
+/// sparse_methods.hpp declares it, a study aid defined here, internally detail::sparse::TransitionTrace).
+struct SparsePathObserver {
+    using StepTrace = detail::sparse::StepTrace;
+    using RouteStats = detail::sparse::RouteStats;
+    using NewtonIterationTrace = detail::sparse::NewtonIterationTrace;
+    static double thread_cpu_s() { return detail::sparse::thread_cpu_s(); }
+
     std::vector<StepTrace> steps;
     StepTrace* current = nullptr;  ///< the step being recorded (the solver's)
     RouteStats routes;             ///< the mode solver's calls so far (ModeSolver::solve adds to it)
@@ -237,4 +248,8 @@ struct TransitionTrace {
     }
 };
 
+}  // namespace stackbeam
+
+namespace stackbeam::detail::sparse {
+using TransitionTrace = ::stackbeam::SparsePathObserver;
 }  // namespace stackbeam::detail::sparse
