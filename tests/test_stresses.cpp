@@ -292,7 +292,8 @@ BOOST_AUTO_TEST_CASE(cambered_leaf_pressed_flat_carries_the_prestress) {
         SimulationOptions o;
         o.dt_s = o.t_end_s = 1e-4;
         const auto stepper = make_stepper(system, o);
-        const LeafStresses& l = stepper->stresses().leaves[1];
+        const Stresses stresses = stepper->stresses();  // a value: a reference into the temporary would dangle
+        const LeafStresses& l = stresses.leaves[1];
         const double sigma = kE * kHeight / (2.0 * R), edge = 0.125 * kLength;  // 2.5 elements of the coarse mesh
         double worst = 0.0;
         for (std::size_t i = 0; i < l.x_m.size(); ++i) {

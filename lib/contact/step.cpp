@@ -70,7 +70,9 @@ ContactOperator::ContactOperator(const StepSystem& system, ContactPath requested
     dense_->ldlt.compute(f.K);
     if (dense_->ldlt.info() != Eigen::Success)
         throw SolverError("contact operator: the step's stiffness K is not positive definite", 0, 0.0, 0.0);
-    dense_->Y = dense_->ldlt.solve(Eigen::MatrixXd(f.G.transpose()));
+    // no contact rows (a single leaf): Y is n x 0 (a solve with an empty right-hand side is UB in Eigen)
+    dense_->Y = f.G.rows() > 0 ? Eigen::MatrixXd(dense_->ldlt.solve(Eigen::MatrixXd(f.G.transpose())))
+                               : Eigen::MatrixXd(f.K.rows(), 0);
     const Eigen::MatrixXd W = f.G * dense_->Y;
     dense_->W = 0.5 * (W + W.transpose());
     if (f.layer_compliance.size() > 0) dense_->W.diagonal() += f.layer_compliance;
