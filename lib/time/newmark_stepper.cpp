@@ -131,7 +131,8 @@ NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& sta
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     dense_projection_ = op_->path() == ContactPath::dense;
     if (massive_leaves_ && system_.num_components() > 0 && dense_projection_) {
-        Z_ = factor_.mass.solve(Eigen::MatrixXd(G.transpose()));
+        Z_ = G.rows() > 0 ? Eigen::MatrixXd(factor_.mass.solve(Eigen::MatrixXd(G.transpose())))
+                          : Eigen::MatrixXd(G.cols(), 0);  // no contact rows: an empty solve is UB in Eigen
         const Eigen::MatrixXd A = G * Z_;
         A_ = 0.5 * (A + A.transpose());
     }

@@ -382,7 +382,9 @@ CvodeModalStepper::Impl::Impl(const System& system, const InitialState& start)
     // residual flexibility R = K^-1 - Phi Omega^-2 Phi^T, on the contact rows
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> kf(K);
     const Eigen::MatrixXd Gd(system.contact_rows());
-    residual_compliance(Gd, kf.solve(Eigen::MatrixXd(Gd.transpose())));
+    // no contact rows (a single leaf): an n x 0 block (a solve with an empty right-hand side is UB in Eigen)
+    residual_compliance(Gd, Gd.rows() > 0 ? Eigen::MatrixXd(kf.solve(Eigen::MatrixXd(Gd.transpose())))
+                                          : Eigen::MatrixXd(K.rows(), 0));
     load = std::make_unique<ModalLoad>(system, options().loading, Phi, om, kf);
     es.nstate = 2 * r + 1;
     if (!load->none()) {  // the loading's work X and the clock t (file comment)

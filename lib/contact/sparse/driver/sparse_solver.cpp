@@ -149,7 +149,8 @@ ContactProblem SparseContactProblem::to_dense() const {
     Eigen::SimplicialLLT<SpMat> llt(K);
     if (llt.info() != Eigen::Success) throw InputError("problem.K", "is not positive definite");
     ContactProblem pr;
-    const Eigen::MatrixXd X = llt.solve(Eigen::MatrixXd(G.transpose()));
+    const Eigen::MatrixXd X = G.rows() > 0 ? Eigen::MatrixXd(llt.solve(Eigen::MatrixXd(G.transpose())))
+                                           : Eigen::MatrixXd(G.cols(), 0);  // an empty solve is UB in Eigen
     pr.W = G * X;
     pr.W = 0.5 * (pr.W + pr.W.transpose()).eval();
     pr.q = G * llt.solve(b) - d;
