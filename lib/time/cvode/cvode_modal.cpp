@@ -360,7 +360,8 @@ void CvodeModalStepper::Impl::residual_compliance(const Eigen::MatrixXd& Gd, con
     W = 0.5 * (W + W.transpose()).eval();
     W.diagonal() += system().layer_compliance_m_per_n();  // the elastic layer, massless (system.hpp)
     phiw = Phi.row(w_dof()).transpose();
-    rw = KiGt.row(w_dof()).transpose() - GPhi * om.cwiseProduct(om).cwiseInverse().cwiseProduct(phiw);
+    rw = Eigen::VectorXd::Zero(Gd.rows());  // no contact rows (a single leaf): empty (a row of an n x 0 block is UB in Eigen)
+    if (Gd.rows() > 0) rw = KiGt.row(w_dof()).transpose() - GPhi * om.cwiseProduct(om).cwiseInverse().cwiseProduct(phiw);
 }
 
 Eigen::VectorXd CvodeModalStepper::Impl::initial_state_vector(const Eigen::SparseMatrix<double>& K,
