@@ -44,6 +44,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.description = "mode newmark with massless leaves";
     c.mode = Mode::newmark;
     c.applied_force = c.base_excitation = c.gravity = true;
+    c.seat_loads = c.windup_rig = c.windup_rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
     c.start = StartKind::whole_stack;
     c.build = &NewmarkStepperAccess::build;
@@ -53,6 +54,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.description = "mode newmark with massive leaves";
     c.massive_leaves = true;
     c.rig = c.damping = c.restitution = true;  // the rig on elastic contact only (the impact law)
+    c.windup_rig_on_rigid_contact = false;     // the windup rig too
     c.leaf_kinetic_energy = c.impact_loss = true;
     rows.push_back(c);
 
@@ -200,11 +202,32 @@ void check_contact(const StepperCapabilities& s, const System& system) {
     }
 }
 
+/// Seat loads and the windup rig (loading.hpp) against the row.
+void check_seat_loading(const StepperCapabilities& s, const System& system, const Loading& L) {
+    if (L.has_seat_load() && !s.seat_loads)
+        throw InputError(L.seat_moment_n_m ? "loading.seat_moment_n_m" : "loading.longitudinal_force_n",
+                         "is not available in " + std::string(s.description) + ": seat loads are " +
+                             taken_by([](auto& r) { return r.seat_loads; }));
+    if (L.windup_rig() && !s.windup_rig)
+        throw InputError("loading.seat_rotation_rad", "is not available in " + std::string(s.description) +
+                                                          ": the windup rig is " + taken_by([](auto& r) { return r.windup_rig; }));
+    if (L.windup_rig() && !s.windup_rig_on_rigid_contact && first_rigid_pair(system) >= 0)
+        throw InputError("loading.seat_rotation_rad", "with rigid contact (pair " + std::to_string(first_rigid_pair(system)) +
+                                                          ") is not available in " + s.description +
+                                                          " (the impact law would move the rig's seat): give the interfaces an "
+                                                          "elastic layer (interfaces[i].contact = 'elastic'); the windup rig on "
+                                                          "rigid contact is " +
+                                                          taken_by([](auto& r) { return r.windup_rig_on_rigid_contact; }));
+}
+
 void check_loading(const StepperCapabilities& s, const System& system, const Loading& L) {
+    check_seat_loading(s, system, L);
+    // the windup rig holds w by the vertical rig's displacement as part of itself
+    const bool windup_holds_w = L.windup_rig() && s.windup_rig;
     const bool takes = L.kind == LoadingKind::initial_conditions ||
                        (L.kind == LoadingKind::applied_force && s.applied_force) ||
                        (L.kind == LoadingKind::base_excitation && s.base_excitation) ||
-                       (L.kind == LoadingKind::prescribed_displacement && s.rig);
+                       (L.kind == LoadingKind::prescribed_displacement && (s.rig || windup_holds_w));
     const LoadingKind kind = L.kind;
     if (!takes)
         throw InputError("loading.kind", "value '" + std::string(to_string(kind)) + "' is not available in " +
@@ -213,7 +236,8 @@ void check_loading(const StepperCapabilities& s, const System& system, const Loa
                                                         (kind == LoadingKind::base_excitation && r.base_excitation) ||
                                                         (kind == LoadingKind::prescribed_displacement && r.rig);
                                              }));
-    if (L.kind == LoadingKind::prescribed_displacement && !s.rig_on_rigid_contact && first_rigid_pair(system) >= 0)
+    if (L.kind == LoadingKind::prescribed_displacement && !s.rig_on_rigid_contact && !windup_holds_w &&
+        first_rigid_pair(system) >= 0)
         throw InputError("loading.kind", "value 'prescribed-displacement' with rigid contact (pair " +
                                              std::to_string(first_rigid_pair(system)) + ") is not available in " +
                                              s.description + " (the impact law would move the rig's seat): give the "

@@ -86,12 +86,22 @@ public:
 
     /// Number of reduced degrees of freedom (including w, the last).
     int num_reduced_dofs() const noexcept { return static_cast<int>(K_red_.rows()); }
+    /// The seat's reduced DOFs (conventions.hpp, "Seat"): node-major leaf DOFs, then u_R (if the seat
+    /// slides), then theta_R (full model), then w, the last. Index of w [m].
+    int seat_w_dof() const noexcept { return num_reduced_dofs() - 1; }
+    /// Index of theta_R [rad, counter-clockwise], -1 on the half model (the symmetry plane holds it).
+    int seat_rotation_dof() const noexcept { return seat_rotation_dof_; }
+    /// Index of u_R [m, +x], -1 where the seat locates the stack axially (RigidBodySpec::axial).
+    int seat_axial_dof() const noexcept { return seat_axial_dof_; }
     /// Reduced stiffness P^T K P [N/m, N, N m per unit DOF], w last.
     const Eigen::SparseMatrix<double>& stiffness_reduced() const noexcept { return K_red_; }
     /// Reduced mass P^T M P [kg, kg m^2 per unit DOF], w last: the leaves' consistent
     /// mass matrices (density from the model; 0 = massless, the paper) plus the rigid
-    /// body's mass on w (the meshed part's share: half on the half model).
-    Eigen::SparseMatrix<double> mass_reduced() const;
+    /// body's mass on w (the meshed part's share: half on the half model), its pitch inertia J
+    /// on theta_R and, with rigid_body.axial = 'free', its mass on u_R (the axle moves with the seat;
+    /// 'auto' leaves it out, as the model before windup did). `with_body` false: the leaves' mass
+    /// only (the windup rig leaves R's inertia out of its quasi-static loop, loading.hpp).
+    Eigen::SparseMatrix<double> mass_reduced(bool with_body = true) const;
     /// The inertia of everything per unit acceleration in +y, on the reduced DOFs [kg] (w last):
     /// l = P^T M_full e_y + m e_w, the leaves' consistent mass times a unit translation of every
     /// node in y (their weight's consistent nodal loads per unit g) plus the rigid body's mass
@@ -134,6 +144,7 @@ private:
     double k_ = 0.0;
     double mass_ = 0.0;
     int probe_ = -1;
+    int seat_rotation_dof_ = -1, seat_axial_dof_ = -1;
     std::vector<int> node_offset_;         // per leaf: first full node index minus first_node
     int num_full_ = 0;
     Eigen::SparseMatrix<double> P_;        // full DOFs <- reduced DOFs
