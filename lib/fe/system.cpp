@@ -243,10 +243,13 @@ System::System(const Model& model) : model_(model) {
     Krw_col_ = K_red_.block(0, nr, nr, 1);
     const double Kww = K_red_.coeff(nr, nr);
     Krr_llt_.compute(Krr);
-    if (Krr_llt_.info() != Eigen::Success && seat_slides && axial == SeatAxial::free && !ends_locate)
+    const bool fixed_end = std::any_of(spec.leaves.begin(), spec.leaves.end(), [](const LeafSpec& l) {
+        return l.left_support == SupportKind::fixed || l.right_support == SupportKind::fixed;
+    });
+    if (seat_slides && axial == SeatAxial::free && !ends_locate && !fixed_end)  // the factor may not see it
         throw InputError("rigid_body.axial", "value 'free': the stack is not located axially, as no end holds it "
-                                             "(give an end a hinged eye, an inclined shackle or a bushing with "
-                                             "bushing_x_n_per_m > 0, or rigid_body.axial = 'held')");
+                                             "(give an end a hinged eye, an inclined shackle, a bushing with "
+                                             "bushing_x_n_per_m > 0 or a fixed support, or rigid_body.axial = 'held')");
     if (Krr_llt_.info() != Eigen::Success)
         throw InputError("leaves", "the stack is not restrained with the rigid body held: some leaf (or the seat) can move "
                                    "as a rigid body; give it supports or tie it to the rigid body (rigid_body.tied_leaves)");
