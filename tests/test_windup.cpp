@@ -80,7 +80,72 @@ std::string refusal(const ModelSpec& spec, const SimulationOptions& o) {
     return "accepted";
 }
 
+/// A two-leaf stack: the main leaf (0) from 0 to kL on pinned ends, a shorter leaf (1) of `lower_m`
+/// below it, centred on x = c, free ends; the seat at `seat_m` ties both; one interface of `law`, mu.
+ModelSpec two_leaves(double seat_m, double lower_m, double c, InterfaceLaw law, double mu = 0.0) {
+    ModelSpec s = leaf(seat_m);
+    LeafSpec lower = s.leaves[0];
+    lower.length_m = lower_m;
+    lower.x_start_m = c - 0.5 * lower_m;
+    lower.left_support = lower.right_support = SupportKind::free;
+    s.leaves.push_back(lower);
+    InterfaceSpec f;
+    f.law = law;
+    f.friction_coefficient = mu;
+    s.interfaces = {f};
+    return s;
+}
+
+/// M / theta of the windup rig at theta [N m/rad] on `spec` (newmark, massless leaves), and the
+/// largest departure from antisymmetry about the seat of every leaf's v [m] with the largest |v|.
+struct Windup {
+    double stiffness = 0.0, w = 0.0, asymmetry = 0.0, largest = 0.0;
+};
+Windup windup_of(const ModelSpec& spec, double theta) {
+    const System sys(Model::build(spec));
+    const auto stepper = make_stepper(sys, newmark(windup_rig(theta, false)));
+    for (int i = 0; i < 10; ++i) stepper->advance();
+    Windup out;
+    out.stiffness = stepper->current().seat_moment_n_m / stepper->current().seat_rotation_rad;
+    out.w = stepper->current().w_m;
+    const double xr = spec.rigid_body.x_m;
+    for (const LeafNodes& l : stepper->nodes())
+        for (std::size_t i = 0; i < l.x_m.size(); ++i) {
+            out.largest = std::max(out.largest, std::abs(l.w_m[i]));
+            for (std::size_t j = 0; j < l.x_m.size(); ++j)  // the node mirrored about the seat
+                if (std::abs(l.x_m[i] + l.x_m[j] - 2.0 * xr) < 1e-9)
+                    out.asymmetry = std::max(out.asymmetry, std::abs(l.w_m[i] + l.w_m[j]));
+        }
+    return out;
+}
+
 }  // namespace
+
+// A symmetric spring with pinned ends and the seat free vertically (statics): a vertical load P at
+// the seat bends each half as a cantilever from the unturned seat with P/2 at its end, so the
+// vertical rate is k_v = 2 k_c (k_c the half's tip stiffness); a windup moment M turns the seat by
+// theta with w = 0 and end reactions -+M/L, each half a cantilever from the turned seat whose end
+// must stay at v = 0: theta L/2 = (M/L)/k_c, so M/theta = k_c L^2/2 = k_v (L/2)^2, for any profile
+// symmetric about the seat. It holds on the discrete model too (the same half's stiffness both
+// times), so to rounding; k_v is System::tied_stiffness_n_per_m() (bonded: every pair tied).
+BOOST_AUTO_TEST_CASE(symmetric_spring_winds_up_at_the_vertical_rate_times_the_half_length_squared) {
+    const double theta = 0.01, half = 0.5 * kL;
+    ModelSpec stack = two_leaves(half, 0.8, half, InterfaceLaw::bonded);
+    ModelSpec tapered = leaf(half);  // 12 mm at the seat to 6 mm at the eyes, linearly
+    tapered.leaves[0].height_m = 0.0;
+    tapered.leaves[0].profile.x_m = {0.0, half, kL};
+    tapered.leaves[0].profile.thickness_m = {0.006, 0.012, 0.006};
+    for (const ModelSpec& spec : {stack, tapered}) {
+        const double k_v = System(Model::build(spec)).tied_stiffness_n_per_m();
+        const Windup r = windup_of(spec, theta);
+        BOOST_TEST_MESSAGE(spec.leaves.size() << " leaves: windup " << r.stiffness << " N m/rad, k_v (L/2)^2 "
+                                              << k_v * half * half);
+        BOOST_TEST(r.stiffness == k_v * half * half, tt::tolerance(1e-9));
+        BOOST_TEST(std::abs(r.w) < 1e-9 * theta * half);   // w = 0 at the seat
+        BOOST_TEST(r.asymmetry < 1e-9 * r.largest);        // v(x_R + s) = -v(x_R - s)
+        BOOST_TEST(r.largest > 0.1 * theta * half);        // (the S shape is there)
+    }
+}
 
 // A single flat leaf, pinned at both ends, the seat held vertically and turned by theta: each half
 // is a propped cantilever (built in at the seat, pinned at its end), rotational stiffness 3 EI / l,
@@ -244,4 +309,86 @@ BOOST_AUTO_TEST_CASE(bad_windup_input_is_refused_by_name) {
     BOOST_TEST(refusal(spec, closed) == "loading.seat_moment_n_m");
     closed.loading = windup_rig(0.01, true);
     BOOST_TEST(refusal(spec, closed) == "loading.seat_rotation_rad");
+}
+
+// A windup rig's loop with friction (the vertical rig holding a two-leaf spring at w0, so the leaves
+// press on each other; mu = 0.3, kappa = mu t / h = 0.06): rate independent, so from the second cycle
+// on each cycle repeats the one before (the pairs' states and forces to the solver's tolerance); over a
+// closed cycle the strain energy returns, so the loop's area, the rig's work, is the friction work of
+// the cycle. The moment at the loop's tip lies between the frictionless spring's (no shear between
+// the leaves) and the bonded one's (every pair tied).
+BOOST_AUTO_TEST_CASE(friction_windup_loop_closes_and_its_area_is_the_friction_work) {
+    const double w0 = 0.05, theta_a = 0.01;
+    const int per_cycle = 100, cycles = 3;
+    auto run = [&](InterfaceLaw law, double mu) {
+        Loading L;
+        L.kind = LoadingKind::prescribed_displacement;
+        L.displacement_m = constant(w0);
+        TimeFunction tri;
+        tri.shape = TimeFunction::Shape::triangle;
+        tri.amplitude = theta_a;
+        tri.frequency_hz = 1.0;
+        L.seat_rotation_rad = tri;
+        const System sys(Model::build(two_leaves(0.6, 0.8, 0.6, law, mu)));
+        return simulate(sys, newmark(L, cycles, 1.0 / per_cycle));
+    };
+    const auto r = run(InterfaceLaw::coulomb, 0.3);
+    BOOST_TEST_REQUIRE(r.size() == static_cast<std::size_t>(cycles * per_cycle + 1));
+    double amplitude = 0.0;
+    for (const auto& x : r) amplitude = std::max(amplitude, std::abs(x.seat_moment_n_m));
+    // the third cycle repeats the second
+    double repeat = 0.0;
+    for (int k = 0; k <= per_cycle; ++k)
+        repeat = std::max(repeat, std::abs(r[2 * per_cycle + k].seat_moment_n_m - r[per_cycle + k].seat_moment_n_m));
+    // the third cycle's area by the trapezoidal rule (the rig's work as the stepper books it)
+    double area = 0.0;
+    for (int k = 2 * per_cycle; k < 3 * per_cycle; ++k)
+        area += 0.5 * (r[k].seat_moment_n_m + r[k + 1].seat_moment_n_m) * (r[k + 1].seat_rotation_rad - r[k].seat_rotation_rad);
+    const double friction = r[3 * per_cycle].dissipated_energy_j - r[2 * per_cycle].dissipated_energy_j;
+    BOOST_TEST_MESSAGE("moment amplitude " << amplitude << " N m, cycle 3 - cycle 2 " << repeat << " N m, area " << area
+                                           << " J, friction work " << friction << " J, slipping pairs at the tip "
+                                           << r[2 * per_cycle + per_cycle / 4].n_slip);
+    BOOST_TEST(repeat < 1e-6 * amplitude);
+    BOOST_TEST(area > 1e-3 * amplitude * theta_a);  // a loop, not a line
+    BOOST_TEST(area == friction, tt::tolerance(1e-6));
+    // the loop's tip between the frictionless and the bonded spring's moment there
+    const int tip = 2 * per_cycle + per_cycle / 4;
+    const double frictionless = run(InterfaceLaw::coulomb, 0.0)[tip].seat_moment_n_m;
+    const double bonded = run(InterfaceLaw::bonded, 0.0)[tip].seat_moment_n_m;
+    BOOST_TEST_MESSAGE("tip moment: frictionless " << frictionless << ", friction " << r[tip].seat_moment_n_m << ", bonded "
+                                                   << bonded << " N m");
+    BOOST_TEST(frictionless < r[tip].seat_moment_n_m);
+    BOOST_TEST(r[tip].seat_moment_n_m < bonded);
+}
+
+// Every stepper that takes the windup rig gives the same response on a problem they share: the
+// flat leaf with the seat held vertically, turned from rest by theta = A (1 - cos 2 pi f t) (smooth,
+// as leaf mass needs), read at its peak t = 1 / (2 f). Massless leaves: 3 E I (1/a + 1/b) theta at
+// every step (static). Steel leaves: the leaves' inertia adds a quasi-static error of order
+// (f / f_1)^2, f_1 ~ 74 Hz the lowest mode with the seat held (the 0.7 m half as a propped cantilever,
+// 15.42 / (2 pi l^2) sqrt(E I / rho A)), so ~5e-5 at f = 0.5 Hz, plus Newmark's (omega dt)^2 on the
+// rig's slow motion (1e-5 at dt = 1 ms): 1e-3 with a margin of 20.
+BOOST_AUTO_TEST_CASE(every_stepper_of_the_windup_rig_gives_the_same_moment) {
+    const double a = 0.5, b = kL - a, A = 0.005, f = 0.5;
+    Loading L;
+    L.kind = LoadingKind::prescribed_displacement;
+    L.displacement_m = constant(0.0);
+    TimeFunction from_rest;
+    from_rest.shape = TimeFunction::Shape::harmonic;
+    from_rest.mean = from_rest.amplitude = A;
+    from_rest.frequency_hz = f;
+    from_rest.phase_rad = -0.5 * kPi;
+    L.seat_rotation_rad = from_rest;
+    const double expected = 3.0 * kEI * (1.0 / a + 1.0 / b) * 2.0 * A;
+    for (const double density : {0.0, 7850.0}) {
+        ModelSpec spec = leaf(a);
+        spec.leaves[0].density_kg_per_m3 = density;
+        const System sys(Model::build(spec));
+        const auto r = simulate(sys, newmark(L, 0.5 / f, 1e-3));
+        BOOST_TEST_MESSAGE("density " << density << ": moment " << r.back().seat_moment_n_m << " N m at "
+                                      << r.back().seat_rotation_rad << " rad, balance " << r.back().energy_balance_error_j << " J");
+        BOOST_TEST(r.back().seat_rotation_rad == 2.0 * A, tt::tolerance(1e-12));
+        BOOST_TEST(r.back().seat_moment_n_m == expected, tt::tolerance(density > 0.0 ? 1e-3 : 1e-9));
+        BOOST_TEST(std::abs(r.back().energy_balance_error_j) < 1e-6 * r.back().strain_energy_j);
+    }
 }

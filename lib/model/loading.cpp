@@ -250,11 +250,21 @@ void Loading::validate(bool leaf_mass) const {
             throw InputError("loading.seat_rotation_rad", "is not available with kind = 'base-excitation': the windup rig "
                                                           "holds the seat vertically (kind 'prescribed-displacement') or "
                                                           "leaves it free under a force (kinds 'initial-conditions', 'applied-force')");
-        const double theta0 = seat_rotation_rad->value(0.0);
-        if (theta0 != 0.0)
+        // "zero" to rounding of the shape's own scale (sin(-pi/2) + 1, cos(-pi/2) are not exactly 0)
+        const TimeFunction& f = *seat_rotation_rad;
+        double scale = std::abs(f.mean) + f.amplitude, rate_scale = 2.0 * 3.14159265358979323846 * f.frequency_hz;
+        for (double v : f.values) scale = std::max(scale, std::abs(v));
+        if (f.times_s.size() >= 2) rate_scale = 1.0 / (f.times_s[1] - f.times_s[0]);
+        const double theta0 = f.value(0.0);
+        if (std::abs(theta0) > 1e-12 * scale)
             throw InputError("loading.seat_rotation_rad", "has the value " + format_value(theta0) +
                                                           " rad at t = 0: the run starts from the unwound seat, so theta_R(0) must be 0 "
                                                           "(a harmonic's phase or a table's first value)");
+        // with leaf mass the rig's motion loads the leaves' inertia, and the run starts them at rest
+        if (leaf_mass && std::abs(seat_rotation_rad->derivative(0.0)) > 1e-12 * scale * rate_scale)
+            throw InputError("loading.seat_rotation_rad", "has the rate " + format_value(seat_rotation_rad->derivative(0.0)) +
+                                                          " rad/s at t = 0: with leaf mass the run starts at rest, so theta_R'(0) "
+                                                          "must be 0 (a harmonic from rest: mean = amplitude, phase_rad = -pi/2)");
     }
 }
 
