@@ -9,8 +9,10 @@
 #define BOOST_TEST_MODULE windup
 #include <boost/test/unit_test.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "single_leaf.hpp"
 #include "stackbeam/errors.hpp"
@@ -67,6 +69,53 @@ Loading windup_rig(double theta_end, bool held_vertically) {
         L.displacement_m = constant(0.0);
     }
     return L;
+}
+
+/// The InputError of parsing `text` as "test.toml": its field and message ("accepted" if none).
+std::pair<std::string, std::string> file_refusal(const std::string& text) {
+    try {
+        parse_scenario(text, "test.toml");
+    } catch (const InputError& e) {
+        return {e.field(), e.what()};
+    }
+    return {"accepted", ""};
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// "test.toml:LINE:" of the line that starts with `key` in `text` (1-based).
+std::string line_of(const std::string& text, const std::string& key) {
+    const auto pos = text.find("\n" + key);
+    BOOST_TEST_REQUIRE(pos != std::string::npos);
+    return "test.toml:" + std::to_string(2 + std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n')) + ":";
+}
+
+/// A one-leaf spring file with the seat off centre and `loading` as its [loading] tables.
+std::string leaf_file(const std::string& loading, const std::string& symmetry = "full", double seat_m = 0.5) {
+    return R"(
+[[leaves]]
+length_m = 1.2
+height_m = 0.01
+width_m = 0.05
+youngs_modulus_pa = 206e9
+left_support = ")" + std::string(symmetry == "half" ? "pinned" : "hinged") + R"("
+right_support = "pinned"
+
+[rigid_body]
+mass_kg = 1.0
+x_m = )" + std::to_string(seat_m) + R"(
+
+)" + loading + R"(
+
+[mesh]
+element_length_m = 0.05
+symmetry = ")" + symmetry + R"("
+
+[integrator]
+mode = "newmark"
+dt_s = 0.1
+t_end_s = 1.0
+)";
 }
 
 /// The InputError's field of make_stepper, or "accepted".
@@ -391,4 +440,73 @@ BOOST_AUTO_TEST_CASE(every_stepper_of_the_windup_rig_gives_the_same_moment) {
         BOOST_TEST(r.back().seat_moment_n_m == expected, tt::tolerance(density > 0.0 ? 1e-3 : 1e-9));
         BOOST_TEST(std::abs(r.back().energy_balance_error_j) < 1e-6 * r.back().strain_energy_j);
     }
+}
+
+// The scenario file of an asymmetric braking case (scenarios/asymmetric_braking.toml): its keys as
+// written, the writer's round trip, and the run: the energy balance closes (massless leaves, static
+// contact with friction at each step: to the solver's tolerance, here 1e-9 of the external work).
+BOOST_AUTO_TEST_CASE(asymmetric_braking_file_reads_writes_and_runs) {
+    const Scenario s = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/asymmetric_braking.toml");
+    const Loading& L = s.simulation.loading;
+    BOOST_TEST(s.model.rigid_body.pitch_inertia_kg_m2 == 6.0);
+    BOOST_TEST((s.model.rigid_body.axial == SeatAxial::free));
+    BOOST_TEST(L.longitudinal_force_height_m == -0.45);
+    BOOST_TEST_REQUIRE(L.longitudinal_force_n.has_value());
+    BOOST_TEST(L.longitudinal_force_n->values.back() == 8000.0);
+    BOOST_TEST(!L.seat_moment_n_m.has_value());
+    const Scenario again = parse_scenario(to_toml(s), "again.toml");
+    BOOST_TEST(again.model.rigid_body.pitch_inertia_kg_m2 == 6.0);
+    BOOST_TEST((again.model.rigid_body.axial == SeatAxial::free));
+    BOOST_TEST(again.simulation.loading.longitudinal_force_height_m == -0.45);
+    BOOST_TEST_REQUIRE(again.simulation.loading.longitudinal_force_n.has_value());
+    BOOST_TEST(again.simulation.loading.longitudinal_force_n->times_s == L.longitudinal_force_n->times_s);
+
+    const System sys(Model::build(s.model));
+    const auto r = simulate(sys, s.simulation);
+    double balance = 0.0;
+    for (const auto& x : r) balance = std::max(balance, std::abs(x.energy_balance_error_j));
+    BOOST_TEST_MESSAGE("braked: w " << r.back().w_m << " m, theta_R " << r.back().seat_rotation_rad << " rad, u_R "
+                                    << r.back().seat_axial_m << " m, moment " << r.back().seat_moment_n_m << " N m");
+    BOOST_TEST(r.back().seat_moment_n_m == 8000.0 * 0.45, tt::tolerance(1e-12));  // -H h
+    BOOST_TEST(balance < 1e-9 * r.back().external_work_j);
+    // braking winds the seat counter-clockwise beyond where the axle load alone left it (t = 0.5 s)
+    BOOST_TEST(r.back().seat_rotation_rad > r[500].seat_rotation_rad);
+}
+
+// The windup keys refused in a file with their key path and line.
+BOOST_AUTO_TEST_CASE(windup_keys_refused_at_their_line) {
+    const std::string rig = "[loading]\nkind = \"prescribed-displacement\"\n[loading.displacement_m]\nshape = \"constant\"\n"
+                            "mean = 0.0\n[loading.seat_rotation_rad]\nshape = \"triangle\"\namplitude = 0.01\nfrequency_hz = 1.0\n";
+    BOOST_TEST(file_refusal(leaf_file(rig)).first == "accepted");
+
+    std::string text = leaf_file(rig + "[loading.seat_moment_n_m]\nshape = \"constant\"\nmean = 10.0\n");
+    auto r = file_refusal(text);
+    BOOST_TEST(r.first == "loading.seat_moment_n_m");
+    BOOST_TEST(contains(r.second, line_of(text, "[loading.seat_moment_n_m]")));
+    BOOST_TEST(contains(r.second, "prescribed seat rotation"));
+
+    text = leaf_file("[loading]\nkind = \"initial-conditions\"\nlongitudinal_force_height_m = nan\n[loading.longitudinal_force_n]\nshape = \"constant\"\nmean = 1.0\n");
+    r = file_refusal(text);
+    BOOST_TEST(r.first == "loading.longitudinal_force_height_m");
+    BOOST_TEST(contains(r.second, line_of(text, "longitudinal_force_height_m")));
+
+    const std::string moment = "[loading]\nkind = \"initial-conditions\"\n[loading.seat_moment_n_m]\nshape = \"constant\"\nmean = 10.0\n";
+    text = leaf_file(moment, "half", 0.6);
+    r = file_refusal(text);
+    BOOST_TEST(r.first == "loading.seat_moment_n_m");
+    BOOST_TEST(contains(r.second, line_of(text, "[loading.seat_moment_n_m]")));
+    BOOST_TEST(contains(r.second, "half model"));
+
+    text = leaf_file("[loading]\nkind = \"initial-conditions\"\n");
+    text.insert(text.find("x_m = "), "axial = \"sideways\"\n");
+    r = file_refusal(text);
+    BOOST_TEST(r.first == "rigid_body.axial");
+    BOOST_TEST(contains(r.second, line_of(text, "axial")));
+    BOOST_TEST(contains(r.second, "auto"));
+
+    text = leaf_file("[loading]\nkind = \"initial-conditions\"\n");
+    text.insert(text.find("x_m = "), "pitch_inertia_kg_m2 = -2.0\n");
+    r = file_refusal(text);
+    BOOST_TEST(r.first == "rigid_body.pitch_inertia_kg_m2");
+    BOOST_TEST(contains(r.second, line_of(text, "pitch_inertia_kg_m2")));
 }
