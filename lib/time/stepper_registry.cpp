@@ -97,6 +97,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
+    c.seat_loads = true;  // through q(t) (ReducedLoad); not the windup rig
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
