@@ -318,6 +318,35 @@ Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w
     return z;
 }
 
+Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w, const Eigen::Vector2d& seat_loads) const {
+    Eigen::VectorXd z = reduced_displacements(p, w);
+    const int nr = static_cast<int>(K_red_.rows()) - 1;
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(nr);
+    if (seat_rotation_dof_ >= 0) e[seat_rotation_dof_] = seat_loads[0];
+    if (seat_axial_dof_ >= 0) e[seat_axial_dof_] = seat_loads[1];
+    if (e.squaredNorm() > 0.0) z.head(nr) += Krr_llt_.solve(e);
+    return z;
+}
+
+System::SeatCondensation System::seat_condensation() const {
+    const int nr = static_cast<int>(K_red_.rows()) - 1;
+    SeatCondensation out;
+    out.B = Eigen::MatrixXd::Zero(Gr_.rows(), 2);
+    const Eigen::VectorXd krw = Eigen::VectorXd(Krw_col_);
+    const int dofs[2] = {seat_rotation_dof_, seat_axial_dof_};
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nr, 2);  // K_rr^-1 E
+    for (int j = 0; j < 2; ++j) {
+        if (dofs[j] < 0) continue;
+        X.col(j) = Krr_llt_.solve(Eigen::VectorXd::Unit(nr, dofs[j]));
+        if (Gr_.rows() > 0) out.B.col(j) = Gr_ * X.col(j);
+        out.g[j] = krw.dot(X.col(j));
+    }
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            if (dofs[i] >= 0) out.F(i, j) = X(dofs[i], j);
+    return out;
+}
+
 Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {
     return P_ * reduced_displacements(p, w);
 }

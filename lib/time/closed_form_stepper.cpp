@@ -46,6 +46,16 @@ struct ClosedFormStepper::Impl {
     // external work [J, whole spring].
     bool rig_ = false;
     double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
+    // Seat loads S = [M - H h; H] on theta_R, u_R (loading.hpp), condensed (System::SeatCondensation):
+    // R feels -g^T S besides the vertical loading fv_ (fe_ = fv_ - g^T S), the contact offsets shift by B S.
+    bool seat_ = false;
+    System::SeatCondensation seat_c_;
+    double fv_ = 0.0;                                          // the vertical loading on R at t [N]
+    Eigen::Vector2d seat_motion_ = Eigen::Vector2d::Zero();    // [theta_R; u_R] at t [rad, m]
+    Eigen::Vector2d seat_state_ = Eigen::Vector2d::Zero();     // S in the state at t: 0 at the start (unloaded), then S(t)
+    Eigen::Vector2d seat_loads(double t_s) const {
+        return {options_.loading.seat_moment_n_m_at(t_s), options_.loading.longitudinal_force_n_at(t_s)};
+    }
     void fill_record(int iterations, int factorizations, double strain_j = -1.0);
 };
 
@@ -104,12 +114,17 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     // Sparse: K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma, b = (k/gamma) w_next e_w; the
     // rig: K_rr z_r = -K_rw w_next + G_r^T p, s = G_r z_r + c_L p - (d - G_w w_next).
     StepSystem sys = rig_ ? detail::held_body_system(system_) : StepSystem{};
+    // seat loads: u = [w_next; S] (the vertical rig with them is refused: check_capabilities)
+    seat_ = load.has_seat_load();
+    if (seat_) seat_c_ = system_.seat_condensation();
     if (!rig_) {
         sys.rows = n;
         sys.dense = [&] {
             DenseStepForm f;
             f.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
-            f.Q = c;
+            f.Q.resize(n, seat_ ? 3 : 1);
+            f.Q.col(0) = c;
+            if (seat_) f.Q.rightCols(2) = seat_c_.B;  // s = C' p + c w + B S - d
             return f;
         };
         sys.sparse = [&] {
@@ -125,8 +140,12 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
             k_r_ = k * one_minus_gamma / gamma_;
             f.K.coeffRef(w_dof_, w_dof_) += k_r_;
             f.K.makeCompressed();
-            f.B.resize(w_dof_ + 1, 1);
+            f.B.resize(w_dof_ + 1, seat_ ? 3 : 1);
             f.B.insert(w_dof_, 0) = k / gamma_;
+            if (seat_) {  // the seat loads on their DOFs (a DOF the seat lacks carries nothing)
+                if (system_.seat_rotation_dof() >= 0) f.B.insert(system_.seat_rotation_dof(), 1) = 1.0;
+                if (system_.seat_axial_dof() >= 0) f.B.insert(system_.seat_axial_dof(), 2) = 1.0;
+            }
             f.B.makeCompressed();
             return f;
         };
@@ -134,11 +153,13 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     contact_ = start_step_contact(sys, options_.contact_path, options_.solver, options_.sparse_tuning, problem_.pairs,
                                   problem_.tau_rule, step_problem_);
     op_ = step_problem_.op;
-    step_problem_.u = Eigen::VectorXd::Zero(1);
+    step_problem_.u = Eigen::VectorXd::Zero(seat_ ? 3 : 1);
     // relative positions at the start: from z where the operator gives z, else from C'
     rel_ = op_->has_displacements() ? detail::relative_positions(system_, z_, p_)
                                     : Eigen::VectorXd(system_.compliance_held() * p_ + c * w_);
-    fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
+    fv_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
+    fe_ = seat_ ? fv_ - seat_c_.g.dot(seat_loads(0.0)) : fv_;  // (seat loads: the full model, f = 1)
+    seat_motion_ = seat_ ? Eigen::Vector2d(seat_c_.B.transpose() * p_ - seat_c_.g * w_) : Eigen::Vector2d::Zero();
     fill_record(0, 0);
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
@@ -151,6 +172,8 @@ void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, do
     // elastic layer (see system.hpp); the sparse path has z itself and never builds C'.
     // step() passes the stiffness form's U (strain_j >= 0), which it has without a product with K.
     const double strain = strain_j >= 0.0 ? strain_j
+                          : seat_ ? f * (0.5 * displacements_now().dot(system_.stiffness_reduced() * displacements_now()) +
+                                         detail::layer_energy_j(system_, p_))
                           : op_->has_displacements()
                               ? f * (0.5 * z_.dot(system_.stiffness_reduced() * z_) + detail::layer_energy_j(system_, p_))
                               : 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
@@ -162,9 +185,17 @@ void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, do
         load.force_on_mass_n = m_whole_ * options_.loading.displacement_m.second_derivative(t_);
         load.external_force_n = f * (k * w_ - (p_.size() > 0 ? system_.coupling().dot(p_) : 0.0));
     } else {
-        load.external_force_n = f * fe_;
+        load.external_force_n = f * fv_;
     }
     detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, load, record_);
+    if (seat_) {  // R's force on the stack with the seat loads (SeatCondensation), and the seat's records
+        const Eigen::Vector2d S = seat_loads(t_);
+        record_.spring_force_n += f * seat_c_.g.dot(S);
+        record_.force_on_mass_n = record_.external_force_n - record_.spring_force_n;
+        record_.seat_moment_n_m = S[0];
+    }
+    record_.seat_rotation_rad = seat_motion_[0];
+    record_.seat_axial_m = seat_motion_[1];
     record_.t_s = t_;
     record_.contact_iterations = iterations;
     record_.factorizations = factorizations;
@@ -182,7 +213,8 @@ std::vector<PairRecord> ClosedFormStepper::Impl::pairs() const {
 }
 
 Eigen::VectorXd ClosedFormStepper::Impl::displacements_now() const {
-    return op_->has_displacements() ? z_ : system_.reduced_displacements(p_, w_);
+    if (op_->has_displacements()) return z_;
+    return seat_ ? system_.reduced_displacements(p_, w_, seat_state_) : system_.reduced_displacements(p_, w_);
 }
 
 std::vector<LeafNodes> ClosedFormStepper::Impl::nodes() const {
@@ -206,6 +238,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
         // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
         fe1 = load.external_force_n(t1, m_whole_) / f_;
+        if (seat_) fe1 -= seat_c_.g.dot(seat_loads(t1));  // the seat loads' force on R (condensed)
         F0 = cp0 + fe_;
         w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
     }
@@ -215,6 +248,12 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     // operator's form; K, G constant over the run. The displacements (where the operator gives
     // them) are z, or z_r with R's w_next (the rig).
     step_problem_.u[0] = w_next;
+    if (seat_) {
+        const Eigen::Vector2d S1 = seat_loads(t1);
+        step_problem_.u.tail(2) = S1;
+        // the stiffness form's R row takes -g^T S1 itself (K_aug z = B u + G^T p): w_next without it
+        if (op_->path() == ContactPath::sparse) step_problem_.u[0] += gamma_ / k * seat_c_.g.dot(S1);
+    }
     step_problem_.d = d_;
     step_problem_.tau_previous_n = problem_.tau_previous_n;
     solve_ = contact_->solve(step_problem_, p_, rig_ ? zr_ : z_);
@@ -251,7 +290,16 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         const double spring0 = f_ * (k * w0 - cp0), spring1 = f_ * (k * w1 - cp1);
         wext_ += 0.5 * (spring0 + spring1) * (w1 - w0) + 0.5 * m_whole_ * wd1 * wd1 - kin0;
     } else {
-        wext_ += 0.5 * f_ * (fe_ + fe1) * (w1 - w0);
+        // the vertical loading's work on w, and the seat loads' on [theta_R; u_R] (not the condensed force)
+        const double fv1 = load.external_force_n(t1, m_whole_) / f_;
+        wext_ += 0.5 * f_ * (fv_ + fv1) * (w1 - w0);
+        if (seat_) {
+            const Eigen::Vector2d motion1 = seat_c_.B.transpose() * p_ - seat_c_.g * w1 + seat_c_.F * seat_loads(t1);
+            wext_ += 0.5 * (seat_loads(t_) + seat_loads(t1)).dot(motion1 - seat_motion_);
+            seat_motion_ = motion1;
+            seat_state_ = seat_loads(t1);
+        }
+        fv_ = fv1;
         fe_ = fe1;
     }
     rel_ = rel1;
@@ -267,7 +315,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     // (~1e2-1e3 at dt = 1 ms): the difference loses that factor of round-off, 1e-13 relative.
     // (The rig's held problem is another system: fill_record takes z^T K z there.)
     double strain = -1.0;
-    if (op_->has_displacements() && !rig_) {
+    if (op_->has_displacements() && !rig_ && !seat_) {  // (seat loads add B u terms: fill_record's z^T K z)
         const double zw = z_[w_dof_];
         strain = 0.5 * f_ * (k / gamma_ * w_next * zw + p_.dot(rel_) - k_r_ * zw * zw);
     }

@@ -35,6 +35,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::closed_form;
     c.applied_force = c.base_excitation = c.gravity = c.rig = c.rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
+    c.seat_loads = true;  // condensed with theta_R (System::SeatCondensation): no J, not with the rig
     c.start = StartKind::massless_stack;
     c.build = &ClosedFormStepperAccess::build;
     rows.push_back(c);
@@ -44,7 +45,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.description = "mode newmark with massless leaves";
     c.mode = Mode::newmark;
     c.applied_force = c.base_excitation = c.gravity = true;
-    c.seat_loads = c.windup_rig = c.windup_rig_on_rigid_contact = true;
+    c.seat_loads = c.windup_rig = c.windup_rig_on_rigid_contact = c.pitch_inertia = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
     c.start = StartKind::whole_stack;
     c.build = &NewmarkStepperAccess::build;
@@ -55,6 +56,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.massive_leaves = true;
     c.rig = c.damping = c.restitution = true;  // the rig on elastic contact only (the impact law)
     c.windup_rig_on_rigid_contact = false;     // the windup rig too
+    c.seat_loads_with_rig = true;
     c.leaf_kinetic_energy = c.impact_loss = true;
     rows.push_back(c);
 
@@ -97,7 +99,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
-    c.seat_loads = true;  // through q(t) (ReducedLoad); not the windup rig
+    c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M; not the windup rig
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
@@ -205,10 +207,20 @@ void check_contact(const StepperCapabilities& s, const System& system) {
 
 /// Seat loads and the windup rig (loading.hpp) against the row.
 void check_seat_loading(const StepperCapabilities& s, const System& system, const Loading& L) {
+    const char* seat_key = L.seat_moment_n_m ? "loading.seat_moment_n_m" : "loading.longitudinal_force_n";
     if (L.has_seat_load() && !s.seat_loads)
-        throw InputError(L.seat_moment_n_m ? "loading.seat_moment_n_m" : "loading.longitudinal_force_n",
-                         "is not available in " + std::string(s.description) + ": seat loads are " +
-                             taken_by([](auto& r) { return r.seat_loads; }));
+        throw InputError(seat_key, "is not available in " + std::string(s.description) + ": seat loads are " +
+                                       taken_by([](auto& r) { return r.seat_loads; }));
+    if (L.has_seat_load() && L.kind == LoadingKind::prescribed_displacement && !L.windup_rig() && !s.seat_loads_with_rig)
+        throw InputError(seat_key, "with kind = 'prescribed-displacement' is not available in " + std::string(s.description) +
+                                       ": seat loads with the vertical rig are " +
+                                       taken_by([](auto& r) { return r.seat_loads_with_rig; }));
+    const double J = system.model().spec().rigid_body.pitch_inertia_kg_m2;
+    if (J > 0.0 && !s.pitch_inertia)
+        throw InputError("rigid_body.pitch_inertia_kg_m2",
+                         "value " + format_value(J) + " is not taken by " + s.description +
+                             " (its seat rotation has no inertia: give 0); the axle's pitch inertia is " +
+                             taken_by([](auto& r) { return r.pitch_inertia; }));
     if (L.windup_rig() && !s.windup_rig)
         throw InputError("loading.seat_rotation_rad", "is not available in " + std::string(s.description) +
                                                           ": the windup rig is " + taken_by([](auto& r) { return r.windup_rig; }));

@@ -109,9 +109,24 @@ public:
     /// y_b'' of the supports loads it, in the frame of the supports, with -y_b'' l (loading.hpp).
     /// Massless leaves: l = m e_w.
     Eigen::VectorXd vertical_inertia_kg() const;
+    /// Seat loads on the massless stack (loading.hpp), condensed as the paper condenses the leaves:
+    /// with seat loads S = [M; H] [N m, N] on theta_R and u_R (a column of zeros where the seat has
+    /// no such DOF), R at w and contact forces p, the free DOFs solve K_rr z_r = G_r^T p - K_rw w + E S:
+    ///     s        = C' p + c w + B S - d           B = G_r K_rr^-1 E   [m per unit load]
+    ///     f        = k w - c^T p + g^T S              g = E^T K_rr^-1 K_rw [N per unit load] (R's force on the stack)
+    ///     [theta_R; u_R] = B^T p - g w + F S          F = E^T K_rr^-1 E     [rad/(N m), m/N ...]
+    /// (K symmetric: E^T K_rr^-1 G_r^T = B^T). Two solves with K_rr, on each call.
+    struct SeatCondensation {
+        Eigen::MatrixXd B;  ///< num_components() x 2
+        Eigen::Vector2d g = Eigen::Vector2d::Zero();
+        Eigen::Matrix2d F = Eigen::Matrix2d::Zero();
+    };
+    SeatCondensation seat_condensation() const;
     /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
     /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
     Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;
+    /// As above with seat loads S = [M; H] [N m, N] on theta_R and u_R (SeatCondensation).
+    Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w, const Eigen::Vector2d& seat_loads) const;
     /// Displacements (u, v, theta) of every leaf node [m, m, rad] for contact forces p
     /// and rigid-body displacement w: index 3*node_dof(leaf, node) + {0,1,2}.
     Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
