@@ -116,7 +116,8 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     StepSystem sys = rig_ ? detail::held_body_system(system_) : StepSystem{};
     // seat loads: u = [w_next; S] (the vertical rig with them is refused: check_capabilities)
     seat_ = load.has_seat_load();
-    if (seat_) seat_c_ = system_.seat_condensation();
+    // the seat's motion is recorded on every full model (an asymmetric spring's seat turns under a vertical load)
+    if (system_.seat_rotation_dof() >= 0) seat_c_ = system_.seat_condensation();
     if (!rig_) {
         sys.rows = n;
         sys.dense = [&] {
@@ -159,7 +160,7 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
                                     : Eigen::VectorXd(system_.compliance_held() * p_ + c * w_);
     fv_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
     fe_ = seat_ ? fv_ - seat_c_.g.dot(seat_loads(0.0)) : fv_;  // (seat loads: the full model, f = 1)
-    seat_motion_ = seat_ ? Eigen::Vector2d(seat_c_.B.transpose() * p_ - seat_c_.g * w_) : Eigen::Vector2d::Zero();
+    if (system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w_;
     fill_record(0, 0);
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
@@ -302,6 +303,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         fv_ = fv1;
         fe_ = fe1;
     }
+    if (!seat_ && system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w1;
     rel_ = rel1;
     w_ = w1;
     wd_ = wd1;
