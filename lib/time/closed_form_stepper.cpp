@@ -189,11 +189,10 @@ void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, do
         load.external_force_n = f * fv_;
     }
     detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, load, record_);
-    if (seat_) {  // R's force on the stack with the seat loads (SeatCondensation), and the seat's records
-        const Eigen::Vector2d S = seat_loads(t_);
-        record_.spring_force_n += f * seat_c_.g.dot(S);
+    if (seat_) {  // R's force on the stack with the state's seat loads (SeatCondensation), and the seat's records
+        record_.spring_force_n += f * seat_c_.g.dot(seat_state_);
         record_.force_on_mass_n = record_.external_force_n - record_.spring_force_n;
-        record_.seat_moment_n_m = S[0];
+        record_.seat_moment_n_m = seat_loads(t_)[0];
     }
     record_.seat_rotation_rad = seat_motion_[0];
     record_.seat_axial_m = seat_motion_[1];
