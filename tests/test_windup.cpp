@@ -647,3 +647,62 @@ BOOST_AUTO_TEST_CASE(asymmetric_springs_with_every_end_kind_are_reciprocal) {
         BOOST_TEST(std::abs(r.energy_balance_error_j) < 1e-9 * r.strain_energy_j);
     }
 }
+
+// The seat loads go with every vertical loading, in every mode that takes them, and the energy
+// balance closes over each (a balance that must close: the seat loads' work, the vertical load's and
+// the strain, kinetic and friction energies). The two-leaf spring with friction, the seat off centre,
+// a smooth seat moment and a longitudinal force at a height (a hinged eye locates the spring), 0.5 s.
+// Bounds: newmark books every work by its own trapezoidal rule, so to the contact solver's tolerance
+// (1e-9 of the external work); closed-form moves R exactly within a step but books the seat loads'
+// work by the trapezoidal rule (second order, decision 063): 1e-5 at dt = 0.5 ms; cvode's massive
+// and modal steppers integrate the work as a state to their tolerances: 1e-6.
+BOOST_AUTO_TEST_CASE(seat_loads_go_with_every_vertical_loading) {
+    TimeFunction smooth;  // from rest: mean = amplitude, phase -pi/2
+    smooth.shape = TimeFunction::Shape::harmonic;
+    smooth.frequency_hz = 1.0;
+    smooth.phase_rad = -0.5 * kPi;
+    for (const double density : {0.0, 7850.0}) {
+        ModelSpec spec = two_leaves(0.5, 0.8, 0.55, InterfaceLaw::coulomb, 0.3);
+        spec.leaves[0].left_support = SupportKind::hinged;  // locates the spring: the seat slides ('auto')
+        for (auto& l : spec.leaves) l.density_kg_per_m3 = density;
+        if (density > 0.0)  // leaf mass with the vertical rig needs an elastic layer (the impact law)
+            spec.interfaces[0].contact = InterfaceContact::elastic;
+        const System sys(Model::build(spec));
+        for (const LoadingKind kind : {LoadingKind::applied_force, LoadingKind::initial_conditions, LoadingKind::base_excitation,
+                                       LoadingKind::prescribed_displacement}) {
+            Loading L;
+            L.kind = kind;
+            TimeFunction vertical = smooth;
+            vertical.mean = vertical.amplitude = kind == LoadingKind::applied_force ? 1000.0 : 0.005;
+            L.force_n = vertical;
+            L.displacement_m = vertical;
+            if (kind == LoadingKind::initial_conditions) L.gravity_m_per_s2 = 9.81;
+            TimeFunction moment = smooth, push = smooth;
+            moment.mean = moment.amplitude = 20.0;
+            push.mean = push.amplitude = 200.0;
+            L.seat_moment_n_m = moment;
+            L.longitudinal_force_n = push;
+            L.longitudinal_force_height_m = -0.3;
+            std::vector<std::pair<Mode, double>> modes = {{Mode::newmark, 1e-9}};
+            if (density == 0.0 && kind != LoadingKind::prescribed_displacement) modes.push_back({Mode::closed_form, 1e-5});
+            if (density > 0.0 && kind != LoadingKind::prescribed_displacement) modes.push_back({Mode::cvode, 1e-6});
+            if (density == 0.0 && kind == LoadingKind::prescribed_displacement) continue;  // no stepper: the refusals above
+            for (const auto& [mode, bound] : modes) {
+                SimulationOptions o = newmark(L, 0.5, 5e-4);
+                o.mode = mode;
+                const auto r = simulate(sys, o);
+                double balance = 0.0, work = 0.0;
+                for (const auto& x : r) {
+                    balance = std::max(balance, std::abs(x.energy_balance_error_j));
+                    work = std::max(work, std::abs(x.external_work_j));
+                }
+                BOOST_TEST_MESSAGE("density " << density << ", " << to_string(kind) << ", " << to_string(mode) << ": balance "
+                                              << balance << " J of " << work << " J, theta_R " << r.back().seat_rotation_rad
+                                              << " rad, u_R " << r.back().seat_axial_m << " m");
+                BOOST_TEST(balance < bound * work);
+                BOOST_TEST(r.back().seat_moment_n_m == 40.0 + 400.0 * 0.3, tt::tolerance(1e-9));
+                BOOST_TEST(std::abs(r.back().seat_axial_m) > 0.0);
+            }
+        }
+    }
+}
