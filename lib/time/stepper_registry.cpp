@@ -88,7 +88,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.assembly = true;  // every loading but the rig
-    c.seat_loads = true;  // two more channels of the modal load (modal_load.hpp)
+    c.seat_loads = c.pitch_inertia = true;  // two more channels of the modal load (modal_load.hpp); J in M's modes
     c.friction = c.rigid_rows = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeModalStepper>;
