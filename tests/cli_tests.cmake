@@ -350,14 +350,14 @@ stackbeam_cli_test(NAME cli_base_cvode
 stackbeam_cli_test(NAME cli_plot
                    ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
                    EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)
-# --stack-color stress (issue 43 item 5): the deformed stack's fibres coloured by their stress; the
-# data file has both figures' fibres (3 leaves x 2 fibres x 41 nodes x 2 figures = 492 rows and the
-# blank lines between blocks); a word other than state or stress, and the option without --plot, refused
+# --stack-color stress (issue 43 item 5): the deformed stack's leaves coloured by their stress; the
+# data file has both figures' bands (3 leaves x 2 fibres x 41 nodes x 2 figures = 492 rows, the
+# header and blank lines); a word other than state or stress, and the option without --plot, refused
 stackbeam_cli_test(NAME cli_plot_stack_stress
                    ARGS simulate --case friction --t-end 0.02 --quiet --out ${_cli_out_dir}/cli_plot_stress.csv
                         --plot ${_cli_out_dir}/cli_plot_stress --stack-color stress
-                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_stress_stack.png" OUT ${_cli_out_dir}/cli_plot_stress_stack_fibres.dat
-                   HEADER_PREFIX "# x [mm], y [mm] (the fibre" MIN_LINES 493)
+                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_stress_stack.png" OUT ${_cli_out_dir}/cli_plot_stress_stack_stress.dat
+                   HEADER_PREFIX "# x [mm], y [mm], sigma [MPa]" MIN_LINES 493)
 stackbeam_cli_test(NAME cli_bad_stack_color_word
                    ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stack_color_bad.csv
                         --plot ${_cli_out_dir}/cli_stack_color_bad --stack-color pressure

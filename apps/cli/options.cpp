@@ -200,8 +200,8 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
         ->type_name("PREFIX");
     sim.add_option("--stack-color", a.stack_color,
                    "with --plot: what colours the deformed stack (PREFIX_stack.png): state (every pair by its state: "
-                   "stick, slip, open) | stress (each leaf's top and bottom fibres by their stress [MPa], tension "
-                   "positive; the run then computes the stresses, as --stresses does) (default state)")
+                   "stick, slip, open) | stress (each leaf a band coloured by its stress [MPa], tension positive, the "
+                   "fibres' at its edges; the run then computes the stresses, as --stresses does) (default state)")
         ->type_name("WORD");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
 }

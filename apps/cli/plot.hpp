@@ -28,11 +28,11 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
 /// in the stack plus its deflection times a scale (stack_figure_scale, printed on the figure),
 /// every pair a point coloured by its state (stick, slip, open); the half model mirrored. The
 /// data in PREFIX_stack_axes.dat and PREFIX_stack_pairs.dat (mm). `stress` (--stack-color stress,
-/// the snapshots' stresses kept): instead of the pairs, each leaf's top and bottom fibres drawn half
-/// its local thickness above and below its drawn axis, coloured by their stress [MPa] (tension
-/// positive; one colour scale, symmetric about 0, over both figures), the data in
-/// PREFIX_stack_fibres.dat (x [mm], y [mm], sigma [MPa]). Returns the file written, or none and a
-/// note why in `note`.
+/// the snapshots' stresses kept): instead of the axes and pairs, each leaf a band of its local
+/// thickness about its drawn axis coloured by its stress [MPa] (tension positive), the fibres' at
+/// its edges and linear between them and between the nodes (gnuplot's pm3d), one colour scale
+/// symmetric about 0 over both figures; the data in PREFIX_stack_stress.dat (x [mm], y [mm],
+/// sigma [MPa]). Returns the file written, or none and a note why in `note`.
 std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
                                     std::string& note, bool stress = false);
 

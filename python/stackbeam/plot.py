@@ -238,7 +238,6 @@ def _draw_stress_stack(ax, stack, i, scale, leaves, norm):
         sigma = _np.vstack([_np.asarray(s["sigma_bottom"])[i], _np.asarray(s["sigma_top"])[i]]) / 1e6
         mesh = ax.pcolormesh(xx, yy, sigma, shading="gouraud", cmap=STRESS_CMAP, norm=norm)
         mesh.set_gid("leaf %d" % leaf)
-        ax.plot(1000 * x, 1000 * y_axis, color="0.3", lw=0.5)
         artists.append(mesh)
     return artists
 
