@@ -118,3 +118,15 @@ def test_deformed_stack_colour_refusals(friction_nodes, friction):
     no_stresses = stackbeam.simulate(stackbeam.paper_example("friction"), t_end_s=0.002, nodes=True)
     with pytest.raises(stackbeam.InputError, match="result.stresses"):
         stackbeam.plot.deformed_stack(no_stresses, color_by="stress")
+
+
+def test_scenario_key_stresses_path():
+    """Scenario.outputs.stresses_path, the file key [outputs] stresses_path (the command line's
+    --stresses): written by to_toml, read back; a non-string refused by its name."""
+    s = stackbeam.paper_example("friction")
+    assert s.outputs.stresses_path == ""
+    s.outputs.stresses_path = "stresses.csv"
+    assert 'stresses_path = "stresses.csv"' in s.to_toml()
+    assert stackbeam.Scenario.from_toml(s.to_toml(), "back").outputs.stresses_path == "stresses.csv"
+    with pytest.raises(stackbeam.InputError, match="outputs.stresses_path"):
+        s.outputs.stresses_path = 3
