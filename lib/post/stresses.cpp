@@ -17,9 +17,10 @@ namespace {
 /// on the upper leaf A, p_t in +x at its bottom surface (h_A/2 below the axis): moment +h_A/2 p_t;
 /// on the lower leaf B the reaction -p_t at its top surface: moment +h_B/2 p_t (G's tangential row).
 /// With `per_length` (each candidate pair's tributary length, tributary_lengths), each pair's
-/// force and moment divided by its tributary length: the traction it stands for, per metre.
+/// force and moment divided by its tributary length: the traction it stands for, per metre; with
+/// `arm_x_m`, the moment's arm (half the thickness) taken at that x rather than at the pair's.
 std::pair<double, double> contact_load(const System& system, const std::vector<PairRecord>& pairs, int l, int j,
-                                       const std::vector<double>* per_length = nullptr) {
+                                       const std::vector<double>* per_length = nullptr, const double* arm_x_m = nullptr) {
     double fx = 0.0, m = 0.0;
     const auto& leaves = system.model().spec().leaves;
     for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -31,12 +32,13 @@ std::pair<double, double> contact_load(const System& system, const std::vector<P
             if (!(length > 0.0)) continue;
             p_t /= length;
         }
+        const double arm = 0.5 * leaf_thickness_m(leaves[l], arm_x_m != nullptr ? *arm_x_m : cp.x_m);
         if (cp.interface_index == l) {
             fx += p_t;
-            m += 0.5 * leaf_thickness_m(leaves[l], cp.x_m) * p_t;
+            m += arm * p_t;
         } else if (cp.interface_index + 1 == l) {
             fx -= p_t;
-            m += 0.5 * leaf_thickness_m(leaves[l], cp.x_m) * p_t;
+            m += arm * p_t;
         }
     }
     return {fx, m};
@@ -138,19 +140,21 @@ void leaf_resultants(const System& system, const Eigen::VectorXd& u, const Nodal
     // (O(h): 5 % of the peak at 20 elements on two bonded leaves). Each half's traction is taken as
     // the neighbouring pair's per metre (its force over its tributary length) over the half element:
     // from the left N(x_s) = N_L - F_L, from the right N(x_s) = N_R + F_R; the value is their mean (M
-    // with the pairs' moments likewise). The half model's seat is the mirror: N_R = N_L, F_R = -F_L.
+    // with the pairs' moments likewise, their arms the leaves' half thicknesses at the seat, where
+    // the axes are stacked and touch: the correction adds no couple to the section, whose sums stay
+    // those of its two sides). The half model's seat is the mirror: N_R = N_L, F_R = -F_L.
     const int seat = model.attachment_node();
     const bool half = model.spec().symmetry == Symmetry::half;
     const auto& tied = model.tied_leaves();
     if (seat > first && (seat < last || (half && seat == last)) && std::find(tied.begin(), tied.end(), l) != tied.end()) {
         const std::size_t i = static_cast<std::size_t>(seat - first);
         const double h_left = xs[seat] - xs[seat - 1];
-        const auto [q_left, qm_left] = contact_load(system, pairs, l, seat - 1, &trib);
+        const auto [q_left, qm_left] = contact_load(system, pairs, l, seat - 1, &trib, &xs[seat]);
         N[i] -= 0.5 * h_left * q_left;
         M[i] -= 0.5 * h_left * qm_left;
         if (seat < last) {
             const double h_right = xs[seat + 1] - xs[seat];
-            const auto [q_right, qm_right] = contact_load(system, pairs, l, seat + 1, &trib);
+            const auto [q_right, qm_right] = contact_load(system, pairs, l, seat + 1, &trib, &xs[seat]);
             N[i] += 0.5 * h_right * q_right;
             M[i] += 0.5 * h_right * qm_right;
         }
