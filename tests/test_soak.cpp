@@ -285,10 +285,11 @@ const KnownFailure kKnownFailures[] = {
     {8, "cvode-massive"}, {14, "cvode-massive"}, {17, "cvode-massive"}, {18, "cvode-massive"},
     {23, "cvode-massive"}, {25, "cvode-massive"}, {27, "cvode-massive"}, {28, "cvode-massive"},
     {31, "cvode-massive"}, {36, "cvode-massive"},
-    // newmark: a fixed balance offset built up while the pairs start slipping (13, 20, 31), as on
-    // graduated_elastic.toml; the contact solve ending at 4x / 1.7x its tolerance (15).
-    {13, "newmark-massless"}, {13, "newmark-massive"}, {15, "newmark-massless"}, {15, "newmark-massive"},
-    {20, "newmark-massless"}, {20, "newmark-massive"}, {31, "newmark-massive"},
+    // newmark: with leaf mass a balance error 2-40x over the round-off bound (20: 1.3e-9 S; 31,
+    // rig and elastic bonded interface: 2.6e-8 S, a drift that follows the stroke); the contact
+    // solve ending at 4x / 1.7x its tolerance (15). (13, 20 massless and graduated_elastic were
+    // round-off of a fine mesh's quadratic forms: decision 065.)
+    {15, "newmark-massless"}, {15, "newmark-massive"}, {20, "newmark-massive"}, {31, "newmark-massive"},
     // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick).
     {29, "cvode-modal"},
 };
@@ -299,7 +300,6 @@ struct KnownScenarioFailure {
 };
 const KnownScenarioFailure kKnownScenarioFailures[] = {
     {"base_steel_elastic.toml", "cvode-massive"},    // the step limit at t = 0.97 ms
-    {"graduated_elastic.toml", "newmark-massless"},  // the balance offset of seeds 13, 20, 31
 };
 bool known_failure(unsigned seed, const char* row) {
     for (const KnownFailure& k : kKnownFailures)
@@ -386,7 +386,8 @@ std::vector<std::string> scenario_files() {
     return files;
 }
 
-void soak_scenario(const std::string& file) {
+/// `only_row`: that row alone, a known failure included (as soak_seed).
+void soak_scenario(const std::string& file, const std::string& only_row = "") {
     const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/" + file);
     const System system(Model::build(sc.model));
     const double k = system.tied_stiffness_n_per_m(), m = sc.model.rigid_body.mass_kg;
@@ -404,7 +405,8 @@ void soak_scenario(const std::string& file) {
         }
         if (!takes(row, system, o)) continue;
         ++runs;
-        const bool known = std::any_of(std::begin(kKnownScenarioFailures), std::end(kKnownScenarioFailures),
+        if (!only_row.empty() && only_row != row.name) continue;
+        const bool known = only_row.empty() && std::any_of(std::begin(kKnownScenarioFailures), std::end(kKnownScenarioFailures),
                                        [&](const KnownScenarioFailure& k) { return file == k.file && std::string(row.name) == k.row; });
         if (known) {
             BOOST_TEST_MESSAGE(file << ", " << row.name << ": skipped, a known failure (kKnownScenarioFailures)");
@@ -462,3 +464,22 @@ BOOST_AUTO_TEST_CASE(seed_1_cvode_massive_chatter_is_named) {
 // balance error 0.088 S (0.48 J of 5.5 J). It now stops at every point of the table
 // (cross_loading_break): 9.8e-7 S measured against the bound 4 N rtol S = 6.7e-5 S.
 BOOST_AUTO_TEST_CASE(seed_5_cvode_modal_one_leaf_base_table) { soak_seed(5, "cvode-modal"); }
+
+// One seed or scenario under one stepper, the known failures included (disabled: run by hand),
+//     test_soak --run_test=one_run --log_level=message -- --seed 13 --row newmark-massless
+//     test_soak --run_test=one_run --log_level=message -- --scenario graduated_elastic.toml --row newmark-massless
+BOOST_AUTO_TEST_CASE(one_run, *boost::unit_test::disabled()) {
+    const auto& suite = boost::unit_test::framework::master_test_suite();
+    std::string row, scenario;
+    long seed = -1;
+    for (int i = 1; i + 1 < suite.argc; i += 2) {
+        const std::string key = suite.argv[i], value = suite.argv[i + 1];
+        if (key == "--seed") seed = std::stol(value);
+        else if (key == "--row") row = value;
+        else if (key == "--scenario") scenario = value;
+    }
+    BOOST_TEST_REQUIRE((seed >= 0) != !scenario.empty(), "give --seed N or --scenario FILE, and --row NAME");
+    if (seed >= 0) soak_seed(static_cast<unsigned>(seed), row);
+    else soak_scenario(scenario, row);
+}
+
