@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "model/mesh_note.hpp"
@@ -205,13 +206,28 @@ void EventDriver::decide_initial_modes(const InitialState& stage, const EventSta
     const Vec& y0 = s.y0;
     Vec p = stage.p;
     if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
-        ev_problem_.q = ev_->motion(y0) - d_;
+        const Vec motion = ev_->motion(y0);
+        ev_problem_.q = motion - d_;
         const SolveResult r0 = ev_solver_->solve(ev_problem_, p);
-        if (!r0.converged) throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
+        // a residual within the problem's round-off is what its numbers resolve (round_off_m)
+        if (!r0.converged && !(r0.residual_m <= round_off_m(motion, d_)))
+            throw SolverError("initial contact state: " + r0.message, 0, 0.0, r0.residual_m);
     }
     modes_from_solution(chk_problem_, p, 1e-12 * scales_.F_ref_n, modes_.nmode, modes_.tmode);
     if (s.resolve_initial_forces) rebuild();
     decide_modes(0.0, y0, p, "start");
+}
+
+double EventDriver::round_off_m(const Vec& motion, const Vec& d) const {
+    // The event problem s = W p + (G z - d) is built from relative positions of the size of the
+    // stack's deflection (1e-2 m); each is rounded to eps |G z|, so its natural-map residual
+    // cannot be resolved below ~eps sqrt(m) max(|G z|, |d|): measured 3-27 times that on soak
+    // seeds 14, 18 and 25 (cvode-massive), whose tolerance 1e-9 F_ref max(c_L) (a stiff layer,
+    // a small reference force) was 3.7e-17 to 4.4e-16 m, under the round-off.
+    constexpr double kRoundOff = 100.0;
+    if (motion.size() == 0) return 0.0;
+    const double scale = std::max(motion.lpNorm<Eigen::Infinity>(), d.lpNorm<Eigen::Infinity>());
+    return kRoundOff * std::numeric_limits<double>::epsilon() * std::sqrt(static_cast<double>(motion.size())) * scale;
 }
 
 StepRecord EventDriver::record_at(double tau, const State& y, Vec& p, Vec& rel) {
@@ -341,7 +357,8 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         const auto& cp = pairs()[kk];
         if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
     }
-    ev_problem_.q = ev_->motion(y_la) - d_la;
+    const Vec motion_la = ev_->motion(y_la);
+    ev_problem_.q = motion_la - d_la;
 
     std::vector<signed char> nm, tm;
     bool decided = false;
@@ -369,7 +386,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         stats_.contact_time_s += seconds_since(t_solve);
         stats_.contact_iterations += res.iterations;
         iters_since_ += res.iterations;
-        if (!res.converged)
+        if (!res.converged && !(res.residual_m <= round_off_m(motion_la, d_la)))
             throw SolverError(who_ + ": the contact iteration " + where + " at t = " + format_value(t_) + " s (" + cause +
                                   ") did not converge: " + res.message + mesh_note(sys_.model()),
                               stats_.steps, t_, res.residual_m);

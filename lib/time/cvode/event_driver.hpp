@@ -325,6 +325,10 @@ private:
     void init_grid();
     void init_slots();
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
+    /// The round-off of the event problem's numbers [m]: its relative positions `motion` = G z
+    /// and anchors `d` [m]. An event solve that stops above its tolerance but within this has
+    /// reached what the problem's own numbers resolve, and its answer is taken.
+    double round_off_m(const Vec& motion, const Vec& d) const;
     void start_cvode(const EventStart& s);
     void decide_initial_modes(const InitialState& stage, const EventStart& s);
     void rebuild();
