@@ -279,9 +279,10 @@ const KnownFailure kKnownFailures[] = {
     {1, "cvode-massive"},
     // Open (issue 41; docs/decisions/062-soak-fixes.md lists each with its message). Each run is
     // skipped here so that the tier guards every other seed and stepper; remove a line when fixed.
-    // The whole massive stack (cvode-massive): the same chatter, named (seeds 8, 17, 23; and 14, 25
-    // since their event solves are taken within the problem's round-off, decision 065); the step
-    // limit without a named chatter (27, 28, 31; and 18, 36, past their event solves now).
+    // The whole massive stack (cvode-massive): the same chatter, named (seeds 8, 17, 23; 14, 25
+    // since their event solves are taken within the problem's round-off; 18, 28, 36 since the
+    // chatter window is a hundredth of the period: decision 065); the step limit, its message
+    // saying what the steps went into (27, 31: the layer's vibrations resolved, 1.5e-7 s a step).
     {8, "cvode-massive"}, {14, "cvode-massive"}, {17, "cvode-massive"}, {18, "cvode-massive"},
     {23, "cvode-massive"}, {25, "cvode-massive"}, {27, "cvode-massive"}, {28, "cvode-massive"},
     {31, "cvode-massive"}, {36, "cvode-massive"},
@@ -290,7 +291,8 @@ const KnownFailure kKnownFailures[] = {
     // eps |K_eff| |z| (3e-5 N on 31), whose work leaves 1.3e-9 S (20) and 2.6e-8 S over the
     // stroke (31, a rig) in the balance (decision 065).
     {20, "newmark-massive"}, {31, "newmark-massive"},
-    // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick).
+    // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick;
+    // traced to a clamp re-engaging at its preload, decision 065).
     {29, "cvode-modal"},
 };
 /// The bundled scenarios' known failures at 20x (as kKnownFailures).
@@ -299,7 +301,7 @@ struct KnownScenarioFailure {
     const char* row;
 };
 const KnownScenarioFailure kKnownScenarioFailures[] = {
-    {"base_steel_elastic.toml", "cvode-massive"},    // the step limit at t = 0.97 ms
+    {"base_steel_elastic.toml", "cvode-massive"},    // the step limit (diagnosed, decision 065)
 };
 bool known_failure(unsigned seed, const char* row) {
     for (const KnownFailure& k : kKnownFailures)

@@ -578,11 +578,44 @@ void EventDriver::note_pair_switch(int kk, double te) {
     const ContactEvent& e = events_.back();
     throw SolverError(who_ + ": pair " + std::to_string(kk) + " (interface " + std::to_string(e.interface_index) +
                           ", x = " + format_value(e.x_m) + " m) changed modes " + std::to_string(kMaxPairSwitches) +
-                          " times within " + format_value(te - times.front()) + " s (a thousandth of the stack's period is " +
+                          " times within " + format_value(te - times.front()) + " s (a hundredth of the stack's period is " +
                           format_value(window) + " s) up to t = " + format_value(te) + " s, the last " + e.from + " -> " +
                           e.to + ": the contact chatters (a contact point vibrating on the elastic layer, each switch a "
                           "restart); leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
                       stats_.steps, te, 0.0);
+}
+
+std::string EventDriver::step_limit_diagnostics() const {
+    // What the steps went into: their mean size against the stack's period, the last one, the
+    // events and the pairs that changed modes most among the last kDiagnosedEvents of them.
+    constexpr std::size_t kDiagnosedEvents = 200;
+    constexpr double kTwoPi = 6.283185307179586;
+    const long steps = std::max(1L, cvode_->counters().steps);
+    std::string d = " (mean step " + format_value(t_ / static_cast<double>(steps)) + " s, the last " +
+                    format_value(cvode_->last_step()) + " s, the stack's period " +
+                    format_value(kTwoPi / scales_.omega_rad_per_s) + " s; " + std::to_string(stats_.events) + " events, " +
+                    std::to_string(stats_.missed_events) + " missed";
+    if (!events_.empty()) {
+        const std::size_t first = events_.size() > kDiagnosedEvents ? events_.size() - kDiagnosedEvents : 0;
+        std::vector<int> count(static_cast<std::size_t>(np_), 0);
+        for (std::size_t i = first; i < events_.size(); ++i) ++count[static_cast<std::size_t>(events_[i].pair)];
+        std::vector<int> order(static_cast<std::size_t>(np_));
+        for (int kk = 0; kk < np_; ++kk) order[static_cast<std::size_t>(kk)] = kk;
+        std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return count[a] > count[b]; });
+        d += "; of the last " + std::to_string(events_.size() - first) + " transitions (since t = " +
+             format_value(events_[first].t_s) + " s)";
+        for (std::size_t i = 0; i < std::min<std::size_t>(3, order.size()) && count[order[i]] > 0; ++i) {
+            const PairSpec& spec = sys_.pair_spec(order[i]);
+            d += std::string(i == 0 ? ": " : ", ") + "pair " + std::to_string(order[i]) + " (interface " +
+                 std::to_string(spec.interface_index) + ", x = " + format_value(spec.x_m) + " m) " +
+                 std::to_string(count[order[i]]);
+        }
+    }
+    d += ")";
+    if (pair_chatter_limit_)  // the massive stack: its layer's vibrations are what takes the steps
+        d += ": the whole massive stack follows its elastic layer's own vibrations; leaf_inertia = modal (a "
+             "massless contact layer) or mode newmark follow such a stack at the stack's time scale";
+    return d;
 }
 
 /// The per-step check of an accepted step at state y; true when the modes hold there.
@@ -625,7 +658,13 @@ bool EventDriver::step_once() {
     // is not held to a tiny first step; without events (one start, no restart) the first output,
     // the horizon an output-to-output loop gives it (the held stepper's figures were made so).
     const double tout = ev_ ? t_final_ : output_time(out_index_ + 1);
-    const int flag = cvode_->advance(tout, CV_ONE_STEP, opt_.cvode.max_steps, tret);
+    int flag = 0;
+    try {
+        flag = cvode_->advance(tout, CV_ONE_STEP, opt_.cvode.max_steps, tret);
+    } catch (const SolverError& e) {
+        if (cvode_->counters().steps <= opt_.cvode.max_steps) throw;
+        throw SolverError(e.what() + step_limit_diagnostics(), e.step(), e.time_s(), e.residual());
+    }
     stats_.cvode_time_s += seconds_since(t_cv);
     const CvodeCounters& cc = cvode_->counters();
     stats_.steps = cc.steps;
