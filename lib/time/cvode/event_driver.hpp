@@ -325,6 +325,13 @@ private:
     void init_grid();
     void init_slots();
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
+    /// The round-off of the event problem's numbers [m]: its relative positions `motion` = G z
+    /// and anchors `d` [m]. An event solve that stops above its tolerance but within this has
+    /// reached what the problem's own numbers resolve, and its answer is taken.
+    double round_off_m(const Vec& motion, const Vec& d) const;
+    /// Appended to the step limit's SolverError: the mean and last step against the stack's
+    /// period, the events, and the pairs that changed modes most lately.
+    std::string step_limit_diagnostics() const;
     void start_cvode(const EventStart& s);
     void decide_initial_modes(const InitialState& stage, const EventStart& s);
     void rebuild();
