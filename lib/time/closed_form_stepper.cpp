@@ -257,8 +257,8 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16), in the
-    // operator's form; K, G constant over the run. The displacements (where the operator gives
-    // them) are z, or z_r with R's w_next (the rig).
+    // operator's form; K, G constant over the run. The operator's displacements are z, or z_r
+    // with R's w_next (the rig), read when asked (displacements_now).
     step_problem_.u[0] = w_next;
     step_problem_.d = d_;
     step_problem_.tau_previous_n = problem_.tau_previous_n;
