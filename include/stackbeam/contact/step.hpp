@@ -103,7 +103,7 @@ public:
     ContactOperator(const ContactOperator&) = delete;
     ContactOperator& operator=(const ContactOperator&) = delete;
 
-    /// The form taken (dense or sparse; never automatic): for reports, not for branching on.
+    /// The form taken (dense or sparse; never automatic): outside the contact layer for reports, not for branching on.
     ContactPath path() const noexcept { return path_; }
     int rows() const noexcept { return rows_; }
 
