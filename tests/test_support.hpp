@@ -190,7 +190,7 @@ inline std::vector<SparseContactProblem> sparse_step_problems(const ModelSpec& s
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < steps; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     return problems;
 }

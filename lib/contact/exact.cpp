@@ -198,12 +198,7 @@ private:
 }  // namespace
 
 std::unique_ptr<ContactSolver> make_exact_solver(const SolverOptions& o) {
-    if (o.tresca_anderson_depth < 0 || o.tresca_anderson_depth > 50)
-        throw InputError("solver.tresca_anderson_depth",
-                         "value " + std::to_string(o.tresca_anderson_depth) + " must be in 0..50 (0: no acceleration)");
-    if (o.max_active_set_iterations < 1)
-        throw InputError("solver.max_active_set_iterations",
-                         "value " + std::to_string(o.max_active_set_iterations) + " must be >= 1");
+    o.validate();
     return std::make_unique<ExactSolver>(o);
 }
 

@@ -31,7 +31,6 @@ struct NewmarkStepper::Impl {
     struct Factor {
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff (its check: positive definite)
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
-        Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
     };
     const System& system_;
     SimulationOptions options_;
@@ -41,16 +40,13 @@ struct NewmarkStepper::Impl {
     Eigen::SparseMatrix<double> gt_f_;    // G^T on the free DOFs
     std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
     std::unique_ptr<StepContactSolver> contact_;
-    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    ContactLaws problem_;        // the pair laws and the previous-step limits
     StepProblem step_problem_;   // the step's problem: u = r / kappa, d
-    bool dense_projection_ = false;  // the impact projection on the dense A = G M^-1 G^T
+    std::unique_ptr<ImpactProjection> projection_;  // the impact law's projection (massive leaves)
     SolveResult solve_;
     Eigen::VectorXd z_, v_, a_, p_, d_, rel_;
     std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
     bool massive_leaves_ = false;
-    Eigen::MatrixXd Z_, A_;       // M^-1 G^T and G M^-1 G^T (impact law, massive leaves)
-    std::vector<int> held_;       // the held rows of the last projection
-    Eigen::LDLT<Eigen::MatrixXd> held_factor_;  // and A restricted to them
     double t_ = 0.0;
     double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
     long step_ = 0;
@@ -128,17 +124,10 @@ NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& sta
     }
     initial_accelerations();
     factorise_step();
-    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection, dense
-    // where the step's contact operator is dense (m^2 doubles are affordable there); otherwise
-    // [M G_C^T; G_C 0] is factorised per held set (project_velocities).
-    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    dense_projection_ = op_->path() == ContactPath::dense;
-    if (massive_leaves_ && system_.num_components() > 0 && dense_projection_) {
-        Z_ = G.rows() > 0 ? Eigen::MatrixXd(factor_.mass.solve(Eigen::MatrixXd(G.transpose())))
-                          : Eigen::MatrixXd(G.cols(), 0);  // no contact rows: an empty solve is UB in Eigen
-        const Eigen::MatrixXd A = G * Z_;
-        A_ = 0.5 * (A + A.transpose());
-    }
+    // Impact law: the velocity projection on the held rows, on the form of the step's operator
+    // (ImpactProjection, step.hpp)
+    if (massive_leaves_ && system_.num_components() > 0)
+        projection_ = std::make_unique<ImpactProjection>(M_, factor_.mass, system_.contact_rows(), *op_);
     solve_ = SolveResult{};
     solve_.converged = true;
     fill_record(0, 0);
@@ -303,56 +292,8 @@ double NewmarkStepper::Impl::project_velocities(const Eigen::VectorXd& p0, const
             }
         }
     }
-    if (!dense_projection_) {
-        // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
-        const int n = static_cast<int>(v_.size());
-        if (held != held_) {
-            std::vector<Eigen::Triplet<double>> t;
-            for (int col = 0; col < M_.outerSize(); ++col)
-                for (Eigen::SparseMatrix<double>::InnerIterator it(M_, col); it; ++it)
-                    t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
-            const Eigen::SparseMatrix<double, Eigen::RowMajor> Gr = system_.contact_rows();
-            for (int i = 0; i < nh; ++i)
-                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Gr, held[i]); it; ++it) {
-                    t.emplace_back(n + i, static_cast<int>(it.col()), it.value());
-                    t.emplace_back(static_cast<int>(it.col()), n + i, it.value());
-                }
-            Eigen::SparseMatrix<double> S(n + nh, n + nh);
-            S.setFromTriplets(t.begin(), t.end());
-            S.makeCompressed();
-            factor_.saddle.compute(S);
-            if (factor_.saddle.info() != Eigen::Success)
-                throw SolverError("newmark: the impact projection's matrix is singular at step " + std::to_string(step_),
-                                  step_, step_ * options_.dt_s, 0.0);
-            held_ = held;
-        }
-        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
-        rhs.head(n) = M_ * v_;
-        rhs.tail(nh) = b;
-        const Eigen::VectorXd x = factor_.saddle.solve(rhs);
-        const Eigen::VectorXd dv = v_ - x.head(n);
-        v_ = x.head(n);
-        if (e == 0.0) return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
-        // M dv = G_C^T l: l^T (G_C v + b) = dv^T M (2 v - dv) = dv^T M v + ... (kinetic energy change)
-        const Eigen::VectorXd vold = v_ + dv;
-        return 0.5 * system_.model().whole_spring_factor() * (vold.dot(M_ * vold) - v_.dot(M_ * v_));
-    }
-    const Eigen::VectorXd gv = system_.contact_rows() * v_;
-    if (held != held_) {  // factorise A_hh once per held set
-        Eigen::MatrixXd Ahh(nh, nh);
-        for (int i = 0; i < nh; ++i)
-            for (int k = 0; k < nh; ++k) Ahh(i, k) = A_(held[i], held[k]);
-        held_factor_.compute(Ahh);
-        held_ = held;
-    }
-    Eigen::VectorXd rhs(nh);
-    for (int i = 0; i < nh; ++i) rhs[i] = gv[held[i]];
-    const Eigen::VectorXd l = held_factor_.solve(Eigen::VectorXd(rhs - b));
-    Eigen::VectorXd dv = Eigen::VectorXd::Zero(v_.size());
-    for (int i = 0; i < nh; ++i) dv += Z_.col(held[i]) * l[i];
-    v_ -= dv;
-    // 1/2 l^T (G_C v + b) (= 1/2 dv^T M dv = 1/2 l^T A_hh l when b = 0; dv = M^-1 G_C^T l)
-    return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
+    return projection_->project(held, b, e != 0.0, system_.model().whole_spring_factor(), step_,
+                                step_ * options_.dt_s, v_);
 }
 
 std::vector<PairRecord> NewmarkStepper::Impl::pairs() const {

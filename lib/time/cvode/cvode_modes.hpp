@@ -129,7 +129,7 @@ inline std::string mode_label(const ContactPair& cp, signed char nm, signed char
 
 /// Modes of the contact solution p of `laws` (tau rule current): a unilateral pair with
 /// p_n >= -eps_f [N] is open; a friction force within 1e-9 of its limit slips.
-inline void modes_from_solution(const ContactProblem& laws, const Eigen::VectorXd& p, double eps_f,
+inline void modes_from_solution(const ContactLaws& laws, const Eigen::VectorXd& p, double eps_f,
                                 std::vector<signed char>& nm, std::vector<signed char>& tm) {
     const int np = static_cast<int>(laws.pairs.size());
     nm.assign(np, NONE);

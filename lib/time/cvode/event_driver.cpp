@@ -100,11 +100,17 @@ void EventDriver::init_slots() {
 }
 
 void EventDriver::init_problems(const Eigen::MatrixXd& W, double event_tolerance_m) {
-    chk_problem_.W = W;
+    StepSystem sys;  // the dense form alone: W given, u the motion of the state (q = u - d)
+    sys.rows = n_;
+    sys.dense = [&W] {
+        DenseStepForm f;
+        f.W = W;
+        return f;
+    };
+    chk_problem_.op = std::make_shared<const ContactOperator>(sys, opt_.contact_path, opt_.solver.kind);
     chk_problem_.pairs = sys_.pairs();
     chk_problem_.tau_rule = TauRule::current;
     chk_problem_.tau_previous_n = Vec::Zero(np_);
-    chk_problem_.q = Vec::Zero(n_);  // sized: ModeSet::linearize takes n from it
     ev_problem_ = chk_problem_;
     ev_tolerance_ = event_tolerance_m;
 }
@@ -162,7 +168,7 @@ void EventDriver::cross_loading_break(double, Vec&) {}
 
 void EventDriver::rebuild() {
     ModeLinearization lin;
-    modes_.linearize(chk_problem_, lin);
+    modes_.linearize(chk_problem_, n_, lin);
     ev_->build_mode(lin);
     ++stats_.mode_factorizations;
     ++facts_since_;
@@ -201,13 +207,14 @@ void EventDriver::start(const InitialState& stage, const EventStart& s) {
 
 void EventDriver::decide_initial_modes(const InitialState& stage, const EventStart& s) {
     init_slots();
-    chk_solver_ = make_solver(opt_.solver);
-    ev_solver_ = make_solver(event_solver_options(opt_.solver, ev_tolerance_));
+    chk_solver_ = std::make_unique<StepContactSolver>(opt_.solver);
+    ev_solver_ = std::make_unique<StepContactSolver>(event_solver_options(opt_.solver, ev_tolerance_));
     const Vec& y0 = s.y0;
     Vec p = stage.p;
     if (s.resolve_initial_forces) {  // the event problem at the motion of y0, warm-started at the stage's forces
         const Vec motion = ev_->motion(y0);
-        ev_problem_.q = motion - d_;
+        ev_problem_.u = motion;
+        ev_problem_.d = d_;
         const SolveResult r0 = ev_solver_->solve(ev_problem_, p);
         // a residual within the problem's round-off is what its numbers resolve (round_off_m)
         if (!r0.converged && !(r0.residual_m <= round_off_m(motion, d_)))
@@ -358,7 +365,8 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         if (cp.row_t >= 0 && cp.kind != PairKind::bonded && modes_.tmode[kk] != STICK) d_la[cp.row_t] = rel[cp.row_t];
     }
     const Vec motion_la = ev_->motion(y_la);
-    ev_problem_.q = motion_la - d_la;
+    ev_problem_.u = motion_la;
+    ev_problem_.d = d_la;
 
     std::vector<signed char> nm, tm;
     bool decided = false;
@@ -436,7 +444,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
             });
             decided = true;
             if (!holds) {
-                ev_problem_.q = ev_->motion(y) - d_la;  // the anchors of the look-ahead's problem, at y
+                ev_problem_.u = ev_->motion(y);  // the anchors of the look-ahead's problem, at y
                 decide_by_solving("at the state");
                 decided = false;
                 ++stats_.settled_transitions;
@@ -491,7 +499,8 @@ bool EventDriver::modes_hold(const State& y, double& residual, bool* witnesses_o
     residual = 0.0;
     if (n_ > 0) {
         const Vec p = ev_->forces(y);
-        chk_problem_.q = ev_->motion(y) - d_chk_;
+        chk_problem_.u = ev_->motion(y);
+        chk_problem_.d = d_chk_;
         // s = (s + d) - d_chk, affine in the state: no product with the compliance
         residual = error_vector(chk_problem_, p, Vec(ev_->relative(y) - d_chk_)).norm();
     }
@@ -635,7 +644,7 @@ bool EventDriver::step_keeps_modes(const Vec& y) {
     if (!ok && witnesses_ok && n_ > 0) {
         const Vec pm = ev_->forces(y);
         Vec p = pm;
-        const SolveResult res = chk_solver_->solve(chk_problem_, p);  // q was set by modes_hold
+        const SolveResult res = chk_solver_->solve(chk_problem_, p);  // u, d set by modes_hold
         stats_.contact_iterations += res.iterations;
         iters_since_ += res.iterations;
         last_check_residual_ = res.residual_m;
