@@ -242,6 +242,18 @@ stackbeam_cli_test(NAME cli_bad_stresses_is_out
                    ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stresses_bad.csv
                         --stresses ${_cli_out_dir}/cli_stresses_bad.csv
                    EXPECT_RC 2 EXPECT_TEXT "--stresses: value" OUT ${_cli_out_dir}/cli_stresses_bad.csv)
+# the scenario's own key (outputs.stresses_path) asks for the same file, no option given; a clash
+# with another output named by its key
+stackbeam_cli_test(NAME cli_scenario_stresses_from_file
+                   ARGS simulate --scenario ${CMAKE_CURRENT_SOURCE_DIR}/cli_stresses_scenario.toml --t-end 0.005 --quiet
+                   EXPECT_RC 0 EXPECT_TEXT "stress leaf 0" OUT ${_cli_out_dir}/cli_stresses_scenario_stresses.csv
+                   HEADER_PREFIX "t,leaf,x,sigma_top,sigma_bottom,axial_force,bending_moment,shear_force"
+                   MIN_LINES 739)
+stackbeam_cli_test(NAME cli_bad_scenario_stresses_is_nodes
+                   ARGS simulate --scenario ${CMAKE_CURRENT_SOURCE_DIR}/cli_stresses_scenario.toml --t-end 0.005
+                        --nodes cli_stresses_scenario_stresses.csv
+                   EXPECT_RC 2 EXPECT_TEXT "outputs.stresses_path (file "
+                   OUT ${_cli_out_dir}/cli_stresses_scenario_stresses.csv)
 stackbeam_cli_test(NAME cli_ok_cvode_inertia_bonded
                    ARGS simulate --case bonded --mode cvode --beam-density 7850 --rtol 1e-6 --t-end 0.01
                         --out ${CMAKE_BINARY_DIR}/cli_cvode_inertia.csv
@@ -338,6 +350,24 @@ stackbeam_cli_test(NAME cli_base_cvode
 stackbeam_cli_test(NAME cli_plot
                    ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
                    EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)
+# --stack-color stress (issue 43 item 5): the deformed stack's leaves coloured by their stress; the
+# data file has both figures' bands (3 leaves x 2 fibres x 41 nodes x 2 figures = 492 rows, the
+# header and blank lines); a word other than state or stress, and the option without --plot, refused
+stackbeam_cli_test(NAME cli_plot_stack_stress
+                   ARGS simulate --case friction --t-end 0.02 --quiet --out ${_cli_out_dir}/cli_plot_stress.csv
+                        --plot ${_cli_out_dir}/cli_plot_stress --stack-color stress
+                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_stress_stack.png" OUT ${_cli_out_dir}/cli_plot_stress_stack_stress.dat
+                   HEADER_PREFIX "# x [mm], y [mm], sigma [MPa]" MIN_LINES 493)
+stackbeam_cli_test(NAME cli_bad_stack_color_word
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stack_color_bad.csv
+                        --plot ${_cli_out_dir}/cli_stack_color_bad --stack-color pressure
+                   EXPECT_RC 2 EXPECT_TEXT "--stack-color: value 'pressure' is not allowed: state or stress"
+                   OUT ${_cli_out_dir}/cli_stack_color_bad.csv)
+stackbeam_cli_test(NAME cli_bad_stack_color_without_plot
+                   ARGS simulate --case friction --t-end 0.005 --out ${_cli_out_dir}/cli_stack_color_noplot.csv
+                        --stack-color stress
+                   EXPECT_RC 2 EXPECT_TEXT "--stack-color: value 'stress' colours the --plot figure"
+                   OUT ${_cli_out_dir}/cli_stack_color_noplot.csv)
 
 # The friction-mesh ratio kappa = mu (t_i + t_i+1) / (2 h) (model.hpp): in the summary
 # (paper example: 0.5 x 5 mm / 12.5 mm = 0.2), and named in the note before the run and in

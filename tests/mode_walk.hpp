@@ -45,7 +45,7 @@ inline const SparseContactProblem& stack_problem() {
         so.contact_path = ContactPath::sparse;
         ClosedFormStepper st(sys, so);
         for (int i = 0; i < 5; ++i) st.advance();
-        return st.last_sparse_problem();
+        return st.contact_solver().last_sparse_problem();
     }();
     return pr;
 }
@@ -166,7 +166,7 @@ inline const SparseContactProblem& elastic_problem() {
         so.contact_path = ContactPath::sparse;
         ClosedFormStepper st(sys, so);
         for (int i = 0; i < 5; ++i) st.advance();
-        const SparseContactProblem& flat = st.last_sparse_problem();
+        const SparseContactProblem& flat = st.contact_solver().last_sparse_problem();
         SparseContactProblem layered = flat;
         if (!sp::layer_structure(flat, layered)) throw std::logic_error("no layer rows");
         layered.b.head(flat.b.size()) = flat.b;

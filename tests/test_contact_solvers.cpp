@@ -216,7 +216,7 @@ BOOST_AUTO_TEST_CASE(solvers_agree_on_recorded_steps_of_the_paper_example) {
             st.advance();
             if (step != record_at[k]) continue;
             ++k;
-            const ContactProblem pr = st.last_problem();
+            const ContactProblem pr = st.contact_solver().last_dense_problem();
             Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(pr.W);
             const double force_tol = 1e-11 / es.eigenvalues().minCoeff();
             for (SolverKind kind : {SolverKind::block_jacobi, SolverKind::accelerated, SolverKind::exact}) {

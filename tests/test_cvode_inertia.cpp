@@ -17,8 +17,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
-constexpr double kPi = 3.14159265358979323846;
 
 System massive(PaperCase c, double density = kSteel) {
     ModelSpec spec = paper_example(c, {});

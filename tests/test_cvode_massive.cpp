@@ -24,7 +24,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
 constexpr double kClamp = 0.01;    // clamp length [m]: an elastic layer over the clamp, as test_elastic_interface
 
 /// The paper's friction case at 10 elements per half leaf (25 mm: the 2 ms runs below stay

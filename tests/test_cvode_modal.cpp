@@ -16,7 +16,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
 
 System friction_stack(double density) {
     ModelSpec spec = paper_example(PaperCase::friction, {});

@@ -31,7 +31,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 System stack(PaperCase c, double w0 = 0.0) { return System(Model::build(steel_elastic_stack(c, w0))); }
 

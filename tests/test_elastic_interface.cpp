@@ -14,7 +14,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
 constexpr double kClamp = 0.01;    // clamp length [m]
 
 // The paper example's case c (20 elements per half leaf) with every interface elastic, the layer

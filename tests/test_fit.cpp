@@ -197,35 +197,45 @@ BOOST_AUTO_TEST_CASE(preload_on_a_frictionless_loop_is_not_identifiable) {
 
 // A graduated spring with elastic interfaces (k_t = 2e8 Pa/m, mu = 0.4), two loops (20 mm
 // and 4 mm strokes), 1 % noise: mu and k_t fitted back from 50 % off (0.6 and 3e8), mu
-// within 2 %, k_t within 5 %, loop area within 1 %. k_t shapes the stick phase after each
-// reversal, a small part of the 20 mm loop (alone, 100 samples of 1 % noise pin k_t to
-// ~7 %, one standard error) and more of the 4 mm loop; 1000 samples a loop (dt 1 ms) and
-// both loops bring the standard error to ~4 % (measured: 2.095e8 +- 0.079e8, seed 59/60),
-// so the brief's 5 % is about 1.3 standard errors: the margin is thin, the seeds fixed.
-// The fit's own standard error is checked to say so (below 5 %).
+// within 2 %, k_t within 5 %, loop area within 1 %, for every one of six noise seeds.
+// How much data that takes: k_t shapes only the turning zones of the 20 mm loop (the 4 mm
+// and smaller loops add almost nothing: below 2 mm the spring sticks whole and its rate
+// hardly depends on k_t), so k_t's standard error falls only as 1/sqrt(samples). Measured over
+// 12 seeds: 1000 samples a loop (a 1 kHz rig) give 3.9 % (errors up to 7.6 %: 5 % is 1.3
+// standard errors, 3 of 12 seeds fail), 4000 give 1.95 % (up to 3.5 %), 10,000 (a 10 kHz rig)
+// 1.24 % (up to 2.9 %): the brief's 5 % is then 4 standard errors. So the "measured" loops are
+// sampled at 10 kHz (dt 0.1 ms) while the model runs at dt 1 ms, its loop interpolated at the
+// measured w: without noise that fits k_t back within 0.07 % (the friction path's
+// dependence on the step), mu within 3e-6: well inside both bounds. The fit's own standard
+// error must say so (below 2.5 %, twice the measured 1.24 %).
 BOOST_AUTO_TEST_CASE(graduated_elastic_round_trip, *boost::unit_test::label("slow")) {
     const std::string scenario = graduated_rig();
     const std::string amplitude = "loading.displacement_m.amplitude";
-    const Made big = make_loop(scenario, {}, 0.01, 59);
-    const Made small = make_loop(scenario, {{amplitude, 0.004}}, 0.01, 60);
-    FitSpec spec = spec_of(scenario, big.csv, {{kMu, 0.1, 1.0, 0.6, ""}, {kKt, 5e7, 1e9, 3e8, ""}});
-    MeasuredLoop loop;
-    loop.name = "small";
-    loop.displacement_column = "w_m";
-    loop.force_column = "force_n";
-    loop.settings.emplace_back(amplitude, 0.004);
-    read_loop_csv(small.csv, loop, 0.05, "loops[1]");
-    spec.loops.push_back(loop);
-    const FitResult r = fit(spec, FitOptions{2, nullptr, {}, {}});
-    BOOST_TEST_MESSAGE("mu " << r.parameters[0].value << " +- " << r.parameters[0].standard_error << ", k_t "
-                             << r.parameters[1].value << " +- " << r.parameters[1].standard_error << ", " << r.runs
-                             << " runs: " << r.termination);
-    BOOST_TEST(std::abs(r.parameters[0].value - 0.4) < 0.02 * 0.4);
-    BOOST_TEST(std::abs(r.parameters[1].value - 2e8) < 0.05 * 2e8);
-    BOOST_TEST(std::abs(r.loops[0].fitted_area_j - big.area_j) < 0.01 * big.area_j);
-    BOOST_TEST(std::abs(r.loops[1].fitted_area_j - small.area_j) < 0.01 * small.area_j);
-    BOOST_TEST(r.parameters[1].identifiable);
-    BOOST_TEST(r.parameters[1].standard_error < 0.05 * 2e8);
+    const std::pair<std::string, double> rig_10_khz{"integrator.dt_s", 1e-4};
+    for (const unsigned seed : {59u, 100u, 200u, 300u, 400u, 500u}) {
+        BOOST_TEST_CONTEXT("noise seed " << seed) {
+            const Made big = make_loop(scenario, {rig_10_khz}, 0.01, seed);
+            const Made small = make_loop(scenario, {{amplitude, 0.004}, rig_10_khz}, 0.01, seed + 1);
+            FitSpec spec = spec_of(scenario, big.csv, {{kMu, 0.1, 1.0, 0.6, ""}, {kKt, 5e7, 1e9, 3e8, ""}});
+            MeasuredLoop loop;
+            loop.name = "small";
+            loop.displacement_column = "w_m";
+            loop.force_column = "force_n";
+            loop.settings.emplace_back(amplitude, 0.004);
+            read_loop_csv(small.csv, loop, 0.05, "loops[1]");
+            spec.loops.push_back(loop);
+            const FitResult r = fit(spec, FitOptions{2, nullptr, {}, {}});
+            BOOST_TEST_MESSAGE("seed " << seed << ": mu " << r.parameters[0].value << " +- " << r.parameters[0].standard_error
+                                       << ", k_t " << r.parameters[1].value << " +- " << r.parameters[1].standard_error << ", "
+                                       << r.runs << " runs: " << r.termination);
+            BOOST_TEST(std::abs(r.parameters[0].value - 0.4) < 0.02 * 0.4);
+            BOOST_TEST(std::abs(r.parameters[1].value - 2e8) < 0.05 * 2e8);
+            BOOST_TEST(std::abs(r.loops[0].fitted_area_j - big.area_j) < 0.01 * big.area_j);
+            BOOST_TEST(std::abs(r.loops[1].fitted_area_j - small.area_j) < 0.01 * small.area_j);
+            BOOST_TEST(r.parameters[1].identifiable);
+            BOOST_TEST(r.parameters[1].standard_error < 0.025 * 2e8);
+        }
+    }
 }
 
 BOOST_AUTO_TEST_CASE(bad_input_is_named) {

@@ -34,8 +34,6 @@ using namespace stackbeam;
 using namespace stackbeam::testing;
 
 namespace {
-constexpr double kSteel = 7850.0;  // [kg/m^3]
-constexpr double kPi = 3.14159265358979323846;
 
 /// The paper's bonded (or frictionless) stack of 3 leaves at 10 elements per half leaf, steel
 /// density, elastic interfaces (derived layer), 10 mm clamps (an elastic layer over them).

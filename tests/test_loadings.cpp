@@ -20,7 +20,7 @@ using namespace stackbeam::testing;
 
 namespace {
 
-constexpr double kMass = 20.0, kG = 9.81, kPi = 3.14159265358979323846;
+constexpr double kMass = 20.0, kG = 9.81;
 
 System paper_system(PaperCase c, double v0 = 0.0) {
     PaperExampleOptions o;

@@ -90,11 +90,13 @@ BOOST_AUTO_TEST_CASE(built_model_with_every_table_round_trips) {
     s.simulation.cvode.rtol = 1e-9;
     s.outputs.pairs_path = "pairs.csv";
     s.outputs.nodes_path = "nodes.csv";
+    s.outputs.stresses_path = "stresses.csv";
     const std::string text = to_toml(s);
     const Scenario back = parse_scenario(text, "built");
     BOOST_TEST(to_toml(back) == text);
     BOOST_TEST(back.description == s.description);
     BOOST_TEST(back.outputs.nodes_path == "nodes.csv");
+    BOOST_TEST(back.outputs.stresses_path == "stresses.csv");
     BOOST_TEST(back.simulation.loading.force_n.values[2] == 1.0 / 3.0);  // shortest round trip, exact
     BOOST_TEST(back.model.leaves[0].profile.width_m[1] == 0.05);
     BOOST_TEST(back.model.clips.at(0).stiffness_n_per_m == 2e8);

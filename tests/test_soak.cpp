@@ -279,17 +279,20 @@ const KnownFailure kKnownFailures[] = {
     {1, "cvode-massive"},
     // Open (issue 41; docs/decisions/062-soak-fixes.md lists each with its message). Each run is
     // skipped here so that the tier guards every other seed and stepper; remove a line when fixed.
-    // The whole massive stack (cvode-massive): the same chatter, named (seeds 8, 17, 23); the step
-    // limit without a named chatter (27, 28, 31); the initial contact solve or an event's decision
-    // ending 1.01-3x above a tolerance of ~1e-16 m (14, 18, 25, 36).
+    // The whole massive stack (cvode-massive): the same chatter, named (seeds 8, 17, 23; 14, 25
+    // since their event solves are taken within the problem's round-off; 18, 28, 36 since the
+    // chatter window is a hundredth of the period: decision 065); the step limit, its message
+    // saying what the steps went into (27, 31: the layer's vibrations resolved, 1.5e-7 s a step).
     {8, "cvode-massive"}, {14, "cvode-massive"}, {17, "cvode-massive"}, {18, "cvode-massive"},
     {23, "cvode-massive"}, {25, "cvode-massive"}, {27, "cvode-massive"}, {28, "cvode-massive"},
     {31, "cvode-massive"}, {36, "cvode-massive"},
-    // newmark: a fixed balance offset built up while the pairs start slipping (13, 20, 31), as on
-    // graduated_elastic.toml; the contact solve ending at 4x / 1.7x its tolerance (15).
-    {13, "newmark-massless"}, {13, "newmark-massive"}, {15, "newmark-massless"}, {15, "newmark-massive"},
-    {20, "newmark-massless"}, {20, "newmark-massive"}, {31, "newmark-massive"},
-    // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick).
+    // newmark with leaf mass, a mesh with a short element (two clamps 1.2 / 0.35 mm apart make an
+    // element of 12 EI / l^3 = 1e11 / 3e14 N/m): z in double meets the step's equations to
+    // eps |K_eff| |z| (3e-5 N on 31), whose work leaves 1.3e-9 S (20) and 2.6e-8 S over the
+    // stroke (31, a rig) in the balance (decision 065).
+    {20, "newmark-massive"}, {31, "newmark-massive"},
+    // the modal stepper: more than 200 events within 1e-10 s at t = 0.1619 s (a slip- -> stick;
+    // traced to a clamp re-engaging at its preload, decision 065).
     {29, "cvode-modal"},
 };
 /// The bundled scenarios' known failures at 20x (as kKnownFailures).
@@ -298,8 +301,7 @@ struct KnownScenarioFailure {
     const char* row;
 };
 const KnownScenarioFailure kKnownScenarioFailures[] = {
-    {"base_steel_elastic.toml", "cvode-massive"},    // the step limit at t = 0.97 ms
-    {"graduated_elastic.toml", "newmark-massless"},  // the balance offset of seeds 13, 20, 31
+    {"base_steel_elastic.toml", "cvode-massive"},    // the step limit (diagnosed, decision 065)
 };
 bool known_failure(unsigned seed, const char* row) {
     for (const KnownFailure& k : kKnownFailures)
@@ -386,7 +388,8 @@ std::vector<std::string> scenario_files() {
     return files;
 }
 
-void soak_scenario(const std::string& file) {
+/// `only_row`: that row alone, a known failure included (as soak_seed).
+void soak_scenario(const std::string& file, const std::string& only_row = "") {
     const Scenario sc = load_scenario(std::string(STACKBEAM_SOURCE_DIR) + "/scenarios/" + file);
     const System system(Model::build(sc.model));
     const double k = system.tied_stiffness_n_per_m(), m = sc.model.rigid_body.mass_kg;
@@ -404,7 +407,8 @@ void soak_scenario(const std::string& file) {
         }
         if (!takes(row, system, o)) continue;
         ++runs;
-        const bool known = std::any_of(std::begin(kKnownScenarioFailures), std::end(kKnownScenarioFailures),
+        if (!only_row.empty() && only_row != row.name) continue;
+        const bool known = only_row.empty() && std::any_of(std::begin(kKnownScenarioFailures), std::end(kKnownScenarioFailures),
                                        [&](const KnownScenarioFailure& k) { return file == k.file && std::string(row.name) == k.row; });
         if (known) {
             BOOST_TEST_MESSAGE(file << ", " << row.name << ": skipped, a known failure (kKnownScenarioFailures)");
@@ -462,3 +466,57 @@ BOOST_AUTO_TEST_CASE(seed_1_cvode_massive_chatter_is_named) {
 // balance error 0.088 S (0.48 J of 5.5 J). It now stops at every point of the table
 // (cross_loading_break): 9.8e-7 S measured against the bound 4 N rtol S = 6.7e-5 S.
 BOOST_AUTO_TEST_CASE(seed_5_cvode_modal_one_leaf_base_table) { soak_seed(5, "cvode-modal"); }
+
+// One seed or scenario under one stepper, the known failures included (disabled: run by hand),
+//     test_soak --run_test=one_run --log_level=message -- --seed 13 --row newmark-massless
+//     test_soak --run_test=one_run --log_level=message -- --scenario graduated_elastic.toml --row newmark-massless
+BOOST_AUTO_TEST_CASE(one_run, *boost::unit_test::disabled()) {
+    const auto& suite = boost::unit_test::framework::master_test_suite();
+    std::string row, scenario;
+    long seed = -1;
+    for (int i = 1; i + 1 < suite.argc; i += 2) {
+        const std::string key = suite.argv[i], value = suite.argv[i + 1];
+        if (key == "--seed") seed = std::stol(value);
+        else if (key == "--row") row = value;
+        else if (key == "--scenario") scenario = value;
+    }
+    BOOST_TEST_REQUIRE((seed >= 0) != !scenario.empty(), "give --seed N or --scenario FILE, and --row NAME");
+    if (seed >= 0) soak_seed(static_cast<unsigned>(seed), row);
+    else soak_scenario(scenario, row);
+}
+
+// Seed 14 (3 leaves, elastic interfaces mu 0.17 and 0.34, clamps of 18 N, base motion, gravity),
+// the whole massive stack: the initial contact state's solve stopped at ||v|| = 1.9e-16 m above
+// its tolerance 1e-9 F_ref max(c_L) = 3.7e-17 m, below the round-off of the problem's relative
+// positions (max |G z| = 0.041 m: eps sqrt(m) |G z| = 5.4e-17 m, 36 rows). An event solve within
+// 100 times that is taken (EventDriver::round_off_m, decision 065); the run then goes on to the
+// massive stack's named chatter (as seed 1) after 665 steps.
+BOOST_AUTO_TEST_CASE(seed_14_cvode_massive_initial_solve_within_round_off) {
+    soak_seed(14, "cvode-massive", "the contact chatters");
+}
+// A run that reaches cvode.max_steps says what the steps went into (decision 065): seed 1's
+// massive stack stopped at 3,000 steps (t = 81 us), well before its chatter is named: the message
+// gives the mean step (2.7e-8 s) and the last against the stack's period (0.31 s), the events
+// (31) and the pairs that changed modes most (pairs 1, 3 and 6 of interface 0, 9 times each), and
+// the steppers that follow such a stack.
+BOOST_AUTO_TEST_CASE(step_limit_says_what_the_steps_went_into) {
+    const RandomCase c = random_case(1);
+    ModelSpec spec = c.spec;
+    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = 7850.0;
+    const System system(Model::build(spec));
+    SimulationOptions o;
+    o.mode = Mode::cvode;
+    o.cvode.leaf_inertia = LeafInertia::massive;
+    o.loading = c.loading;
+    o.t_end_s = 0.05;
+    o.dt_s = 0.005;
+    o.solver.tolerance_m = 1e-9;
+    o.damping.rayleigh_beta_s = 1e-6;
+    o.cvode.max_steps = 3000;
+    const Soak s = soak_run(system, o);
+    BOOST_TEST_MESSAGE(s.error);
+    BOOST_TEST(!s.completed);
+    for (const char* part : {"more than cvode.max_steps = 3000 steps", "mean step", "the stack's period", "events",
+                             "of the last", "pair 1 (interface 0", "leaf_inertia = modal"})
+        BOOST_TEST(s.error.find(part) != std::string::npos, "\"" << part << "\" in: " << s.error);
+}

@@ -183,11 +183,11 @@ BOOST_AUTO_TEST_CASE(sparse_problem_is_the_dense_problem) {
         sp.advance();
         de.advance();
     }
-    const ContactProblem c = sp.last_sparse_problem().to_dense();
-    const ContactProblem& ref = de.last_problem();
+    const ContactProblem c = sp.contact_solver().last_sparse_problem().to_dense();
+    const ContactProblem& ref = de.contact_solver().last_dense_problem();
     BOOST_TEST((c.W - ref.W).norm() / ref.W.norm() < 1e-9);
     BOOST_TEST((c.q - ref.q).norm() / ref.q.norm() < 1e-9);
-    BOOST_TEST(sp.last_problem().W.size() == 0);  // the sparse stepper holds no dense W
+    BOOST_TEST(sp.contact_solver().last_dense_problem().W.size() == 0);  // the sparse stepper holds no dense W
 }
 
 BOOST_AUTO_TEST_CASE(automatic_choice_and_bad_input) {
@@ -246,7 +246,7 @@ BOOST_AUTO_TEST_CASE(sparse_compliance_diagonal_is_exact) {
         so.contact_path = ContactPath::sparse;
         ClosedFormStepper st(sys, so);
         st.advance();
-        const SparseContactProblem& pr = st.last_sparse_problem();
+        const SparseContactProblem& pr = st.contact_solver().last_sparse_problem();
         SparseContactSolver solver(so.solver);
         Eigen::VectorXd p = Eigen::VectorXd::Zero(pr.size()), z;
         const SolveResult r = solver.solve(pr, p, z);
@@ -324,7 +324,7 @@ BOOST_AUTO_TEST_CASE(sparse_ways_agree_on_replayed_problems) {
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 300; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     const Replay rl = replay_sparse(problems, so.solver, SparsePathTuning{0, 0});
     const Replay rb = replay_sparse(problems, so.solver, SparsePathTuning{0, 150});
@@ -377,7 +377,7 @@ BOOST_AUTO_TEST_CASE(low_rank_updates_agree_with_fresh_factorisations) {
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 400; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     const Replay rf = replay_sparse(problems, so.solver, SparsePathTuning{0, 0});
     const Replay rb = replay_sparse(problems, so.solver, SparsePathTuning{0, 150});
@@ -551,7 +551,7 @@ BOOST_AUTO_TEST_CASE(accelerated_tresca_settles_a_graduated_ten_leaf_stack, *boo
     std::vector<Eigen::VectorXd> reference;
     for (int i = 0; i < 25; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
         reference.push_back(st.contact_forces());
     }
     SparsePathTuning tresca;
@@ -616,7 +616,7 @@ BOOST_AUTO_TEST_CASE(newton_and_tresca_transitions_agree) {
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 20; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     SparsePathMethods tresca;
     tresca.transition = TransitionMethod::tresca;
@@ -664,7 +664,7 @@ BOOST_AUTO_TEST_CASE(transition_method_of_decision_037_keeps_the_answers) {
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < 30; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     const Replay ra = replay_sparse(problems, so.solver);
     const Replay rb = replay_sparse(problems, so.solver, {}, SparsePathMethods::before_037());

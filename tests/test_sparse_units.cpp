@@ -62,7 +62,7 @@ const Recorded& friction_steps() {
         const auto dense = make_solver(so.solver);
         for (int i = 0; i < 300; ++i) {
             st.advance();
-            r.problems.push_back(st.last_sparse_problem());
+            r.problems.push_back(st.contact_solver().last_sparse_problem());
             Eigen::VectorXd p = r.exact.empty() ? Eigen::VectorXd::Zero(r.problems.back().size()) : r.exact.back();
             const SolveResult rd = dense->solve(r.problems.back().to_dense(), p);
             BOOST_TEST_REQUIRE(rd.converged);

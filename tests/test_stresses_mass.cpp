@@ -155,6 +155,59 @@ BOOST_AUTO_TEST_CASE(stack_weight_at_rest_on_the_cvode_steppers) {
     }
 }
 
+// (a'') The seat's per-leaf split where the shear flow between the leaves varies (decision 066): two
+// bonded leaves, pinned at both ends, R at midspan, at rest under their weight on newmark. One beam of
+// twice the thickness: the section's moment M(x) = q x (L - x) / 2 + P min(x, L - x) / 2 (q both
+// leaves' weight per length, P R's weight), each leaf's N = -+ 3 M / (4 t) (top / bottom: the linear
+// stress over 2t integrated over each half), so the shear flow 3 V / (4 t) is linear in x, not constant
+// as under R alone (test_stresses: exact there). The node-to-node bond transmits it at the nodes; the
+// recovery spreads each pair's force over its tributary length, and at the seat, which has no pair,
+// takes each half element's flow as the neighbouring pair's per metre. Measured (elements over the
+// whole leaf): the seat's N against 3 M / (4 t), relative to the seat's N: 1.32e-2, 3.30e-3, 8.25e-4
+// at 10, 20, 40 elements, order 2.00 (the mean of the sides alone, decision 054, left h/2 of the flow
+// out: order 1, 5 % at 20 elements under R alone); the other nodes' worst, the node-to-node bond's
+// own discretisation error, is half of it at every mesh (6.6e-3, 1.65e-3, 4.1e-4). Required: the
+// seat's error falls by at least 3.5 per halving (order >= 1.8), at most 1.5e-2 at 10 elements and
+// at most 2.5 times the other nodes' worst.
+BOOST_AUTO_TEST_CASE(seat_split_converges_at_order_two_where_the_shear_flow_varies) {
+    std::vector<double> seat_errors;
+    for (const int elements : {10, 20, 40}) {
+        ModelSpec spec = testing::single_leaf(kLength, kHeight, kWidth, kE, SupportKind::pinned, SupportKind::pinned, 0.5 * kLength,
+                                              kLength / elements);
+        spec.leaves[0].density_kg_per_m3 = kRho;
+        spec.leaves.push_back(spec.leaves[0]);
+        InterfaceSpec i;
+        i.law = InterfaceLaw::bonded;
+        spec.interfaces = {i};
+        const System system(Model::build(spec));
+        SimulationOptions o;
+        o.mode = Mode::newmark;
+        o.loading.gravity_m_per_s2 = kG;
+        o.dt_s = 1e-3;
+        o.t_end_s = 0.002;
+        const double q = 2.0 * kRho * kWidth * kHeight * kG, P = spec.rigid_body.mass_kg * kG;
+        const auto stepper = make_stepper(system, o);
+        double seat = 0.0, interior = 0.0;
+        run(*stepper, 2, [&](Stepper& st) {
+            const Stresses s = st.stresses();
+            for (std::size_t k = 0; k < s.leaves[0].x_m.size(); ++k) {
+                const double x = s.leaves[0].x_m[k];
+                const double M = q * x * (kLength - x) / 2.0 + P * std::min(x, kLength - x) / 2.0;
+                const double N_ref = 0.75 * (q * kLength * kLength / 8.0 + P * kLength / 4.0) / kHeight;  // at the seat
+                const double e = std::max(std::abs(s.leaves[0].axial_force_n[k] + 0.75 * M / kHeight),
+                                          std::abs(s.leaves[1].axial_force_n[k] - 0.75 * M / kHeight)) / N_ref;
+                double& worst = std::abs(x - 0.5 * kLength) < 1e-9 ? seat : interior;
+                worst = std::max(worst, e);
+            }
+        });
+        BOOST_TEST_MESSAGE(elements << " elements: the seat's N against 3 M / (4 t) " << seat << ", the other nodes' worst " << interior);
+        seat_errors.push_back(seat);
+        BOOST_TEST(seat <= 2.5 * interior);
+    }
+    BOOST_TEST(seat_errors[0] <= 1.5e-2);
+    for (std::size_t k = 1; k < seat_errors.size(); ++k) BOOST_TEST(seat_errors[k - 1] / seat_errors[k] >= 3.5);
+}
+
 namespace {
 
 /// The external axial force and moment (sagging positive, about (x_j, 0); y the leaves' axis heights)

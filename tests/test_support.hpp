@@ -13,6 +13,9 @@
 
 namespace stackbeam::testing {
 
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kSteel = 7850.0;  ///< steel's density [kg/m^3]
+
 inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_s,
                                          Symmetry sym = Symmetry::half, double tol_m = 1e-10,
                                          SolverKind solver = SolverKind::exact) {
@@ -187,7 +190,7 @@ inline std::vector<SparseContactProblem> sparse_step_problems(const ModelSpec& s
     std::vector<SparseContactProblem> problems;
     for (int i = 0; i < steps; ++i) {
         st.advance();
-        problems.push_back(st.last_sparse_problem());
+        problems.push_back(st.contact_solver().last_sparse_problem());
     }
     return problems;
 }

@@ -264,3 +264,93 @@ BOOST_AUTO_TEST_CASE(bad_inputs_named) {
                       "'[99999999999999999999]' is too large"));
     fs::remove_all(dir);
 }
+
+// Issue 43 (decision 061): a sweep directory begun before the points table had the stress columns
+// (stress_max_abs_pa, fatigue_least_safety_factor) cannot be resumed, its rows two cells short: a
+// named error that says so and what to do (--restart, or another --out-dir), never a row dropped as
+// "damaged" one by one; --restart then starts it over. The old directory is made from a new one by
+// taking the two columns out of its journal and the "stresses" key out of its spec.json, as the
+// older program wrote them. A directory begun with [outputs] stresses = false is refused when the
+// spec now asks for them (its rows' columns would stay empty), and the other way round. A refused
+// directory releases its lock: the --restart right after it, in the same process, is not refused
+// as "in use" (it was: the lock's descriptor stayed open when the constructor threw).
+BOOST_AUTO_TEST_CASE(directory_from_before_the_stress_columns_named) {
+    const SweepSpec spec = map_with_mu("[0.3, 0.5]");
+    const SweepPoints points(spec);
+    const std::string dir = fresh_dir("before_stresses");
+    {
+        SweepDirectory d(dir, points, false, false);
+        for (int i = 0; i < 2; ++i) d.record(row_of(i));
+    }
+    const std::string journal = dir + "/finished.csv";
+    auto lines = lines_of(journal);
+    BOOST_REQUIRE_EQUAL(lines.size(), 4u);  // the spec's id, the header, 2 rows
+    auto cells = [](const std::string& line) {
+        std::vector<std::string> c(1);
+        for (char ch : line) {
+            if (ch == ',') c.emplace_back();
+            else c.back().push_back(ch);
+        }
+        return c;
+    };
+    const auto header = cells(lines[1]);
+    std::vector<std::size_t> keep;
+    for (std::size_t i = 0; i < header.size(); ++i)
+        if (header[i] != "stress_max_abs_pa" && header[i] != "fatigue_least_safety_factor") keep.push_back(i);
+    BOOST_REQUIRE_EQUAL(keep.size() + 2, header.size());
+    {
+        std::ofstream old(journal, std::ios::trunc);
+        old << lines[0] << "\n";
+        for (std::size_t k = 1; k < lines.size(); ++k) {
+            const auto c = cells(lines[k]);
+            for (std::size_t i = 0; i < keep.size(); ++i) old << (i ? "," : "") << c[keep[i]];
+            old << "\n";
+        }
+    }
+    {
+        std::string text = read(dir + "/spec.json");
+        const std::size_t at = text.find(",\n  \"stresses\": false");
+        BOOST_REQUIRE(at != std::string::npos);
+        text.erase(at, std::string(",\n  \"stresses\": false").size());
+        std::ofstream(dir + "/spec.json", std::ios::trunc) << text;
+    }
+    const std::string e = error_of([&] { SweepDirectory d(dir, points, false, false); });
+    BOOST_TEST(has(e, "--out-dir: '" + journal + "' was written before the points table had the stress columns "
+                      "stress_max_abs_pa and fatigue_least_safety_factor (an older stackbeam): its rows cannot be "
+                      "resumed; use --restart to discard them and run every point again, or another --out-dir"),
+               e);
+    {
+        SweepDirectory again(dir, points, true, false);  // --restart
+        BOOST_TEST(again.finished_count() == 0);
+        again.record(row_of(1));
+    }
+    // another header (a column renamed): the first difference named, the same advice
+    lines = lines_of(journal);
+    {
+        std::ofstream other(journal, std::ios::trunc);
+        std::string h = lines[1];
+        h.replace(h.find("loop_area_j"), std::string("loop_area_j").size(), "loop_area");
+        other << lines[0] << "\n" << h << "\n" << lines[2] << "\n";
+    }
+    const std::string e2 = error_of([&] { SweepDirectory d(dir, points, false, false); });
+    BOOST_TEST(has(e2, "has other columns than this program writes (another version?): column 6 is 'loop_area', this "
+                       "program writes 'loop_area_j': its rows cannot be resumed; use --restart"),
+               e2);
+
+    // the stresses switched on after the directory was begun (and off again): refused by name
+    const std::string dir2 = fresh_dir("stresses_switched");
+    { SweepDirectory d(dir2, points, false, false); }
+    const SweepSpec with = parse_sweep_spec("scenario = \"rig_small.toml\"\n[outputs]\nstresses = true\n"
+                                            "[[axes]]\nkey = \"loading.displacement_m.amplitude\"\nvalues = [0.01, 0.02]\n"
+                                            "[[axes]]\nkey = \"interfaces[*].friction_coefficient\"\nvalues = [0.3, 0.5]\n",
+                                            kSource);
+    BOOST_TEST(sweep_spec_id(with) == sweep_spec_id(spec));  // the journal's id: the points' values only
+    const SweepPoints with_points(with);
+    const std::string e3 = error_of([&] { SweepDirectory d(dir2, with_points, false, false); });
+    BOOST_TEST(has(e3, "holds the results of another sweep: it was begun with [outputs] stresses = false, the spec now "
+                       "says true (its rows' stress columns would be empty where the new rows' are not); use another "
+                       "directory, or --restart"),
+               e3);
+    fs::remove_all(dir);
+    fs::remove_all(dir2);
+}

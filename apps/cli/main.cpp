@@ -66,7 +66,7 @@ int run_request(const SimulateRequest& request) {
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
             if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)
-                const auto stack = plot_stack(system, result, request.plot, note);
+                const auto stack = plot_stack(system, result, request.plot, note, request.stack_stress);
                 for (const auto& f : stack) std::printf("figure                     %s\n", f.c_str());
                 if (stack.empty()) std::printf("figure (stack)             none: %s\n", note.c_str());
             }

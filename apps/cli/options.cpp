@@ -194,10 +194,15 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
     sim.add_option("--stresses", a.stresses,
                    "write every leaf's stresses and resultants (t, leaf, x, sigma_top, sigma_bottom [Pa], axial_force, "
                    "shear_force [N], bending_moment [N m]; whole leaves) at every output time; the summary then has "
-                   "the largest stress per leaf")
+                   "the largest stress per leaf (file key outputs.stresses_path)")
         ->type_name("FILE.csv");
     sim.add_option("--plot", a.plot, "draw PNG figures with gnuplot: PREFIX_*.png (file key outputs.plot_prefix)")
         ->type_name("PREFIX");
+    sim.add_option("--stack-color", a.stack_color,
+                   "with --plot: what colours the deformed stack (PREFIX_stack.png): state (every pair by its state: "
+                   "stick, slip, open) | stress (each leaf a band coloured by its stress [MPa], tension positive, the "
+                   "fibres' at its edges; the run then computes the stresses, as --stresses does) (default state)")
+        ->type_name("WORD");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
 }
 
@@ -230,6 +235,7 @@ SimulateRequest make_request(const SimulateArgs& a) {
         if (r.pairs.empty()) r.pairs = scenario.outputs.pairs_path;
         if (r.nodes.empty()) r.nodes = scenario.outputs.nodes_path;
         if (r.plot.empty()) r.plot = scenario.outputs.plot_prefix;
+        if (r.stresses.empty()) r.stresses = scenario.outputs.stresses_path;
         if (density_given)
             for (auto& leaf : r.spec.leaves) leaf.density_kg_per_m3 = parse_density(a.beam_density);
         apply_interface(contact, r.spec);
@@ -263,12 +269,15 @@ SimulateRequest make_request(const SimulateArgs& a) {
                 throw ArgumentError(what + ": value '" + r.nodes + "' is also the " + other +
                                     " file: give the nodal displacements a file of their own");
     }
-    if (!r.stresses.empty())  // the stresses' rows would overwrite (or interleave with) another output
+    if (!r.stresses.empty()) {  // the stresses' rows would overwrite (or interleave with) another output
+        const std::string what =
+            a.stresses.empty() ? "outputs.stresses_path (file " + a.scenario + ")" : std::string("--stresses");
         for (const auto& [other, file] : {std::pair<const char*, const std::string*>{"--out", &r.out}, {"--pairs", &r.pairs},
                                           {"--nodes", &r.nodes}, {"--events", &r.events}, {"--summary", &r.summary}})
             if (*file == r.stresses)
-                throw ArgumentError("--stresses: value '" + r.stresses + "' is also the " + other +
+                throw ArgumentError(what + ": value '" + r.stresses + "' is also the " + other +
                                     " file: give the stresses a file of their own");
+    }
     // every output checked before the run: a bad path is found in a moment, not after the simulation
     auto name = [&](const std::string& flag, const std::string& given, const char* key) {
         return given.empty() && !a.scenario.empty() ? std::string("outputs.") + key + " (file " + a.scenario + ")" : flag;
@@ -278,7 +287,15 @@ SimulateRequest make_request(const SimulateArgs& a) {
     check_output_file(name("--summary", a.summary, "summary_path"), r.summary);
     check_output_file(name("--pairs", a.pairs, "pairs_path"), r.pairs);
     check_output_file(name("--nodes", a.nodes, "nodes_path"), r.nodes);
-    check_output_file("--stresses", r.stresses);
+    check_output_file(name("--stresses", a.stresses, "stresses_path"), r.stresses);
+    if (a.given.count("--stack-color") > 0) {
+        if (a.stack_color != "state" && a.stack_color != "stress")
+            throw ArgumentError("--stack-color: value '" + a.stack_color + "' is not allowed: state or stress");
+        if (r.plot.empty())
+            throw ArgumentError("--stack-color: value '" + a.stack_color + "' colours the --plot figure of the deformed stack: "
+                                "give --plot PREFIX (or outputs.plot_prefix) too");
+        r.stack_stress = a.stack_color == "stress";
+    }
     validate(a, r.options, r.scenario ? &*r.scenario : nullptr);
     return r;
 }

@@ -37,6 +37,7 @@ struct SimulateArgs {
     std::string beam_density;  ///< "" = the leaves' own density (the case's: 0, massless)
     std::string interface;     ///< --interface: "" = the case's or the file's contact law (rigid | elastic)
     std::string out, events, summary, pairs, nodes, stresses, plot;
+    std::string stack_color;   ///< --stack-color: "" = state
     bool quiet = false;
     std::map<std::string, std::string> table_text;  ///< flag (or alias) of the option table -> text
     std::set<std::string> given;                     ///< the flags given on the command line
@@ -51,6 +52,7 @@ struct SimulateRequest {
     SimulationOptions options;
     std::string out, events, summary, pairs, nodes, stresses, plot;  ///< files ("" = none); out is required
     std::string setup;                              ///< the summary's first line: the case or the scenario
+    bool stack_stress = false;  ///< --stack-color stress: the deformed stack's leaves coloured by their fibre stresses
     bool quiet = false;
     std::optional<Scenario> scenario;  ///< the file read, for --scenario (its keys' locations)
 };

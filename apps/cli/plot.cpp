@@ -119,7 +119,7 @@ double drawn_axis_m(const LeafNodes& leaf, double height_m, double scale, double
 }  // namespace
 
 std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
-                                    std::string& note) {
+                                    std::string& note, bool stress) {
     using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
@@ -167,6 +167,37 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
     pairs.close();
     if (!axes || !pairs) throw std::runtime_error("writing the deformed stack's data '" + axes_path + "' failed");
 
+    // --stack-color stress: each leaf a band from its bottom to its top fibre (its drawn axis -+ half
+    // its local thickness), a grid of two scans for gnuplot's pm3d: one index per figure and leaf
+    const std::string band_path = prefix + "_stack_stress.dat";
+    double sigma_max_mpa = 0.0;
+    if (stress) {
+        std::ofstream band(band_path);
+        if (!band) throw ArgumentError("--plot: cannot write '" + band_path + "'");
+        band << "# x [mm], y [mm], sigma [MPa] (tension positive): per figure (largest, smallest w) and leaf one "
+                "index, its bottom fibre (the drawn axis - t/2) then its top fibre (+ t/2)\n";
+        for (const StackSnapshot* s : shots) {
+            if (s->stresses.size() != s->nodes.size())
+                throw std::logic_error("plot_stack: the snapshot has no stresses (--stack-color stress)");
+            for (std::size_t l = 0; l < s->stresses.size(); ++l) {
+                const LeafStresses& ls = s->stresses[l];
+                for (const double side : {-1.0, 1.0}) {
+                    const auto& sigma = side > 0.0 ? ls.top_stress_pa : ls.bottom_stress_pa;
+                    for (std::size_t j = 0; j < ls.x_m.size(); ++j) {
+                        const double y = drawn_axis_m(s->nodes[l], heights[ls.leaf], scale, ls.x_m[j]) + 0.5 * side * ls.thickness_m[j];
+                        band << 1000.0 * ls.x_m[j] << ' ' << 1000.0 * y << ' ' << sigma[j] / 1e6 << '\n';
+                        sigma_max_mpa = std::max(sigma_max_mpa, std::abs(sigma[j]) / 1e6);
+                    }
+                    band << '\n';  // the next scan
+                }
+                band << "\n";  // two blank lines: the next index
+            }
+        }
+        band.close();
+        if (!band) throw std::runtime_error("writing the deformed stack's data '" + band_path + "' failed");
+        if (!(sigma_max_mpa > 0.0)) sigma_max_mpa = 1.0;
+    }
+
     const std::string script_path = prefix + "_stack.gp", png = prefix + "_stack.png";
     std::ofstream g(script_path);
     if (!g) throw ArgumentError("--plot: cannot write '" + script_path + "'");
@@ -175,11 +206,20 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
     g << "set terminal " << *terminal << " size 1000,900\nset output '" << png << "'\nset grid\nset key outside bottom center horizontal\n"
       << "set multiplot layout 2,1 title 'deformed stack: the deflection drawn x " << scale_text.str()
       << " (the leaves at their heights in the stack)'\n";
+    if (stress)  // blue compression, white 0, red tension: one scale for both figures; a map view
+        g << "set view map\nset pm3d map interpolate 1,4 corners2color mean\nset palette defined (-1 '#3b4cc0', 0 '#f2f2f2', 1 '#b40426')\nset cbrange [" << -sigma_max_mpa << ":"
+          << sigma_max_mpa << "]\nset cblabel 'fibre stress [MPa], tension positive'\n";
     for (int i = 0; i < 2; ++i) {
         std::ostringstream title;
         title << (i == 0 ? "largest" : "smallest") << " w = " << 1000.0 * shots[i]->w_m << " mm at t = " << shots[i]->t_s << " s";
         g << "set title '" << title.str() << "'\nset xlabel 'x [mm]'\nset ylabel 'height + " << scale_text.str()
           << " x deflection [mm]'\n";
+        if (stress) {  // a map of the bands, linear between the nodes and through the thickness (pm3d)
+            const std::size_t leaves_drawn = shots[i]->stresses.size(), first = static_cast<std::size_t>(i) * leaves_drawn;
+            g << "splot for [k=" << first << ":" << first + leaves_drawn - 1 << "] '" << band_path
+              << "' index k using 1:2:(0):3 with pm3d notitle\n";
+            continue;
+        }
         g << "plot '" << axes_path << "' index " << i << " using 1:2 with lines lw 2 lc rgb 'black' title 'leaf axes', '"
           << pairs_path << "' index " << i << " using 1:($3==0?$2:1/0) with points pt 7 ps 0.8 lc rgb '#1a9850' title 'stick', '"
           << pairs_path << "' index " << i << " using 1:($3==1?$2:1/0) with points pt 7 ps 0.8 lc rgb '#d73027' title 'slip', '"

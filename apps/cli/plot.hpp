@@ -27,10 +27,14 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
 /// smallest w, RunResult::stack_at_w_max / _min), PREFIX_stack.png: each leaf's axis at its height
 /// in the stack plus its deflection times a scale (stack_figure_scale, printed on the figure),
 /// every pair a point coloured by its state (stick, slip, open); the half model mirrored. The
-/// data in PREFIX_stack_axes.dat and PREFIX_stack_pairs.dat (mm). Returns the file written, or
-/// none and a note why in `note`.
+/// data in PREFIX_stack_axes.dat and PREFIX_stack_pairs.dat (mm). `stress` (--stack-color stress,
+/// the snapshots' stresses kept): instead of the axes and pairs, each leaf a band of its local
+/// thickness about its drawn axis coloured by its stress [MPa] (tension positive), the fibres' at
+/// its edges and linear between them and between the nodes (gnuplot's pm3d), one colour scale
+/// symmetric about 0 over both figures; the data in PREFIX_stack_stress.dat (x [mm], y [mm],
+/// sigma [MPa]). Returns the file written, or none and a note why in `note`.
 std::vector<std::string> plot_stack(const System& system, const RunResult& result, const std::string& prefix,
-                                    std::string& note);
+                                    std::string& note, bool stress = false);
 
 /// The deflection's scale of the deformed stack figure: the number 1, 2 or 5 times a power of
 /// ten at or below 2 H / max |w|, H the stack's height at the seat (the leaves' thicknesses) and

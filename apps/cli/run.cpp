@@ -156,7 +156,8 @@ public:
     FileSink(const SimulateRequest& request, RunResult& result)
         : csv(request.out, "--out"), pairs_csv(request.pairs, "--pairs"), nodes_csv(request.nodes, "--nodes"),
           stresses_csv(request.stresses, "--stresses"),
-          progress(!request.quiet, request.options.t_end_s), snapshots_(!request.plot.empty()), result_(result) {
+          progress(!request.quiet, request.options.t_end_s), snapshots_(!request.plot.empty()),
+          snapshot_stresses_(snapshots_ && request.stack_stress), result_(result) {
         write_csv_header(csv.stream());
         if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
         pairs_csv.stream().precision(17);
@@ -172,7 +173,7 @@ public:
         RunOutputs o;
         o.pairs = pairs_csv.active() || snapshots_;
         o.nodes = nodes_csv.active() || snapshots_;
-        o.stresses = stresses_csv.active();
+        o.stresses = stresses_csv.active() || snapshot_stresses_;
         return o;
     }
     void on_record(const StepRecord& r) override {
@@ -215,6 +216,9 @@ public:
 
     /// Stepper::stresses() gives whole leaves (the half model mirrored): one row per node.
     void on_stresses(double t, const Stresses& stresses) override {
+        if (snapshot_stresses_)
+            for (StackSnapshot* s : marked_) s->stresses = stresses.leaves;
+        if (!stresses_csv.active()) return;
         auto& o = stresses_csv.stream();
         for (const LeafStresses& l : stresses.leaves)
             for (std::size_t j = 0; j < l.x_m.size(); ++j)
@@ -227,6 +231,7 @@ public:
 
 private:
     bool snapshots_;
+    bool snapshot_stresses_;  // --stack-color stress: the snapshots keep the stresses too
     RunResult& result_;
     std::vector<StackSnapshot*> marked_;  // the snapshots the current record replaces
     long records_ = 0;

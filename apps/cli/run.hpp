@@ -28,6 +28,7 @@ struct StackSnapshot {
     double t_s = 0.0, w_m = 0.0;
     std::vector<LeafNodes> nodes;
     std::vector<PairRecord> pairs;
+    std::vector<LeafStresses> stresses;  ///< --stack-color stress: every leaf's stresses (whole leaves); else empty
 };
 
 struct RunResult {

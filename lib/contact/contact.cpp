@@ -79,7 +79,7 @@ void detail::validate_laws(const std::vector<ContactPair>& pairs, int n, TauRule
         throw InputError("problem.tau_previous_n", "needs one entry per pair with TauRule::previous_step");
 }
 
-double friction_normal_force(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
+double friction_normal_force(const ContactLaws& problem, int k, const Eigen::VectorXd& p) {
     const auto& c = problem.pairs[k];
     const double pn = c.row_n >= 0 ? p[c.row_n] : 0.0;
     if (c.kind == PairKind::clamp) {
@@ -93,7 +93,7 @@ double friction_normal_force(const ContactProblem& problem, int k, const Eigen::
     return std::numeric_limits<double>::infinity();  // bonded: no limit
 }
 
-Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
+Eigen::VectorXd error_vector(const ContactLaws& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s) {
     Eigen::VectorXd v = Eigen::VectorXd::Zero(s.size());
     for (std::size_t k = 0; k < problem.pairs.size(); ++k) {
         const auto& c = problem.pairs[k];
@@ -176,7 +176,7 @@ void detail::residual_norms(const ContactProblem& problem, const Eigen::VectorXd
     natural_norm_m = std::sqrt(r2);
 }
 
-PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p) {
+PairState pair_state(const ContactLaws& problem, int k, const Eigen::VectorXd& p) {
     const auto& c = problem.pairs[k];
     if (c.kind == PairKind::bonded) return PairState::stick;
     if (c.kind == PairKind::coulomb && (c.row_n < 0 || p[c.row_n] >= 0.0)) return PairState::open;
@@ -209,7 +209,8 @@ private:
 };
 }  // namespace
 
-std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
+void SolverOptions::validate() const {
+    const SolverOptions& o = *this;
     if (!std::isfinite(o.tolerance_m) || o.tolerance_m <= 0.0)
         throw InputError("solver.tolerance_m", "value " + format_value(o.tolerance_m) + " must be finite and > 0 [m]");
     if (o.max_iterations < 1)
@@ -218,6 +219,17 @@ std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
         throw InputError("solver.alpha", "value " + format_value(o.alpha) + " must be finite and >= 0 (0: automatic) [N/m]");
     if (!std::isfinite(o.alpha_fraction) || o.alpha_fraction <= 0.0)
         throw InputError("solver.alpha_fraction", "value " + format_value(o.alpha_fraction) + " must be finite and > 0");
+    if (o.kind != SolverKind::exact) return;  // the exact solver's own fields
+    if (o.tresca_anderson_depth < 0 || o.tresca_anderson_depth > 50)
+        throw InputError("solver.tresca_anderson_depth",
+                         "value " + std::to_string(o.tresca_anderson_depth) + " must be in 0..50 (0: no acceleration)");
+    if (o.max_active_set_iterations < 1)
+        throw InputError("solver.max_active_set_iterations",
+                         "value " + std::to_string(o.max_active_set_iterations) + " must be >= 1");
+}
+
+std::unique_ptr<ContactSolver> make_solver(const SolverOptions& o) {
+    o.validate();
     std::unique_ptr<ContactSolver> inner;
     switch (o.kind) {
         case SolverKind::paper:

@@ -2,6 +2,7 @@
 #include "stackbeam/contact/step.hpp"
 
 #include <Eigen/SparseCholesky>
+#include <stdexcept>
 
 #include "stackbeam/errors.hpp"
 
@@ -45,6 +46,10 @@ struct ContactOperator::Dense {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
     Eigen::MatrixXd Y;                    // K^-1 G^T (from the sparse form)
     bool factored = false;
+    // the closed form's displacements and strain energy (DenseStepForm), or the stiffness form's energy
+    std::function<Eigen::VectorXd(const Eigen::VectorXd&, const Eigen::VectorXd&)> displacements;
+    std::function<double(const Eigen::VectorXd&, const Eigen::VectorXd&)> strain_energy_j;
+    decltype(SparseStepForm::strain_energy_j) stiffness_energy_j;
 };
 
 struct ContactOperator::Sparse {
@@ -52,7 +57,10 @@ struct ContactOperator::Sparse {
 };
 
 ContactOperator::ContactOperator(const StepSystem& system, ContactPath requested, SolverKind solver)
-    : path_(resolve_contact_path(requested, system.rows, solver)), rows_(system.rows) {
+    : path_(system.sparse ? resolve_contact_path(requested, system.rows, solver) : ContactPath::dense),
+      rows_(system.rows) {
+    if (!system.sparse && !system.dense)
+        throw InputError("system", "gives neither the sparse nor the dense form of the step's contact problem");
     if (path_ == ContactPath::sparse) {
         sparse_ = std::make_unique<Sparse>();
         sparse_->form = system.sparse();
@@ -63,6 +71,8 @@ ContactOperator::ContactOperator(const StepSystem& system, ContactPath requested
         DenseStepForm f = system.dense();
         dense_->W = std::move(f.W);
         dense_->Q = std::move(f.Q);
+        dense_->displacements = std::move(f.displacements);
+        dense_->strain_energy_j = std::move(f.strain_energy_j);
         return;
     }
     // From the stiffness form: W = G K^-1 G^T (symmetrised) + diag(c_L); q and z by K's factor.
@@ -79,12 +89,11 @@ ContactOperator::ContactOperator(const StepSystem& system, ContactPath requested
     dense_->G = f.G;
     dense_->B = f.B;
     dense_->E = f.E;
+    dense_->stiffness_energy_j = f.strain_energy_j;
     dense_->factored = true;
 }
 
 ContactOperator::~ContactOperator() = default;
-
-bool ContactOperator::has_displacements() const noexcept { return sparse_ || dense_->factored; }
 
 struct StepContactSolver::Impl {
     SolverOptions options;
@@ -96,11 +105,16 @@ struct StepContactSolver::Impl {
     ContactProblem dense;          // W set once per operator; q, pairs, tau per step
     SparseContactProblem sparse;   // K, G, c_L once per operator; b, d, pairs, tau per step
     Eigen::VectorXd d;             // the last problem's offsets
+    Eigen::VectorXd u;             // the last problem's load parameters
     Eigen::VectorXd eu;            // E u of the last sparse step (empty: none)
+    Eigen::VectorXd z;             // the last solve's displacements (a closed dense form: when first read)
+    Eigen::VectorXd p;             // the closed dense form: the forces z is to be made from
+    bool z_pending = false;        // z not yet made from the closed dense form
 };
 
 StepContactSolver::StepContactSolver(const SolverOptions& options, const SparsePathTuning& tuning)
     : impl_(std::make_unique<Impl>()) {
+    options.validate();
     impl_->options = options;
     impl_->tuning = tuning;
 }
@@ -108,16 +122,22 @@ StepContactSolver::StepContactSolver(const SolverOptions& options, const SparseP
 StepContactSolver::~StepContactSolver() = default;
 
 SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd& p, Eigen::VectorXd& z) {
+    const SolveResult r = solve(problem, p);
+    z = displacements();
+    return r;
+}
+
+SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd& p) {
     Impl& im = *impl_;
     if (!problem.op) throw InputError("problem.op", "is empty: a StepProblem needs its ContactOperator");
     const ContactOperator& op = *problem.op;
     const bool same = im.last_op == &op;
     if (!same) im.op = problem.op;  // keep the operator alive while its factors are cached
     im.d = problem.d;
+    im.u = problem.u;
+    im.z_pending = false;
     // the laws of the last problem (last_dense_problem() has them on either form)
-    im.dense.pairs = problem.pairs;
-    im.dense.tau_rule = problem.tau_rule;
-    im.dense.tau_previous_n = problem.tau_previous_n;
+    static_cast<ContactLaws&>(im.dense) = problem;
     if (const ContactOperator::Dense* D = op.dense()) {
         if (!im.dense_solver) im.dense_solver = make_solver(im.options);
         ContactProblem& pr = im.dense;
@@ -127,16 +147,25 @@ SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd
             v = D->ldlt.solve(D->B.size() > 0 ? Eigen::VectorXd(D->B * problem.u) : problem.u);
             pr.q = D->G * v - problem.d;
             if (D->E.size() > 0) pr.q += D->E * problem.u;
-        } else {
+        } else if (D->Q.size() > 0) {
             pr.q = D->Q * problem.u - problem.d;
+        } else {
+            pr.q = problem.u - problem.d;
         }
         im.last_op = &op;
         const SolveResult r = im.dense_solver->solve(pr, p);
-        if (D->factored) z = v + D->Y * p;  // else z is left as it was (no displacements)
+        if (D->factored) {
+            im.z = v + D->Y * p;
+        } else {  // the closed form's z, when read (the paper's step never needs it)
+            im.p = p;
+            im.z_pending = static_cast<bool>(D->displacements);
+            im.z.resize(0);
+        }
         return r;
     }
     const ContactOperator::Sparse& S = *op.sparse();
-    if (!im.sparse_solver) im.sparse_solver = std::make_unique<SparseContactSolver>(im.options, im.tuning);
+    // a new operator: a new sparse solver (its factors and warm starts are of the operator's K, G)
+    if (!im.sparse_solver || !same) im.sparse_solver = std::make_unique<SparseContactSolver>(im.options, im.tuning);
     SparseContactProblem& pr = im.sparse;
     if (!same) {
         pr.K = S.form.K;
@@ -151,13 +180,20 @@ SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd
         im.eu.resize(0);
         pr.d = problem.d;
     }
-    pr.pairs = problem.pairs;
-    pr.tau_rule = problem.tau_rule;
-    pr.tau_previous_n = problem.tau_previous_n;
+    static_cast<ContactLaws&>(pr) = problem;
     // K, G and the pairs are those of the previous call on the same operator (fixed over a run)
-    const SolveResult r = im.sparse_solver->solve(pr, p, z, same);
+    const SolveResult r = im.sparse_solver->solve(pr, p, im.z, same);
     im.last_op = &op;
     return r;
+}
+
+const Eigen::VectorXd& StepContactSolver::displacements() const {
+    Impl& im = *impl_;
+    if (im.z_pending) {
+        im.z = im.last_op->dense()->displacements(im.u, im.p);
+        im.z_pending = false;
+    }
+    return im.z;
 }
 
 Eigen::VectorXd StepContactSolver::relative_positions(const Eigen::VectorXd& p) const {
@@ -166,6 +202,22 @@ Eigen::VectorXd StepContactSolver::relative_positions(const Eigen::VectorXd& p) 
     Eigen::VectorXd rel = im.sparse_solver->relative_positions() + im.sparse.d;
     if (im.eu.size() > 0) rel += im.eu;
     return rel;
+}
+
+double StepContactSolver::strain_energy_j(const Eigen::VectorXd& p, const Eigen::VectorXd& rel) const {
+    const Impl& im = *impl_;
+    if (!im.last_op) throw std::logic_error("StepContactSolver::strain_energy_j before a solve");
+    if (const ContactOperator::Dense* D = im.last_op->dense()) {
+        if (D->strain_energy_j) return D->strain_energy_j(im.u, p);
+        if (D->stiffness_energy_j) return D->stiffness_energy_j(im.u, p, displacements(), rel);
+    } else if (im.last_op->sparse()->form.strain_energy_j) {
+        return im.last_op->sparse()->form.strain_energy_j(im.u, p, im.z, rel);
+    }
+    throw std::logic_error("StepContactSolver::strain_energy_j: the step's form gives no strain energy");
+}
+
+ContactPath StepContactSolver::path() const noexcept {
+    return impl_->last_op ? impl_->last_op->path() : ContactPath::automatic;
 }
 
 const ContactProblem& StepContactSolver::last_dense_problem() const noexcept { return impl_->dense; }

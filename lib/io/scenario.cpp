@@ -565,7 +565,8 @@ void parse_integrator(const Table& top, SimulationOptions& o) {
 
 void parse_outputs(const Table& top, ScenarioOutputs& out) {
     if (!top.has("outputs")) return;
-    const Table t = top.table("outputs", {"csv_path", "events_path", "summary_path", "pairs_path", "nodes_path", "plot_prefix"});
+    const Table t = top.table("outputs", {"csv_path", "events_path", "summary_path", "pairs_path", "nodes_path", "plot_prefix",
+                                         "stresses_path"});
     auto path = [&](const char* key, const char* what) {
         if (!t.has(key)) return std::string();
         const std::string p = t.string(key, what);
@@ -578,6 +579,7 @@ void parse_outputs(const Table& top, ScenarioOutputs& out) {
     out.pairs_path = path("pairs_path", "the per-pair CSV");
     out.nodes_path = path("nodes_path", "the nodal displacements' CSV");
     out.plot_prefix = path("plot_prefix", "the prefix of the PNG figures");
+    out.stresses_path = path("stresses_path", "the leaves' stresses' CSV");
 }
 
 /// The TOML parser recurses into nested arrays and inline tables, so a file of

@@ -250,14 +250,15 @@ std::string to_toml(const Scenario& s) {
 
     const ScenarioOutputs& o = s.outputs;
     if (!o.csv_path.empty() || !o.events_path.empty() || !o.summary_path.empty() || !o.pairs_path.empty() ||
-        !o.nodes_path.empty() || !o.plot_prefix.empty()) {
+        !o.nodes_path.empty() || !o.plot_prefix.empty() || !o.stresses_path.empty()) {
         out << "\n[outputs]\n";
         for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"csv_path", &o.csv_path},
                                          {"events_path", &o.events_path},
                                          {"summary_path", &o.summary_path},
                                          {"pairs_path", &o.pairs_path},
                                          {"nodes_path", &o.nodes_path},
-                                         {"plot_prefix", &o.plot_prefix}})
+                                         {"plot_prefix", &o.plot_prefix},
+                                         {"stresses_path", &o.stresses_path}})
             if (!value->empty()) top.word(key, *value);
     }
     return out.str();

@@ -106,7 +106,8 @@ nlohmann::json spec_json(const SweepSpec& spec) {
     return {{"scenario_path", spec.scenario_path},
             {"scenario_text", spec.scenario_text},
             {"combine", to_string(spec.combine)},
-            {"axes", axes}};
+            {"axes", axes},
+            {"stresses", spec.stresses}};
 }
 
 /// The first difference between two resolved specs, in words ("" if none).
@@ -117,6 +118,11 @@ std::string spec_difference(const nlohmann::json& old_spec, const nlohmann::json
     if (old_spec.value("combine", "") != now["combine"].get<std::string>())
         return "combine was '" + old_spec.value("combine", std::string("?")) + "', now '" +
                now["combine"].get<std::string>() + "'";
+    // a spec.json written before the key (no "stresses") is not compared: its journal's header tells
+    if (old_spec.contains("stresses") && old_spec["stresses"] != now["stresses"])
+        return "it was begun with [outputs] stresses = " + old_spec["stresses"].dump() + ", the spec now says " +
+               now["stresses"].dump() + " (its rows' stress columns would be " +
+               (now["stresses"].get<bool>() ? "empty" : "filled") + " where the new rows' are not)";
     const auto& a0 = old_spec.contains("axes") ? old_spec["axes"] : nlohmann::json::array();
     const auto& a1 = now["axes"];
     if (a0.size() != a1.size())
@@ -191,6 +197,24 @@ std::string axis_cell(const AxisValue& v) {
     return s;
 }
 
+/// Why a journal's header `old` is not this program's `now`, in words: written before the stress
+/// columns (decision 061), or the first column that differs.
+std::string header_difference(const std::string& old, const std::string& now) {
+    const std::vector<std::string> a = split_row(old), b = split_row(now);
+    const std::vector<std::string> stress = {"stress_max_abs_pa", "fatigue_least_safety_factor"};
+    std::vector<std::string> without = b;
+    for (const std::string& c : stress) without.erase(std::remove(without.begin(), without.end(), c), without.end());
+    if (a == without)
+        return "was written before the points table had the stress columns " + stress[0] + " and " + stress[1] +
+               " (an older stackbeam)";
+    for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i)
+        if (i >= a.size() || i >= b.size() || a[i] != b[i])
+            return "has other columns than this program writes (another version?): column " + std::to_string(i + 1) +
+                   " is '" + (i < a.size() ? a[i] : std::string("(none)")) + "', this program writes '" +
+                   (i < b.size() ? b[i] : std::string("(none)")) + "'";
+    return "has other columns than this program writes";
+}
+
 /// parse_point_row that also hands back the axis cells.
 PointResult parse_row(const SweepSpec& spec, const std::string& row, std::vector<std::string>* axis_cells);
 
@@ -237,7 +261,9 @@ std::string format_point_row(const std::vector<AxisValue>& values, const PointRe
 }
 
 std::string sweep_spec_id(const SweepSpec& spec) {
-    const std::string text = spec_json(spec).dump();
+    nlohmann::json values = spec_json(spec);
+    values.erase("stresses");  // the id of the points' values, as before the key (a journal's first line)
+    const std::string text = values.dump();
     std::uint64_t h = 14695981039346656037ULL;  // FNV-1a, 64 bits
     for (unsigned char c : text) {
         h ^= c;
@@ -293,19 +319,35 @@ void check_row_values(const SweepSpec& spec, const std::vector<AxisValue>& value
 
 }  // namespace
 
+namespace {
+/// Runs `open`; when it throws (a directory refused), closes the lock it may have taken first:
+/// the destructor does not run for an object whose constructor threw, and a process that goes on
+/// (Python) would hold the lock on the directory until it ends.
+template <class Open>
+void release_on_throw(int& lock_fd, Open&& open) {
+    try {
+        open();
+    } catch (...) {
+        if (lock_fd >= 0) ::close(lock_fd);
+        lock_fd = -1;
+        throw;
+    }
+}
+}  // namespace
+
 SweepDirectory::SweepDirectory(std::string directory, const SweepSpec& spec, const std::vector<SweepPoint>& points,
                                bool restart, bool keep_series)
     : directory_(std::move(directory)), spec_(spec), count_(static_cast<int>(points.size())), keep_series_(keep_series) {
     values_at_ = [&points](int i) { return points.at(static_cast<std::size_t>(i)).values; };
     point_at_ = [&points](int i) { return points.at(static_cast<std::size_t>(i)); };
-    open(restart);
+    release_on_throw(lock_fd_, [&] { open(restart); });
 }
 
 SweepDirectory::SweepDirectory(std::string directory, const SweepPoints& points, bool restart, bool keep_series)
     : directory_(std::move(directory)), spec_(points.spec()), count_(points.size()), keep_series_(keep_series) {
     values_at_ = [&points](int i) { return points.values(i); };
     point_at_ = [&points](int i) { return points.point(i); };
-    open(restart);
+    release_on_throw(lock_fd_, [&] { open(restart); });
 }
 
 SweepDirectory::~SweepDirectory() {
@@ -414,8 +456,9 @@ void SweepDirectory::open(bool restart) {
                     continue;
                 }
                 if (line != header)
-                    throw InputError("--out-dir", "'" + where + "' has other columns than this program "
-                                                  "writes (another version?): use --restart to start over");
+                    throw InputError("--out-dir", "'" + where + "' " + header_difference(line, header) +
+                                                      ": its rows cannot be resumed; use --restart to discard them and "
+                                                      "run every point again, or another --out-dir");
                 header_seen = true;
                 if (line_no == 1) repaired = true;  // a journal of an older version: its id line is added
                 continue;

@@ -29,9 +29,9 @@ struct ClosedFormStepper::Impl {
     SimulationOptions options_;
     std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
     std::unique_ptr<StepContactSolver> contact_;
-    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    ContactLaws problem_;        // the pair laws and the previous-step limits
     StepProblem step_problem_;   // the step's problem: u = [w_next], d
-    Eigen::VectorXd z_, zr_;     // z, and the rig's z_r (R held at w_next)
+    Eigen::VectorXd z_;          // z at the start (the steps': the contact solve's, when read)
     int w_dof_ = -1;
     double k_r_ = 0.0;  // stiffness form: the rigid body's spring k_R [N/m] in K_aug
     SolveResult solve_;
@@ -56,7 +56,11 @@ struct ClosedFormStepper::Impl {
     Eigen::Vector2d seat_loads(double t_s) const {
         return {options_.loading.seat_moment_n_m_at(t_s), options_.loading.longitudinal_force_n_at(t_s)};
     }
-    void fill_record(int iterations, int factorizations, double strain_j = -1.0);
+    /// U [J, whole spring] from z (w last) and p.
+    double strain_of(const Eigen::VectorXd& z, const Eigen::VectorXd& p) const;
+    /// z of the rig's state: z_r and R held at w.
+    Eigen::VectorXd held_z(const Eigen::VectorXd& zr, double w) const;
+    void fill_record(int iterations, int factorizations, double strain);
 };
 
 ClosedFormStepper::ClosedFormStepper(const System& system, const SimulationOptions& options)
@@ -81,12 +85,9 @@ const Eigen::VectorXd& ClosedFormStepper::contact_forces() const noexcept { retu
 const Eigen::VectorXd& ClosedFormStepper::relative_positions() const noexcept { return impl_->rel_; }
 const Eigen::VectorXd& ClosedFormStepper::anchors() const noexcept { return impl_->d_; }
 std::vector<PairState> ClosedFormStepper::pair_states() const { return impl_->pair_states(); }
-const ContactProblem& ClosedFormStepper::last_problem() const noexcept { return impl_->contact_->last_dense_problem(); }
-const SparseContactProblem& ClosedFormStepper::last_sparse_problem() const noexcept {
-    return impl_->contact_->last_sparse_problem();
-}
+const StepContactSolver& ClosedFormStepper::contact_solver() const noexcept { return *impl_->contact_; }
 ContactPath ClosedFormStepper::contact_path() const noexcept { return impl_->op_->path(); }
-const Eigen::VectorXd& ClosedFormStepper::reduced_displacements() const noexcept { return impl_->z_; }
+Eigen::VectorXd ClosedFormStepper::reduced_displacements() const { return impl_->displacements_now(); }
 const SolveResult& ClosedFormStepper::last_solve() const noexcept { return impl_->solve_; }
 const System& ClosedFormStepper::system() const noexcept { return impl_->system_; }
 double ClosedFormStepper::omega_rad_per_s() const noexcept { return impl_->omega_; }
@@ -113,19 +114,52 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     // u = [w_next]. Dense: W = C' + (gamma/k) c c^T (the rig holds R: W = C'), q = c w_next - d.
     // Sparse: K_aug = K + k_R e_w e_w^T, k_R = k (1 - gamma)/gamma, b = (k/gamma) w_next e_w; the
     // rig: K_rr z_r = -K_rw w_next + G_r^T p, s = G_r z_r + c_L p - (d - G_w w_next).
+    // Each form gives the step's strain energy its own way (the operator evaluates the one it took):
+    // U = (p^T C' p + k w^2) / 2 on the dense form (w = w_next + gamma c^T p / k; the rig: w_next),
+    // z^T K z / 2 + p^T C_L p / 2 on the sparse one (advance(): without a product with K).
     StepSystem sys = rig_ ? detail::held_body_system(system_) : StepSystem{};
     // seat loads: u = [w_next; S] (the vertical rig with them is refused: check_capabilities)
     seat_ = load.has_seat_load();
     // the seat's motion is recorded on every full model (an asymmetric spring's seat turns under a vertical load)
     if (system_.seat_rotation_dof() >= 0) seat_c_ = system_.seat_condensation();
-    if (!rig_) {
+    const auto dense_energy = [this, k](double w, const Eigen::VectorXd& p) {
+        return 0.5 * f_ * (p.dot(system_.compliance_held() * p) + k * w * w);
+    };
+    if (rig_) {
+        sys.dense = [this, dense_energy, held = sys.dense] {
+            DenseStepForm f = held();
+            f.strain_energy_j = [dense_energy](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
+                return dense_energy(u[0], p);
+            };
+            return f;
+        };
+        sys.sparse = [this, held = sys.sparse] {
+            SparseStepForm f = held();
+            f.strain_energy_j = [this](const Eigen::VectorXd& u, const Eigen::VectorXd& p, const Eigen::VectorXd& zr,
+                                       const Eigen::VectorXd&) { return strain_of(held_z(zr, u[0]), p); };
+            return f;
+        };
+    } else {
         sys.rows = n;
-        sys.dense = [&] {
+        sys.dense = [&, dense_energy] {
             DenseStepForm f;
             f.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
             f.Q.resize(n, seat_ ? 3 : 1);
             f.Q.col(0) = c;
             if (seat_) f.Q.rightCols(2) = seat_c_.B;  // s = C' p + c w + B S - d
+            // z = (z_r, w) with R free at w = w_next + gamma c^T p / k (the step's w(t + dt)), and the
+            // seat loads S = u.tail(2) on theta_R, u_R
+            f.displacements = [this, k, &c](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
+                const double w = u[0] + gamma_ * c.dot(p) / k;
+                return seat_ ? system_.reduced_displacements(p, w, Eigen::Vector2d(u.tail(2)))
+                             : system_.reduced_displacements(p, w);
+            };
+            f.strain_energy_j = [this, k, &c, dense_energy](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
+                const double w = u[0] + gamma_ * c.dot(p) / k;
+                // with seat loads the free DOFs are loaded: (p^T C' p + k w^2) / 2 no longer holds
+                return seat_ ? strain_of(system_.reduced_displacements(p, w, Eigen::Vector2d(u.tail(2))), p)
+                             : dense_energy(w, p);
+            };
             return f;
         };
         sys.sparse = [&] {
@@ -146,8 +180,24 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
             if (seat_) {  // the seat loads on their DOFs (a DOF the seat lacks carries nothing)
                 if (system_.seat_rotation_dof() >= 0) f.B.insert(system_.seat_rotation_dof(), 1) = 1.0;
                 if (system_.seat_axial_dof() >= 0) f.B.insert(system_.seat_axial_dof(), 2) = 1.0;
+                // and their condensed force on R, -g^T S, which w_next (the dense form's) holds:
+                // R's row of K_aug z = B u reads (k/gamma) (w_next + (gamma/k) g^T S)
+                f.B.insert(w_dof_, 1) = seat_c_.g[0];
+                f.B.insert(w_dof_, 2) = seat_c_.g[1];
             }
             f.B.makeCompressed();
+            // U without a product with K, from K_aug z = b + G^T p (the solved system, K_aug = K +
+            // k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2, with G z = rel (with an elastic
+            // layer the solved system is the augmented one, sparse_solver.cpp, and p^T rel = p^T G z +
+            // p^T C_L p adds the layer's energy twice over, as z^T K z does for the leaves). b_w w and
+            // k_R w^2 are each about 1/gamma times U (~1e2-1e3 at dt = 1 ms): the difference loses
+            // that factor of round-off, 1e-13 relative.
+            f.strain_energy_j = [this, k](const Eigen::VectorXd& u, const Eigen::VectorXd& p, const Eigen::VectorXd& z,
+                                          const Eigen::VectorXd& rel) {
+                if (seat_) return strain_of(z, p);  // b has the seat loads' terms too: z^T K z directly
+                const double zw = z[w_dof_];
+                return 0.5 * f_ * (k / gamma_ * u[0] * zw + p.dot(rel) - k_r_ * zw * zw);
+            };
             return f;
         };
     }
@@ -155,29 +205,32 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
                                   problem_.tau_rule, step_problem_);
     op_ = step_problem_.op;
     step_problem_.u = Eigen::VectorXd::Zero(seat_ ? 3 : 1);
-    // relative positions at the start: from z where the operator gives z, else from C'
-    rel_ = op_->has_displacements() ? detail::relative_positions(system_, z_, p_)
-                                    : Eigen::VectorXd(system_.compliance_held() * p_ + c * w_);
+    // relative positions and strain energy at the start: from the start's z
+    rel_ = detail::relative_positions(system_, z_, p_);
     fv_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
     fe_ = seat_ ? fv_ - seat_c_.g.dot(seat_loads(0.0)) : fv_;  // (seat loads: the full model, f = 1)
     if (system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w_;
-    fill_record(0, 0);
+    fill_record(0, 0, strain_of(z_, p_));
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
 }
 
-void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, double strain_j) {
+double ClosedFormStepper::Impl::strain_of(const Eigen::VectorXd& z, const Eigen::VectorXd& p) const {
+    // U = z^T K z / 2 + p^T C_L p / 2 = (p^T C' p + k w^2) / 2 on the meshed part, leaves and
+    // elastic layer (see system.hpp)
+    return f_ * (0.5 * z.dot(system_.stiffness_reduced() * z) + detail::layer_energy_j(system_, p));
+}
+
+Eigen::VectorXd ClosedFormStepper::Impl::held_z(const Eigen::VectorXd& zr, double w) const {
+    Eigen::VectorXd z(w_dof_ + 1);
+    z.head(w_dof_) = zr;
+    z[w_dof_] = w;
+    return z;
+}
+
+void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, double strain) {
     const double f = f_;
     const double k = system_.stiffness_n_per_m();
-    // U = z^T K z / 2 + p^T C_L p / 2 = (p^T C' p + k w^2) / 2 on the meshed part, leaves and
-    // elastic layer (see system.hpp); the sparse path has z itself and never builds C'.
-    // step() passes the stiffness form's U (strain_j >= 0), which it has without a product with K.
-    const double strain = strain_j >= 0.0 ? strain_j
-                          : seat_ ? f * (0.5 * displacements_now().dot(system_.stiffness_reduced() * displacements_now()) +
-                                         detail::layer_energy_j(system_, p_))
-                          : op_->has_displacements()
-                              ? f * (0.5 * z_.dot(system_.stiffness_reduced() * z_) + detail::layer_energy_j(system_, p_))
-                              : 0.5 * f * (p_.dot(system_.compliance_held() * p_) + k * w_ * w_);
     detail::LoadState load;
     load.external_work_j = wext_;
     load.base_displacement_m = options_.loading.base_displacement_m(t_);
@@ -213,8 +266,8 @@ std::vector<PairRecord> ClosedFormStepper::Impl::pairs() const {
 }
 
 Eigen::VectorXd ClosedFormStepper::Impl::displacements_now() const {
-    if (op_->has_displacements()) return z_;
-    return seat_ ? system_.reduced_displacements(p_, w_, seat_state_) : system_.reduced_displacements(p_, w_);
+    if (step_ == 0) return z_;
+    return rig_ ? held_z(contact_->displacements(), w_) : contact_->displacements();
 }
 
 std::vector<LeafNodes> ClosedFormStepper::Impl::nodes() const {
@@ -245,22 +298,16 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     // Steps 2-8: resolve the contact forces at t+dt, s = W p + q (eq. 6 with eq. 16), in the
-    // operator's form; K, G constant over the run. The displacements (where the operator gives
-    // them) are z, or z_r with R's w_next (the rig).
+    // operator's form; K, G constant over the run. The operator's displacements are z, or z_r
+    // with R's w_next (the rig), read when asked (displacements_now).
     step_problem_.u[0] = w_next;
     if (seat_) {
         const Eigen::Vector2d S1 = seat_loads(t1);
         step_problem_.u.tail(2) = S1;
-        // the stiffness form's R row takes -g^T S1 itself (K_aug z = B u + G^T p): w_next without it
-        if (op_->path() == ContactPath::sparse) step_problem_.u[0] += gamma_ / k * seat_c_.g.dot(S1);
     }
     step_problem_.d = d_;
     step_problem_.tau_previous_n = problem_.tau_previous_n;
-    solve_ = contact_->solve(step_problem_, p_, rig_ ? zr_ : z_);
-    if (rig_ && op_->has_displacements()) {
-        z_.head(w_dof_) = zr_;
-        z_[w_dof_] = w_next;
-    }
+    solve_ = contact_->solve(step_problem_, p_);
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
@@ -308,19 +355,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     wd_ = wd1;
     t_ = step_ * dt;
     detail::reanchor(problem_, p_, rel_, d_);
-    // Stiffness form: U = z^T K z / 2 without a product with K, from K_aug z = b + G^T p
-    // (the solved system, K_aug = K + k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2,
-    // with G z = rel_ (made above; with an elastic layer the solved system is the augmented
-    // one, sparse_solver.cpp, and p^T rel_ = p^T G z + p^T C_L p adds the layer's energy twice
-    // over, as z^T K z does for the leaves). b_w w and k_R w^2 are each about 1/gamma times U
-    // (~1e2-1e3 at dt = 1 ms): the difference loses that factor of round-off, 1e-13 relative.
-    // (The rig's held problem is another system: fill_record takes z^T K z there.)
-    double strain = -1.0;
-    if (op_->has_displacements() && !rig_ && !seat_) {  // (seat loads add B u terms: fill_record's z^T K z)
-        const double zw = z_[w_dof_];
-        strain = 0.5 * f_ * (k / gamma_ * w_next * zw + p_.dot(rel_) - k_r_ * zw * zw);
-    }
-    fill_record(solve_.iterations, solve_.factorizations, strain);
+    fill_record(solve_.iterations, solve_.factorizations, contact_->strain_energy_j(p_, rel_));
     detail::count_step(record_, report_);
     return record_;
 }

@@ -5,7 +5,7 @@
 
 namespace stackbeam {
 
-void detail::reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel,
+void detail::reanchor(const ContactLaws& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel,
                       Eigen::VectorXd& d) {
     for (std::size_t j = 0; j < laws.pairs.size(); ++j) {
         const auto& pr = laws.pairs[j];
@@ -14,7 +14,7 @@ void detail::reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, cons
     }
 }
 
-void detail::set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p) {
+void detail::set_previous_step_limits(ContactLaws& problem, const Eigen::VectorXd& p) {
     for (int j = 0; j < static_cast<int>(problem.pairs.size()); ++j) {
         const auto& pr = problem.pairs[j];
         const double pn = pr.row_n >= 0 ? p[pr.row_n] : 0.0;

@@ -10,7 +10,7 @@
 
 namespace stackbeam::detail {
 
-/// The layer compliance for a SparseContactProblem (SparseContactProblem::layer_compliance):
+/// The layer compliance for a stiffness form (SparseStepForm::layer_compliance):
 /// the system's c_L [m/N] when it has an elastic layer, else empty (rigid contact).
 inline Eigen::VectorXd sparse_layer(const System& system) {
     return system.has_layer() ? system.layer_compliance_m_per_n() : Eigen::VectorXd();
@@ -33,7 +33,7 @@ inline double layer_energy_j(const System& system, const Eigen::VectorXd& p) {
 /// Anchors (paper, section 5): a pair that sticks keeps its d_t; every other tangential
 /// row of `laws` (not bonded) is re-anchored where it is, d_t = rel_t. `p`: the forces
 /// that give the states, `rel`: the relative positions s + d [m].
-void reanchor(const ContactProblem& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel, Eigen::VectorXd& d);
+void reanchor(const ContactLaws& laws, const Eigen::VectorXd& p, const Eigen::VectorXd& rel, Eigen::VectorXd& d);
 
 /// The contact rows tied in the initial velocity shape of the steppers with leaf mass (the stack
 /// moving with R, nothing impacting at t = 0): every bilateral normal row, a unilateral one whose
@@ -43,6 +43,6 @@ std::vector<int> closed_rows(const std::vector<ContactPair>& pairs, const Eigen:
 
 /// TauRule::previous_step: sets problem.tau_previous_n [N] per pair from the forces p of
 /// the step before (|p_n| for a unilateral pair, max(0, F_c - p_n) at a clamp).
-void set_previous_step_limits(ContactProblem& problem, const Eigen::VectorXd& p);
+void set_previous_step_limits(ContactLaws& problem, const Eigen::VectorXd& p);
 
 }  // namespace stackbeam::detail

@@ -20,55 +20,47 @@ void require_converged(const SolveResult& r) {
 }
 
 /// The contact state with R held at w0 (held_body_system) by `options`' solver on the start's
-/// path: p [N] on exit; z (w last) set where the operator gives displacements.
+/// path: p [N] and z (w last) on exit.
 void held_contact_state(const System& sys, InitialState& st, const SolverOptions& options) {
     const int w_dof = sys.num_reduced_dofs() - 1;
     StepProblem held;
     held.op = std::make_shared<const ContactOperator>(held_body_system(sys), st.path, options.kind);
-    held.pairs = st.laws.pairs;
-    held.tau_rule = st.laws.tau_rule;
-    held.tau_previous_n = st.laws.tau_previous_n;
+    static_cast<ContactLaws&>(held) = st.laws;
     held.u = Eigen::VectorXd::Constant(1, st.w0_m);
     held.d = st.d;
     StepContactSolver solver(options, st.options.sparse_tuning);
     Eigen::VectorXd zr;
     st.solve = solver.solve(held, st.p, zr);
     require_converged(st.solve);
-    if (held.op->has_displacements()) {
-        if (st.z.size() != w_dof + 1) st.z = Eigen::VectorXd::Zero(w_dof + 1);
-        st.z.head(w_dof) = zr;
-        st.z[w_dof] = st.w0_m;
-    }
+    if (st.z.size() != w_dof + 1) st.z = Eigen::VectorXd::Zero(w_dof + 1);
+    st.z.head(w_dof) = zr;
+    st.z[w_dof] = st.w0_m;
 }
 
-/// The massless stack: the assembly and R's weight -m g as static steps (dense: on C' with `solver`;
-/// sparse: on the whole stack), then the contact state with R held at w0 (no re-anchoring).
+/// The massless stack: the assembly and R's weight -m g as static steps with R free (one solver
+/// over both, on the start's path), then the contact state with R held at w0 (no re-anchoring).
 void start_massless(const System& sys, InitialState& st, const SolverOptions& options) {
-    const int n = sys.num_components(), w_dof = sys.num_reduced_dofs() - 1;
+    const int n = sys.num_components();
     const Loading& L = st.options.loading;
     const double m = sys.mass_kg();
-    if (st.path == ContactPath::dense) {
-        const auto solver = make_solver(options);
-        const bool assemble = needs_assembly(sys.model().spec()) && n > 0;
-        for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
-            if (stage == 0 ? !assemble : !(L.gravity_m_per_s2 > 0.0)) continue;
-            const double Fs = stage == 0 ? 0.0 : -m * L.gravity_m_per_s2;  // [N] on the meshed part
-            const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
-            const StaticState s = static_equilibrium_dense(sys, st.laws, Fs, *solver, st.p, st.d, what);
-            st.w_static_m = s.w_m;
-            st.solve = s.solve;
-            st.pre_stressed = true;
-        }
-    } else {
-        Eigen::VectorXd weight = Eigen::VectorXd::Zero(w_dof + 1);
-        weight[w_dof] = -m * L.gravity_m_per_s2;
-        st.pre_stressed = static_stages(sys, st.laws, weight, st.options, st.z, st.p, st.d, &st.solve);
-        if (st.pre_stressed) st.w_static_m = st.z[w_dof];
-        else st.z = sys.reduced_displacements(st.p, 0.0);
+    StepContactSolver solver(options, st.options.sparse_tuning);
+    const bool assemble = needs_assembly(sys.model().spec()) && n > 0;
+    for (int stage = 0; stage < 2; ++stage) {  // 0: the assembly, 1: R's weight
+        const double Fs = stage == 0 ? 0.0 : -m * L.gravity_m_per_s2;  // [N] on the meshed part
+        if (stage == 0 ? !assemble : !(Fs != 0.0)) continue;
+        const std::string what = stage == 0 ? "assembly of the cambered leaves" : "static equilibrium under gravity";
+        StaticState s = massless_static_state(sys, st.laws, Fs, st.path, solver, st.p, st.d, what);
+        st.w_static_m = s.w_m;
+        st.z = std::move(s.z);
+        st.solve = s.solve;
+        st.pre_stressed = true;
     }
     const auto& rb = sys.model().spec().rigid_body;
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
-    if (st.w0_m == st.w_static_m || n == 0) return;
+    if (st.w0_m == st.w_static_m || n == 0) {  // z: the stages' (R at rest), or the unloaded stack's
+        if (!st.pre_stressed || n == 0) st.z = sys.reduced_displacements(st.p, st.w0_m);
+        return;
+    }
     // the contact state with R held at w(0)
     held_contact_state(sys, st, options);
 }

@@ -16,7 +16,7 @@ namespace stackbeam::detail {
 struct InitialState {
     SimulationOptions options;  ///< as given, the loading prepared for the stepper (Loading::prepare)
     ContactPath path = ContactPath::dense;  ///< the contact path (never automatic; mode cvode: dense)
-    ContactProblem laws;        ///< the pairs, the tau rule and zero previous-step limits (W, q empty)
+    ContactLaws laws;           ///< the pairs, the tau rule and zero previous-step limits
     Eigen::VectorXd p;          ///< contact forces at t = 0 [N] (paper sign)
     Eigen::VectorXd d;          ///< gaps and anchors at t = 0 [m] (the offsets, re-anchored by the static steps)
     /// Reduced displacements at t = 0 [m, rad] (w last): the whole stack's starts and the sparse

@@ -10,6 +10,7 @@
 #include "stackbeam/contact/step.hpp"
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
+#include "time/accurate_sum.hpp"
 #include "time/contact_state.hpp"
 #include "time/record.hpp"
 #include "time/reduced_load.hpp"
@@ -31,24 +32,22 @@ struct NewmarkStepper::Impl {
     struct Factor {
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> llt;   // K_eff (its check: positive definite)
         Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mass;  // M (massive leaves)
-        Eigen::SparseLU<Eigen::SparseMatrix<double>> saddle;      // [M G_C^T; G_C 0] (impact law, sparse path)
     };
     const System& system_;
     SimulationOptions options_;
     Factor factor_;
     Eigen::SparseMatrix<double> K_, M_;
+    Eigen::SparseMatrix<double> keff_f_;  // K_eff on the free DOFs (the rig: without w), factorised in factor_.llt
+    Eigen::SparseMatrix<double> gt_f_;    // G^T on the free DOFs
     std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
     std::unique_ptr<StepContactSolver> contact_;
-    ContactProblem problem_;     // the pair laws and the previous-step limits (W, q empty)
+    ContactLaws problem_;        // the pair laws and the previous-step limits
     StepProblem step_problem_;   // the step's problem: u = r / kappa, d
-    bool dense_projection_ = false;  // the impact projection on the dense A = G M^-1 G^T
+    std::unique_ptr<ImpactProjection> projection_;  // the impact law's projection (massive leaves)
     SolveResult solve_;
     Eigen::VectorXd z_, v_, a_, p_, d_, rel_;
     std::vector<char> massless_;  // DOFs whose row of M is zero (statically condensed)
     bool massive_leaves_ = false;
-    Eigen::MatrixXd Z_, A_;       // M^-1 G^T and G M^-1 G^T (impact law, massive leaves)
-    std::vector<int> held_;       // the held rows of the last projection
-    Eigen::LDLT<Eigen::MatrixXd> held_factor_;  // and A restricted to them
     double t_ = 0.0;
     double e0_ = 0.0, dissipated_ = 0.0, impact_loss_ = 0.0;
     long step_ = 0;
@@ -160,17 +159,10 @@ NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& sta
     }
     initial_accelerations();
     factorise_step();
-    // Impact law (e = 0): Z = M^-1 G^T and A = G M^-1 G^T for the velocity projection, dense
-    // where the step's contact operator is dense (m^2 doubles are affordable there); otherwise
-    // [M G_C^T; G_C 0] is factorised per held set (project_velocities).
-    const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-    dense_projection_ = op_->path() == ContactPath::dense;
-    if (massive_leaves_ && system_.num_components() > 0 && dense_projection_) {
-        Z_ = G.rows() > 0 ? Eigen::MatrixXd(factor_.mass.solve(Eigen::MatrixXd(G.transpose())))
-                          : Eigen::MatrixXd(G.cols(), 0);  // no contact rows: an empty solve is UB in Eigen
-        const Eigen::MatrixXd A = G * Z_;
-        A_ = 0.5 * (A + A.transpose());
-    }
+    // Impact law: the velocity projection on the held rows, on the form of the step's operator
+    // (ImpactProjection, step.hpp)
+    if (massive_leaves_ && system_.num_components() > 0)
+        projection_ = std::make_unique<ImpactProjection>(M_, factor_.mass, system_.contact_rows(), *op_);
     solve_ = SolveResult{};
     solve_.converged = true;
     fill_record(0, 0);
@@ -248,6 +240,8 @@ void NewmarkStepper::Impl::factorise_step() {
             g_h_.col(h) = Eigen::VectorXd(G.col(prescribed_[h]));
         }
     }
+    keff_f_ = KeffF;
+    gt_f_ = GF.transpose();
     factor_.llt.compute(KeffF);
     if (factor_.llt.info() != Eigen::Success)
         throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
@@ -304,7 +298,8 @@ void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
     const double f = system_.model().whole_spring_factor();
     const auto& body = system_.model().spec().rigid_body;
     const int w_dof = static_cast<int>(z_.size()) - 1;
-    const double strain = f * (0.5 * z_.dot(K_ * z_) + detail::layer_energy_j(system_, p_));  // leaves and layer
+    // leaves and layer; z^T K z in twice the working precision (a fine mesh's form cancels: accurate_sum.hpp)
+    const double strain = f * (0.5 * detail::accurate_quadratic_form(K_, z_) + detail::layer_energy_j(system_, p_));
     const Loading& L = options_.loading;
     detail::LoadState ls;  // the loading's force on R (the rig: the load cell's), whole spring, and its work
     // the vertical rig's reaction is the last of rig_force_ (w is the last DOF)
@@ -316,9 +311,9 @@ void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
     // a seat load or the windup rig loads theta_R, so k w - c^T p (every free DOF unloaded) is not R's
     // force on the stack: it is w's row of K z - G^T p (massless leaves; massive ones: below)
     if (!massive_leaves_ && (L.has_seat_load() || L.windup_rig()))
-        record_.spring_force_n = f * (Eigen::VectorXd(K_.col(w_dof)).dot(z_) -
+        record_.spring_force_n = f * (detail::accurate_dot(Eigen::VectorXd(K_.col(w_dof)), z_) -
                                       Eigen::VectorXd(system_.contact_rows().col(w_dof)).dot(p_));
-    const double kinetic = 0.5 * f * v_.dot(M_ * v_);
+    const double kinetic = 0.5 * f * detail::accurate_quadratic_form(M_, v_);
     const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
     record_.kinetic_energy_j = kinetic;
     record_.leaf_kinetic_energy_j = kinetic - body_kinetic;
@@ -383,56 +378,8 @@ double NewmarkStepper::Impl::project_velocities(const Eigen::VectorXd& p0, const
             }
         }
     }
-    if (!dense_projection_) {
-        // M v+ + G_C^T l = M v,  G_C v+ = 0: one sparse LU per held set
-        const int n = static_cast<int>(v_.size());
-        if (held != held_) {
-            std::vector<Eigen::Triplet<double>> t;
-            for (int col = 0; col < M_.outerSize(); ++col)
-                for (Eigen::SparseMatrix<double>::InnerIterator it(M_, col); it; ++it)
-                    t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
-            const Eigen::SparseMatrix<double, Eigen::RowMajor> Gr = system_.contact_rows();
-            for (int i = 0; i < nh; ++i)
-                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Gr, held[i]); it; ++it) {
-                    t.emplace_back(n + i, static_cast<int>(it.col()), it.value());
-                    t.emplace_back(static_cast<int>(it.col()), n + i, it.value());
-                }
-            Eigen::SparseMatrix<double> S(n + nh, n + nh);
-            S.setFromTriplets(t.begin(), t.end());
-            S.makeCompressed();
-            factor_.saddle.compute(S);
-            if (factor_.saddle.info() != Eigen::Success)
-                throw SolverError("newmark: the impact projection's matrix is singular at step " + std::to_string(step_),
-                                  step_, step_ * options_.dt_s, 0.0);
-            held_ = held;
-        }
-        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + nh);
-        rhs.head(n) = M_ * v_;
-        rhs.tail(nh) = b;
-        const Eigen::VectorXd x = factor_.saddle.solve(rhs);
-        const Eigen::VectorXd dv = v_ - x.head(n);
-        v_ = x.head(n);
-        if (e == 0.0) return 0.5 * system_.model().whole_spring_factor() * dv.dot(M_ * dv);
-        // M dv = G_C^T l: l^T (G_C v + b) = dv^T M (2 v - dv) = dv^T M v + ... (kinetic energy change)
-        const Eigen::VectorXd vold = v_ + dv;
-        return 0.5 * system_.model().whole_spring_factor() * (vold.dot(M_ * vold) - v_.dot(M_ * v_));
-    }
-    const Eigen::VectorXd gv = system_.contact_rows() * v_;
-    if (held != held_) {  // factorise A_hh once per held set
-        Eigen::MatrixXd Ahh(nh, nh);
-        for (int i = 0; i < nh; ++i)
-            for (int k = 0; k < nh; ++k) Ahh(i, k) = A_(held[i], held[k]);
-        held_factor_.compute(Ahh);
-        held_ = held;
-    }
-    Eigen::VectorXd rhs(nh);
-    for (int i = 0; i < nh; ++i) rhs[i] = gv[held[i]];
-    const Eigen::VectorXd l = held_factor_.solve(Eigen::VectorXd(rhs - b));
-    Eigen::VectorXd dv = Eigen::VectorXd::Zero(v_.size());
-    for (int i = 0; i < nh; ++i) dv += Z_.col(held[i]) * l[i];
-    v_ -= dv;
-    // 1/2 l^T (G_C v + b) (= 1/2 dv^T M dv = 1/2 l^T A_hh l when b = 0; dv = M^-1 G_C^T l)
-    return 0.5 * system_.model().whole_spring_factor() * l.dot(rhs + b);
+    return projection_->project(held, b, e != 0.0, system_.model().whole_spring_factor(), step_,
+                                step_ * options_.dt_s, v_);
 }
 
 std::vector<PairRecord> NewmarkStepper::Impl::pairs() const {
@@ -453,11 +400,12 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     const Eigen::VectorXd q0 = loaded ? load_.at(t_) : Eigen::VectorXd();
     const Eigen::VectorXd q1 = loaded ? load_.at(t1) : Eigen::VectorXd();
     Eigen::VectorXd r = massive_leaves_
-                            ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) - K_ * z_)
+                            ? Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_) -
+                                              detail::accurate_product(K_, z_))  // K z0 cancels on a fine mesh
                             : Eigen::VectorXd(M_ * Eigen::VectorXd((4.0 / (dt * dt)) * z_ + (4.0 / dt) * v_ + a_));
     if (loaded) r += massive_leaves_ ? Eigen::VectorXd(q0 + q1) : q1;
     const bool damped = C_.nonZeros() > 0;
-    if (damped) r += (2.0 / dt) * (C_ * z_);  // K_eff holds (2/dt) C: the step's damping force is -C (z1 - z0)/dt
+    if (damped) r += (2.0 / dt) * detail::accurate_product(C_, z_);  // K_eff holds (2/dt) C: the step's damping force is -C (z1 - z0)/dt
     // The rigs: the step's problem on z_F with z_H1 given (constructor)
     const bool held = !prescribed_.empty();
     const Eigen::VectorXd zH1 = held ? prescribed_at(t1, 0) : Eigen::VectorXd();
@@ -471,6 +419,18 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     step_problem_.d = dF;
     step_problem_.tau_previous_n = problem_.tau_previous_n;
     solve_ = contact_->solve(step_problem_, p_, zF);
+    // One step of iterative refinement with the residual in twice the working precision
+    // (accurate_sum.hpp): K_eff's factor and z = v + Y p leave a residual ~ cond(K_eff) eps |b|, a
+    // spurious force whose work showed in the balance (1e-8 of the run's energy on
+    // graduated_elastic.toml; 1.9e-13 after one pass; more passes measured no better, down to the
+    // rounding of z itself, eps |K_eff| |z|: decision 065).
+    if (solve_.converged) {
+        detail::AccurateVector rho(zF.size());
+        rho.add(rF);
+        rho.add_product(gt_f_, p_, kappa);
+        rho.add_product(keff_f_, zF, -1.0);
+        zF += factor_.llt.solve(rho.value());
+    }
     Eigen::VectorXd z1 = zF;
     if (held) {
         z1 = S_.transpose() * zF;
@@ -519,14 +479,15 @@ const StepRecord& NewmarkStepper::Impl::advance() {
             // M (v1 - v0) = dt [-K (z0 + z1)/2 + G^T p1 + qbar + lambda_bar e_h], and its work
             // lambda_bar (z1_h - z0_h): the balance closes as for the other forces. Only the row is
             // needed: M, K and C are symmetric, so row h is column h.
-            double lambda_bar = M_.col(h).dot(Eigen::VectorXd((v1 - v_) / dt)) +
-                                0.5 * K_.col(h).dot(Eigen::VectorXd(z_ + z1)) - G.col(h).dot(p_);
+            double lambda_bar = detail::accurate_dot(Eigen::VectorXd(M_.col(h)), Eigen::VectorXd((v1 - v_) / dt)) +
+                                0.5 * detail::accurate_dot(Eigen::VectorXd(K_.col(h)), Eigen::VectorXd(z_ + z1)) -
+                                G.col(h).dot(p_);
             if (loaded) lambda_bar -= 0.5 * (q0[h] + q1[h]);
-            if (damped) lambda_bar += C_.col(h).dot(Eigen::VectorXd((z1 - z_) / dt));
+            if (damped) lambda_bar += detail::accurate_dot(Eigen::VectorXd(C_.col(h)), Eigen::VectorXd((z1 - z_) / dt));
             external_work_ += lambda_bar * (z1[h] - z_[h]);
         }
         // the damping force's work over the step, (z1 - z0)^T C (z1 - z0) / dt >= 0
-        if (damped) damping_energy_ += (z1 - z_).dot(C_ * (z1 - z_)) / dt;
+        if (damped) damping_energy_ += detail::accurate_quadratic_form(C_, Eigen::VectorXd(z1 - z_)) / dt;
         v_ = v1;
         Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 - C v1 + q1 (+ the rig's lambda1 e_w)
         if (loaded) r1 += q1;

@@ -6,7 +6,7 @@
 
 namespace stackbeam {
 
-std::vector<PairRecord> detail::pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+std::vector<PairRecord> detail::pair_records(const System& system, const ContactLaws& laws, const Eigen::VectorXd& p,
                                              const Eigen::VectorXd& rel) {
     std::vector<PairRecord> out(laws.pairs.size());
     const Eigen::VectorXd& d0 = system.initial_offsets_m();
@@ -30,7 +30,7 @@ std::vector<PairRecord> detail::pair_records(const System& system, const Contact
     return out;
 }
 
-void detail::fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
+void detail::fill_state(const System& system, const ContactLaws& laws, const Eigen::VectorXd& p, double w_m,
                         double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
                         const LoadState& load, StepRecord& r) {
     const double f = system.model().whole_spring_factor();

@@ -22,14 +22,14 @@ struct LoadState {
 /// and dissipated energies [J], the loading's fields and the balance
 /// e0 + external work - (kinetic + strain + dissipated) [J]. Leaves t, the
 /// counters and the residual to the caller.
-void fill_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p, double w_m,
+void fill_state(const System& system, const ContactLaws& laws, const Eigen::VectorXd& p, double w_m,
                 double w_dot_m_per_s, double strain_energy_j, double dissipated_energy_j, double e0_j,
                 const LoadState& load, StepRecord& r);
 
 /// The pairs at one time (Stepper::pairs()): states by `laws` (the pairs and their tau
 /// rule), forces p [N] and the relative positions rel = s + d [m], all rows; the gap of
 /// a normal row is max(0, d0 - rel) with d0 the system's initial offsets.
-std::vector<PairRecord> pair_records(const System& system, const ContactProblem& laws, const Eigen::VectorXd& p,
+std::vector<PairRecord> pair_records(const System& system, const ContactLaws& laws, const Eigen::VectorXd& p,
                                      const Eigen::VectorXd& rel);
 
 /// A fixed-step mode's counters after one more step whose record is `r`: one step, its

@@ -89,7 +89,7 @@ void SimulationOptions::validate() const {
         if (spec.type != OptionSpec::Type::keyword) check_option(spec, spec.get(*this));
     if (t_end_s / dt_s > 1e9)
         throw InputError("dt_s", "value " + format_value(dt_s) + " gives more than 1e9 steps to t_end_s = " + format_value(t_end_s) + " s");
-    make_solver(solver);  // validates the solver options
+    solver.validate();
     loading.validate();
     if (restitution > 0.0 && mode != Mode::newmark)
         throw InputError("restitution", "value " + format_value(restitution) + " is not used by mode " + to_string(mode) +

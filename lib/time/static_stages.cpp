@@ -10,21 +10,51 @@
 
 namespace stackbeam {
 
-detail::StaticState detail::static_equilibrium_dense(const System& system, const ContactProblem& laws, double force_n,
-                                                     ContactSolver& solver, Eigen::VectorXd& p, Eigen::VectorXd& d,
-                                                     const std::string& what) {
+detail::StaticState detail::massless_static_state(const System& system, const ContactLaws& laws, double force_n,
+                                                  ContactPath path, StepContactSolver& solver, Eigen::VectorXd& p,
+                                                  Eigen::VectorXd& d, const std::string& what) {
     const double k = system.stiffness_n_per_m();
     const Eigen::VectorXd& c = system.coupling();
+    const int w_dof = system.num_reduced_dofs() - 1;
     StaticState out;
-    if (system.num_components() > 0) {
-        ContactProblem st = laws;
-        st.W = system.compliance_held() + (1.0 / k) * c * c.transpose();
-        st.q = c * (force_n / k) - d;
-        out.solve = solver.solve(st, p);
-        if (!out.solve.converged) throw SolverError(what + ": " + out.solve.message, 0, 0.0, out.solve.residual_m);
-        reanchor(st, p, Eigen::VectorXd(st.W * p + st.q + d), d);
+    if (system.num_components() == 0) {
+        out.w_m = force_n / k;
+        out.z = system.reduced_displacements(p, out.w_m);
+        return out;
     }
-    out.w_m = (force_n + (system.num_components() > 0 ? c.dot(p) : 0.0)) / k;
+    // One load parameter u = [1], the load itself in the forms (so that both take it exactly):
+    // dense W = C' + c c^T / k, q = c F / k - d (R's balance k w - c^T p = F eliminated), z from
+    // p and w = (F + c^T p) / k; sparse K z = F e_w + G^T p, s = G z + c_L p - d on every DOF.
+    StepSystem sys;
+    sys.rows = system.num_components();
+    sys.dense = [&] {
+        DenseStepForm f;
+        f.W = system.compliance_held() + (1.0 / k) * c * c.transpose();
+        f.Q = c * (force_n / k);
+        f.displacements = [&system, &c, k, force_n](const Eigen::VectorXd&, const Eigen::VectorXd& pp) {
+            return system.reduced_displacements(pp, (force_n + c.dot(pp)) / k);
+        };
+        return f;
+    };
+    sys.sparse = [&] {
+        SparseStepForm f;
+        f.K = system.stiffness_reduced();
+        f.G = system.contact_rows();
+        f.layer_compliance = sparse_layer(system);
+        f.B.resize(w_dof + 1, 1);
+        f.B.insert(w_dof, 0) = force_n;
+        f.B.makeCompressed();
+        return f;
+    };
+    StepProblem pr;
+    static_cast<ContactLaws&>(pr) = laws;
+    pr.op = std::make_shared<const ContactOperator>(sys, path, SolverKind::exact);
+    pr.u = Eigen::VectorXd::Ones(1);
+    pr.d = d;
+    out.solve = solver.solve(pr, p, out.z);
+    if (!out.solve.converged) throw SolverError(what + ": " + out.solve.message, 0, 0.0, out.solve.residual_m);
+    reanchor(laws, p, relative_positions(system, out.z, p), d);
+    out.w_m = out.z[w_dof];
     return out;
 }
 
@@ -35,6 +65,10 @@ StepSystem detail::held_body_system(const System& system) {
         DenseStepForm f;
         f.W = system.compliance_held();
         f.Q = system.coupling();
+        f.displacements = [&system](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {  // z_r
+            const Eigen::VectorXd z = system.reduced_displacements(p, u[0]);
+            return Eigen::VectorXd(z.head(z.size() - 1));
+        };
         return f;
     };
     sys.sparse = [&system] {
@@ -53,42 +87,34 @@ StepSystem detail::held_body_system(const System& system) {
     return sys;
 }
 
-SparseContactProblem detail::sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
-                                            const Eigen::VectorXd& d, double w_held_m) {
-    const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
-    const Eigen::SparseMatrix<double>& G = system.contact_rows();
-    const int w_dof = static_cast<int>(K.rows()) - 1;
-    SparseContactProblem st;
-    if (!std::isnan(w_held_m)) {  // K_rr z_r = G_r^T p + b_r - K_rw w,  s = G_r z_r + G_w w + c_L p - d
-        st.K = K.topLeftCorner(w_dof, w_dof);
-        st.G = G.leftCols(w_dof);
-        const Eigen::VectorXd krw_w = Eigen::VectorXd(K.block(0, w_dof, w_dof, 1)) * w_held_m;
-        st.b = b.size() > 0 ? Eigen::VectorXd(b.head(w_dof) - krw_w) : Eigen::VectorXd(-krw_w);
-        st.d = d - Eigen::VectorXd(G.col(w_dof)) * w_held_m;
-    } else {
-        st.K = K;
-        st.G = G;
-        st.b = b.size() > 0 ? b : Eigen::VectorXd::Zero(K.rows());
-        st.d = d;
-    }
-    st.layer_compliance = sparse_layer(system);
-    st.pairs = laws.pairs;
-    st.tau_rule = laws.tau_rule;
-    st.tau_previous_n = laws.tau_previous_n;
-    return st;
-}
-
-Eigen::VectorXd detail::static_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
+Eigen::VectorXd detail::static_state(const System& system, const ContactLaws& laws, const Eigen::VectorXd& b,
                                      double w_held_m, const SimulationOptions& options, Eigen::VectorXd& p,
                                      Eigen::VectorXd& d, const std::string& what, SolveResult* result) {
     const int nz = system.num_reduced_dofs(), w_dof = nz - 1;
     const bool held = !std::isnan(w_held_m);
-    SparseContactProblem st = sparse_problem(system, laws, b, d, w_held_m);
+    const Eigen::SparseMatrix<double>& K = system.stiffness_reduced();
+    const Eigen::SparseMatrix<double>& G = system.contact_rows();
+    // the stiffness form: with R held, K_rr z_r = G_r^T p + b_r - K_rw w, s = G_r z_r + G_w w + c_L p - d
+    SparseStepForm form;
+    Eigen::VectorXd b_form, d_form;
+    if (held) {
+        form.K = K.topLeftCorner(w_dof, w_dof);
+        form.G = G.leftCols(w_dof);
+        const Eigen::VectorXd krw_w = Eigen::VectorXd(K.block(0, w_dof, w_dof, 1)) * w_held_m;
+        b_form = b.size() > 0 ? Eigen::VectorXd(b.head(w_dof) - krw_w) : Eigen::VectorXd(-krw_w);
+        d_form = d - Eigen::VectorXd(G.col(w_dof)) * w_held_m;
+    } else {
+        form.K = K;
+        form.G = G;
+        b_form = b.size() > 0 ? b : Eigen::VectorXd::Zero(K.rows());
+        d_form = d;
+    }
+    form.layer_compliance = sparse_layer(system);
     if (system.num_components() == 0) {  // no contact: K z = b (R held: on z_r)
-        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(st.K);
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(form.K);
         Eigen::VectorXd z = Eigen::VectorXd::Constant(nz, held ? w_held_m : 0.0);
-        if (held) z.head(w_dof) = ldlt.solve(st.b);
-        else z = ldlt.solve(st.b);
+        if (held) z.head(w_dof) = ldlt.solve(b_form);
+        else z = ldlt.solve(b_form);
         if (result) *result = SolveResult{};
         return z;
     }
@@ -97,20 +123,12 @@ Eigen::VectorXd detail::static_state(const System& system, const ContactProblem&
     // the stiffness form whatever the model's size (a one-off solve): the operator forced sparse
     StepSystem sys;
     sys.rows = system.num_components();
-    sys.sparse = [&st] {
-        SparseStepForm f;
-        f.K = st.K;
-        f.G = st.G;
-        f.layer_compliance = st.layer_compliance;
-        return f;
-    };
+    sys.sparse = [&form] { return form; };
     StepProblem pr;
     pr.op = std::make_shared<const ContactOperator>(sys, ContactPath::sparse, SolverKind::exact);
-    pr.pairs = st.pairs;
-    pr.tau_rule = st.tau_rule;
-    pr.tau_previous_n = st.tau_previous_n;
-    pr.u = st.b;
-    pr.d = st.d;
+    static_cast<ContactLaws&>(pr) = laws;
+    pr.u = b_form;
+    pr.d = d_form;
     StepContactSolver solver(exact, options.sparse_tuning);
     Eigen::VectorXd z = Eigen::VectorXd::Zero(nz), zs;
     if (p.size() != system.num_components()) p = Eigen::VectorXd::Zero(system.num_components());
@@ -127,7 +145,7 @@ Eigen::VectorXd detail::static_state(const System& system, const ContactProblem&
     return z;
 }
 
-bool detail::static_stages(const System& system, const ContactProblem& laws, const Eigen::VectorXd& weight,
+bool detail::static_stages(const System& system, const ContactLaws& laws, const Eigen::VectorXd& weight,
                            const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
                            SolveResult* result) {
     const ModelSpec& spec = system.model().spec();

@@ -1,7 +1,7 @@
 #pragma once
 // Internal: the quasi-static solves before t = 0: the stack under a load with R free or held
 // (sparse path), the assembly and gravity stages of the steppers with leaf mass, and the
-// massless stack's static equilibrium under a force on R (dense path).
+// massless stack's static equilibrium under a force on R (on the run's path).
 #include <Eigen/Dense>
 #include <string>
 
@@ -11,14 +11,6 @@
 #include "stackbeam/time/simulation.hpp"
 
 namespace stackbeam::detail {
-
-/// The sparse contact problem of the stack under a load b on the reduced DOFs [N, N m per DOF]
-/// (w last; empty: none) with the offsets d [m] and `laws`' pairs, tau rule and previous-step
-/// limits: with R free (w_held_m NaN) K z = G^T p + b, s = G z + c_L p - d on every DOF; with R
-/// held at w_held_m [m] on z_r alone, K_rr z_r = G_r^T p + b_r - K_rw w, s = G_r z_r + G_w w +
-/// c_L p - d. static_state below poses it.
-SparseContactProblem sparse_problem(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b,
-                                    const Eigen::VectorXd& d, double w_held_m);
 
 /// The contact problem of the massless stack with R held at w [m], the load parameter u = [w],
 /// in both forms (step.hpp; the operator takes one): dense W = C', q = c w - d; sparse (on z_r)
@@ -33,7 +25,7 @@ StepSystem held_body_system(const System& system);
 /// options' tuning, whatever the model's size (a one-off solve). On exit p holds the forces [N]
 /// and d is re-anchored (reanchor). Returns z [m, rad]; throws SolverError naming `what` if the
 /// solve fails; `result` (optional) receives the solve.
-Eigen::VectorXd static_state(const System& system, const ContactProblem& laws, const Eigen::VectorXd& b, double w_held_m,
+Eigen::VectorXd static_state(const System& system, const ContactLaws& laws, const Eigen::VectorXd& b, double w_held_m,
                              const SimulationOptions& options, Eigen::VectorXd& p, Eigen::VectorXd& d,
                              const std::string& what, SolveResult* result = nullptr);
 
@@ -43,22 +35,24 @@ Eigen::VectorXd static_state(const System& system, const ContactProblem& laws, c
 /// "assembly"), then the static equilibrium under `weight` [N per reduced DOF] when it is not
 /// zero (gravity: -g l). Returns whether a stage ran; z [m, rad], p [N] and d (re-anchored)
 /// hold the state, `result` the last solve.
-bool static_stages(const System& system, const ContactProblem& laws, const Eigen::VectorXd& weight,
+bool static_stages(const System& system, const ContactLaws& laws, const Eigen::VectorXd& weight,
                    const SimulationOptions& options, Eigen::VectorXd& z, Eigen::VectorXd& p, Eigen::VectorXd& d,
                    SolveResult* result = nullptr);
 
 /// The static equilibrium of the massless stack under a force `force_n` [N] on R (meshed
-/// part), as one quasi-static load step from the state with anchors d on the dense
-/// compliance: k w - c^T p = F, s = C'p + c w - d, i.e. W = C' + c c^T/k, q = c F/k - d.
-/// `laws` gives the pairs and tau rule, `p` the warm start and the forces on exit; d's
-/// non-stuck pairs are re-anchored. Returns w [m] and the solve; throws SolverError
-/// (naming `what`) if the contact solve fails.
+/// part), as one quasi-static load step from the state with anchors d, R free: K z = F e_w + G^T p,
+/// s = G z + c_L p - d, on the form `path` resolves to (dense: R's balance k w - c^T p = F
+/// eliminated, W = C' + c c^T/k, q = c F/k - d). `laws` gives the pairs and tau rule, `p` the warm
+/// start and the forces on exit; d's non-stuck pairs are re-anchored. `solver` is shared by the
+/// stages (the dense exact solver keeps its modes over them). Returns w [m], z and the solve;
+/// throws SolverError (naming `what`) if the contact solve fails.
 struct StaticState {
     double w_m = 0.0;
+    Eigen::VectorXd z;  ///< [m, rad], w last
     SolveResult solve;
 };
-StaticState static_equilibrium_dense(const System& system, const ContactProblem& laws, double force_n,
-                                     ContactSolver& solver, Eigen::VectorXd& p, Eigen::VectorXd& d,
-                                     const std::string& what);
+StaticState massless_static_state(const System& system, const ContactLaws& laws, double force_n, ContactPath path,
+                                  StepContactSolver& solver, Eigen::VectorXd& p, Eigen::VectorXd& d,
+                                  const std::string& what);
 
 }  // namespace stackbeam::detail

@@ -67,13 +67,13 @@ private:
 struct StressTable {
     struct Leaf {
         int leaf = 0;
-        std::vector<double> x, top, bottom, n, m, v;  // x: one per node; the rest row by row
+        std::vector<double> x, thickness, top, bottom, n, m, v;  // x, thickness: one per node; the rest row by row
     };
     std::vector<double> t;
     std::vector<Leaf> leaves;
     void add(double t_s, const Stresses& s) {
         if (leaves.empty())
-            for (const LeafStresses& l : s.leaves) leaves.push_back({l.leaf, l.x_m, {}, {}, {}, {}, {}});
+            for (const LeafStresses& l : s.leaves) leaves.push_back({l.leaf, l.x_m, l.thickness_m, {}, {}, {}, {}, {}});
         t.push_back(t_s);
         for (std::size_t i = 0; i < s.leaves.size() && i < leaves.size(); ++i) {
             const LeafStresses& l = s.leaves[i];
@@ -96,6 +96,7 @@ struct StressTable {
             d["leaf"] = k.leaf;
             d["t"] = py::array_t<double>(t.size(), t.data());
             d["x"] = py::array_t<double>(k.x.size(), k.x.data());
+            d["thickness"] = py::array_t<double>(k.thickness.size(), k.thickness.data());
             d["sigma_top"] = grid(k.top);
             d["sigma_bottom"] = grid(k.bottom);
             d["N"] = grid(k.n);

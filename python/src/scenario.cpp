@@ -307,7 +307,9 @@ void bind_scenario(py::module_& m) {
         .def_property("summary_path", getter(&ScenarioOutputs::summary_path), setter(&ScenarioOutputs::summary_path, "outputs.summary_path"))
         .def_property("pairs_path", getter(&ScenarioOutputs::pairs_path), setter(&ScenarioOutputs::pairs_path, "outputs.pairs_path"))
         .def_property("nodes_path", getter(&ScenarioOutputs::nodes_path), setter(&ScenarioOutputs::nodes_path, "outputs.nodes_path"))
-        .def_property("plot_prefix", getter(&ScenarioOutputs::plot_prefix), setter(&ScenarioOutputs::plot_prefix, "outputs.plot_prefix"));
+        .def_property("plot_prefix", getter(&ScenarioOutputs::plot_prefix), setter(&ScenarioOutputs::plot_prefix, "outputs.plot_prefix"))
+        .def_property("stresses_path", getter(&ScenarioOutputs::stresses_path),
+                      setter(&ScenarioOutputs::stresses_path, "outputs.stresses_path"));
 
     py::class_<PyScenario, ScenarioPtr>(m, "Scenario", "A whole run: the stack, the loading, the integrator, the outputs")
         .def(py::init([] {

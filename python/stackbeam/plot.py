@@ -8,7 +8,9 @@ friction force at the probe, force-deflection loop), each on an Axes you may giv
 
 The deformed stack (each leaf's deflected axis, every pair coloured by its state) needs the
 nodes and the pairs of the run: simulate(..., nodes=True, pairs=True), then
-deformed_stack(result, times=[...]) or animate_stack(result, "run.gif").
+deformed_stack(result, times=[...]) or animate_stack(result, "run.gif"); coloured by the leaves'
+fibre stresses instead: simulate(..., nodes=True, stresses=True), then
+deformed_stack(result, color_by="stress").
 
 The stresses along each leaf (top and bottom fibre at chosen times, and the cycle's envelope)
 need simulate(..., stresses=True), then stresses(result, times=[...]).
@@ -212,14 +214,56 @@ def _draw_stack(ax, stack, i, scale):
     return artists
 
 
-def deformed_stack(result, times=None, scale=None, ax=None):
+STACK_COLORS = ("state", "stress")
+STRESS_CMAP = "coolwarm"  # blue compression, red tension; the scale symmetric about 0
+
+
+def _draw_stress_stack(ax, stack, i, scale, leaves, norm):
+    """Draws record i with each leaf as a band from its bottom to its top fibre (the drawn axis
+    -+ half the local thickness: the thickness true, the deflection scaled) coloured by its stress
+    [MPa] at that record (result.stresses), Gouraud-shaded: linear through the thickness between
+    the two fibres' values, as sigma = N/A - M y/I is, and linear along x between the nodes.
+    Returns the meshes, one per leaf, each with gid "leaf L" and its colour data (get_array) the
+    (2 x nodes) array [sigma_bottom, sigma_top] at that record [MPa]."""
+    axes = stack.leaf_axes(i)
+    artists = []
+    for s in leaves:
+        leaf = int(s["leaf"])
+        x_axis, w_axis = axes[leaf]
+        x = _np.asarray(s["x"])
+        y_axis = stack.heights[leaf] + scale * _np.interp(x, x_axis, w_axis)
+        half = 0.5 * _np.asarray(s["thickness"])
+        xx = 1000 * _np.vstack([x, x])
+        yy = 1000 * _np.vstack([y_axis - half, y_axis + half])
+        sigma = _np.vstack([_np.asarray(s["sigma_bottom"])[i], _np.asarray(s["sigma_top"])[i]]) / 1e6
+        mesh = ax.pcolormesh(xx, yy, sigma, shading="gouraud", cmap=STRESS_CMAP, norm=norm)
+        mesh.set_gid("leaf %d" % leaf)
+        artists.append(mesh)
+    return artists
+
+
+def deformed_stack(result, times=None, scale=None, ax=None, color_by="state"):
     """The deformed stack at the records nearest to `times` [s] (default: the records of the
     largest and the smallest w, as the command line's --plot): each leaf's axis at its height in
     the stack plus its deflection times `scale` (default: stack_scale's rule; the scale is printed
     on the figure), every pair a point midway between its two leaves coloured by its state
     (stick green, slip red, open hollow blue), the half model mirrored to the whole stack.
     Needs simulate(..., nodes=True) (and pairs=True for the states). One Axes per time, stacked;
-    `ax` (one time only) draws on that Axes. Returns the Figure."""
+    `ax` (one time only) draws on that Axes. Returns the Figure.
+
+    color_by="stress" (needs simulate(..., nodes=True, stresses=True)): instead of the pairs, each
+    leaf drawn as a band of its true local thickness about its drawn axis, coloured by its stress
+    at that record [MPa, tension positive]: the top and bottom fibres' (result.stresses' sigma_top,
+    sigma_bottom) at the band's edges, linear between them (through the thickness, as the bending
+    stress is) and between the nodes; one colour scale symmetric about 0 over every time drawn,
+    with a colour bar."""
+    if color_by not in STACK_COLORS:
+        raise _error("color_by", "value %r is not allowed: must be one of %s" % (color_by, ", ".join(STACK_COLORS)))
+    leaves = None
+    if color_by == "stress":
+        leaves = getattr(result, "stresses", None)
+        if leaves is None:
+            raise _error("result.stresses", "is None: color_by='stress' needs simulate(..., nodes=True, stresses=True)")
     stack = _Stack(result)
     if times is None:
         records = [int(_np.argmax(stack.w_record)), int(_np.argmin(stack.w_record))]
@@ -241,12 +285,25 @@ def deformed_stack(result, times=None, scale=None, ax=None):
         axs = axs[:, 0]
     else:
         fig, axs = ax.figure, [ax]
+    norm = None
+    if leaves is not None:
+        from matplotlib.colors import Normalize
+
+        # the records of the stresses are the run's (Result.stresses' t is result["t"])
+        peak = max(float(_np.max(_np.abs(_np.concatenate([_np.asarray(s["sigma_top"])[records],
+                                                           _np.asarray(s["sigma_bottom"])[records]])))) for s in leaves)
+        peak = peak / 1e6 if peak > 0 else 1.0
+        norm = Normalize(-peak, peak)
     for a, i in zip(axs, records):
-        _draw_stack(a, stack, i, scale)
+        if leaves is None:
+            _draw_stack(a, stack, i, scale)
+        else:
+            drawn = _draw_stress_stack(a, stack, i, scale, leaves, norm)
+            fig.colorbar(drawn[0], ax=a, label="fibre stress [MPa], tension positive")
         a.set(title="t = %.4g s, w = %.4g mm" % (stack.times[i], 1000 * stack.w_record[i]),
               xlabel="x [mm]", ylabel="height + %g x deflection [mm]" % scale)
         a.grid(True)
-        if stack.pairs is not None:
+        if leaves is None and stack.pairs is not None:
             a.legend(loc="upper right", fontsize="small")
     fig.suptitle("deformed stack: deflection drawn x %g" % scale)
     fig.tight_layout()

@@ -22,13 +22,18 @@
 
 namespace stackbeam {
 
-/// The per-step contact problem: s = W p + q with the pair laws.
-struct ContactProblem {
-    Eigen::MatrixXd W;                 ///< compliance [m/N], symmetric positive definite
-    Eigen::VectorXd q;                 ///< free term [m]: s when p = 0
+/// The pair laws of a contact problem, whatever form its operator takes: the pairs and their
+/// rows, the tau rule and the previous step's limits. Every problem type below is one.
+struct ContactLaws {
     std::vector<ContactPair> pairs;    ///< the pairs and their rows
     TauRule tau_rule = TauRule::current;
     Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (used with TauRule::previous_step)
+};
+
+/// The per-step contact problem in dense form: s = W p + q with the pair laws.
+struct ContactProblem : ContactLaws {
+    Eigen::MatrixXd W;                 ///< compliance [m/N], symmetric positive definite
+    Eigen::VectorXd q;                 ///< free term [m]: s when p = 0
 
     int size() const { return static_cast<int>(q.size()); }
     /// Throws InputError if the sizes, rows or laws are inconsistent.
@@ -40,10 +45,10 @@ enum class PairState { stick, slip, open };
 const char* to_string(PairState state);
 
 /// tau [N] of pair `k` for the force vector p, by the problem's tau rule.
-double friction_normal_force(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+double friction_normal_force(const ContactLaws& problem, int k, const Eigen::VectorXd& p);
 
 /// The paper's error vector v (eq. 9) for forces p and relative positions s = W p + q.
-Eigen::VectorXd error_vector(const ContactProblem& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
+Eigen::VectorXd error_vector(const ContactLaws& problem, const Eigen::VectorXd& p, const Eigen::VectorXd& s);
 
 /// Solver-independent residual [m]: the natural map of the contact laws, scaled to
 /// metres by the diagonal of W. Per component, with w = W_kk:
@@ -56,7 +61,7 @@ Eigen::VectorXd natural_map(const ContactProblem& problem, const Eigen::VectorXd
 
 /// State of pair k at (p, s). A pair whose normal force is zero and may open is
 /// open; a tangential force at the friction limit (relative 1e-9) is slip; bonded pairs stick.
-PairState pair_state(const ContactProblem& problem, int k, const Eigen::VectorXd& p);
+PairState pair_state(const ContactLaws& problem, int k, const Eigen::VectorXd& p);
 
 /// The available solvers.
 enum class SolverKind {
@@ -85,28 +90,32 @@ struct SolverOptions {
                                           ///< the Tresca fixed point on the friction limits, 0..50; 0 = the plain
                                           ///< fixed point (decision 007: of 3, 5 and 8 only 8 settles the graduated
                                           ///< 10 x 400 first step; 3 needs 6-23 % fewer factorisations at 10 x 100)
+    /// Throws InputError naming `solver.<field>`, the value and what is allowed, for a field out of range.
+    void validate() const;
 };
 
-/// What a solve reports. A solve that does not converge says so; it never passes silently.
+/// What a solve reports, the same fields in the same meaning whichever form (dense W or sparse
+/// K, G: step.hpp) and solver ran; a count of a route the solver did not take is 0. A solve that
+/// does not converge says so; it never passes silently.
 struct SolveResult {
     bool converged = false;
-    int iterations = 0;        ///< iterations (paper/accelerated) or active-set passes (exact; sparse path:
-                               ///< also the semismooth Newton iterations, counted in newton_iterations too,
-                               ///< and the box QPs' pivoting passes and interior-point iterations)
+    int iterations = 0;        ///< the solver's iterations of every kind, its measure of work: sweeps (paper,
+                               ///< accelerated, block-Jacobi, the Gauss-Seidel fallback), active-set passes,
+                               ///< Newton iterations (also counted in newton_iterations) and box-QP iterations
     double residual_m = 0.0;   ///< ||v||_2 (eq. 9) at the returned forces [m]
     double natural_residual_m = 0.0;  ///< ||natural_map||_2 at the returned forces [m]
-    int factorizations = 0;    ///< factorisations done in this solve (exact solver; sparse path: sparse LU
-                               ///< of the saddle-point system or dense LU of the held rows' Schur complement,
-                               ///< and one sparse LDL^T per interior-point iteration on a box QP)
-    int updates = 0;           ///< sparse path: sets of modes solved by a low-rank update of the last
-                               ///< sparse LU instead of a factorisation (SparsePathTuning::max_border_rows)
-    int newton_iterations = 0; ///< sparse path: iterations of the semismooth Newton method (each one linear
-                               ///< solve of a set of modes: a factorisation, an update or a cached one)
-    int smoothing_iterations = 0;  ///< sparse path: iterations of the smoothing Newton method (each one sparse LU
-                                   ///< of its Jacobian's saddle-point system), for transitions the semismooth one does not settle
-    int tresca_iterations = 0;   ///< exact solver: passes of the Tresca fixed point on the friction limits (box
-                                 ///< QPs solved; SolverOptions::tresca_anderson_depth), where it ran
-    bool fell_back = false;    ///< the exact solver cycled and finished with Gauss-Seidel
+    int factorizations = 0;    ///< matrix factorisations this solve did (LU or LDL^T of a set of modes' linear
+                               ///< system, dense or sparse, and of the box QPs' systems); 0 for the iterative solvers
+    int updates = 0;           ///< sets of modes solved by a low-rank update of an earlier factorisation instead of
+                               ///< a new one (the sparse form's bordered LU, SparsePathTuning::max_border_rows)
+    int newton_iterations = 0; ///< iterations of the semismooth Newton method (each one linear solve of a set of
+                               ///< modes: a factorisation, an update or a cached one; SparsePathTuning::newton_min_rows)
+    int smoothing_iterations = 0;  ///< iterations of the smoothing Newton method (each one LU of its Jacobian's
+                                   ///< system), for transitions the semismooth one does not settle
+    int tresca_iterations = 0;   ///< passes of the Tresca fixed point on the friction limits (box QPs solved;
+                                 ///< SolverOptions::tresca_anderson_depth), where it ran
+    bool fell_back = false;    ///< the answer is not one the active-set passes confirmed: the settled Tresca fixed
+                               ///< point, the Gauss-Seidel sweeps or (sparse form) the dense exact solver finished it
     std::string message;       ///< why it did not converge, when it did not
 };
 
@@ -131,7 +140,7 @@ std::unique_ptr<ContactSolver> make_solver(const SolverOptions& options);
 ///     W = G K^-1 G^T,  q = G K^-1 b - d     (to_dense()),
 /// so both have the same solution; this form never builds the dense W (its cost
 /// grows with the number of elements, not with its square or cube).
-struct SparseContactProblem {
+struct SparseContactProblem : ContactLaws {
     Eigen::SparseMatrix<double> K;     ///< stiffness, n x n, symmetric positive definite (both triangles stored)
     Eigen::SparseMatrix<double> G;     ///< contact rows [-], m x n
     Eigen::VectorXd b;                 ///< load with p = 0, n entries
@@ -142,9 +151,6 @@ struct SparseContactProblem {
     /// (K' = diag(K, 1/c_L), G' = [G  E]): G' K'^-1 G'^T = G K^-1 G^T + diag(c_L), the same problem with
     /// a positive definite K' (docs/decisions/013-elastic-interface.md).
     Eigen::VectorXd layer_compliance;
-    std::vector<ContactPair> pairs;    ///< the pairs and their rows (rows of G)
-    TauRule tau_rule = TauRule::current;
-    Eigen::VectorXd tau_previous_n;    ///< per pair tau [N] of the previous step (TauRule::previous_step)
 
     int size() const { return static_cast<int>(d.size()); }
     /// Throws InputError if the sizes, rows or laws are inconsistent.

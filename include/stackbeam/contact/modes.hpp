@@ -82,8 +82,9 @@ public:
     }
 
     /// The linear problem of the current modes.
-    void linearize(const ContactProblem& pr, ModeLinearization& lin) const {
-        const int n = pr.size();
+    void linearize(const ContactProblem& pr, ModeLinearization& lin) const { linearize(pr, pr.size(), lin); }
+    /// The same for the laws of a problem of n rows.
+    void linearize(const ContactLaws& pr, int n, ModeLinearization& lin) const {
         const int np = static_cast<int>(pr.pairs.size());
         const bool prev = pr.tau_rule == TauRule::previous_step;
         lin.e.setZero(n);

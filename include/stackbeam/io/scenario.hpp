@@ -27,6 +27,7 @@ struct ScenarioOutputs {
     std::string pairs_path;   ///< `[outputs] pairs_path`: every pair at every output time (CSV), optional
     std::string nodes_path;   ///< `[outputs] nodes_path`: every leaf's nodal displacements at every output time (CSV), optional
     std::string plot_prefix;  ///< `[outputs] plot_prefix`: PNG figures PREFIX_*.png (gnuplot), optional
+    std::string stresses_path;  ///< `[outputs] stresses_path`: every leaf's stresses at every output time (CSV), optional
 };
 
 /// The words of `[[interfaces]] law` (and of the Python module's Interface.law): coulomb,

@@ -61,15 +61,13 @@ public:
     const Eigen::VectorXd& anchors() const noexcept;
     /// State of each pair of system().pairs().
     std::vector<PairState> pair_states() const;
-    /// The contact problem of the last step (W, q, pairs), e.g. to replay it with another solver.
-    /// On the sparse path W and q are empty (the pairs and tau rule are set): see last_sparse_problem().
-    const ContactProblem& last_problem() const noexcept;
-    /// The sparse contact problem of the last step (sparse path; empty on the dense path).
-    const SparseContactProblem& last_sparse_problem() const noexcept;
-    /// The path this stepper's contact operator took (never automatic).
+    /// The step's contact solve (step.hpp): its last problem in the form solved
+    /// (last_dense_problem(), last_sparse_problem()), e.g. to replay a step with another solver.
+    const StepContactSolver& contact_solver() const noexcept;
+    /// The path this stepper's contact operator took (never automatic): for reports.
     ContactPath contact_path() const noexcept;
-    /// Reduced displacements z of the leaves [m, rad] at the current step (sparse path; empty on the dense path).
-    const Eigen::VectorXd& reduced_displacements() const noexcept;
+    /// Reduced displacements z of the leaves [m, rad] at the current step (w last), on either path.
+    Eigen::VectorXd reduced_displacements() const;
     const SolveResult& last_solve() const noexcept;
     const System& system() const noexcept;
     double omega_rad_per_s() const noexcept;

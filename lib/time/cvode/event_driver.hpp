@@ -213,7 +213,7 @@ protected:
     /// Gaps (normal rows) and anchors (tangential rows) [m] of the current modes.
     const Vec& anchors() const noexcept { return d_; }
     /// The pairs and their laws (tau rule current), the check problem's W.
-    const ContactProblem& laws() const noexcept { return chk_problem_; }
+    const ContactLaws& laws() const noexcept { return chk_problem_; }
     const std::vector<ContactPair>& pairs() const { return chk_problem_.pairs; }
     double time() const noexcept { return t_; }        ///< the last accepted time [s]
     long steps() const noexcept { return stats_.steps; }
@@ -298,8 +298,9 @@ private:
     ModeSet modes_;
     Vec d_, d_chk_;                // anchors of the modes and of the per-step check [m]
     std::vector<Slot> slots_;      // one witness per possible transition
-    ContactProblem chk_problem_, ev_problem_;
-    std::unique_ptr<ContactSolver> chk_solver_, ev_solver_;
+    // the check's and the events' problems on one dense operator (W; u = the motion, q = u - d)
+    StepProblem chk_problem_, ev_problem_;
+    std::unique_ptr<StepContactSolver> chk_solver_, ev_solver_;
     double ev_tolerance_ = 0.0;    // [m]
     std::unique_ptr<CvodeSession> cvode_;
     double t_ = 0.0, t_final_ = 0.0, dt_ = 0.0;
@@ -325,6 +326,13 @@ private:
     void init_grid();
     void init_slots();
     void init_problems(const Eigen::MatrixXd& W, double event_tolerance_m);
+    /// The round-off of the event problem's numbers [m]: its relative positions `motion` = G z
+    /// and anchors `d` [m]. An event solve that stops above its tolerance but within this has
+    /// reached what the problem's own numbers resolve, and its answer is taken.
+    double round_off_m(const Vec& motion, const Vec& d) const;
+    /// Appended to the step limit's SolverError: the mean and last step against the stack's
+    /// period, the events, and the pairs that changed modes most lately.
+    std::string step_limit_diagnostics() const;
     void start_cvode(const EventStart& s);
     void decide_initial_modes(const InitialState& stage, const EventStart& s);
     void rebuild();
