@@ -23,6 +23,18 @@
 /// initial velocity" is met by giving the paper example an initial velocity of
 /// +2 m/s (the example is mirror-symmetric in y, so the sign is immaterial).
 ///
+/// Seat (the rigid body's attachment, full model; loading.hpp "Seat loads and the windup rig"):
+///  - its reference point lies on the tied leaves' mid-height at x_R (RigidBodySpec::x_m); the tied
+///    leaves move there as one plane section with R's w (+y) [m], theta_R (counter-clockwise, +theta)
+///    [rad] and, where the seat slides (RigidBodySpec::axial), u_R (+x) [m]: a tied leaf at height y
+///    moves (u_R - y theta_R, w). The half model has neither theta_R nor u_R (its symmetry plane).
+///  - A seat moment M [N m] is counter-clockwise positive (it turns the seat by +theta_R).
+///  - A longitudinal force H [N] is +x, its line of action h [m] above the reference point (+y; a
+///    braking force at the tyre's contact patch has h < 0): it acts as H on u_R and the moment
+///    M_z = x F_y - y F_x = -H h on theta_R.
+///  - The seat's moment in the records is the moment applied to the spring there, M - H h plus the
+///    windup rig's reaction.
+///
 /// Contact (the paper's convention, eqs. 7-10, kept so the equations read as printed):
 ///  - Interface i lies between leaf i (upper, body "A") and leaf i+1 (lower, body "B").
 ///  - The pair normal n points from A into B, i.e. DOWN (-y); the tangent t is +x.

@@ -25,12 +25,6 @@ namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-/// Whether an end support holds the stack axially through its eye (then the seat does not).
-bool holds_axially(SupportKind s, const LeafEndSpec& e) {
-    return s == SupportKind::hinged || (s == SupportKind::shackle && e.shackle_angle_rad != 0.0) ||
-           (s == SupportKind::bushing && e.bushing_x_n_per_m > 0.0);
-}
-
 }  // namespace
 
 int System::node_dof(int leaf, int node) const {
@@ -69,9 +63,10 @@ System::System(const Model& model) : model_(model) {
     const bool seat_rotates = !half;
     // The seat locates the stack axially unless an end's eye does (a hinged eye, a shackle, a bushing):
     // then it slides, with the axial displacement u_R of its own (docs/model-and-scenarios.md).
-    const bool seat_slides = !half && std::any_of(spec.leaves.begin(), spec.leaves.end(), [](const LeafSpec& l) {
-        return holds_axially(l.left_support, l.left_end) || holds_axially(l.right_support, l.right_end);
-    });
+    // rigid_body.axial: 'auto' as described, 'held' never slides, 'free' always does.
+    const SeatAxial axial = spec.rigid_body.axial;
+    const bool ends_locate = ends_locate_axially(spec);
+    const bool seat_slides = stackbeam::seat_slides(spec);
     std::vector<int> role(num_full_, 0);
     std::vector<std::vector<std::pair<int, double>>> dependent(num_full_);
     for (int l = 0; l < nleaf; ++l) {
@@ -137,6 +132,8 @@ System::System(const Model& model) : model_(model) {
     const int slide_master = seat_slides ? nm++ : -1;
     const int theta_master = seat_rotates ? nm++ : -1;
     const int w_master = nm++;
+    seat_axial_dof_ = slide_master;
+    seat_rotation_dof_ = theta_master;
     Triplets pt;
     for (int l = 0; l < nleaf; ++l)
         for (int j = model_.first_node(l); j <= model_.last_node(l); ++j)
@@ -246,6 +243,13 @@ System::System(const Model& model) : model_(model) {
     Krw_col_ = K_red_.block(0, nr, nr, 1);
     const double Kww = K_red_.coeff(nr, nr);
     Krr_llt_.compute(Krr);
+    const bool fixed_end = std::any_of(spec.leaves.begin(), spec.leaves.end(), [](const LeafSpec& l) {
+        return l.left_support == SupportKind::fixed || l.right_support == SupportKind::fixed;
+    });
+    if (seat_slides && axial == SeatAxial::free && !ends_locate && !fixed_end)  // the factor may not see it
+        throw InputError("rigid_body.axial", "value 'free': the stack is not located axially, as no end holds it "
+                                             "(give an end a hinged eye, an inclined shackle, a bushing with "
+                                             "bushing_x_n_per_m > 0 or a fixed support, or rigid_body.axial = 'held')");
     if (Krr_llt_.info() != Eigen::Success)
         throw InputError("leaves", "the stack is not restrained with the rigid body held: some leaf (or the seat) can move "
                                    "as a rigid body; give it supports or tie it to the rigid body (rigid_body.tied_leaves)");
@@ -312,6 +316,35 @@ Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w
     z.head(nr) = Krr_llt_.solve(rhs);
     z[nr] = w;
     return z;
+}
+
+Eigen::VectorXd System::reduced_displacements(const Eigen::VectorXd& p, double w, const Eigen::Vector2d& seat_loads) const {
+    Eigen::VectorXd z = reduced_displacements(p, w);
+    const int nr = static_cast<int>(K_red_.rows()) - 1;
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(nr);
+    if (seat_rotation_dof_ >= 0) e[seat_rotation_dof_] = seat_loads[0];
+    if (seat_axial_dof_ >= 0) e[seat_axial_dof_] = seat_loads[1];
+    if (e.squaredNorm() > 0.0) z.head(nr) += Krr_llt_.solve(e);
+    return z;
+}
+
+System::SeatCondensation System::seat_condensation() const {
+    const int nr = static_cast<int>(K_red_.rows()) - 1;
+    SeatCondensation out;
+    out.B = Eigen::MatrixXd::Zero(Gr_.rows(), 2);
+    const Eigen::VectorXd krw = Eigen::VectorXd(Krw_col_);
+    const int dofs[2] = {seat_rotation_dof_, seat_axial_dof_};
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nr, 2);  // K_rr^-1 E
+    for (int j = 0; j < 2; ++j) {
+        if (dofs[j] < 0) continue;
+        X.col(j) = Krr_llt_.solve(Eigen::VectorXd::Unit(nr, dofs[j]));
+        if (Gr_.rows() > 0) out.B.col(j) = Gr_ * X.col(j);
+        out.g[j] = krw.dot(X.col(j));
+    }
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            if (dofs[i] >= 0) out.F(i, j) = X(dofs[i], j);
+    return out;
 }
 
 Eigen::VectorXd System::leaf_displacements(const Eigen::VectorXd& p, double w) const {

@@ -29,10 +29,17 @@ Eigen::SparseMatrix<double> leaf_mass_full(const Model& model, int num_full,
 }
 }  // namespace
 
-Eigen::SparseMatrix<double> System::mass_reduced() const {
+Eigen::SparseMatrix<double> System::mass_reduced(bool with_body) const {
     const Eigen::SparseMatrix<double> M = leaf_mass_full(model_, num_full_, [this](int l, int j) { return node_dof(l, j); });
     Eigen::SparseMatrix<double> Mr = (P_.transpose() * M * P_).pruned();
+    if (!with_body) return Mr;
     Mr.coeffRef(Mr.rows() - 1, Mr.cols() - 1) += mass_;  // the rigid body on w (meshed part's share)
+    // the axle's pitch inertia on theta_R and its mass on u_R (full model only: no share to take)
+    const auto& body = model_.spec().rigid_body;
+    if (seat_rotation_dof_ >= 0 && body.pitch_inertia_kg_m2 > 0.0)
+        Mr.coeffRef(seat_rotation_dof_, seat_rotation_dof_) += body.pitch_inertia_kg_m2;
+    // (rigid_body.axial = 'auto' keeps the model before windup: the body's axial inertia left out)
+    if (seat_axial_dof_ >= 0 && body.axial == SeatAxial::free) Mr.coeffRef(seat_axial_dof_, seat_axial_dof_) += mass_;
     return Mr;
 }
 

@@ -412,9 +412,13 @@ void parse_clips(const Table& top, ModelSpec& spec) {
 }
 
 void parse_rigid_body(const Table& top, ModelSpec& spec) {
-    const Table t = top.table("rigid_body", {"mass_kg", "x_m", "tied_leaves"});
+    const Table t = top.table("rigid_body", {"mass_kg", "x_m", "tied_leaves", "pitch_inertia_kg_m2", "axial"});
     spec.rigid_body.mass_kg = t.number("mass_kg", "the mass [kg], > 0");
     spec.rigid_body.x_m = t.number("x_m", "the attachment position [m]");
+    spec.rigid_body.pitch_inertia_kg_m2 =
+        t.number_or("pitch_inertia_kg_m2", "the axle's pitch inertia about the seat [kg m^2], >= 0", 0.0);
+    const SeatAxial automatic = SeatAxial::automatic;
+    spec.rigid_body.axial = choice<SeatAxial>(t, "axial", &automatic);
     if (t.has("tied_leaves")) {
         const auto& v = t.at("tied_leaves");
         if (!v.is_array()) t.wrong_type("tied_leaves", v, "an array of leaf indices");
@@ -468,7 +472,8 @@ TimeFunction parse_time_function(const Table& parent, const std::string& key, co
 
 Loading parse_loading(const Table& top, ModelSpec& spec) {
     const Table t = top.table("loading", {"kind", "initial_displacement_m", "initial_velocity_m_per_s", "gravity_m_per_s2",
-                                          "force_n", "displacement_m"});
+                                          "force_n", "displacement_m", "seat_moment_n_m", "longitudinal_force_n",
+                                          "longitudinal_force_height_m", "seat_rotation_rad"});
     Loading l;
     l.kind = choice<LoadingKind>(t, "kind", nullptr);
     spec.rigid_body.initial_displacement_m = t.number_or("initial_displacement_m", "w(0) [m]", 0.0);
@@ -485,6 +490,12 @@ Loading parse_loading(const Table& top, ModelSpec& spec) {
                              std::string(to_string(l.kind)) + "')");
     if (force) l.force_n = parse_time_function(t, "force_n", "N");
     if (disp) l.displacement_m = parse_time_function(t, "displacement_m", "m");
+    // seat loads and the windup rig (loading.hpp)
+    if (t.has("seat_moment_n_m")) l.seat_moment_n_m = parse_time_function(t, "seat_moment_n_m", "N m");
+    if (t.has("longitudinal_force_n")) l.longitudinal_force_n = parse_time_function(t, "longitudinal_force_n", "N");
+    l.longitudinal_force_height_m =
+        t.number_or("longitudinal_force_height_m", "the longitudinal force's height above the seat [m]", 0.0);
+    if (t.has("seat_rotation_rad")) l.seat_rotation_rad = parse_time_function(t, "seat_rotation_rad", "rad");
     return l;
 }
 

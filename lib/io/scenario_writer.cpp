@@ -217,6 +217,9 @@ std::string to_toml(const Scenario& s) {
             out << (i ? ", " : "") << m.rigid_body.tied_leaves[i];
         out << "]\n";
     }
+    // the windup keys only where they differ from the defaults (files of vertical loadings unchanged)
+    if (m.rigid_body.pitch_inertia_kg_m2 != 0.0) top.num("pitch_inertia_kg_m2", m.rigid_body.pitch_inertia_kg_m2);
+    if (m.rigid_body.axial != SeatAxial::automatic) top.word("axial", to_string(m.rigid_body.axial));
 
     // [loading]: the loading of the options and R's initial conditions of the model
     const Loading& load = s.simulation.loading;
@@ -225,9 +228,13 @@ std::string to_toml(const Scenario& s) {
     top.num("initial_displacement_m", m.rigid_body.initial_displacement_m);
     top.num("initial_velocity_m_per_s", m.rigid_body.initial_velocity_m_per_s);
     top.num("gravity_m_per_s2", load.gravity_m_per_s2);
+    if (load.longitudinal_force_n) top.num("longitudinal_force_height_m", load.longitudinal_force_height_m);
     if (load.kind == LoadingKind::applied_force) write_time_function(out, "loading.force_n", load.force_n);
     if (load.kind == LoadingKind::prescribed_displacement || load.kind == LoadingKind::base_excitation)
         write_time_function(out, "loading.displacement_m", load.displacement_m);
+    if (load.seat_moment_n_m) write_time_function(out, "loading.seat_moment_n_m", *load.seat_moment_n_m);
+    if (load.longitudinal_force_n) write_time_function(out, "loading.longitudinal_force_n", *load.longitudinal_force_n);
+    if (load.seat_rotation_rad) write_time_function(out, "loading.seat_rotation_rad", *load.seat_rotation_rad);
 
     out << "\n[mesh]\n";
     top.num("element_length_m", m.mesh.element_length_m);

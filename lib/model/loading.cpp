@@ -231,11 +231,59 @@ void Loading::validate(bool leaf_mass) const {
             break;
         case LoadingKind::base_excitation: displacement_m.validate("loading.displacement_m", true); break;
     }
+    // seat loads and the windup rig (loading.hpp)
+    if (seat_moment_n_m) seat_moment_n_m->validate("loading.seat_moment_n_m", false);
+    if (longitudinal_force_n) longitudinal_force_n->validate("loading.longitudinal_force_n", false);
+    if (!std::isfinite(longitudinal_force_height_m))
+        throw InputError("loading.longitudinal_force_height_m", "value " + format_value(longitudinal_force_height_m) +
+                                                                    " is not allowed: the height [m] must be finite");
+    if (longitudinal_force_height_m != 0.0 && !longitudinal_force_n)
+        throw InputError("loading.longitudinal_force_height_m",
+                         "value " + format_value(longitudinal_force_height_m) +
+                             " is given without a longitudinal force (loading.longitudinal_force_n): give both, or remove it");
+    if (seat_rotation_rad) {
+        seat_rotation_rad->validate("loading.seat_rotation_rad", leaf_mass);
+        if (seat_moment_n_m)
+            throw InputError("loading.seat_moment_n_m", "is given together with a prescribed seat rotation "
+                                                        "(loading.seat_rotation_rad): the windup rig's moment is a result; give one of them");
+        if (kind == LoadingKind::base_excitation)
+            throw InputError("loading.seat_rotation_rad", "is not available with kind = 'base-excitation': the windup rig "
+                                                          "holds the seat vertically (kind 'prescribed-displacement') or "
+                                                          "leaves it free under a force (kinds 'initial-conditions', 'applied-force')");
+        // "zero" to rounding of the shape's own scale (sin(-pi/2) + 1, cos(-pi/2) are not exactly 0)
+        const TimeFunction& f = *seat_rotation_rad;
+        double scale = std::abs(f.mean) + f.amplitude, rate_scale = 2.0 * 3.14159265358979323846 * f.frequency_hz;
+        for (double v : f.values) scale = std::max(scale, std::abs(v));
+        if (f.times_s.size() >= 2) rate_scale = 1.0 / (f.times_s[1] - f.times_s[0]);
+        const double theta0 = f.value(0.0);
+        if (std::abs(theta0) > 1e-12 * scale)
+            throw InputError("loading.seat_rotation_rad", "has the value " + format_value(theta0) +
+                                                          " rad at t = 0: the run starts from the unwound seat, so theta_R(0) must be 0 "
+                                                          "(a harmonic's phase or a table's first value)");
+        // with leaf mass the rig's motion loads the leaves' inertia, and the run starts them at rest
+        if (leaf_mass && std::abs(seat_rotation_rad->derivative(0.0)) > 1e-12 * scale * rate_scale)
+            throw InputError("loading.seat_rotation_rad", "has the rate " + format_value(seat_rotation_rad->derivative(0.0)) +
+                                                          " rad/s at t = 0: with leaf mass the run starts at rest, so theta_R'(0) "
+                                                          "must be 0 (a harmonic from rest: mean = amplitude, phase_rad = -pi/2)");
+    }
+}
+
+double Loading::seat_moment_n_m_at(double t) const {
+    double M = seat_moment_n_m ? seat_moment_n_m->value(t) : 0.0;
+    if (longitudinal_force_n) M -= longitudinal_force_n->value(t) * longitudinal_force_height_m;  // H at h: -H h
+    return M;
+}
+
+double Loading::longitudinal_force_n_at(double t) const {
+    return longitudinal_force_n ? longitudinal_force_n->value(t) : 0.0;
 }
 
 void Loading::prepare(bool leaf_mass) {
     validate(leaf_mass);
     force_n.prepare(false);
+    if (seat_moment_n_m) seat_moment_n_m->prepare(false);
+    if (longitudinal_force_n) longitudinal_force_n->prepare(false);
+    if (seat_rotation_rad) seat_rotation_rad->prepare(leaf_mass);
     displacement_m.prepare(kind == LoadingKind::base_excitation ||
                            (leaf_mass && kind == LoadingKind::prescribed_displacement));
 }
@@ -257,13 +305,15 @@ double Loading::base_velocity_m_per_s(double t) const {
 }
 
 double Loading::period_s() const {
+    double period = 0.0;
     switch (kind) {
-        case LoadingKind::applied_force: return force_n.period_s();
+        case LoadingKind::applied_force: period = force_n.period_s(); break;
         case LoadingKind::prescribed_displacement:
-        case LoadingKind::base_excitation: return displacement_m.period_s();
+        case LoadingKind::base_excitation: period = displacement_m.period_s(); break;
         case LoadingKind::initial_conditions: break;
     }
-    return 0.0;
+    if (period == 0.0 && seat_rotation_rad) period = seat_rotation_rad->period_s();  // the windup rig's
+    return period;
 }
 
 }  // namespace stackbeam

@@ -43,6 +43,16 @@ const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>() {
 }
 
 template <>
+const std::vector<EnumWord<SeatAxial>>& enum_words<SeatAxial>() {
+    static const std::vector<EnumWord<SeatAxial>> words = {
+        {SeatAxial::automatic, "auto"},
+        {SeatAxial::held, "held"},
+        {SeatAxial::free, "free"},
+    };
+    return words;
+}
+
+template <>
 const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>() {
     static const std::vector<EnumWord<MeanStressCorrection>> words = {
         {MeanStressCorrection::goodman, "goodman"},
@@ -56,6 +66,27 @@ const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrecti
 const char* to_string(SupportKind kind) { return word_of(kind); }
 const char* to_string(InterfaceContact contact) { return word_of(contact); }
 const char* to_string(MeanStressCorrection correction) { return word_of(correction); }
+const char* to_string(SeatAxial axial) { return word_of(axial); }
+
+namespace {
+/// Whether an end support holds the stack axially through its eye (then the seat need not).
+bool holds_axially(SupportKind s, const LeafEndSpec& e) {
+    return s == SupportKind::hinged || (s == SupportKind::shackle && e.shackle_angle_rad != 0.0) ||
+           (s == SupportKind::bushing && e.bushing_x_n_per_m > 0.0);
+}
+}  // namespace
+
+bool ends_locate_axially(const ModelSpec& spec) {
+    return std::any_of(spec.leaves.begin(), spec.leaves.end(), [](const LeafSpec& l) {
+        return holds_axially(l.left_support, l.left_end) || holds_axially(l.right_support, l.right_end);
+    });
+}
+
+bool seat_slides(const ModelSpec& spec) {
+    if (spec.symmetry == Symmetry::half) return false;
+    return spec.rigid_body.axial == SeatAxial::free ||
+           (spec.rigid_body.axial == SeatAxial::automatic && ends_locate_axially(spec));
+}
 
 InterfaceContact parse_interface_contact(const std::string& text, const std::string& field) {
     if (const auto contact = find_word<InterfaceContact>(text)) return *contact;
@@ -313,6 +344,7 @@ Model Model::build(ModelSpec spec) {
     require_finite("rigid_body.x_m", rb.x_m);
     require_finite("rigid_body.initial_displacement_m", rb.initial_displacement_m);
     require_finite("rigid_body.initial_velocity_m_per_s", rb.initial_velocity_m_per_s);
+    require_nonnegative("rigid_body.pitch_inertia_kg_m2", rb.pitch_inertia_kg_m2, "[kg m^2]");
     auto present = [&](std::size_t leaf, double x) {
         return x >= leaves[leaf].x_start_m - tol && x <= leaf_end(leaves[leaf]) + tol;
     };
@@ -366,6 +398,14 @@ Model Model::build(ModelSpec spec) {
     const bool half = spec.symmetry == Symmetry::half;
     if (half) {
         const double xr = rb.x_m;
+        // the symmetry plane holds the seat's rotation and axial motion (theta = u = 0 there)
+        if (rb.pitch_inertia_kg_m2 > 0.0)
+            throw InputError("rigid_body.pitch_inertia_kg_m2",
+                             "value " + format_value(rb.pitch_inertia_kg_m2) +
+                                 " is not used by the half model, whose seat does not rotate (give 0, or use mesh.symmetry = 'full')");
+        if (rb.axial == SeatAxial::free)
+            throw InputError("rigid_body.axial", "value 'free' is not available on the half model, whose symmetry plane "
+                                                 "locates the seat axially (use mesh.symmetry = 'full')");
         for (std::size_t i = 0; i < leaves.size(); ++i) {
             const auto& l = leaves[i];
             if (std::abs(l.x_start_m + 0.5 * l.length_m - xr) > tol)

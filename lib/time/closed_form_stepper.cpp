@@ -46,6 +46,16 @@ struct ClosedFormStepper::Impl {
     // external work [J, whole spring].
     bool rig_ = false;
     double f_ = 1.0, m_whole_ = 0.0, fe_ = 0.0, wext_ = 0.0;
+    // Seat loads S = [M - H h; H] on theta_R, u_R (loading.hpp), condensed (System::SeatCondensation):
+    // R feels -g^T S besides the vertical loading fv_ (fe_ = fv_ - g^T S), the contact offsets shift by B S.
+    bool seat_ = false;
+    System::SeatCondensation seat_c_;
+    double fv_ = 0.0;                                          // the vertical loading on R at t [N]
+    Eigen::Vector2d seat_motion_ = Eigen::Vector2d::Zero();    // [theta_R; u_R] at t [rad, m]
+    Eigen::Vector2d seat_state_ = Eigen::Vector2d::Zero();     // S in the state at t: 0 at the start (unloaded), then S(t)
+    Eigen::Vector2d seat_loads(double t_s) const {
+        return {options_.loading.seat_moment_n_m_at(t_s), options_.loading.longitudinal_force_n_at(t_s)};
+    }
     /// U [J, whole spring] from z (w last) and p.
     double strain_of(const Eigen::VectorXd& z, const Eigen::VectorXd& p) const;
     /// z of the rig's state: z_r and R held at w.
@@ -108,6 +118,10 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     // U = (p^T C' p + k w^2) / 2 on the dense form (w = w_next + gamma c^T p / k; the rig: w_next),
     // z^T K z / 2 + p^T C_L p / 2 on the sparse one (advance(): without a product with K).
     StepSystem sys = rig_ ? detail::held_body_system(system_) : StepSystem{};
+    // seat loads: u = [w_next; S] (the vertical rig with them is refused: check_capabilities)
+    seat_ = load.has_seat_load();
+    // the seat's motion is recorded on every full model (an asymmetric spring's seat turns under a vertical load)
+    if (system_.seat_rotation_dof() >= 0) seat_c_ = system_.seat_condensation();
     const auto dense_energy = [this, k](double w, const Eigen::VectorXd& p) {
         return 0.5 * f_ * (p.dot(system_.compliance_held() * p) + k * w * w);
     };
@@ -130,13 +144,21 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
         sys.dense = [&, dense_energy] {
             DenseStepForm f;
             f.W = system_.compliance_held() + (gamma_ / k) * c * c.transpose();
-            f.Q = c;
-            // z = (z_r, w) with R free at w = w_next + gamma c^T p / k (the step's w(t + dt))
+            f.Q.resize(n, seat_ ? 3 : 1);
+            f.Q.col(0) = c;
+            if (seat_) f.Q.rightCols(2) = seat_c_.B;  // s = C' p + c w + B S - d
+            // z = (z_r, w) with R free at w = w_next + gamma c^T p / k (the step's w(t + dt)), and the
+            // seat loads S = u.tail(2) on theta_R, u_R
             f.displacements = [this, k, &c](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
-                return system_.reduced_displacements(p, u[0] + gamma_ * c.dot(p) / k);
+                const double w = u[0] + gamma_ * c.dot(p) / k;
+                return seat_ ? system_.reduced_displacements(p, w, Eigen::Vector2d(u.tail(2)))
+                             : system_.reduced_displacements(p, w);
             };
             f.strain_energy_j = [this, k, &c, dense_energy](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
-                return dense_energy(u[0] + gamma_ * c.dot(p) / k, p);
+                const double w = u[0] + gamma_ * c.dot(p) / k;
+                // with seat loads the free DOFs are loaded: (p^T C' p + k w^2) / 2 no longer holds
+                return seat_ ? strain_of(system_.reduced_displacements(p, w, Eigen::Vector2d(u.tail(2))), p)
+                             : dense_energy(w, p);
             };
             return f;
         };
@@ -153,8 +175,16 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
             k_r_ = k * one_minus_gamma / gamma_;
             f.K.coeffRef(w_dof_, w_dof_) += k_r_;
             f.K.makeCompressed();
-            f.B.resize(w_dof_ + 1, 1);
+            f.B.resize(w_dof_ + 1, seat_ ? 3 : 1);
             f.B.insert(w_dof_, 0) = k / gamma_;
+            if (seat_) {  // the seat loads on their DOFs (a DOF the seat lacks carries nothing)
+                if (system_.seat_rotation_dof() >= 0) f.B.insert(system_.seat_rotation_dof(), 1) = 1.0;
+                if (system_.seat_axial_dof() >= 0) f.B.insert(system_.seat_axial_dof(), 2) = 1.0;
+                // and their condensed force on R, -g^T S, which w_next (the dense form's) holds:
+                // R's row of K_aug z = B u reads (k/gamma) (w_next + (gamma/k) g^T S)
+                f.B.insert(w_dof_, 1) = seat_c_.g[0];
+                f.B.insert(w_dof_, 2) = seat_c_.g[1];
+            }
             f.B.makeCompressed();
             // U without a product with K, from K_aug z = b + G^T p (the solved system, K_aug = K +
             // k_R e_w e_w^T): z^T K z = b_w w + p^T (G z) - k_R w^2, with G z = rel (with an elastic
@@ -164,6 +194,7 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
             // that factor of round-off, 1e-13 relative.
             f.strain_energy_j = [this, k](const Eigen::VectorXd& u, const Eigen::VectorXd& p, const Eigen::VectorXd& z,
                                           const Eigen::VectorXd& rel) {
+                if (seat_) return strain_of(z, p);  // b has the seat loads' terms too: z^T K z directly
                 const double zw = z[w_dof_];
                 return 0.5 * f_ * (k / gamma_ * u[0] * zw + p.dot(rel) - k_r_ * zw * zw);
             };
@@ -173,10 +204,12 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     contact_ = start_step_contact(sys, options_.contact_path, options_.solver, options_.sparse_tuning, problem_.pairs,
                                   problem_.tau_rule, step_problem_);
     op_ = step_problem_.op;
-    step_problem_.u = Eigen::VectorXd::Zero(1);
+    step_problem_.u = Eigen::VectorXd::Zero(seat_ ? 3 : 1);
     // relative positions and strain energy at the start: from the start's z
     rel_ = detail::relative_positions(system_, z_, p_);
-    fe_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
+    fv_ = rig_ ? 0.0 : load.external_force_n(0.0, m_whole_) / f_;
+    fe_ = seat_ ? fv_ - seat_c_.g.dot(seat_loads(0.0)) : fv_;  // (seat loads: the full model, f = 1)
+    if (system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w_;
     fill_record(0, 0, strain_of(z_, p_));
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
@@ -206,9 +239,16 @@ void ClosedFormStepper::Impl::fill_record(int iterations, int factorizations, do
         load.force_on_mass_n = m_whole_ * options_.loading.displacement_m.second_derivative(t_);
         load.external_force_n = f * (k * w_ - (p_.size() > 0 ? system_.coupling().dot(p_) : 0.0));
     } else {
-        load.external_force_n = f * fe_;
+        load.external_force_n = f * fv_;
     }
     detail::fill_state(system_, problem_, p_, w_, wd_, strain, dissipated_, e0_, load, record_);
+    if (seat_) {  // R's force on the stack with the state's seat loads (SeatCondensation), and the seat's records
+        record_.spring_force_n += f * seat_c_.g.dot(seat_state_);
+        record_.force_on_mass_n = record_.external_force_n - record_.spring_force_n;
+        record_.seat_moment_n_m = seat_loads(t_)[0];
+    }
+    record_.seat_rotation_rad = seat_motion_[0];
+    record_.seat_axial_m = seat_motion_[1];
     record_.t_s = t_;
     record_.contact_iterations = iterations;
     record_.factorizations = factorizations;
@@ -251,6 +291,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         // Step 1: k1, k2 from w^t, w_dot^t; the part of w(t+dt) that does not depend on p(t+dt).
         // F = c^T p + F_e, both linear over the step (eq. 14; F_e the loading, loading.hpp).
         fe1 = load.external_force_n(t1, m_whole_) / f_;
+        if (seat_) fe1 -= seat_c_.g.dot(seat_loads(t1));  // the seat loads' force on R (condensed)
         F0 = cp0 + fe_;
         w_next = w_ * cos_ + wd_ * sin_ / omega_ + F0 / k * (1.0 - cos_) - gamma_ * F0 / k + gamma_ * fe1 / k;
     }
@@ -260,6 +301,10 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
     // operator's form; K, G constant over the run. The operator's displacements are z, or z_r
     // with R's w_next (the rig), read when asked (displacements_now).
     step_problem_.u[0] = w_next;
+    if (seat_) {
+        const Eigen::Vector2d S1 = seat_loads(t1);
+        step_problem_.u.tail(2) = S1;
+    }
     step_problem_.d = d_;
     step_problem_.tau_previous_n = problem_.tau_previous_n;
     solve_ = contact_->solve(step_problem_, p_);
@@ -292,9 +337,19 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         const double spring0 = f_ * (k * w0 - cp0), spring1 = f_ * (k * w1 - cp1);
         wext_ += 0.5 * (spring0 + spring1) * (w1 - w0) + 0.5 * m_whole_ * wd1 * wd1 - kin0;
     } else {
-        wext_ += 0.5 * f_ * (fe_ + fe1) * (w1 - w0);
+        // the vertical loading's work on w, and the seat loads' on [theta_R; u_R] (not the condensed force)
+        const double fv1 = load.external_force_n(t1, m_whole_) / f_;
+        wext_ += 0.5 * f_ * (fv_ + fv1) * (w1 - w0);
+        if (seat_) {
+            const Eigen::Vector2d motion1 = seat_c_.B.transpose() * p_ - seat_c_.g * w1 + seat_c_.F * seat_loads(t1);
+            wext_ += 0.5 * (seat_loads(t_) + seat_loads(t1)).dot(motion1 - seat_motion_);
+            seat_motion_ = motion1;
+            seat_state_ = seat_loads(t1);
+        }
+        fv_ = fv1;
         fe_ = fe1;
     }
+    if (!seat_ && system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w1;
     rel_ = rel1;
     w_ = w1;
     wd_ = wd1;

@@ -4,6 +4,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <algorithm>
 #include <cmath>
 
 #include "stackbeam/contact/step.hpp"
@@ -53,10 +54,17 @@ struct NewmarkStepper::Impl {
     StepRecord record_;
     RunReport report_;
     detail::ReducedLoad load_;                 // the loading's q(t) on the reduced DOFs
-    bool rig_ = false;                         // w prescribed (the rig)
-    Eigen::VectorXd keff_w_, g_w_;             // the rig: K_eff's and G's columns of w
-    Eigen::VectorXd u_w_;                      // the rig: M^-1 e_w [1/kg]
-    double rig_force_ = 0.0;                   // the rig: its force lambda on R's DOF at t [N, meshed part]
+    bool rig_ = false;                         // w prescribed (the vertical rig)
+    // The rigs: the prescribed DOFs H (ascending; w by the vertical rig, theta_R by the windup rig,
+    // loading.hpp), each with its function of time, and the free DOFs F, the rest.
+    std::vector<int> prescribed_;
+    std::vector<const TimeFunction*> prescribed_f_;
+    Eigen::SparseMatrix<double> S_;            // F <- all: the free rows (nf x n)
+    bool free_leading_ = true;                 // F = the first nf DOFs (H the last ones)
+    Eigen::MatrixXd keff_h_, g_h_;             // K_eff's free rows and G's, on the columns of H
+    Eigen::MatrixXd u_h_;                      // M^-1 E_H [1/kg, 1/(kg m^2)] (massive leaves)
+    Eigen::VectorXd rig_force_;                // lambda per prescribed DOF at t [N, N m, meshed part]
+    double body_mass_on_w_ = 0.0;              // R's mass in M_'s w entry [kg, whole spring] (0: the windup rig)
     double external_work_ = 0.0;               // the loading's (or the rig's) work [J, meshed part]
     Eigen::SparseMatrix<double> C_;            // structural damping alpha M + beta K (empty: none)
     double damping_energy_ = 0.0;              // its work [J, meshed part]
@@ -65,8 +73,14 @@ struct NewmarkStepper::Impl {
     void initial_accelerations();
     /// K_eff factorised and the step's contact operator (on K_eff / kappa, dense or sparse).
     void factorise_step();
-    /// Massive leaves with the rig: M a = r + lambda e_w with a_w = w_p''(t); lambda [N] in lambda_n.
-    Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, double* lambda_n) const;
+    /// Massive leaves with a rig: M a = r + E_H lambda with a_H = z_p''(t); lambda [N, N m] in lambda.
+    Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, Eigen::VectorXd* lambda) const;
+    /// The prescribed DOFs' values z_H(t) [m, rad] (derivative 0), velocities (1) or accelerations (2).
+    Eigen::VectorXd prescribed_at(double t_s, int derivative) const;
+    /// The free rows of a matrix on the reduced DOFs, S A S^T.
+    Eigen::SparseMatrix<double> free_block(const Eigen::SparseMatrix<double>& A) const;
+    /// Massless leaves with a rig (static: M = 0): lambda = (K z - G^T p - q)_H at t [N, N m].
+    Eigen::VectorXd static_rig_forces(double t_s) const;
     double project_velocities(const Eigen::VectorXd& p0, const Eigen::VectorXd& gv0);
 };
 
@@ -109,7 +123,28 @@ NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& sta
     const auto& leaves = system_.model().spec().leaves;
     massive_leaves_ = !leaves.empty() && leaves[0].density_kg_per_m3 > 0.0;
     K_ = system_.stiffness_reduced();
-    M_ = system_.mass_reduced();
+    // The windup rig is quasi-static as the vertical rig: R's inertia (m on w and u_R, J) is not in its loop.
+    const bool windup = options_.loading.windup_rig();
+    M_ = system_.mass_reduced(!windup);
+    body_mass_on_w_ = windup ? 0.0 : system_.model().spec().rigid_body.mass_kg;
+    const int n = static_cast<int>(K_.rows());
+    if (windup) {
+        prescribed_.push_back(system_.seat_rotation_dof());
+        prescribed_f_.push_back(&*options_.loading.seat_rotation_rad);
+    }
+    if (rig_) {
+        prescribed_.push_back(n - 1);
+        prescribed_f_.push_back(&options_.loading.displacement_m);
+    }
+    std::vector<Eigen::Triplet<double>> sel;
+    for (int i = 0, row = 0; i < n; ++i)
+        if (std::find(prescribed_.begin(), prescribed_.end(), i) == prescribed_.end()) {
+            if (i != row) free_leading_ = false;
+            sel.emplace_back(row++, i, 1.0);
+        }
+    S_.resize(n - static_cast<int>(prescribed_.size()), n);
+    S_.setFromTriplets(sel.begin(), sel.end());
+    rig_force_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(prescribed_.size()));
     if (options_.damping.active()) {  // structural damping C = alpha M + beta K (massive leaves)
         C_ = options_.damping.rayleigh_alpha_per_s * M_ + options_.damping.rayleigh_beta_s * K_;
         C_.makeCompressed();
@@ -150,11 +185,18 @@ void NewmarkStepper::Impl::initial_accelerations() {
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     const Eigen::VectorXd r0 = Eigen::VectorXd(G.transpose() * p_) - K_ * z_ + load_.at(0.0) -
                                (C_.nonZeros() > 0 ? Eigen::VectorXd(C_ * v_) : Eigen::VectorXd::Zero(n));
-    if (rig_) {  // M^-1 e_w, once: the rig's reaction per unit force
-        Eigen::VectorXd ew = Eigen::VectorXd::Zero(n);
-        ew[n - 1] = 1.0;
-        u_w_ = factor_.mass.solve(ew);
+    if (!prescribed_.empty() && !massive_leaves_) {
+        // massless leaves with a rig (the windup rig): M = 0 (mass_reduced(false)), every step static
+        a_ = Eigen::VectorXd::Zero(n);
+        rig_force_ = static_rig_forces(0.0);
+    } else if (!prescribed_.empty()) {  // M^-1 E_H, once: the rigs' reactions per unit force
+        const int nh = static_cast<int>(prescribed_.size());
+        Eigen::MatrixXd eh = Eigen::MatrixXd::Zero(n, nh);
+        for (int h = 0; h < nh; ++h) eh(prescribed_[h], h) = 1.0;
+        u_h_ = factor_.mass.solve(eh);
         a_ = accelerations_with_rig(0.0, r0, &rig_force_);
+    } else if (massive.empty()) {
+        a_ = Eigen::VectorXd::Zero(n);  // nothing has mass (an empty factorisation is UB in Eigen)
     } else {
         const int ns = static_cast<int>(massive.size());
         Eigen::SparseMatrix<double> S(ns, n);
@@ -175,20 +217,28 @@ void NewmarkStepper::Impl::factorise_step() {
     // K_eff = K + 4 M / dt^2, factorised once. The contact force enters the step as
     // kappa G^T p1: kappa = 1 (massless leaves: the trapezoidal rule) or 2 (massive leaves:
     // the contact impulse over the step is dt p1, newmark_stepper.hpp).
-    // The rig: w1 = w_p(t1) is given, so the step solves the rows of z_r only (the "free" DOFs F:
-    // K_eff,rr z_r1 = r_r - K_eff,rw w1 + kappa G_r^T p1, s = G_r z_r1 + G_w w1 + c_L p1 - d).
+    // The rigs: z_H1 = z_p(t1) is given (w by the vertical rig, theta_R by the windup rig), so the step
+    // solves the rows of the free DOFs F only:
+    // K_eff,FF z_F1 = r_F - K_eff,FH z_H1 + kappa G_F^T p1, s = G_F z_F1 + G_H z_H1 + c_L p1 - d.
     const double dt = options_.dt_s;
-    const int n = static_cast<int>(K_.rows()), w_dof = n - 1, m = system_.num_components();
+    const int n = static_cast<int>(K_.rows()), m = system_.num_components();
     const Eigen::SparseMatrix<double>& G = system_.contact_rows();
     const double kappa = massive_leaves_ ? 2.0 : 1.0;
     Eigen::SparseMatrix<double> Keff = K_ + (4.0 / (dt * dt)) * M_;
     if (C_.nonZeros() > 0) Keff += (2.0 / dt) * C_;  // the trapezoidal damping force -C (z1 - z0) / dt
     Keff.makeCompressed();
-    const int nf = rig_ ? w_dof : n;
-    Eigen::SparseMatrix<double> KeffF = Keff.topLeftCorner(nf, nf), GF = G.leftCols(nf);
-    if (rig_) {
-        keff_w_ = Eigen::VectorXd(Keff.block(0, w_dof, w_dof, 1));
-        g_w_ = Eigen::VectorXd(G.col(w_dof));
+    const int nf = n - static_cast<int>(prescribed_.size());
+    Eigen::SparseMatrix<double> KeffF = free_block(Keff);
+    Eigen::SparseMatrix<double> GF = free_leading_ ? Eigen::SparseMatrix<double>(G.leftCols(nf))
+                                                   : Eigen::SparseMatrix<double>(G * S_.transpose());
+    if (!prescribed_.empty()) {
+        const int nh = static_cast<int>(prescribed_.size());
+        keff_h_.resize(nf, nh);
+        g_h_.resize(m, nh);
+        for (int h = 0; h < nh; ++h) {
+            keff_h_.col(h) = S_ * Eigen::VectorXd(Keff.col(prescribed_[h]));
+            g_h_.col(h) = Eigen::VectorXd(G.col(prescribed_[h]));
+        }
     }
     keff_f_ = KeffF;
     gt_f_ = GF.transpose();
@@ -213,12 +263,35 @@ void NewmarkStepper::Impl::factorise_step() {
 }
 
 Eigen::VectorXd NewmarkStepper::Impl::accelerations_with_rig(double t_s, const Eigen::VectorXd& r,
-                                                             double* lambda_n) const {
-    // M a = r + lambda e_w with a_w = w_p''(t)
+                                                             Eigen::VectorXd* lambda) const {
+    // M a = r + E_H lambda with a_H = z_p''(t): (M^-1)_HH lambda = z_p'' - (M^-1 r)_H
     Eigen::VectorXd a = factor_.mass.solve(r);
-    const double lambda = detail::prescribe_w_acceleration(a, u_w_, options_.loading.displacement_m.second_derivative(t_s));
-    if (lambda_n) *lambda_n = lambda;
+    const Eigen::VectorXd l = detail::prescribe_accelerations(a, u_h_, prescribed_, prescribed_at(t_s, 2));
+    if (lambda) *lambda = l;
     return a;
+}
+
+Eigen::VectorXd NewmarkStepper::Impl::prescribed_at(double t_s, int derivative) const {
+    Eigen::VectorXd z(static_cast<Eigen::Index>(prescribed_.size()));
+    for (std::size_t h = 0; h < prescribed_.size(); ++h) {
+        const TimeFunction& f = *prescribed_f_[h];
+        z[h] = derivative == 0 ? f.value(t_s) : derivative == 1 ? f.derivative(t_s) : f.second_derivative(t_s);
+    }
+    return z;
+}
+
+Eigen::SparseMatrix<double> NewmarkStepper::Impl::free_block(const Eigen::SparseMatrix<double>& A) const {
+    const int nf = static_cast<int>(S_.rows());
+    if (free_leading_) return A.topLeftCorner(nf, nf);
+    return Eigen::SparseMatrix<double>(S_ * A * S_.transpose());
+}
+
+Eigen::VectorXd NewmarkStepper::Impl::static_rig_forces(double t_s) const {
+    Eigen::VectorXd r = K_ * z_ - system_.contact_rows().transpose() * p_;
+    if (!load_.none()) r -= load_.at(t_s);
+    Eigen::VectorXd l(static_cast<Eigen::Index>(prescribed_.size()));
+    for (std::size_t h = 0; h < prescribed_.size(); ++h) l[h] = r[prescribed_[h]];
+    return l;
 }
 
 void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
@@ -229,10 +302,17 @@ void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
     const double strain = f * (0.5 * detail::accurate_quadratic_form(K_, z_) + detail::layer_energy_j(system_, p_));
     const Loading& L = options_.loading;
     detail::LoadState ls;  // the loading's force on R (the rig: the load cell's), whole spring, and its work
-    ls.external_force_n = rig_ ? f * rig_force_ - body.mass_kg * a_[w_dof] : L.external_force_n(t_, body.mass_kg);
+    // the vertical rig's reaction is the last of rig_force_ (w is the last DOF)
+    ls.external_force_n = rig_ ? f * rig_force_[rig_force_.size() - 1] - body_mass_on_w_ * a_[w_dof]
+                               : L.external_force_n(t_, body.mass_kg);
     ls.external_work_j = f * external_work_;
     ls.base_displacement_m = L.base_displacement_m(t_);
     detail::fill_state(system_, problem_, p_, z_[w_dof], v_[w_dof], strain, dissipated_, e0_, ls, record_);
+    // a seat load or the windup rig loads theta_R, so k w - c^T p (every free DOF unloaded) is not R's
+    // force on the stack: it is w's row of K z - G^T p (massless leaves; massive ones: below)
+    if (!massive_leaves_ && (L.has_seat_load() || L.windup_rig()))
+        record_.spring_force_n = f * (detail::accurate_dot(Eigen::VectorXd(K_.col(w_dof)), z_) -
+                                      Eigen::VectorXd(system_.contact_rows().col(w_dof)).dot(p_));
     const double kinetic = 0.5 * f * detail::accurate_quadratic_form(M_, v_);
     const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
     record_.kinetic_energy_j = kinetic;
@@ -241,10 +321,16 @@ void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
     // R is attached to the w DOF: the force on it is m w''. With massive leaves the force of R on
     // the stack follows from R's balance (m w'' = F - spring force); the rig's load cell reads
     // the force on the spring (the leaves' inertia included).
-    record_.force_on_mass_n = body.mass_kg * a_[w_dof];
+    record_.force_on_mass_n = body_mass_on_w_ * a_[w_dof];
     if (massive_leaves_)
         record_.spring_force_n = rig_ ? record_.external_force_n : record_.external_force_n - record_.force_on_mass_n;
     record_.damping_energy_j = f * damping_energy_;
+    // the seat (full model): theta_R, u_R, and the moment on the spring there, the applied M - H h plus
+    // the windup rig's reaction (its first prescribed DOF, theta_R)
+    const int theta = system_.seat_rotation_dof(), axial = system_.seat_axial_dof();
+    record_.seat_rotation_rad = theta >= 0 ? z_[theta] : 0.0;
+    record_.seat_axial_m = axial >= 0 ? z_[axial] : 0.0;
+    record_.seat_moment_n_m = L.seat_moment_n_m_at(t_) + (L.windup_rig() ? rig_force_[0] : 0.0);
     record_.energy_balance_error_j = e0_ + record_.external_work_j -
                                      (record_.kinetic_energy_j + record_.strain_energy_j + record_.dissipated_energy_j +
                                       impact_loss_ + record_.damping_energy_j);
@@ -320,10 +406,11 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     if (loaded) r += massive_leaves_ ? Eigen::VectorXd(q0 + q1) : q1;
     const bool damped = C_.nonZeros() > 0;
     if (damped) r += (2.0 / dt) * detail::accurate_product(C_, z_);  // K_eff holds (2/dt) C: the step's damping force is -C (z1 - z0)/dt
-    // The rig: the step's problem on z_r with w1 given (constructor)
-    const double w1 = rig_ ? options_.loading.displacement_m.value(t1) : 0.0;
-    const Eigen::VectorXd rF = rig_ ? Eigen::VectorXd(r.head(w_dof) - keff_w_ * w1) : r;
-    const Eigen::VectorXd dF = rig_ ? Eigen::VectorXd(d_ - g_w_ * w1) : d_;
+    // The rigs: the step's problem on z_F with z_H1 given (constructor)
+    const bool held = !prescribed_.empty();
+    const Eigen::VectorXd zH1 = held ? prescribed_at(t1, 0) : Eigen::VectorXd();
+    const Eigen::VectorXd rF = held ? Eigen::VectorXd(S_ * r - keff_h_ * zH1) : r;
+    const Eigen::VectorXd dF = held ? Eigen::VectorXd(d_ - g_h_ * zH1) : d_;
     if (problem_.tau_rule == TauRule::previous_step) detail::set_previous_step_limits(problem_, p_);
     const Eigen::VectorXd p0 = p_;
     const Eigen::VectorXd gv0 = massive_leaves_ && options_.restitution > 0.0 ? Eigen::VectorXd(G * v_) : Eigen::VectorXd();
@@ -345,10 +432,9 @@ const StepRecord& NewmarkStepper::Impl::advance() {
         zF += factor_.llt.solve(rho.value());
     }
     Eigen::VectorXd z1 = zF;
-    if (rig_) {
-        z1.resize(w_dof + 1);
-        z1.head(w_dof) = zF;
-        z1[w_dof] = w1;
+    if (held) {
+        z1 = S_.transpose() * zF;
+        for (std::size_t h = 0; h < prescribed_.size(); ++h) z1[prescribed_[h]] = zH1[h];
     }
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
@@ -388,17 +474,17 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     // Newmark's update of v and a (beta = 1/4, gamma = 1/2): v1 = 2 (z1 - z0)/dt - v0.
     if (massive_leaves_) {
         const Eigen::VectorXd v1 = (2.0 / dt) * (z1 - z_) - v_;
-        if (rig_) {
-            // The rig's mean force over the step from R's row of the step's momentum balance,
-            // M (v1 - v0) = dt [-K (z0 + z1)/2 + G^T p1 + qbar + lambda_bar e_w], and its work
-            // lambda_bar (w1 - w0): the balance closes as for the other forces. Only R's row is
-            // needed: M, K and C are symmetric, so row w is column w.
-            double lambda_bar = detail::accurate_dot(Eigen::VectorXd(M_.col(w_dof)), Eigen::VectorXd((v1 - v_) / dt)) +
-                                0.5 * detail::accurate_dot(Eigen::VectorXd(K_.col(w_dof)), Eigen::VectorXd(z_ + z1)) -
-                                G.col(w_dof).dot(p_);
-            if (loaded) lambda_bar -= 0.5 * (q0[w_dof] + q1[w_dof]);
-            if (damped) lambda_bar += detail::accurate_dot(Eigen::VectorXd(C_.col(w_dof)), Eigen::VectorXd((z1 - z_) / dt));
-            external_work_ += lambda_bar * (z1[w_dof] - z_[w_dof]);
+        for (const int h : prescribed_) {
+            // A rig's mean force over the step from its DOF's row of the step's momentum balance,
+            // M (v1 - v0) = dt [-K (z0 + z1)/2 + G^T p1 + qbar + lambda_bar e_h], and its work
+            // lambda_bar (z1_h - z0_h): the balance closes as for the other forces. Only the row is
+            // needed: M, K and C are symmetric, so row h is column h.
+            double lambda_bar = detail::accurate_dot(Eigen::VectorXd(M_.col(h)), Eigen::VectorXd((v1 - v_) / dt)) +
+                                0.5 * detail::accurate_dot(Eigen::VectorXd(K_.col(h)), Eigen::VectorXd(z_ + z1)) -
+                                G.col(h).dot(p_);
+            if (loaded) lambda_bar -= 0.5 * (q0[h] + q1[h]);
+            if (damped) lambda_bar += detail::accurate_dot(Eigen::VectorXd(C_.col(h)), Eigen::VectorXd((z1 - z_) / dt));
+            external_work_ += lambda_bar * (z1[h] - z_[h]);
         }
         // the damping force's work over the step, (z1 - z0)^T C (z1 - z0) / dt >= 0
         if (damped) damping_energy_ += detail::accurate_quadratic_form(C_, Eigen::VectorXd(z1 - z_)) / dt;
@@ -406,15 +492,24 @@ const StepRecord& NewmarkStepper::Impl::advance() {
         Eigen::VectorXd r1 = G.transpose() * p_ - K_ * z1;  // M a1 = G^T p1 - K z1 - C v1 + q1 (+ the rig's lambda1 e_w)
         if (loaded) r1 += q1;
         if (damped) r1 -= C_ * v_;
-        a_ = rig_ ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_.mass.solve(r1));
+        a_ = held ? accelerations_with_rig(t1, r1, &rig_force_) : Eigen::VectorXd(factor_.mass.solve(r1));
     } else {
         const Eigen::VectorXd a1 = (4.0 / (dt * dt)) * (z1 - z_ - dt * v_) - a_;
         v_ += 0.5 * dt * (a_ + a1);
         a_ = a1;
     }
+    Eigen::VectorXd zH0(static_cast<Eigen::Index>(prescribed_.size()));
+    for (std::size_t h = 0; h < prescribed_.size(); ++h) zH0[h] = z_[prescribed_[h]];
     z_ = std::move(z1);
     for (int i = 0; i < static_cast<int>(z_.size()); ++i)
         if (massless_[i]) v_[i] = a_[i] = 0.0;
+    if (held && !massive_leaves_) {
+        // massless leaves with a rig (static, M = 0): lambda = (K z - G^T p - q)_H at t1, and its work
+        // over the step by the trapezoidal rule (as the loading's)
+        const Eigen::VectorXd lambda1 = static_rig_forces(t1);
+        external_work_ += 0.5 * (rig_force_ + lambda1).dot(zH1 - zH0);
+        rig_force_ = lambda1;
+    }
     rel_ = rel1;
     if (massive_leaves_) impact_loss_ += project_velocities(p0, gv0);
     t_ = t1;

@@ -15,7 +15,7 @@ std::vector<std::string> step_record_columns() {
             "contact_iterations", "n_stick", "n_slip",         "n_open",            "kinetic_energy",
             "strain_energy", "dissipated_energy", "energy_balance_error", "contact_residual", "factorizations",
             "spring_force", "external_force", "base_displacement", "external_work", "leaf_kinetic_energy",
-            "impact_loss", "damping_energy"};
+            "impact_loss", "damping_energy", "seat_rotation", "seat_moment", "seat_axial"};
 }
 
 std::vector<double> step_record_values(const StepRecord& r) {
@@ -40,7 +40,10 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.external_work_j,
             r.leaf_kinetic_energy_j,
             r.impact_loss_j,
-            r.damping_energy_j};
+            r.damping_energy_j,
+            r.seat_rotation_rad,
+            r.seat_moment_n_m,
+            r.seat_axial_m};
 }
 
 template <>
@@ -101,6 +104,33 @@ void SimulationOptions::validate() const {
 
 void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     const auto& rb = model.rigid_body;
+    // seat loads and the windup rig (loading.hpp): not symmetric, so the full model; H needs a sliding seat
+    const char* seat_key = loading.seat_moment_n_m ? "loading.seat_moment_n_m"
+                           : loading.longitudinal_force_n ? "loading.longitudinal_force_n"
+                           : loading.seat_rotation_rad ? "loading.seat_rotation_rad"
+                                                       : nullptr;
+    if (seat_key && model.symmetry == Symmetry::half)
+        throw InputError(seat_key, "is not available on the half model (mesh.symmetry = 'half'): a load that turns or "
+                                   "pushes the seat is not symmetric about it; use mesh.symmetry = 'full'");
+    if (loading.longitudinal_force_n && !seat_slides(model))
+        throw InputError("loading.longitudinal_force_n",
+                         std::string("needs a seat that slides, but the seat locates the stack axially (rigid_body.axial = '") +
+                             to_string(rb.axial) + "'" + (ends_locate_axially(model) ? "" : ", and no end holds it axially") +
+                             "): give rigid_body.axial = 'free' with an end that locates the stack (a hinged eye, an inclined "
+                             "shackle or a bushing with bushing_x_n_per_m > 0)");
+    if (loading.seat_rotation_rad && loading.kind != LoadingKind::prescribed_displacement) {
+        // the seat free vertically under the windup rig is quasi-static: no initial motion of R
+        if (rb.initial_displacement_m != 0.0)
+            throw InputError("rigid_body.initial_displacement_m",
+                             "value " + format_value(rb.initial_displacement_m) +
+                                 " is not allowed with the windup rig (loading.seat_rotation_rad): the seat follows the "
+                                 "rig quasi-statically (give 0)");
+        if (rb.initial_velocity_m_per_s != 0.0)
+            throw InputError("rigid_body.initial_velocity_m_per_s",
+                             "value " + format_value(rb.initial_velocity_m_per_s) +
+                                 " is not allowed with the windup rig (loading.seat_rotation_rad): the seat follows the "
+                                 "rig quasi-statically (give 0)");
+    }
     if (loading.kind == LoadingKind::prescribed_displacement) {
         if (rb.initial_displacement_m != 0.0)
             throw InputError("rigid_body.initial_displacement_m",

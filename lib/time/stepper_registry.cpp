@@ -35,6 +35,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::closed_form;
     c.applied_force = c.base_excitation = c.gravity = c.rig = c.rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
+    c.seat_loads = true;  // condensed with theta_R (System::SeatCondensation): no J, not with the rig
     c.start = StartKind::massless_stack;
     c.build = &ClosedFormStepperAccess::build;
     rows.push_back(c);
@@ -44,6 +45,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.description = "mode newmark with massless leaves";
     c.mode = Mode::newmark;
     c.applied_force = c.base_excitation = c.gravity = true;
+    c.seat_loads = c.windup_rig = c.windup_rig_on_rigid_contact = c.pitch_inertia = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
     c.start = StartKind::whole_stack;
     c.build = &NewmarkStepperAccess::build;
@@ -53,6 +55,8 @@ std::vector<StepperCapabilities> make_registry() {
     c.description = "mode newmark with massive leaves";
     c.massive_leaves = true;
     c.rig = c.damping = c.restitution = true;  // the rig on elastic contact only (the impact law)
+    c.windup_rig_on_rigid_contact = false;     // the windup rig too
+    c.seat_loads_with_rig = true;
     c.leaf_kinetic_energy = c.impact_loss = true;
     rows.push_back(c);
 
@@ -84,6 +88,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.assembly = true;  // every loading but the rig
+    c.seat_loads = c.pitch_inertia = true;  // two more channels of the modal load (modal_load.hpp); J in M's modes
     c.friction = c.rigid_rows = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeModalStepper>;
@@ -95,6 +100,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
+    c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M; not the windup rig
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
@@ -200,11 +206,42 @@ void check_contact(const StepperCapabilities& s, const System& system) {
     }
 }
 
+/// Seat loads and the windup rig (loading.hpp) against the row.
+void check_seat_loading(const StepperCapabilities& s, const System& system, const Loading& L) {
+    const char* seat_key = L.seat_moment_n_m ? "loading.seat_moment_n_m" : "loading.longitudinal_force_n";
+    if (L.has_seat_load() && !s.seat_loads)
+        throw InputError(seat_key, "is not available in " + std::string(s.description) + ": seat loads are " +
+                                       taken_by([](auto& r) { return r.seat_loads; }));
+    if (L.has_seat_load() && L.kind == LoadingKind::prescribed_displacement && !L.windup_rig() && !s.seat_loads_with_rig)
+        throw InputError(seat_key, "with kind = 'prescribed-displacement' is not available in " + std::string(s.description) +
+                                       ": seat loads with the vertical rig are " +
+                                       taken_by([](auto& r) { return r.seat_loads_with_rig; }));
+    const double J = system.model().spec().rigid_body.pitch_inertia_kg_m2;
+    if (J > 0.0 && !s.pitch_inertia)
+        throw InputError("rigid_body.pitch_inertia_kg_m2",
+                         "value " + format_value(J) + " is not taken by " + s.description +
+                             " (its seat rotation has no inertia: give 0); the axle's pitch inertia is " +
+                             taken_by([](auto& r) { return r.pitch_inertia; }));
+    if (L.windup_rig() && !s.windup_rig)
+        throw InputError("loading.seat_rotation_rad", "is not available in " + std::string(s.description) +
+                                                          ": the windup rig is " + taken_by([](auto& r) { return r.windup_rig; }));
+    if (L.windup_rig() && !s.windup_rig_on_rigid_contact && first_rigid_pair(system) >= 0)
+        throw InputError("loading.seat_rotation_rad", "with rigid contact (pair " + std::to_string(first_rigid_pair(system)) +
+                                                          ") is not available in " + s.description +
+                                                          " (the impact law would move the rig's seat): give the interfaces an "
+                                                          "elastic layer (interfaces[i].contact = 'elastic'); the windup rig on "
+                                                          "rigid contact is " +
+                                                          taken_by([](auto& r) { return r.windup_rig_on_rigid_contact; }));
+}
+
 void check_loading(const StepperCapabilities& s, const System& system, const Loading& L) {
+    check_seat_loading(s, system, L);
+    // the windup rig holds w by the vertical rig's displacement as part of itself
+    const bool windup_holds_w = L.windup_rig() && s.windup_rig;
     const bool takes = L.kind == LoadingKind::initial_conditions ||
                        (L.kind == LoadingKind::applied_force && s.applied_force) ||
                        (L.kind == LoadingKind::base_excitation && s.base_excitation) ||
-                       (L.kind == LoadingKind::prescribed_displacement && s.rig);
+                       (L.kind == LoadingKind::prescribed_displacement && (s.rig || windup_holds_w));
     const LoadingKind kind = L.kind;
     if (!takes)
         throw InputError("loading.kind", "value '" + std::string(to_string(kind)) + "' is not available in " +
@@ -213,7 +250,8 @@ void check_loading(const StepperCapabilities& s, const System& system, const Loa
                                                         (kind == LoadingKind::base_excitation && r.base_excitation) ||
                                                         (kind == LoadingKind::prescribed_displacement && r.rig);
                                              }));
-    if (L.kind == LoadingKind::prescribed_displacement && !s.rig_on_rigid_contact && first_rigid_pair(system) >= 0)
+    if (L.kind == LoadingKind::prescribed_displacement && !s.rig_on_rigid_contact && !windup_holds_w &&
+        first_rigid_pair(system) >= 0)
         throw InputError("loading.kind", "value 'prescribed-displacement' with rigid contact (pair " +
                                              std::to_string(first_rigid_pair(system)) + ") is not available in " +
                                              s.description + " (the impact law would move the rig's seat): give the "

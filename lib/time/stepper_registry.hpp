@@ -45,6 +45,11 @@ struct StepperCapabilities {
     // loadings (initial conditions: every stepper)
     bool applied_force, base_excitation, gravity, rig;
     bool rig_on_rigid_contact;  ///< the rig with a contact row that has no elastic layer
+    bool seat_loads;            ///< a seat moment, a longitudinal force (Loading::has_seat_load)
+    bool seat_loads_with_rig;   ///< seat loads together with the vertical rig (kind prescribed-displacement)
+    bool pitch_inertia;         ///< the axle's pitch inertia J > 0 on theta_R (RigidBodySpec::pitch_inertia_kg_m2)
+    bool windup_rig;            ///< theta_R prescribed (Loading::seat_rotation_rad), w held by the vertical rig or free
+    bool windup_rig_on_rigid_contact;  ///< the windup rig with a contact row that has no elastic layer
     bool assembly;              ///< free camber, clips, interference (needs_assembly)
     bool damping;               ///< structural (Rayleigh) damping
     bool restitution;           ///< the impact law's restitution > 0

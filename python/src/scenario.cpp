@@ -14,6 +14,22 @@ void enum_property(Cls& cls, const char* name, E C::*member) {
         [member, name](C& c, const py::object& text) { c.*member = parse_word<E>(string_arg(text, name), name); });
 }
 
+/// A property for an optional time function of the loading (a seat load, the windup rig): None when
+/// absent; assigning a TimeFunction gives it. The function returned is the loading's own (edits reach it).
+template <class Cls>
+void optional_time_function(Cls& cls, const char* name, std::optional<TimeFunction> Loading::*member) {
+    cls.def_property(
+        name,
+        [member](const py::object& self) -> py::object {
+            std::optional<TimeFunction>& f = self.cast<LoadingView&>().s->scenario.simulation.loading.*member;
+            if (!f) return py::none();
+            return py::cast(&*f, py::return_value_policy::reference_internal, self);
+        },
+        [member, name](LoadingView& v, const py::object& f) {
+            v.s->scenario.simulation.loading.*member = checked<TimeFunction>(f, std::string("loading.") + name);
+        });
+}
+
 }  // namespace
 
 // --- options by member name (the option table) --------------------------------------------
@@ -167,10 +183,14 @@ void bind_scenario(py::module_& m) {
         .def_property("last_leaf", getter(&ClipSpec::last_leaf), setter(&ClipSpec::last_leaf, "Clip.last_leaf"))
         .def_property("clearance_m", getter(&ClipSpec::clearance_m), setter(&ClipSpec::clearance_m, "Clip.clearance_m"))
         .def_property("stiffness_n_per_m", getter(&ClipSpec::stiffness_n_per_m), setter(&ClipSpec::stiffness_n_per_m, "Clip.stiffness_n_per_m"));
-    py::class_<RigidBodySpec>(m, "RigidBody", "[rigid_body]: the axle seat R (its initial conditions: model.loading)")
+    py::class_<RigidBodySpec> rigid_body(m, "RigidBody", "[rigid_body]: the axle seat R (its initial conditions: model.loading)");
+    rigid_body
         .def_property("mass_kg", getter(&RigidBodySpec::mass_kg), setter(&RigidBodySpec::mass_kg, "rigid_body.mass_kg"))
         .def_property("x_m", getter(&RigidBodySpec::x_m), setter(&RigidBodySpec::x_m, "rigid_body.x_m"))
-        .def_property("tied_leaves", getter(&RigidBodySpec::tied_leaves), setter(&RigidBodySpec::tied_leaves, "rigid_body.tied_leaves"));
+        .def_property("tied_leaves", getter(&RigidBodySpec::tied_leaves), setter(&RigidBodySpec::tied_leaves, "rigid_body.tied_leaves"))
+        .def_property("pitch_inertia_kg_m2", getter(&RigidBodySpec::pitch_inertia_kg_m2),
+                      setter(&RigidBodySpec::pitch_inertia_kg_m2, "rigid_body.pitch_inertia_kg_m2"));
+    enum_property(rigid_body, "axial", &RigidBodySpec::axial);
     py::class_<ProbeSpec, std::shared_ptr<ProbeSpec>>(m, "Probe", "[probe]: where the probe friction force is read")
         .def(py::init<>())
         .def(py::init([](const py::object& i, const py::object& x) {
@@ -194,7 +214,8 @@ void bind_scenario(py::module_& m) {
     py::bind_vector<Shared<ClampSpec>>(m, "ClampList");
     py::bind_vector<Shared<ClipSpec>>(m, "ClipList");
 
-    py::class_<LoadingView>(m, "Loading", "[loading]: how the run loads the spring, and R's initial conditions")
+    py::class_<LoadingView> loading(m, "Loading", "[loading]: how the run loads the spring, and R's initial conditions");
+    loading
         .def_property(
             "kind", [](const LoadingView& v) { return std::string(to_string(v.s->scenario.simulation.loading.kind)); },
             [](LoadingView& v, const py::object& text) {
@@ -227,7 +248,17 @@ void bind_scenario(py::module_& m) {
             [](LoadingView& v, const py::object& f) {
                 v.s->scenario.simulation.loading.displacement_m = checked<TimeFunction>(f, "loading.displacement_m");
             },
-            py::return_value_policy::reference_internal);
+            py::return_value_policy::reference_internal)
+        .def_property(
+            "longitudinal_force_height_m",
+            [](const LoadingView& v) { return v.s->scenario.simulation.loading.longitudinal_force_height_m; },
+            [](LoadingView& v, const py::object& x) {
+                v.s->scenario.simulation.loading.longitudinal_force_height_m = real_arg(x, "loading.longitudinal_force_height_m");
+            });
+    // the seat loads and the windup rig (docs/windup.md): None when absent
+    optional_time_function(loading, "seat_moment_n_m", &Loading::seat_moment_n_m);
+    optional_time_function(loading, "longitudinal_force_n", &Loading::longitudinal_force_n);
+    optional_time_function(loading, "seat_rotation_rad", &Loading::seat_rotation_rad);
     py::class_<MeshView>(m, "Mesh", "[mesh]: the node grid and the symmetry")
         .def_property(
             "element_length_m", [](const MeshView& v) { return v.s->scenario.model.mesh.element_length_m; },

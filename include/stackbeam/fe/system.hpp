@@ -86,12 +86,22 @@ public:
 
     /// Number of reduced degrees of freedom (including w, the last).
     int num_reduced_dofs() const noexcept { return static_cast<int>(K_red_.rows()); }
+    /// The seat's reduced DOFs (conventions.hpp, "Seat"): node-major leaf DOFs, then u_R (if the seat
+    /// slides), then theta_R (full model), then w, the last. Index of w [m].
+    int seat_w_dof() const noexcept { return num_reduced_dofs() - 1; }
+    /// Index of theta_R [rad, counter-clockwise], -1 on the half model (the symmetry plane holds it).
+    int seat_rotation_dof() const noexcept { return seat_rotation_dof_; }
+    /// Index of u_R [m, +x], -1 where the seat locates the stack axially (RigidBodySpec::axial).
+    int seat_axial_dof() const noexcept { return seat_axial_dof_; }
     /// Reduced stiffness P^T K P [N/m, N, N m per unit DOF], w last.
     const Eigen::SparseMatrix<double>& stiffness_reduced() const noexcept { return K_red_; }
     /// Reduced mass P^T M P [kg, kg m^2 per unit DOF], w last: the leaves' consistent
     /// mass matrices (density from the model; 0 = massless, the paper) plus the rigid
-    /// body's mass on w (the meshed part's share: half on the half model).
-    Eigen::SparseMatrix<double> mass_reduced() const;
+    /// body's mass on w (the meshed part's share: half on the half model), its pitch inertia J
+    /// on theta_R and, with rigid_body.axial = 'free', its mass on u_R (the axle moves with the seat;
+    /// 'auto' leaves it out, as the model before windup did). `with_body` false: the leaves' mass
+    /// only (the windup rig leaves R's inertia out of its quasi-static loop, loading.hpp).
+    Eigen::SparseMatrix<double> mass_reduced(bool with_body = true) const;
     /// The inertia of everything per unit acceleration in +y, on the reduced DOFs [kg] (w last):
     /// l = P^T M_full e_y + m e_w, the leaves' consistent mass times a unit translation of every
     /// node in y (their weight's consistent nodal loads per unit g) plus the rigid body's mass
@@ -99,9 +109,24 @@ public:
     /// y_b'' of the supports loads it, in the frame of the supports, with -y_b'' l (loading.hpp).
     /// Massless leaves: l = m e_w.
     Eigen::VectorXd vertical_inertia_kg() const;
+    /// Seat loads on the massless stack (loading.hpp), condensed as the paper condenses the leaves:
+    /// with seat loads S = [M; H] [N m, N] on theta_R and u_R (a column of zeros where the seat has
+    /// no such DOF), R at w and contact forces p, the free DOFs solve K_rr z_r = G_r^T p - K_rw w + E S:
+    ///     s        = C' p + c w + B S - d           B = G_r K_rr^-1 E   [m per unit load]
+    ///     f        = k w - c^T p + g^T S              g = E^T K_rr^-1 K_rw [N per unit load] (R's force on the stack)
+    ///     [theta_R; u_R] = B^T p - g w + F S          F = E^T K_rr^-1 E     [rad/(N m), m/N ...]
+    /// (K symmetric: E^T K_rr^-1 G_r^T = B^T). Two solves with K_rr, on each call.
+    struct SeatCondensation {
+        Eigen::MatrixXd B;  ///< num_components() x 2
+        Eigen::Vector2d g = Eigen::Vector2d::Zero();
+        Eigen::Matrix2d F = Eigen::Matrix2d::Zero();
+    };
+    SeatCondensation seat_condensation() const;
     /// Reduced displacements z = [z_r; w] for contact forces p and rigid-body displacement w
     /// (one sparse solve with K_rr): K_rr z_r = G_r^T p - K_rw w.
     Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w) const;
+    /// As above with seat loads S = [M; H] [N m, N] on theta_R and u_R (SeatCondensation).
+    Eigen::VectorXd reduced_displacements(const Eigen::VectorXd& p, double w, const Eigen::Vector2d& seat_loads) const;
     /// Displacements (u, v, theta) of every leaf node [m, m, rad] for contact forces p
     /// and rigid-body displacement w: index 3*node_dof(leaf, node) + {0,1,2}.
     Eigen::VectorXd leaf_displacements(const Eigen::VectorXd& p, double w) const;
@@ -134,6 +159,7 @@ private:
     double k_ = 0.0;
     double mass_ = 0.0;
     int probe_ = -1;
+    int seat_rotation_dof_ = -1, seat_axial_dof_ = -1;
     std::vector<int> node_offset_;         // per leaf: first full node index minus first_node
     int num_full_ = 0;
     Eigen::SparseMatrix<double> P_;        // full DOFs <- reduced DOFs

@@ -39,7 +39,21 @@
 /// cell between R and the spring reads lambda - m w_p'' (the leaves' inertia included), and
 /// w(t) must then be smooth (validate(true): a triangle is refused, a table splined).
 /// Energy balance of every loading: E(0) + W_ext(t) = kinetic + strain + dissipated.
+///
+/// Seat loads and the windup rig (full model only; signs in conventions.hpp, "Seat"), alone or
+/// with any of the above: a moment M(t) on the seat [N m, counter-clockwise = +theta_R] and a
+/// longitudinal force H(t) [N, +x] whose line of action lies h [m] above the seat's reference
+/// (the tied leaves' mid-height). A point at height h moves u_R - h theta_R, so H does the work
+/// H (u_R - h theta_R): on the reduced DOFs
+///     q(t) += e_theta (M(t) - H(t) h) + e_u H(t),
+/// H needs a seat that slides (rigid_body.axial: the ends locate the stack, not the seat). The
+/// windup rig prescribes theta_R(t) instead of a moment (a servo rotating the seat, quasi-static as
+/// the vertical rig: R's inertia, w's and u_R's mass and J, is not part of the loop); the record's
+/// seat_moment is the rig's reaction moment on the spring. Vertically the seat is then held
+/// (kind prescribed-displacement, w(t) the vertical rig's) or free under the vertical loads.
+/// The loads act from t = 0 on the state without them (the run starts unwound).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,6 +140,17 @@ struct Loading {
     TimeFunction displacement_m;  ///< prescribed_displacement: w(t) [m]; base_excitation: y_b(t) [m]
     double gravity_m_per_s2 = 0.0;///< acceleration of gravity g [m/s^2], >= 0, acting in -y on R;
                                   ///< 0: none. Not with prescribed_displacement (the rig holds R)
+    /// M(t): a moment on the seat [N m], counter-clockwise (+theta_R) positive; absent: none.
+    std::optional<TimeFunction> seat_moment_n_m;
+    /// H(t): a longitudinal force on the seat [N], +x, whole spring; absent: none. Needs a seat that
+    /// slides (RigidBodySpec::axial; the ends locate the stack).
+    std::optional<TimeFunction> longitudinal_force_n;
+    /// h: H's line of action above the seat's reference, the tied leaves' mid-height [m], finite
+    /// (braking at the tyre's contact patch: minus the seat's height above the road). Adds -H h to the moment.
+    double longitudinal_force_height_m = 0.0;
+    /// The windup rig: theta_R(t) prescribed [rad] (counter-clockwise), theta_R(0) = 0; absent: none.
+    /// Not with seat_moment_n_m (the rig's moment is a result).
+    std::optional<TimeFunction> seat_rotation_rad;
 
     /// Throws InputError naming the field ("loading.force_n.amplitude", ...) when out of range.
     /// `leaf_mass`: the leaves have mass, so a rig's displacement must be smooth too (a
@@ -134,7 +159,9 @@ struct Loading {
     /// validate(leaf_mass) and the derived data (splines). Steppers call it on their copy.
     void prepare(bool leaf_mass = false);
     /// True when nothing but initial conditions act (the paper).
-    bool is_free() const noexcept { return kind == LoadingKind::initial_conditions && gravity_m_per_s2 == 0.0; }
+    bool is_free() const noexcept {
+        return kind == LoadingKind::initial_conditions && gravity_m_per_s2 == 0.0 && !has_seat_load() && !windup_rig();
+    }
 
     /// External force on R [N] at t, whole spring, for mass `mass_kg` (the whole R): F(t) - m g - m y_b''(t).
     /// 0 for a prescribed displacement (the rig's force is a result).
@@ -143,8 +170,16 @@ struct Loading {
     double base_displacement_m(double t_s) const;
     /// Base velocity y_b'(t) [m/s] (base_excitation), 0 otherwise.
     double base_velocity_m_per_s(double t_s) const;
-    /// Period of the loading's excitation [s] (periodic shapes), 0 otherwise.
+    /// Period of the loading's excitation [s] (periodic shapes; else the windup rig's), 0 otherwise.
     double period_s() const;
+    /// Whether a seat moment or a longitudinal force acts.
+    bool has_seat_load() const noexcept { return seat_moment_n_m.has_value() || longitudinal_force_n.has_value(); }
+    /// Whether theta_R is prescribed (the windup rig).
+    bool windup_rig() const noexcept { return seat_rotation_rad.has_value(); }
+    /// The moment on theta_R [N m] at t: M(t) - H(t) h (0 without seat loads).
+    double seat_moment_n_m_at(double t_s) const;
+    /// H(t) [N] (0 without).
+    double longitudinal_force_n_at(double t_s) const;
 };
 
 

@@ -176,17 +176,29 @@ struct ClipSpec {
     double stiffness_n_per_m = 1e8;
 };
 
+/// Whether the seat locates the stack axially (RigidBodySpec::axial; conventions.hpp, "Seat").
+enum class SeatAxial {
+    automatic,  ///< held unless an end's eye locates the stack axially (a hinged eye, an inclined
+                ///< shackle, a bushing with k_x > 0); then free (the default: the model before windup)
+    held,       ///< the seat locates the stack: u_R = 0, each tied leaf's axial u = -y theta_R
+    free,       ///< the seat slides with its own axial DOF u_R (u = u_R - y theta_R); the ends must locate it
+};
+
 /// The rigid body R on the stack (the axle seat and the mass it carries).
 /// At x_m the tied leaves move as one rigid plane section: they share the
 /// transverse displacement w and the rotation theta_R, and each tied leaf's axial
-/// displacement is -y*theta_R (y its centroid height above the mid-height of the
-/// tied leaves), which also locates the stack axially.
+/// displacement is u_R - y*theta_R (y its centroid height above the mid-height of the
+/// tied leaves); u_R = 0 where the seat locates the stack axially (axial).
 struct RigidBodySpec {
     double mass_kg = 0.0;                  ///< mass m [kg], > 0
     double x_m = 0.0;                      ///< attachment position [m]
     std::vector<int> tied_leaves;          ///< leaves tied by the seat (empty: every leaf present at x_m)
     double initial_displacement_m = 0.0;   ///< w(0) [m] (+y)
     double initial_velocity_m_per_s = 0.0; ///< dw/dt(0) [m/s] (+y)
+    /// J: the axle's pitch inertia about the seat [kg m^2], >= 0, on theta_R (whole spring; full
+    /// model only, the half model has no theta_R). 0: the seat's rotation has no inertia of its own.
+    double pitch_inertia_kg_m2 = 0.0;
+    SeatAxial axial = SeatAxial::automatic;  ///< whether the seat locates the stack axially
 };
 
 /// Mesh: one node grid shared by all leaves. Every leaf end, clamp, the
@@ -278,6 +290,12 @@ private:
 
 /// The curvature of a leaf's free shape [1/m]: 1/free_radius_m, or 8 free_camber_m / L^2 (0: flat).
 double free_curvature_per_m(const LeafSpec& leaf);
+/// Whether the seat slides, with an axial DOF u_R of its own (RigidBodySpec::axial): 'free', or
+/// 'auto' where an end's eye locates the stack axially (a hinged eye, an inclined shackle, a bushing
+/// with k_x > 0); never on the half model.
+bool seat_slides(const ModelSpec& spec);
+/// Whether an end's eye locates the stack axially (a hinged eye, an inclined shackle, a bushing with k_x > 0).
+bool ends_locate_axially(const ModelSpec& spec);
 /// Whether any leaf has a free camber.
 bool has_free_camber(const ModelSpec& spec);
 /// Whether a run of the model starts with the assembly (simulation.hpp, "assembly"): a
@@ -290,6 +308,9 @@ template <>
 const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>();
 template <>
 const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>();
+template <>
+const std::vector<EnumWord<SeatAxial>>& enum_words<SeatAxial>();
+const char* to_string(SeatAxial axial);
 template <>
 const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>();
 const char* to_string(SupportKind kind);

@@ -46,6 +46,12 @@ struct StepRecord {
                                         ///< impulse's loss on the layer, (p1 - p0)^T C_L (p1 - p0) / 2 per step)
     double damping_energy_j = 0.0;      ///< cumulative energy taken by structural damping, int v^T C v dt [J]
                                         ///< (SimulationOptions::damping; 0 without); in the balance as dissipated
+    // The seat (conventions.hpp, "Seat"; loading.hpp, seat loads and the windup rig): modes closed-form,
+    // newmark and cvode's massive and modal steppers; 0 on the half model and in cvode's massless and held ones.
+    double seat_rotation_rad = 0.0;     ///< theta_R, the seat's rotation [rad], counter-clockwise
+    double seat_moment_n_m = 0.0;       ///< the moment on the spring at the seat [N m], counter-clockwise: the
+                                        ///< applied M - H h, or the windup rig's reaction moment
+    double seat_axial_m = 0.0;          ///< u_R, the seat's axial displacement [m], +x (0 where it locates the stack)
 };
 
 /// Column names of StepRecord in CSV order.

@@ -371,6 +371,11 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         // R's balance m w'' = F - spring force; the rig: the load cell between R and the spring reads
         // the force on the spring, lambda - m w'' (the leaves' inertia included)
         rec.spring_force_n = rig ? rec.external_force_n : rec.external_force_n - rec.force_on_mass_n;
+        // the seat (full model; loading.hpp): theta_R, u_R and the applied moment M - H h
+        const int theta = system().seat_rotation_dof(), axial = system().seat_axial_dof();
+        rec.seat_rotation_rad = theta >= 0 ? z[theta] : 0.0;
+        rec.seat_axial_m = axial >= 0 ? z[axial] : 0.0;
+        rec.seat_moment_n_m = L.seat_moment_n_m_at(tau);
         return rec;
     }
 };

@@ -59,6 +59,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
     Eigen::MatrixXd W;        // residual compliance G R G^T, n x n [m/N]
     Eigen::VectorXd rw;       // row w of R G^T, n: w = Phi_w q + rw . p
     Eigen::VectorXd phiw;     // row w of Phi
+    Eigen::MatrixXd r_seat, phi_seat;  // rows theta_R, u_R of R G^T (2 x n) and of Phi (2 x r); 0 where absent
     // the current modes: p = P q + p0, s = Hs q + bs, q'' = A1 q + a0
     Eigen::MatrixXd P, Hs, A1;
     Eigen::VectorXd p0, bs, a0;
@@ -95,7 +96,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         const int ms = T.columns;
         const Eigen::MatrixXd WT = T.compliance_times(W);
         const Eigen::VectorXd We = W * lin.e;
-        Eigen::MatrixXd A(ms, ms), B1(ms, r), Bu(ms, 2);
+        Eigen::MatrixXd A(ms, ms), B1(ms, r), Bu(ms, ModalLoad::kChannels);
         Eigen::VectorXd b0(ms);
         for (int i = 0; i < ms; ++i) {
             A.row(i) = WT.row(S[i]);
@@ -103,7 +104,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
             Bu.row(i) = -load->Hq.row(S[i]);
             b0[i] = d[S[i]] - We[S[i]];
         }
-        Eigen::MatrixXd X1 = Eigen::MatrixXd::Zero(ms, r), Xu = Eigen::MatrixXd::Zero(ms, 2);
+        Eigen::MatrixXd X1 = Eigen::MatrixXd::Zero(ms, r), Xu = Eigen::MatrixXd::Zero(ms, ModalLoad::kChannels);
         Eigen::VectorXd x0 = Eigen::VectorXd::Zero(ms);
         if (ms > 0) {
             Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
@@ -114,7 +115,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
                 throw failure("the contact conditions of the current modes are singular");
         }
         P = Eigen::MatrixXd::Zero(n, r);
-        Pu = Eigen::MatrixXd::Zero(n, 2);
+        Pu = Eigen::MatrixXd::Zero(n, ModalLoad::kChannels);
         p0 = lin.e;
         for (const auto& l : T.links) {
             P.row(l.row) += l.coef * X1.row(l.col);
@@ -135,7 +136,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         }
     }
 
-    Eigen::VectorXd forces_q(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Vector2d& u) const {
+    Eigen::VectorXd forces_q(const Eigen::Ref<const Eigen::VectorXd>& q, const ModalLoad::Channels& u) const {
         return P * q + p0 + Pu * u;
     }
     Vec forces(const State& y) const override { return forces_q(y.head(r), u_of(y).u); }
@@ -151,7 +152,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
             [&](int row) { return Hs.row(row).dot(qd) + Hsu.row(row).dot(u.ud); }, g);
     }
     /// q'' of the current modes at (q, u(t)).
-    Eigen::VectorXd modal_acceleration(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Vector2d& u) const {
+    Eigen::VectorXd modal_acceleration(const Eigen::Ref<const Eigen::VectorXd>& q, const ModalLoad::Channels& u) const {
         return A1 * q + a0 + Au * u;
     }
 
@@ -239,7 +240,7 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         load->enter_piece(t_s);
         const ModalLoad::Values after = u_of(y);
         const Vec p_after = forces(y);
-        const Eigen::Vector2d du = after.u - before.u;
+        const ModalLoad::Channels du = after.u - before.u;
         y[i_work] += 0.5 * (load->q_dot_z(q, p_before, before.u, du) + load->q_dot_z(q, p_after, after.u, du));
         for (int rt : slip_rows) y[2 * r] -= 0.5 * (p_before[rt] + p_after[rt]) * Hsu.row(rt).dot(du);
     }
@@ -327,6 +328,14 @@ struct CvodeModalStepper::Impl final : EventDriver, ContactEventHooks {
         StepRecord rec;
         fill_state(system(), laws(), p, w, wd, strain, f * Y[2 * r] + jump_dissipation_j(), initial_energy_j(), ls, rec);
         finish_inertia_record(rec, 0.5 * f * qd.squaredNorm(), body_mass_kg() * wdd);
+        // the seat (full model; loading.hpp): theta_R, u_R as w above, and the applied moment M - H h
+        const int seat[2] = {system().seat_rotation_dof(), system().seat_axial_dof()};
+        double motion[2] = {0.0, 0.0};
+        for (int j = 0; j < 2; ++j)
+            if (seat[j] >= 0) motion[j] = phi_seat.row(j).dot(q) + r_seat.row(j).dot(p) + load->RB.row(seat[j]).dot(u.u);
+        rec.seat_rotation_rad = motion[0];
+        rec.seat_axial_m = motion[1];
+        rec.seat_moment_n_m = options().loading.seat_moment_n_m_at(tau);
         return rec;
     }
 
@@ -362,6 +371,17 @@ void CvodeModalStepper::Impl::residual_compliance(const Eigen::MatrixXd& Gd, con
     phiw = Phi.row(w_dof()).transpose();
     rw = Eigen::VectorXd::Zero(Gd.rows());  // no contact rows (a single leaf): empty (a row of an n x 0 block is UB in Eigen)
     if (Gd.rows() > 0) rw = KiGt.row(w_dof()).transpose() - GPhi * om.cwiseProduct(om).cwiseInverse().cwiseProduct(phiw);
+    // the seat's rows likewise, for its records: [theta_R; u_R] = phi_seat q + r_seat p + (R B)_seat u
+    phi_seat = Eigen::MatrixXd::Zero(2, Phi.cols());
+    r_seat = Eigen::MatrixXd::Zero(2, Gd.rows());
+    const int seat[2] = {system().seat_rotation_dof(), system().seat_axial_dof()};
+    for (int j = 0; j < 2; ++j) {
+        if (seat[j] < 0) continue;
+        phi_seat.row(j) = Phi.row(seat[j]);
+        if (Gd.rows() > 0)
+            r_seat.row(j) = KiGt.row(seat[j]) - (GPhi * om.cwiseProduct(om).cwiseInverse().cwiseProduct(
+                                                             Eigen::VectorXd(Phi.row(seat[j]).transpose()))).transpose();
+    }
 }
 
 Eigen::VectorXd CvodeModalStepper::Impl::initial_state_vector(const Eigen::SparseMatrix<double>& K,

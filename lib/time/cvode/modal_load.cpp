@@ -15,12 +15,14 @@ namespace stackbeam::detail {
 ModalLoad::ModalLoad(const System& system, const Loading& prepared, const Eigen::MatrixXd& Phi,
                      const Eigen::VectorXd& omega, const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& kf)
     : load_(prepared), l_(system.vertical_inertia_kg()), f_(system.model().whole_spring_factor()) {
-    none_ = load_.gravity_m_per_s2 == 0.0 &&
+    none_ = load_.gravity_m_per_s2 == 0.0 && !load_.has_seat_load() &&
             (load_.kind == LoadingKind::initial_conditions || load_.kind == LoadingKind::prescribed_displacement);
     const Eigen::Index ndof = l_.size();
-    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(ndof, 2);
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(ndof, kChannels);
     B.col(0) = l_;
     B(ndof - 1, 1) = 1.0;
+    if (system.seat_rotation_dof() >= 0) B(system.seat_rotation_dof(), 2) = 1.0;
+    if (system.seat_axial_dof() >= 0) B(system.seat_axial_dof(), 3) = 1.0;
     // R B = K^-1 B - Phi Omega^-2 Phi^T B: the quasi-static response of the modes above the cut
     Fq = Phi.transpose() * B;
     RB = Eigen::MatrixXd(kf.solve(B)) - Phi * omega.cwiseProduct(omega).cwiseInverse().asDiagonal() * Fq;
@@ -51,6 +53,8 @@ std::vector<double> ModalLoad::breaks(double t_end_s) const {
     };
     if (load_.kind == LoadingKind::base_excitation) add(load_.displacement_m);
     if (load_.kind == LoadingKind::applied_force) add(load_.force_n);
+    if (load_.seat_moment_n_m) add(*load_.seat_moment_n_m);
+    if (load_.longitudinal_force_n) add(*load_.longitudinal_force_n);
     std::sort(b.begin(), b.end());
     b.erase(std::unique(b.begin(), b.end()), b.end());
     return b;
@@ -87,27 +91,34 @@ ModalLoad::Values ModalLoad::at(double t_s) const {
             v.udd[0] = -(y.second_derivative(t_s + h2) - 2.0 * a + y.second_derivative(t_s - h2)) / (h2 * h2);
         }
     }
-    // channel 1: F(t)/f; a table (piecewise linear) as the line of the current piece
-    if (load_.kind == LoadingKind::applied_force) {
-        const TimeFunction& F = load_.force_n;
+    // a force's channel: scale F(t) and its rates added to channel c; a table (piecewise linear) as the
+    // line of the current piece
+    auto add_force = [&](const TimeFunction& F, double scale, int c) {
         if (F.shape == TimeFunction::Shape::table) {
             const std::vector<double>& ts = F.times_s;
             const long i = table_piece(ts, piece_t_s_);
             if (i < 0) {
-                v.u[1] = F.values.front() / f_;
+                v.u[c] += scale * F.values.front();
             } else if (i + 1 >= static_cast<long>(ts.size())) {
-                v.u[1] = F.values.back() / f_;
+                v.u[c] += scale * F.values.back();
             } else {
                 const std::size_t k = static_cast<std::size_t>(i);
                 const double slope = (F.values[k + 1] - F.values[k]) / (ts[k + 1] - ts[k]);
-                v.u[1] = (F.values[k] + slope * (t_s - ts[k])) / f_;
-                v.ud[1] = slope / f_;
+                v.u[c] += scale * (F.values[k] + slope * (t_s - ts[k]));
+                v.ud[c] += scale * slope;
             }
         } else {
-            v.u[1] = F.value(t_s) / f_;
-            v.ud[1] = F.derivative(t_s) / f_;
-            v.udd[1] = F.second_derivative(t_s) / f_;
+            v.u[c] += scale * F.value(t_s);
+            v.ud[c] += scale * F.derivative(t_s);
+            v.udd[c] += scale * F.second_derivative(t_s);
         }
+    };
+    // channel 1: F(t)/f; channels 2 and 3: the seat's M(t) - H(t) h and H(t) (full model: f = 1)
+    if (load_.kind == LoadingKind::applied_force) add_force(load_.force_n, 1.0 / f_, 1);
+    if (load_.seat_moment_n_m) add_force(*load_.seat_moment_n_m, 1.0, 2);
+    if (load_.longitudinal_force_n) {
+        add_force(*load_.longitudinal_force_n, -load_.longitudinal_force_height_m, 2);
+        add_force(*load_.longitudinal_force_n, 1.0, 3);
     }
     return v;
 }
