@@ -13,6 +13,7 @@
 #include "stackbeam/run/run.hpp"
 #include "stackbeam/run/summary_json.hpp"
 #include "stackbeam/study/sweep.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 using namespace stackbeam;
 
@@ -122,6 +123,35 @@ BOOST_AUTO_TEST_CASE(a_stop_ends_the_run_at_a_whole_record) {
     BOOST_TEST(summary.report.steps == 0);  // no report for an interrupted run (documented)
     const std::string json = summary_json(summary, system.model());
     BOOST_TEST(json.find("\"interrupted\": true") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(modes_with_a_feature_are_those_whose_stepper_takes_it) {
+    // the front-ends' question before a system exists (modes_with) against the stepper make_stepper
+    // chooses for a built system (describe_stepper): a mode is listed for massive leaves exactly
+    // when make_stepper builds one for the bonded paper example with steel leaves (no refusal),
+    // and for the event log exactly when its stepper for the massless example keeps one
+    const std::vector<Mode> massive = modes_with(StepperFeature::massive_leaves);
+    const std::vector<Mode> events = modes_with(StepperFeature::event_log);
+    BOOST_TEST(mode_list(massive, " or ") == "newmark or cvode");  // docs/time-integration.md
+    BOOST_TEST(mode_list(events, " or ") == "cvode");
+    ModelSpec steel = paper_example(PaperCase::bonded);
+    for (auto& leaf : steel.leaves) leaf.density_kg_per_m3 = 7850.0;
+    const System massive_system(Model::build(steel));
+    const System massless_system(Model::build(paper_example(PaperCase::bonded)));
+    for (const auto& w : enum_words<Mode>()) {
+        SimulationOptions o;
+        o.mode = w.value;
+        const bool listed = std::find(massive.begin(), massive.end(), w.value) != massive.end();
+        bool taken = true;
+        try {
+            make_stepper(massive_system, o);
+        } catch (const InputError&) {
+            taken = false;
+        }
+        BOOST_TEST(listed == taken, "mode " << w.word);
+        const bool logs = std::find(events.begin(), events.end(), w.value) != events.end();
+        BOOST_TEST(logs == describe_stepper(massless_system, o).cvode_stats, "mode " << w.word);
+    }
 }
 
 BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {

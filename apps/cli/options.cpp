@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -254,13 +255,21 @@ SimulateRequest make_request(const SimulateArgs& a) {
         apply_interface(contact, r.spec);
         r.setup = case_setup(pcase, example);
     }
-    if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
-        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "
-                            "treats the leaves as massless, the paper");
-    if (r.options.mode != Mode::cvode && !r.events.empty())
+    // what the modes' steppers take: the registry's rows (run/run.hpp), before the system is built
+    auto has = [&](StepperFeature f) {
+        const auto modes = modes_with(f);
+        return std::find(modes.begin(), modes.end(), r.options.mode) != modes.end();
+    };
+    if (density_given && parse_density(a.beam_density) > 0.0 && !has(StepperFeature::massive_leaves))
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode " +
+                            mode_list(modes_with(StepperFeature::massive_leaves), " or ") + ": mode " +
+                            to_string(r.options.mode) + " treats the leaves as massless, the paper");
+    if (!r.events.empty() && !has(StepperFeature::event_log)) {
+        const std::string modes = mode_list(modes_with(StepperFeature::event_log), " or ");
         throw ArgumentError((a.events.empty() ? "outputs.events_path (file " + a.scenario + ")" : std::string("--events")) +
-                            ": value '" + r.events + "': the event log exists in mode cvode only (mode " +
-                            std::string(to_string(r.options.mode)) + "): remove it, or use mode cvode");
+                            ": value '" + r.events + "': the event log exists in mode " + modes + " only (mode " +
+                            std::string(to_string(r.options.mode)) + "): remove it, or use mode " + modes);
+    }
     if (!r.nodes.empty()) {  // the nodes' rows would overwrite (or interleave with) another output
         const std::string what = a.nodes.empty() ? "outputs.nodes_path (file " + a.scenario + ")" : std::string("--nodes");
         for (const auto& [other, file] : {std::pair<const char*, const std::string*>{"--out", &r.out},
