@@ -32,6 +32,14 @@ bool same(const StepRecord& a, const StepRecord& b) {
     return std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
 }
 
+/// A request to run `options`, its rows to `sink` (the outputs off).
+RunRequest request_of(const SimulationOptions& options, RunSink* sink) {
+    RunRequest request;
+    request.options = options;
+    request.sink = sink;
+    return request;
+}
+
 struct CountingSink : RunSink {
     long records = 0, pair_calls = 0, pairs = 0;
     double last_t_s = -1.0;
@@ -54,10 +62,8 @@ BOOST_AUTO_TEST_CASE(run_scenario_is_simulate_with_its_figures) {
     // so the records must be bitwise equal (no tolerance: the same arithmetic)
     const std::vector<StepRecord> reference = simulate(system, s.simulation);
     CountingSink sink;
-    RunRequest request;
-    request.options = s.simulation;
+    RunRequest request = request_of(s.simulation, &sink);
     request.outputs.pairs = true;
-    request.sink = &sink;
     const RunSummary summary = run_scenario(system, request);
     BOOST_TEST(!summary.interrupted);
     BOOST_REQUIRE_EQUAL(summary.records.size(), reference.size());
@@ -107,9 +113,7 @@ BOOST_AUTO_TEST_CASE(a_stop_ends_the_run_at_a_whole_record) {
     const Scenario s = rig();
     const System system(Model::build(s.model));
     CountingSink sink;
-    RunRequest request;
-    request.options = s.simulation;
-    request.sink = &sink;
+    RunRequest request = request_of(s.simulation, &sink);
     // asked to stop once the sink has 10 records: the 11th is dropped (or not made), the run ends
     request.stop = [&] { return sink.records >= 10; };
     const RunSummary summary = run_scenario(system, request);
@@ -196,8 +200,7 @@ struct StressSink : RunSink {
 BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_monitors_summary) {
     const Scenario s = rig();
     const System system(Model::build(s.model));
-    RunRequest plain;
-    plain.options = s.simulation;
+    const RunRequest plain = request_of(s.simulation, nullptr);
     const RunSummary without = run_scenario(system, plain);
     BOOST_TEST(!without.stresses.has_value());  // not asked: nothing made (and no note)
     BOOST_TEST(without.stresses_note.empty());
@@ -261,10 +264,8 @@ BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_fatigue_figures) {
     for (LeafSpec& l : s.model.leaves) l.material = steel;
     const System system(Model::build(s.model));
     StressSink sink;
-    RunRequest request;
-    request.options = s.simulation;
+    RunRequest request = request_of(s.simulation, &sink);
     request.outputs.stresses = true;
-    request.sink = &sink;
     const RunSummary summary = run_scenario(system, request);
     BOOST_REQUIRE(summary.stresses.has_value());
     const StressSummary& got = summary.stresses->summary;

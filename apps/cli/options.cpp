@@ -139,7 +139,12 @@ void validate(const SimulateArgs& a, const SimulationOptions& options, const Sce
 
 }  // namespace
 
-void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
+CLI::App* add_simulate_command(CLI::App& app, SimulateArgs& a) {
+    CLI::App& sim = *app.add_subcommand("simulate", "Simulate the paper example or a scenario and write one CSV row per time step");
+    sim.footer("One name per option: a flag is its scenario key's last part without the unit suffix, '_' written '-'\n"
+               "(integrator.cvode.max_step_s: --max-step; integrator.solver.kind: --solver); the key is the member's\n"
+               "path in SimulationOptions under [integrator]. Renamed flags keep their old name: --tol (--tolerance).\n"
+               "Errors name the flag as given, or the file's key with file:line:column.");
     CLI::Option* case_opt =
         sim.add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
     CLI::Option* scenario_opt =
@@ -205,17 +210,12 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
                    "fibres' at its edges; the run then computes the stresses, as --stresses does) (default state)")
         ->type_name("WORD");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
+    return &sim;
 }
 
 SimulateRequest make_request(const SimulateArgs& a) {
     SimulateRequest r;
-    r.out = a.out;
-    r.events = a.events;
-    r.summary = a.summary;
-    r.pairs = a.pairs;
-    r.nodes = a.nodes;
-    r.stresses = a.stresses;
-    r.plot = a.plot;
+    static_cast<OutputPaths&>(r) = a;  // the files as given; the scenario's fill those not given below
     r.quiet = a.quiet;
     const bool density_given = a.given.count("--beam-density") > 0;
     std::optional<InterfaceContact> contact;  // --interface, checked before the file is read

@@ -206,16 +206,22 @@ std::string to_string(const AxisValue& value) {
     return std::get<std::string>(value);
 }
 
-const char* to_string(Combine combine) { return combine == Combine::zip ? "zip" : "product"; }
-
-const char* to_string(PointStatus status) {
-    switch (status) {
-        case PointStatus::ok: return "ok";
-        case PointStatus::failed: return "failed";
-        case PointStatus::input_error: return "input-error";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<Combine>>& enum_words<Combine>() {
+    static const std::vector<EnumWord<Combine>> words = {{Combine::product, "product"}, {Combine::zip, "zip"}};
+    return words;
 }
+
+const char* to_string(Combine combine) { return word_of(combine); }
+
+template <>
+const std::vector<EnumWord<PointStatus>>& enum_words<PointStatus>() {
+    static const std::vector<EnumWord<PointStatus>> words = {
+        {PointStatus::ok, "ok"}, {PointStatus::failed, "failed"}, {PointStatus::input_error, "input-error"}};
+    return words;
+}
+
+const char* to_string(PointStatus status) { return word_of(status); }
 
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
     return parse_sweep_spec(text, source_name, [&](const std::string& path, const std::string& location) {
@@ -251,8 +257,7 @@ void read_sweep_settings(const toml::table& top, const std::string& source_name,
     if (top.count("combine")) {
         const auto& c = top.at("combine");
         const std::string word = c.is_string() ? c.as_string().str : "";
-        if (word == "product") spec.combine = Combine::product;
-        else if (word == "zip") spec.combine = Combine::zip;
+        if (const auto combine = find_word<Combine>(word)) spec.combine = *combine;
         else
             throw InputError("combine", "value '" + (c.is_string() ? word : toml::format(c)) +
                                             "' is not allowed: must be 'product' (every combination) or 'zip' (the "

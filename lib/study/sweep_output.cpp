@@ -294,10 +294,8 @@ PointResult parse_row(const SweepSpec& spec, const std::string& row, std::vector
     if (axis_cells) axis_cells->assign(cells.begin() + 1, cells.begin() + 1 + static_cast<std::ptrdiff_t>(spec.axes.size()));
     k += spec.axes.size();
     const std::string& status = cells[k++];
-    if (status == "ok") r.status = PointStatus::ok;
-    else if (status == "failed") r.status = PointStatus::failed;
-    else if (status == "input-error") r.status = PointStatus::input_error;
-    else throw std::invalid_argument("status '" + status + "' is not ok, failed or input-error");
+    if (const auto s = find_word<PointStatus>(status)) r.status = *s;
+    else throw std::invalid_argument("status '" + status + "' is not " + word_list<PointStatus>("", ", ", " or "));
     r.message = cells[k++];
     for (std::size_t i = 0; i < figures; ++i) r.figures.push_back(parse_cell(cells[k++]));
     r.wall_s = parse_cell(cells[k++]);

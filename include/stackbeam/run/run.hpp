@@ -7,7 +7,8 @@
 /// The library writes nothing here: every row goes to the caller's sink.
 ///
 /// Adding an output: a flag in RunOutputs, a callback in RunSink (default: ignore), one
-/// line in run_scenario's record loop; a figure of the summary: a member of RunSummary (or
+/// line in run_scenario's per-record callback (to the record loop it shares with simulate(),
+/// lib/time/record_loop.hpp); a figure of the summary: a member of RunSummary (or
 /// of RunStats, gathered per record) and its key in summary_json. Every front-end then has it.
 ///
 /// Interruption: the stop check (RunRequest::stop) is polled before each record is handed to
