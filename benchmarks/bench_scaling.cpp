@@ -34,19 +34,17 @@ void Scaling(benchmark::State& state) {
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
         const System s(Model::build(spec));
-        SimulationOptions so;
-        so.t_end_s = t_sim;
-        so.contact_path = path;
+        SimulationOptions so = run_to(t_sim, path);
         ClosedFormStepper st(s, so);
-        setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        setup = seconds_since(t0);
         steps = static_cast<long>(std::ceil(t_sim / so.dt_s - 1e-9));
         factorizations = newton = 0.0;
         for (long i = 0; i < steps; ++i) {
             factorizations += st.advance().factorizations;
             newton += st.last_solve().newton_iterations;
-            if (i == 0) first_step = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - setup;
+            if (i == 0) first_step = seconds_since(t0) - setup;
         }
-        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        total = seconds_since(t0);
         components = s.num_components();
     }
     state.SetLabel(std::string(to_string(c)) + ", " + to_string(path));
@@ -103,9 +101,7 @@ void Transitions(benchmark::State& state) {
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
         const System s(Model::build(spec));
-        SimulationOptions so;
-        so.t_end_s = t_sim;
-        so.contact_path = ContactPath::sparse;
+        SimulationOptions so = run_to(t_sim, ContactPath::sparse);
         SparsePathMethods switches;
         switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
         switches.box_qp = static_cast<SparseBoxQpMethod>(state.range(4));
@@ -118,13 +114,13 @@ void Transitions(benchmark::State& state) {
         for (long i = 0; i < steps; ++i) {
             const auto t1 = std::chrono::steady_clock::now();
             factorizations += st.advance().factorizations;
-            worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+            worst_step = std::max(worst_step, seconds_since(t1));
             newton += st.last_solve().newton_iterations;
             smoothing += st.last_solve().smoothing_iterations;
             passes += st.last_solve().tresca_iterations;
             if (st.last_solve().fell_back) ++tresca;
         }
-        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        total = seconds_since(t0);
         components = s.num_components();
     }
     state.counters["components"] = components;
@@ -166,9 +162,7 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
         const Model model = Model::build(spec);
         kappa = friction_mesh_ratio(model).ratio;
         const System s(model);
-        SimulationOptions so;
-        so.t_end_s = t_sim;
-        so.contact_path = ContactPath::sparse;
+        SimulationOptions so = run_to(t_sim, ContactPath::sparse);
         SparsePathMethods switches;
         switches.transition = static_cast<SparseTransitionMethod>(state.range(2));
         so.sparse_tuning.methods = switches;  // for the stepper's solvers
@@ -186,12 +180,12 @@ void FrictionMeshRatioRuns(benchmark::State& state) {
                 break;
             }
             ++steps;
-            worst_step = std::max(worst_step, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+            worst_step = std::max(worst_step, seconds_since(t1));
             passes += st.last_solve().tresca_iterations;
             most_passes = std::max(most_passes, static_cast<double>(st.last_solve().tresca_iterations));
             if (st.last_solve().fell_back) ++fell_back;
         }
-        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        total = seconds_since(t0);
     }
     state.counters["kappa"] = kappa;
     state.counters["failed_at_step"] = static_cast<double>(failed_at);

@@ -31,6 +31,19 @@ namespace stackbeam::bench {
 using testing::graduated_stack;
 using testing::paper_stack;
 
+/// Wall time since `t0` [s].
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The default options (mode closed-form, dt 1 ms) of a run to t_sim_s [s] on the contact path `path`.
+inline SimulationOptions run_to(double t_sim_s, ContactPath path) {
+    SimulationOptions so;
+    so.t_end_s = t_sim_s;
+    so.contact_path = path;
+    return so;
+}
+
 /// The figures of one ElasticRuns-style run (closed-form stepper, dt = 1 ms, every step made
 /// even if it does not converge): CPU and wall time, factorisations and Newton iterations per
 /// step, mode-set solves per transition step, and which step of the sparse chain settled each.
@@ -64,7 +77,7 @@ struct ElasticFigures {
             else if (r.newton_iterations > 0) ++by_semismooth;
             else ++by_passes;
         }
-        total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        total = seconds_since(t0);
         cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         components = s.num_components();
         final_w_m = st.current().w_m;
