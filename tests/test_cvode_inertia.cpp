@@ -18,21 +18,11 @@ using namespace stackbeam::testing;
 
 namespace {
 
-System massive(PaperCase c, double density = kSteel) {
-    ModelSpec spec = paper_example(c, {});
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = density;
-    return System(Model::build(spec));
-}
+System massive(PaperCase c, double density = kSteel) { return System(Model::build(paper_with_mass(c, density, false))); }
 
 std::vector<StepRecord> run(const System& s, Mode mode, double t_end_s, double dt_s, double rtol = 1e-8,
                             RunReport* report = nullptr) {
-    SimulationOptions so;
-    so.mode = mode;
-    so.dt_s = dt_s;
-    so.t_end_s = t_end_s;
-    so.cvode.rtol = rtol;
-    so.solver.tolerance_m = 1e-9;
-    return simulate(s, so, {}, report);
+    return simulate(s, run_options(mode, t_end_s, dt_s, 1e-9, rtol), {}, report);
 }
 }  // namespace
 

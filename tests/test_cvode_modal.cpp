@@ -17,21 +17,12 @@ using namespace stackbeam::testing;
 
 namespace {
 
-System friction_stack(double density) {
-    ModelSpec spec = paper_example(PaperCase::friction, {});
-    for (auto& leaf : spec.leaves) leaf.density_kg_per_m3 = density;
-    return System(Model::build(spec));
-}
+System friction_stack(double density) { return System(Model::build(paper_with_mass(PaperCase::friction, density, false))); }
 
 std::vector<StepRecord> run(const System& s, Mode mode, double t_end_s, double dt_s, double rtol, double cut_rad_per_s,
                             RunReport* report = nullptr) {
-    SimulationOptions so;
-    so.mode = mode;
-    so.dt_s = dt_s;
-    so.t_end_s = t_end_s;
-    so.cvode.rtol = rtol;
+    SimulationOptions so = run_options(mode, t_end_s, dt_s, 1e-9, rtol);
     so.cvode.modal_cutoff_rad_per_s = cut_rad_per_s;
-    so.solver.tolerance_m = 1e-9;
     return simulate(s, so, {}, report);
 }
 

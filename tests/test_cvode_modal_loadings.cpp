@@ -108,19 +108,9 @@ void check_bonded(const std::string& name, const System& s, const Loading& load,
 /// The friction stack (10 elements per half leaf, elastic interfaces, 10 mm clamps, steel) under
 /// gravity and the supports moving 5 mm at 8 Hz (the loading of scenarios/base_steel_elastic.toml).
 Loading base_and_gravity() {
-    Loading load;
-    load.kind = LoadingKind::base_excitation;
+    Loading load = periodic_loading(LoadingKind::base_excitation, TimeFunction::Shape::harmonic, 0.005, 8.0);
     load.gravity_m_per_s2 = 9.81;
-    load.displacement_m.shape = TimeFunction::Shape::harmonic;
-    load.displacement_m.amplitude = 0.005;
-    load.displacement_m.frequency_hz = 8.0;
     return load;
-}
-
-double dev_w(const std::vector<StepRecord>& a, const std::vector<StepRecord>& b) {
-    double d = 0.0;
-    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) d = std::max(d, std::abs(a[i].w_m - b[i].w_m));
-    return d;
 }
 
 /// Mode newmark's records at dt on the 0.1 ms output grid.
@@ -166,34 +156,16 @@ BOOST_AUTO_TEST_CASE(bonded_stack_follows_the_exact_solution_under_every_loading
     const Linear L = linear(s);
     {
         // F(t) = 200 N sin(2 pi 5 Hz t) on R from rest, 50 ms
-        Loading load;
-        load.kind = LoadingKind::applied_force;
-        load.force_n.shape = TimeFunction::Shape::harmonic;
-        load.force_n.amplitude = 200.0;
-        load.force_n.frequency_hz = 5.0;
-        Forcing q;
-        q.omega = 2.0 * kPi * 5.0;
-        q.c = Eigen::VectorXd::Zero(L.w + 1);
-        q.c[L.w] = 200.0 / L.f;
-        const Modal ref(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q);
-        const double amp = 200.0 / s.tied_stiffness_n_per_m();
-        check_bonded("applied force", s, load, 0.05, w_reference(ref, L.w), 0.5 * s.tied_stiffness_n_per_m() * amp * amp);
+        const HarmonicForceCase force = harmonic_force_case(s, L, 200.0, 5.0);
+        check_bonded("applied force", s, force.load, 0.05, w_reference(force.ref, L.w), force.energy_scale_j);
     }
     {
         // the supports move by A cos(Omega t), 1 mm at 3 Hz, from rest relative to them: every mass
         // feels -y_b'' times itself, 50 ms
-        const double A = 1e-3, Om = 2.0 * kPi * 3.0;
-        Loading load;
-        load.kind = LoadingKind::base_excitation;
-        load.displacement_m.shape = TimeFunction::Shape::harmonic;
-        load.displacement_m.amplitude = A;
-        load.displacement_m.frequency_hz = 3.0;
-        load.displacement_m.phase_rad = kPi / 2.0;
-        Forcing q;
-        q.omega = Om;
-        q.b = A * Om * Om * L.l;
-        const Modal ref(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q);
-        check_bonded("base excitation", s, load, 0.05, w_reference(ref, L.w), 0.5 * s.tied_stiffness_n_per_m() * A * A);
+        const double A = 1e-3;
+        const BaseExcitationCase base = base_excitation_case(L, A, 3.0);
+        check_bonded("base excitation", s, base.load, 0.05, w_reference(base.ref, L.w),
+                     0.5 * s.tied_stiffness_n_per_m() * A * A);
     }
     {
         // gravity: the static state of the whole stack under its weight and R's, K_t z = -g l
@@ -224,14 +196,14 @@ BOOST_AUTO_TEST_CASE(friction_stack_converges_to_the_massive_stack_as_the_cut_ri
     so.loading = base_and_gravity();
     const auto massive = simulate(s, so);
     const auto nm = newmark(s, base_and_gravity(), 0.005, 1e-5);
-    BOOST_TEST_MESSAGE("massive vs newmark " << dev_w(massive, nm) << " m");
-    BOOST_TEST(dev_w(massive, nm) < 1e-9);
+    BOOST_TEST_MESSAGE("massive vs newmark " << max_w_deviation(massive, nm) << " m");
+    BOOST_TEST(max_w_deviation(massive, nm) < 1e-9);
     const double motion = motion_of(massive);
     double prev = 0.0;
     for (double cut : {0.0, 1000.0, 2000.0}) {
         RunReport rep;
         const auto r = modal_friction(s, 0.005, cut, rep);
-        const double dev = dev_w(r, massive), dev_nm = dev_w(r, nm);
+        const double dev = max_w_deviation(r, massive), dev_nm = max_w_deviation(r, nm);
         BOOST_TEST_MESSAGE("cut " << rep.cvode.modal_cutoff_rad_per_s << " rad/s (" << rep.cvode.retained_modes
                                   << " modes): max |w - w_massive| " << dev << " m, newmark " << dev_nm << " m of "
                                   << motion << " m; " << rep.cvode.steps << " steps, " << rep.cvode.events << " event times");
@@ -256,13 +228,13 @@ BOOST_AUTO_TEST_CASE(friction_stack_over_stick_slip_converges_to_newmark, *boost
     const System s = stack(PaperCase::friction);
     const auto nm1 = newmark(s, base_and_gravity(), 0.05, 1e-5);
     const auto ref = newmark(s, base_and_gravity(), 0.05, 5e-6);
-    const double newmark_change = dev_w(nm1, ref), motion = motion_of(ref);
+    const double newmark_change = max_w_deviation(nm1, ref), motion = motion_of(ref);
     BOOST_TEST_MESSAGE("newmark 1e-5 vs 5e-6 s: " << newmark_change << " m of " << motion << " m");
     double first = 0.0;
     for (double cut : {0.0, 1000.0, 2000.0, 5000.0}) {
         RunReport rep;
         const auto r = modal_friction(s, 0.05, cut, rep);
-        const double dev = dev_w(r, ref);
+        const double dev = max_w_deviation(r, ref);
         BOOST_TEST_MESSAGE("cut " << rep.cvode.modal_cutoff_rad_per_s << " rad/s (" << rep.cvode.retained_modes
                                   << " modes): max |w - w_newmark| " << dev << " m; " << rep.cvode.steps << " steps, "
                                   << rep.cvode.events << " event times");

@@ -30,29 +30,13 @@ System paper_system(PaperCase c, bool elastic, double density = 0.0, double clam
 
 SimulationOptions options(Mode mode, double t_end_s, double dt_s, double tol_m = 1e-10,
                           SolverKind solver = SolverKind::exact, ContactPath path = ContactPath::dense) {
-    SimulationOptions so;
-    so.mode = mode;
-    so.t_end_s = t_end_s;
-    so.dt_s = dt_s;
+    SimulationOptions so = run_options(mode, t_end_s, dt_s, tol_m);
     so.solver.kind = solver;
-    so.solver.tolerance_m = tol_m;
     so.contact_path = path;
     // leaf mass with friction: the modal formulation these checks measured (the whole massive
     // stack, the default on elastic interfaces, has its own tests: test_cvode_massive)
     so.cvode.leaf_inertia = LeafInertia::modal;
     return so;
-}
-
-double max_deviation(const std::vector<StepRecord>& a, const std::vector<StepRecord>& b) {
-    double d = 0.0;
-    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) d = std::max(d, std::abs(a[i].w_m - b[i].w_m));
-    return d;
-}
-
-double worst_balance(const std::vector<StepRecord>& r) {
-    double worst = 0.0;
-    for (const auto& x : r) worst = std::max(worst, std::abs(x.energy_balance_error_j));
-    return worst;
 }
 
 // Whole-spring stiffness at R with only the clamp pairs' components tied [N/m]:
@@ -100,8 +84,8 @@ BOOST_AUTO_TEST_CASE(dense_and_sparse_paths_agree) {
     BOOST_TEST_REQUIRE(d.size() == sp.size());
     double dq = 0.0;
     for (std::size_t i = 0; i < d.size(); ++i) dq = std::max(dq, std::abs(d[i].dissipated_energy_j - sp[i].dissipated_energy_j));
-    BOOST_TEST_MESSAGE("dense vs sparse: max |dw| " << max_deviation(d, sp) << " m, max |d dissipated| " << dq << " J");
-    BOOST_TEST(max_deviation(d, sp) < 1e-10);
+    BOOST_TEST_MESSAGE("dense vs sparse: max |dw| " << max_w_deviation(d, sp) << " m, max |d dissipated| " << dq << " J");
+    BOOST_TEST(max_w_deviation(d, sp) < 1e-10);
     BOOST_TEST(dq < 1e-8);
 }
 
@@ -121,8 +105,8 @@ BOOST_AUTO_TEST_CASE(every_solver_gives_the_same_steps) {
                                                   : std::vector<SolverKind>{SolverKind::block_jacobi};
         for (SolverKind k : kinds) {
             const auto r = simulate(s, options(Mode::closed_form, 0.01, 1e-3, 1e-8, k));
-            BOOST_TEST_MESSAGE(to_string(c) << ", " << to_string(k) << ": max |dw| vs exact " << max_deviation(r, ref) << " m");
-            BOOST_TEST_CONTEXT(to_string(c) << ", " << to_string(k)) { BOOST_TEST(max_deviation(r, ref) < 1e-8); }
+            BOOST_TEST_MESSAGE(to_string(c) << ", " << to_string(k) << ": max |dw| vs exact " << max_w_deviation(r, ref) << " m");
+            BOOST_TEST_CONTEXT(to_string(c) << ", " << to_string(k)) { BOOST_TEST(max_w_deviation(r, ref) < 1e-8); }
         }
     }
 }
@@ -184,7 +168,7 @@ std::pair<double, double> balances(const ModeCase& k, double* e0 = nullptr) {
     for (int el = 0; el < 2; ++el) {
         const auto r = simulate(paper_system(k.c, el == 1, k.density, kClamp),
                                 options(k.mode, 0.3, 1e-3, 1e-10, SolverKind::exact, k.path));
-        worst[el] = worst_balance(r);
+        worst[el] = max_balance_error(r);
         if (e0) *e0 = r.front().kinetic_energy_j + r.front().strain_energy_j;
         if (el == 1)
             BOOST_TEST_MESSAGE(k.name << ": E0 " << r.front().kinetic_energy_j + r.front().strain_energy_j

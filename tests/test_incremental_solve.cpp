@@ -26,20 +26,26 @@ struct Solvers {
     }
 };
 
-}  // namespace
-
-BOOST_AUTO_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random_mode_changes) {
-    // 1,500 sets of modes, each 1-6 pair changes from the one before (every kind of change),
-    // the accepted set (accept(): the base of the next updates) every 5th, a return to an
-    // earlier set every 50th. Both solvers always on the Schur way (schur_max_rows large).
+/// What a random walk over the modes compares: the two solvers on the stack's problem, the
+/// walk, and the figures gathered (the largest error against its bound, the updates made).
+struct Walk {
     const SparseContactProblem& pr = stack_problem();
-    BOOST_TEST_REQUIRE(pr.size() > 200);
-    Solvers sv(pr);
-    auto& [inc, ref] = sv;
-    ModeWalk walk(pr);
+    Solvers sv{pr};
+    sp::ModeSolver& inc = sv.inc;
+    sp::ModeSolver& ref = sv.ref;
+    ModeWalk walk{pr};
     Counts counts;
     double worst = 0.0;
     int updates = 0;
+};
+
+}  // namespace
+
+BOOST_FIXTURE_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random_mode_changes, Walk) {
+    // 1,500 sets of modes, each 1-6 pair changes from the one before (every kind of change),
+    // the accepted set (accept(): the base of the next updates) every 5th, a return to an
+    // earlier set every 50th. Both solvers always on the Schur way (schur_max_rows large).
+    BOOST_TEST_REQUIRE(pr.size() > 200);
     std::vector<modes::ModeSet> earlier;
     std::uniform_int_distribution<int> changes(1, 6);
     for (int i = 0; i < 1500; ++i) {
@@ -62,18 +68,12 @@ BOOST_AUTO_TEST_CASE(incremental_solve_equals_the_solve_from_scratch_over_random
 
 // Release only (label slow: the longest case of this file under the sanitizers); the sanitizer
 // build still runs the incremental solve against the solve from scratch over 1,500 random mode sets.
-BOOST_AUTO_TEST_CASE(incremental_solve_does_not_drift_over_ten_thousand_updates, *boost::unit_test::label("slow")) {
+BOOST_FIXTURE_TEST_CASE(incremental_solve_does_not_drift_over_ten_thousand_updates, Walk,
+                        *boost::unit_test::label("slow")) {
     // 10,000 sets of modes, one pair change each, never accepted: every set is an update of
     // the last base (refactorised only when the changes reach a quarter of the held rows),
     // compared with the solve from scratch every 100th set. The error stays within its
     // round-off bound instead of growing with the number of updates.
-    const SparseContactProblem& pr = stack_problem();
-    Solvers sv(pr);
-    auto& [inc, ref] = sv;
-    ModeWalk walk(pr);
-    Counts counts;
-    double worst = 0.0;
-    int updates = 0;
     for (int i = 0; i < 10000; ++i) {
         walk.change(1);
         if (i % 100 == 99) {

@@ -40,14 +40,9 @@ namespace {
 System stack(PaperCase c) { return System(Model::build(steel_elastic_stack(c))); }
 
 SimulationOptions options(Mode mode, double t_end_s, double dt_s) {
-    SimulationOptions so;
-    so.mode = mode;
-    so.t_end_s = t_end_s;
-    so.dt_s = dt_s;
-    so.cvode.rtol = 1e-6;
+    SimulationOptions so = run_options(mode, t_end_s, dt_s, 1e-12, 1e-6);
     so.cvode.atol_m = 1e-10;
     so.cvode.leaf_inertia = LeafInertia::massive;
-    so.solver.tolerance_m = 1e-12;
     return so;
 }
 
@@ -151,18 +146,8 @@ BOOST_AUTO_TEST_CASE(applied_force_with_leaf_mass) {
     // meshed part), 50 ms, below R's mode (11 Hz).
     const System s = stack(PaperCase::bonded);
     const Linear L = linear(s);
-    Loading load;
-    load.kind = LoadingKind::applied_force;
-    load.force_n.shape = TimeFunction::Shape::harmonic;
-    load.force_n.amplitude = 200.0;
-    load.force_n.frequency_hz = 5.0;
-    Forcing q;
-    q.omega = 2.0 * kPi * 5.0;
-    q.c = Eigen::VectorXd::Zero(L.w + 1);
-    q.c[L.w] = 200.0 / L.f;
-    const Modal ref(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q);
-    const double amp = 200.0 / s.tied_stiffness_n_per_m();
-    check_case("applied force", s, load, 0.0, 0.05, w_of, w_reference(ref, L.w), 0.5 * s.tied_stiffness_n_per_m() * amp * amp);
+    const HarmonicForceCase force = harmonic_force_case(s, L, 200.0, 5.0);
+    check_case("applied force", s, force.load, 0.0, 0.05, w_of, w_reference(force.ref, L.w), force.energy_scale_j);
 }
 
 // Release only (label slow: the longest case of this file under the sanitizers); the sanitizer
@@ -174,18 +159,10 @@ BOOST_AUTO_TEST_CASE(base_excitation_with_leaf_mass, *boost::unit_test::label("s
     const System s = stack(PaperCase::bonded);
     const Linear L = linear(s);
     const double A = 1e-3, Om = 2.0 * kPi * 3.0;
-    Loading load;
-    load.kind = LoadingKind::base_excitation;
-    load.displacement_m.shape = TimeFunction::Shape::harmonic;
-    load.displacement_m.amplitude = A;
-    load.displacement_m.frequency_hz = 3.0;
-    load.displacement_m.phase_rad = kPi / 2.0;
-    Forcing q;
-    q.omega = Om;
-    q.b = A * Om * Om * L.l;
-    const Modal ref(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q);
+    const BaseExcitationCase base = base_excitation_case(L, A, 3.0);
+    const Loading& load = base.load;
     const double amp = A * (Om * Om) / (70.0 * 70.0);
-    check_case("base excitation", s, load, 0.0, 0.05, w_of, w_reference(ref, L.w),
+    check_case("base excitation", s, load, 0.0, 0.05, w_of, w_reference(base.ref, L.w),
                0.5 * s.tied_stiffness_n_per_m() * A * A);
     // R's absolute motion follows the base's to the quasi-static (Omega/omega_1)^2 ~ 0.07 of it
     SimulationOptions so = options(Mode::cvode, 0.05, 1e-4);

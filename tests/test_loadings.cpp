@@ -29,12 +29,7 @@ System paper_system(PaperCase c, double v0 = 0.0) {
 }
 
 SimulationOptions options(Mode mode, double dt, double t_end, const Loading& loading) {
-    SimulationOptions so;
-    so.mode = mode;
-    so.dt_s = dt;
-    so.t_end_s = t_end;
-    so.solver.tolerance_m = 1e-10;
-    so.cvode.rtol = 1e-10;
+    SimulationOptions so = run_options(mode, t_end, dt, 1e-10, 1e-10);
     so.loading = loading;
     return so;
 }
@@ -267,11 +262,8 @@ BOOST_AUTO_TEST_CASE(rig_loop_with_friction_dissipates_its_area) {
     for (double dt : {1e-3, 5e-4}) {
         BOOST_TEST_CONTEXT("dt " << dt) {
             const System sys = paper_system(PaperCase::friction);
-            Loading l;
-            l.kind = LoadingKind::prescribed_displacement;
-            l.displacement_m.shape = TimeFunction::Shape::triangle;
-            l.displacement_m.amplitude = 0.02;
-            l.displacement_m.frequency_hz = 1.0;
+            const Loading l =
+                periodic_loading(LoadingKind::prescribed_displacement, TimeFunction::Shape::triangle, 0.02, 1.0);
             auto so = options(Mode::closed_form, dt, 3.0, l);
             so.solver.tolerance_m = 1e-9;
             const auto run = simulate(sys, so);
@@ -407,11 +399,7 @@ BOOST_AUTO_TEST_CASE(sparse_path_equals_dense_path_under_loadings) {
     // of C'^-1 scale): spring force to 1e-6 N, w to 1e-10 m, energies to 1e-8 J.
     const System sys = paper_system(PaperCase::friction, 2.0);
     const System rig_sys = paper_system(PaperCase::friction);
-    Loading rig;
-    rig.kind = LoadingKind::prescribed_displacement;
-    rig.displacement_m.shape = TimeFunction::Shape::triangle;
-    rig.displacement_m.amplitude = 0.02;
-    rig.displacement_m.frequency_hz = 2.0;
+    const Loading rig = periodic_loading(LoadingKind::prescribed_displacement, TimeFunction::Shape::triangle, 0.02, 2.0);
     Loading grav;
     grav.gravity_m_per_s2 = kG;
     Loading force;

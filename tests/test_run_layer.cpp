@@ -13,6 +13,7 @@
 #include "stackbeam/run/run.hpp"
 #include "stackbeam/run/summary_json.hpp"
 #include "stackbeam/study/sweep.hpp"
+#include "stackbeam/time/stepper.hpp"
 
 using namespace stackbeam;
 
@@ -29,6 +30,14 @@ Scenario rig() {
 bool same(const StepRecord& a, const StepRecord& b) {
     const auto x = step_record_values(a), y = step_record_values(b);
     return std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+}
+
+/// A request to run `options`, its rows to `sink` (the outputs off).
+RunRequest request_of(const SimulationOptions& options, RunSink* sink) {
+    RunRequest request;
+    request.options = options;
+    request.sink = sink;
+    return request;
 }
 
 struct CountingSink : RunSink {
@@ -53,10 +62,8 @@ BOOST_AUTO_TEST_CASE(run_scenario_is_simulate_with_its_figures) {
     // so the records must be bitwise equal (no tolerance: the same arithmetic)
     const std::vector<StepRecord> reference = simulate(system, s.simulation);
     CountingSink sink;
-    RunRequest request;
-    request.options = s.simulation;
+    RunRequest request = request_of(s.simulation, &sink);
     request.outputs.pairs = true;
-    request.sink = &sink;
     const RunSummary summary = run_scenario(system, request);
     BOOST_TEST(!summary.interrupted);
     BOOST_REQUIRE_EQUAL(summary.records.size(), reference.size());
@@ -106,9 +113,7 @@ BOOST_AUTO_TEST_CASE(a_stop_ends_the_run_at_a_whole_record) {
     const Scenario s = rig();
     const System system(Model::build(s.model));
     CountingSink sink;
-    RunRequest request;
-    request.options = s.simulation;
-    request.sink = &sink;
+    RunRequest request = request_of(s.simulation, &sink);
     // asked to stop once the sink has 10 records: the 11th is dropped (or not made), the run ends
     request.stop = [&] { return sink.records >= 10; };
     const RunSummary summary = run_scenario(system, request);
@@ -122,6 +127,35 @@ BOOST_AUTO_TEST_CASE(a_stop_ends_the_run_at_a_whole_record) {
     BOOST_TEST(summary.report.steps == 0);  // no report for an interrupted run (documented)
     const std::string json = summary_json(summary, system.model());
     BOOST_TEST(json.find("\"interrupted\": true") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(modes_with_a_feature_are_those_whose_stepper_takes_it) {
+    // the front-ends' question before a system exists (modes_with) against the stepper make_stepper
+    // chooses for a built system (describe_stepper): a mode is listed for massive leaves exactly
+    // when make_stepper builds one for the bonded paper example with steel leaves (no refusal),
+    // and for the event log exactly when its stepper for the massless example keeps one
+    const std::vector<Mode> massive = modes_with(StepperFeature::massive_leaves);
+    const std::vector<Mode> events = modes_with(StepperFeature::event_log);
+    BOOST_TEST(mode_list(massive, " or ") == "newmark or cvode");  // docs/time-integration.md
+    BOOST_TEST(mode_list(events, " or ") == "cvode");
+    ModelSpec steel = paper_example(PaperCase::bonded);
+    for (auto& leaf : steel.leaves) leaf.density_kg_per_m3 = 7850.0;
+    const System massive_system(Model::build(steel));
+    const System massless_system(Model::build(paper_example(PaperCase::bonded)));
+    for (const auto& w : enum_words<Mode>()) {
+        SimulationOptions o;
+        o.mode = w.value;
+        const bool listed = std::find(massive.begin(), massive.end(), w.value) != massive.end();
+        bool taken = true;
+        try {
+            make_stepper(massive_system, o);
+        } catch (const InputError&) {
+            taken = false;
+        }
+        BOOST_TEST(listed == taken, "mode " << w.word);
+        const bool logs = std::find(events.begin(), events.end(), w.value) != events.end();
+        BOOST_TEST(logs == describe_stepper(massless_system, o).cvode_stats, "mode " << w.word);
+    }
 }
 
 BOOST_AUTO_TEST_CASE(word_tables_read_back_what_they_write) {
@@ -166,8 +200,7 @@ struct StressSink : RunSink {
 BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_monitors_summary) {
     const Scenario s = rig();
     const System system(Model::build(s.model));
-    RunRequest plain;
-    plain.options = s.simulation;
+    const RunRequest plain = request_of(s.simulation, nullptr);
     const RunSummary without = run_scenario(system, plain);
     BOOST_TEST(!without.stresses.has_value());  // not asked: nothing made (and no note)
     BOOST_TEST(without.stresses_note.empty());
@@ -231,10 +264,8 @@ BOOST_AUTO_TEST_CASE(the_stresses_flag_gives_the_fatigue_figures) {
     for (LeafSpec& l : s.model.leaves) l.material = steel;
     const System system(Model::build(s.model));
     StressSink sink;
-    RunRequest request;
-    request.options = s.simulation;
+    RunRequest request = request_of(s.simulation, &sink);
     request.outputs.stresses = true;
-    request.sink = &sink;
     const RunSummary summary = run_scenario(system, request);
     BOOST_REQUIRE(summary.stresses.has_value());
     const StressSummary& got = summary.stresses->summary;

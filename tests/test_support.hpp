@@ -2,6 +2,7 @@
 // Helpers shared by the physics tests (and the benchmarks' stacks): runs of the paper
 // example, the many-leaf stacks built from its leaf, and measurements on time series
 // (period from zero crossings, peaks).
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -43,6 +44,33 @@ inline ModelSpec paper_with_mass(PaperCase c, double density_kg_per_m3, bool mas
         for (auto& cl : spec.clamps) cl.length_m = 0.01;
     }
     return spec;
+}
+
+/// A loading of `kind` whose time function (force_n [N] for an applied force, else displacement_m
+/// [m]) is `shape` with `amplitude`, `frequency_hz` and `phase_rad` (time_function.hpp).
+inline Loading periodic_loading(LoadingKind kind, TimeFunction::Shape shape, double amplitude, double frequency_hz,
+                                double phase_rad = 0.0) {
+    Loading load;
+    load.kind = kind;
+    TimeFunction& f = kind == LoadingKind::applied_force ? load.force_n : load.displacement_m;
+    f.shape = shape;
+    f.amplitude = amplitude;
+    f.frequency_hz = frequency_hz;
+    f.phase_rad = phase_rad;
+    return load;
+}
+
+/// Options of a run in `mode` to t_end_s [s], a record every dt_s [s] (mode cvode's output
+/// interval), the contact solver's tolerance tol_m [m] and CVODE's relative tolerance rtol.
+inline SimulationOptions run_options(Mode mode, double t_end_s, double dt_s, double tol_m,
+                                     double rtol = SimulationOptions{}.cvode.rtol) {
+    SimulationOptions so;
+    so.mode = mode;
+    so.dt_s = dt_s;
+    so.t_end_s = t_end_s;
+    so.cvode.rtol = rtol;
+    so.solver.tolerance_m = tol_m;
+    return so;
 }
 
 /// The paper example's case `c` with `leaves` identical leaves of `elements` per half
@@ -97,6 +125,20 @@ inline ModelSpec graduated_stack(int elements, int leaves) {
 }
 
 /// Times [s] where w crosses zero upwards, by linear interpolation between steps.
+/// max |w_a - w_b| [m] over the records two runs share by index (runs on the same output times).
+inline double max_w_deviation(const std::vector<StepRecord>& a, const std::vector<StepRecord>& b) {
+    double d = 0.0;
+    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) d = std::max(d, std::abs(a[i].w_m - b[i].w_m));
+    return d;
+}
+
+/// The largest |energy balance error| [J] over a run's records.
+inline double max_balance_error(const std::vector<StepRecord>& r) {
+    double e = 0.0;
+    for (const auto& rec : r) e = std::max(e, std::abs(rec.energy_balance_error_j));
+    return e;
+}
+
 inline std::vector<double> upward_zero_crossings(const std::vector<StepRecord>& r) {
     std::vector<double> t;
     for (std::size_t i = 1; i < r.size(); ++i)

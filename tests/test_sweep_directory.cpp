@@ -53,6 +53,15 @@ PointResult row_of(int index) {
     return r;
 }
 
+/// A fresh directory `name` (fresh_dir) holding a sweep of `points` with the rows of its first
+/// `rows` points (row_of), its lock released.
+std::string directory_with_rows(const std::string& name, const SweepPoints& points, int rows) {
+    const std::string dir = fresh_dir(name);
+    SweepDirectory d(dir, points, false, false);
+    for (int i = 0; i < rows; ++i) d.record(row_of(i));
+    return dir;
+}
+
 std::string read(const std::string& path) {
     std::ifstream in(path);
     std::ostringstream s;
@@ -108,11 +117,7 @@ BOOST_AUTO_TEST_CASE(journal_rows_checked_against_points) {
     const SweepSpec map = map_with_mu("[0.3, 0.5]");
     const SweepSpec mapY = map_with_mu("[0.3, 0.4]");
     const SweepPoints points(map), pointsY(mapY);
-    const std::string dir = fresh_dir("relabel");
-    {
-        SweepDirectory d(dir, points, false, false);
-        for (int i = 0; i < 4; ++i) d.record(row_of(i));
-    }
+    const std::string dir = directory_with_rows("relabel", points, 4);
     const std::string journal = dir + "/finished.csv";
     const auto lines = lines_of(journal);
     BOOST_REQUIRE_EQUAL(lines.size(), 6u);  // the spec's id, the header, 4 rows
@@ -139,11 +144,7 @@ BOOST_AUTO_TEST_CASE(journal_rows_checked_against_points) {
 BOOST_AUTO_TEST_CASE(damaged_middle_row_keeps_later_rows) {
     const SweepSpec spec = map_with_mu("[0.3, 0.5]");
     const SweepPoints points(spec);
-    const std::string dir = fresh_dir("damaged");
-    {
-        SweepDirectory d(dir, points, false, false);
-        for (int i = 0; i < 4; ++i) d.record(row_of(i));
-    }
+    const std::string dir = directory_with_rows("damaged", points, 4);
     const std::string journal = dir + "/finished.csv";
     auto lines = lines_of(journal);
     lines[3] = "1,0.01,0.5,ok,,not a number";  // point 1's row, damaged (line 4 of the file)
@@ -169,11 +170,7 @@ BOOST_AUTO_TEST_CASE(stale_point_files_rewritten) {
     const SweepSpec old_spec = map_with_mu("[0.3, 0.5]");
     const SweepSpec spec = map_with_mu("[0.3, 0.4]");
     const SweepPoints old_points(old_spec), points(spec);
-    const std::string dir = fresh_dir("stale");
-    {
-        SweepDirectory d(dir, old_points, false, false);
-        for (int i = 0; i < 4; ++i) d.record(row_of(i));
-    }
+    const std::string dir = directory_with_rows("stale", old_points, 4);
     const std::string scenario1 = point_file(dir, "scenarios", 1, "toml");
     BOOST_TEST(has(read(scenario1), "friction_coefficient = 0.5"));
     // the journal and tables gone, the scenarios left: the new spec's run must not reuse them
@@ -277,11 +274,7 @@ BOOST_AUTO_TEST_CASE(bad_inputs_named) {
 BOOST_AUTO_TEST_CASE(directory_from_before_the_stress_columns_named) {
     const SweepSpec spec = map_with_mu("[0.3, 0.5]");
     const SweepPoints points(spec);
-    const std::string dir = fresh_dir("before_stresses");
-    {
-        SweepDirectory d(dir, points, false, false);
-        for (int i = 0; i < 2; ++i) d.record(row_of(i));
-    }
+    const std::string dir = directory_with_rows("before_stresses", points, 2);
     const std::string journal = dir + "/finished.csv";
     auto lines = lines_of(journal);
     BOOST_REQUIRE_EQUAL(lines.size(), 4u);  // the spec's id, the header, 2 rows

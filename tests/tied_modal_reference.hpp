@@ -11,7 +11,9 @@
 #include <functional>
 #include <vector>
 
+#include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "test_support.hpp"  // kPi
 
 namespace stackbeam::testing {
 
@@ -144,4 +146,44 @@ inline Eigen::VectorXd held_shape(const Linear& L, double w0) {
     z0[w] = w0;
     return z0;
 }
+
+/// The supports moved by y_b = A cos(Omega t), Omega = 2 pi frequency_hz, from rest relative to them
+/// (Loading::base_excitation): the loading and its exact response, every mass feeling -y_b'' times
+/// itself, q = A Omega^2 cos(Omega t) l.
+struct BaseExcitationCase {
+    Loading load;
+    Modal ref;
+};
+
+inline BaseExcitationCase base_excitation_case(const Linear& L, double amplitude_m, double frequency_hz) {
+    const double Om = 2.0 * kPi * frequency_hz;
+    Forcing q;
+    q.omega = Om;
+    q.b = amplitude_m * Om * Om * L.l;
+    return {periodic_loading(LoadingKind::base_excitation, TimeFunction::Shape::harmonic, amplitude_m, frequency_hz,
+                             kPi / 2.0),
+            Modal(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q)};
+}
+
+/// F(t) = amplitude_n sin(2 pi frequency_hz t) on R from rest (Loading::applied_force): the
+/// loading, its exact response (q = e_w F / f: the whole-spring force on the meshed part) and the
+/// energy scale k_t A^2 / 2 of the static amplitude A = F / k_t [J] (the balance's scale).
+struct HarmonicForceCase {
+    Loading load;
+    Modal ref;
+    double energy_scale_j;
+};
+
+inline HarmonicForceCase harmonic_force_case(const System& s, const Linear& L, double amplitude_n, double frequency_hz) {
+    const Loading load =
+        periodic_loading(LoadingKind::applied_force, TimeFunction::Shape::harmonic, amplitude_n, frequency_hz);
+    Forcing q;
+    q.omega = 2.0 * kPi * frequency_hz;
+    q.c = Eigen::VectorXd::Zero(L.w + 1);
+    q.c[L.w] = amplitude_n / L.f;
+    const double amp = amplitude_n / s.tied_stiffness_n_per_m();
+    return {load, Modal(L.M, L.K, Eigen::VectorXd::Zero(L.w + 1), Eigen::VectorXd::Zero(L.w + 1), q),
+            0.5 * s.tied_stiffness_n_per_m() * amp * amp};
+}
+
 }  // namespace stackbeam::testing

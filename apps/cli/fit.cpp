@@ -119,7 +119,9 @@ void write_outputs(const FitSpec& spec, const FitResult& r, const fs::path& dir,
 
 }  // namespace
 
-void add_fit_options(CLI::App& fit, FitArgs& args) {
+CLI::App* add_fit_command(CLI::App& app, FitArgs& args) {
+    CLI::App& fit = *app.add_subcommand("fit", "Fit scenario keys (friction, interface stiffness, preload, ...) to measured "
+                                               "force-displacement loops (docs/calibration.md)");
     fit.add_option("spec", args.spec, "The fit spec (TOML): base scenario, measured loops, parameters (docs/calibration.md)")->required();
     fit.add_option("--jobs,-j", args.jobs, "Threads for the runs (0: the machine's cores)")->check(CLI::Range(0, 1024));
     fit.add_option("--out-dir", args.out_dir, "Output directory (default: the spec's [outputs] directory, else SPEC_fit)");
@@ -127,6 +129,7 @@ void add_fit_options(CLI::App& fit, FitArgs& args) {
     fit.add_flag("--no-plot", args.no_plot, "No gnuplot figure");
     fit.add_option("--stop-after", args.stop_after, "tests: stop as on SIGINT after this many iterations")
         ->check(CLI::Range(0, 1000000));
+    return &fit;
 }
 
 int run_fit_command(const FitArgs& args) {

@@ -20,7 +20,8 @@ struct FitArgs {
     int stop_after = 0;    ///< tests: stop as on SIGINT after this many iterations (0: never)
 };
 
-void add_fit_options(CLI::App& fit, FitArgs& args);
+/// Adds the subcommand `fit` to `app` with every flag, storing them in `args`.
+CLI::App* add_fit_command(CLI::App& app, FitArgs& args);
 
 /// Runs the fit; returns the exit status (0 done, 130 / 143 stopped: run again to resume).
 /// Throws InputError / ArgumentError for a bad spec or argument (exit 2).

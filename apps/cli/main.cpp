@@ -122,26 +122,13 @@ int run_main(int argc, char** argv, const MpiWorld& world) {
                "Exit status: 0 success, 2 bad input, 3 solver failure, 130 / 143 stopped by SIGINT / SIGTERM\n"
                "(the rows so far stay in FILE.partial), 1 other errors.");
 
+    // the subcommands, each with its flags (options.hpp, sweep.hpp, fit.hpp, fmu.hpp)
     SimulateArgs args;
-    CLI::App* sim = app.add_subcommand("simulate", "Simulate the paper example or a scenario and write one CSV row per time step");
-    sim->footer("One name per option: a flag is its scenario key's last part without the unit suffix, '_' written '-'\n"
-                "(integrator.cvode.max_step_s: --max-step; integrator.solver.kind: --solver); the key is the member's\n"
-                "path in SimulationOptions under [integrator]. Renamed flags keep their old name: --tol (--tolerance).\n"
-                "Errors name the flag as given, or the file's key with file:line:column.");
-    add_simulate_options(*sim, args);
-
+    CLI::App* sim = add_simulate_command(app, args);
     SweepArgs sweep_args;
-    CLI::App* sweep = app.add_subcommand("sweep", "Run a base scenario at many points (axes over any scenario key) on threads or "
-                                                  "MPI ranks: a table of loop figures, resumable (docs/sweep.md)");
-    sweep->footer("Exit status: 0 every point ok, 2 bad spec (nothing run), 3 some points failed (their rows say why),\n"
-                  "130 / 143 stopped by SIGINT / SIGTERM (run the same command again to resume), 1 other errors.\n"
-                  "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
-    add_sweep_options(*sweep, sweep_args);
-
+    CLI::App* sweep = add_sweep_command(app, sweep_args);
     FitArgs fit_args;
-    CLI::App* fit = app.add_subcommand("fit", "Fit scenario keys (friction, interface stiffness, preload, ...) to measured "
-                                              "force-displacement loops (docs/calibration.md)");
-    add_fit_options(*fit, fit_args);
+    CLI::App* fit = add_fit_command(app, fit_args);
     FmuArgs fmu_args;
     CLI::App* fmu = add_fmu_command(app, fmu_args);  // `stackbeam fmu SCENARIO.toml --out spring.fmu` (fmu.hpp)
 

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -138,7 +139,12 @@ void validate(const SimulateArgs& a, const SimulationOptions& options, const Sce
 
 }  // namespace
 
-void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
+CLI::App* add_simulate_command(CLI::App& app, SimulateArgs& a) {
+    CLI::App& sim = *app.add_subcommand("simulate", "Simulate the paper example or a scenario and write one CSV row per time step");
+    sim.footer("One name per option: a flag is its scenario key's last part without the unit suffix, '_' written '-'\n"
+               "(integrator.cvode.max_step_s: --max-step; integrator.solver.kind: --solver); the key is the member's\n"
+               "path in SimulationOptions under [integrator]. Renamed flags keep their old name: --tol (--tolerance).\n"
+               "Errors name the flag as given, or the file's key with file:line:column.");
     CLI::Option* case_opt =
         sim.add_option("--case", a.case_name, "the paper example: bonded | friction | frictionless")->type_name("CASE");
     CLI::Option* scenario_opt =
@@ -204,17 +210,12 @@ void add_simulate_options(CLI::App& sim, SimulateArgs& a) {
                    "fibres' at its edges; the run then computes the stresses, as --stresses does) (default state)")
         ->type_name("WORD");
     sim.add_flag("--quiet", a.quiet, "no progress line on the terminal");
+    return &sim;
 }
 
 SimulateRequest make_request(const SimulateArgs& a) {
     SimulateRequest r;
-    r.out = a.out;
-    r.events = a.events;
-    r.summary = a.summary;
-    r.pairs = a.pairs;
-    r.nodes = a.nodes;
-    r.stresses = a.stresses;
-    r.plot = a.plot;
+    static_cast<OutputPaths&>(r) = a;  // the files as given; the scenario's fill those not given below
     r.quiet = a.quiet;
     const bool density_given = a.given.count("--beam-density") > 0;
     std::optional<InterfaceContact> contact;  // --interface, checked before the file is read
@@ -254,13 +255,21 @@ SimulateRequest make_request(const SimulateArgs& a) {
         apply_interface(contact, r.spec);
         r.setup = case_setup(pcase, example);
     }
-    if (density_given && r.options.mode == Mode::closed_form && parse_density(a.beam_density) > 0.0)
-        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode newmark or cvode: mode closed-form "
-                            "treats the leaves as massless, the paper");
-    if (r.options.mode != Mode::cvode && !r.events.empty())
+    // what the modes' steppers take: the registry's rows (run/run.hpp), before the system is built
+    auto has = [&](StepperFeature f) {
+        const auto modes = modes_with(f);
+        return std::find(modes.begin(), modes.end(), r.options.mode) != modes.end();
+    };
+    if (density_given && parse_density(a.beam_density) > 0.0 && !has(StepperFeature::massive_leaves))
+        throw ArgumentError("--beam-density: value '" + a.beam_density + "' needs --mode " +
+                            mode_list(modes_with(StepperFeature::massive_leaves), " or ") + ": mode " +
+                            to_string(r.options.mode) + " treats the leaves as massless, the paper");
+    if (!r.events.empty() && !has(StepperFeature::event_log)) {
+        const std::string modes = mode_list(modes_with(StepperFeature::event_log), " or ");
         throw ArgumentError((a.events.empty() ? "outputs.events_path (file " + a.scenario + ")" : std::string("--events")) +
-                            ": value '" + r.events + "': the event log exists in mode cvode only (mode " +
-                            std::string(to_string(r.options.mode)) + "): remove it, or use mode cvode");
+                            ": value '" + r.events + "': the event log exists in mode " + modes + " only (mode " +
+                            std::string(to_string(r.options.mode)) + "): remove it, or use mode " + modes);
+    }
     if (!r.nodes.empty()) {  // the nodes' rows would overwrite (or interleave with) another output
         const std::string what = a.nodes.empty() ? "outputs.nodes_path (file " + a.scenario + ")" : std::string("--nodes");
         for (const auto& [other, file] : {std::pair<const char*, const std::string*>{"--out", &r.out},

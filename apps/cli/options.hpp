@@ -28,29 +28,33 @@ struct ArgumentError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-/// The text of `simulate`'s arguments as given.
-struct SimulateArgs {
+/// The files of a run ("" = none): --out (the records' CSV, required), --events, --summary,
+/// --pairs, --nodes, --stresses and the --plot prefix (or the scenario's outputs.*).
+struct OutputPaths {
+    std::string out, events, summary, pairs, nodes, stresses, plot;
+};
+
+/// The text of `simulate`'s arguments as given (the files as given: OutputPaths).
+struct SimulateArgs : OutputPaths {
     std::string case_name;
     std::string scenario;
     std::string elements;      ///< "" = the library's default (PaperExampleOptions)
     bool full_model = false;
     std::string beam_density;  ///< "" = the leaves' own density (the case's: 0, massless)
     std::string interface;     ///< --interface: "" = the case's or the file's contact law (rigid | elastic)
-    std::string out, events, summary, pairs, nodes, stresses, plot;
     std::string stack_color;   ///< --stack-color: "" = state
     bool quiet = false;
     std::map<std::string, std::string> table_text;  ///< flag (or alias) of the option table -> text
     std::set<std::string> given;                     ///< the flags given on the command line
 };
 
-/// Registers every flag of `simulate` on `sim`, storing their text in `args`.
-void add_simulate_options(CLI::App& sim, SimulateArgs& args);
+/// Adds the subcommand `simulate` to `app` with every flag, storing their text in `args`.
+CLI::App* add_simulate_command(CLI::App& app, SimulateArgs& args);
 
-/// One run, ready to go: everything checked.
-struct SimulateRequest {
+/// One run, ready to go: everything checked (the files: OutputPaths, out required).
+struct SimulateRequest : OutputPaths {
     ModelSpec spec;
     SimulationOptions options;
-    std::string out, events, summary, pairs, nodes, stresses, plot;  ///< files ("" = none); out is required
     std::string setup;                              ///< the summary's first line: the case or the scenario
     bool stack_stress = false;  ///< --stack-color stress: the deformed stack's leaves coloured by their fibre stresses
     bool quiet = false;

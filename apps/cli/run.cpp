@@ -279,10 +279,10 @@ RunResult run(const SimulateRequest& request, const System& system) {
         sink.pairs_csv.close();
         sink.nodes_csv.close();
         sink.stresses_csv.close();
-        result.csv_file = sink.csv.partial();
-        if (sink.pairs_csv.active()) result.pairs_file = sink.pairs_csv.partial();
-        if (sink.nodes_csv.active()) result.nodes_file = sink.nodes_csv.partial();
-        if (sink.stresses_csv.active()) result.stresses_file = sink.stresses_csv.partial();
+        result.files.csv_file = sink.csv.partial();
+        if (sink.pairs_csv.active()) result.files.pairs_file = sink.pairs_csv.partial();
+        if (sink.nodes_csv.active()) result.files.nodes_file = sink.nodes_csv.partial();
+        if (sink.stresses_csv.active()) result.files.stresses_file = sink.stresses_csv.partial();
         std::cerr << "stackbeam: interrupted by signal " << result.signal << " at t = " << result.summary.t_reached_s
                   << " s; the rows up to it are in " << sink.csv.partial() << "\n";
         return result;
@@ -291,16 +291,16 @@ RunResult run(const SimulateRequest& request, const System& system) {
         PartialFile ev(request.events, "--events");
         write_events_csv(ev.stream(), result.summary.report.events);
         ev.commit();
-        result.events_file = request.events;
+        result.files.events_file = request.events;
     }
     sink.csv.commit();
     sink.pairs_csv.commit();
     sink.nodes_csv.commit();
     sink.stresses_csv.commit();
-    result.csv_file = request.out;
-    result.pairs_file = request.pairs;
-    result.nodes_file = request.nodes;
-    result.stresses_file = request.stresses;
+    result.files.csv_file = request.out;
+    result.files.pairs_file = request.pairs;
+    result.files.nodes_file = request.nodes;
+    result.files.stresses_file = request.stresses;
     return result;
 }
 

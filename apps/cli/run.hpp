@@ -20,6 +20,7 @@
 #include "options.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/run/run.hpp"
+#include "stackbeam/run/summary_json.hpp"
 
 namespace stackbeam::cli {
 
@@ -34,13 +35,12 @@ struct StackSnapshot {
 struct RunResult {
     RunSummary summary;               ///< the library's: stats, records, report, loop figures, stepper
     int signal = 0;                   ///< the signal that stopped the run, 0 if it finished
-    std::string csv_file;             ///< where the rows are (FILE, or FILE.partial when interrupted)
-    std::string pairs_file;           ///< likewise for --pairs ("" none)
-    std::string nodes_file;           ///< likewise for --nodes ("" none)
-    std::string stresses_file;        ///< likewise for --stresses ("" none)
+    /// The files written, as the JSON summary names them: csv_file where the rows are (FILE, or
+    /// FILE.partial when interrupted), likewise pairs_file, nodes_file, stresses_file ("" none);
+    /// events_file the event log written ("" none)
+    SummaryContext files;
     /// With --plot: the stack at the records of the largest and the smallest w (the first such record).
     StackSnapshot stack_at_w_max, stack_at_w_min;
-    std::string events_file;          ///< the event log written ("" none)
 };
 
 /// Installs the SIGINT / SIGTERM handlers that ask the run to stop.

@@ -84,20 +84,16 @@ void print_summary(const SimulateRequest& request, const System& system, const R
     else if (!summary.stresses_note.empty())
         std::printf("stresses                   none (%s)\n", summary.stresses_note.c_str());
     std::printf("wall time                  %.3f s\n", summary.wall_s);
-    std::printf("output                     %s\n", result.csv_file.c_str());
-    if (!result.events_file.empty()) std::printf("event log                  %s\n", result.events_file.c_str());
-    if (!result.pairs_file.empty()) std::printf("pairs                      %s\n", result.pairs_file.c_str());
-    if (!result.nodes_file.empty()) std::printf("nodes                      %s\n", result.nodes_file.c_str());
-    if (!result.stresses_file.empty()) std::printf("stresses                   %s\n", result.stresses_file.c_str());
+    const SummaryContext& f = result.files;
+    std::printf("output                     %s\n", f.csv_file.c_str());
+    if (!f.events_file.empty()) std::printf("event log                  %s\n", f.events_file.c_str());
+    if (!f.pairs_file.empty()) std::printf("pairs                      %s\n", f.pairs_file.c_str());
+    if (!f.nodes_file.empty()) std::printf("nodes                      %s\n", f.nodes_file.c_str());
+    if (!f.stresses_file.empty()) std::printf("stresses                   %s\n", f.stresses_file.c_str());
 }
 
 SummaryContext summary_context(const RunResult& result) {
-    SummaryContext c;
-    c.csv_file = result.csv_file;
-    c.events_file = result.events_file;
-    c.pairs_file = result.pairs_file;
-    c.nodes_file = result.nodes_file;
-    c.stresses_file = result.stresses_file;
+    SummaryContext c = result.files;
     c.signal = result.signal;
     if (result.signal != 0)
         c.interrupted_note = "stopped by a signal at t_reached_s: the rows up to it are in the .partial files "

@@ -73,7 +73,12 @@ private:
 
 }  // namespace
 
-void add_sweep_options(CLI::App& sweep, SweepArgs& a) {
+CLI::App* add_sweep_command(CLI::App& app, SweepArgs& a) {
+    CLI::App& sweep = *app.add_subcommand("sweep", "Run a base scenario at many points (axes over any scenario key) on threads or "
+                                                   "MPI ranks: a table of loop figures, resumable (docs/sweep.md)");
+    sweep.footer("Exit status: 0 every point ok, 2 bad spec (nothing run), 3 some points failed (their rows say why),\n"
+                 "130 / 143 stopped by SIGINT / SIGTERM (run the same command again to resume), 1 other errors.\n"
+                 "Under MPI: mpirun -n N stackbeam sweep SPEC.toml (rank 0 writes DIR, every rank runs points).");
     sweep.add_option("spec", a.spec, "the sweep spec (TOML, docs/sweep.md): the base scenario and the axes")
         ->required()
         ->type_name("SPEC.toml");
@@ -90,6 +95,7 @@ void add_sweep_options(CLI::App& sweep, SweepArgs& a) {
     sweep.add_option("--stop-after", a.stop_after, "tests: stop as on SIGINT after this many points")
         ->group("")  // hidden
         ->check(CLI::Range(1, 1 << 30));
+    return &sweep;
 }
 
 int run_sweep_command(const SweepArgs& a, MpiWorld world) {

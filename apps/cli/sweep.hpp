@@ -24,7 +24,8 @@ struct SweepArgs {
     int stop_after = 0;     ///< hidden, for tests: stop as on SIGINT after this many points (0: never)
 };
 
-void add_sweep_options(CLI::App& sweep, SweepArgs& args);
+/// Adds the subcommand `sweep` to `app` with every flag, storing them in `args`.
+CLI::App* add_sweep_command(CLI::App& app, SweepArgs& args);
 
 /// Runs the sweep; returns the exit status (0 all points ok, 3 some failed, 130 / 143
 /// stopped). `world`: mpi_start's (rank 0 writes the results, the others run points). Throws InputError / ArgumentError for a bad spec or argument (exit 2).

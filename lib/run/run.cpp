@@ -7,6 +7,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "time/record_loop.hpp"
 #include "time/stepper_registry.hpp"
 
 namespace stackbeam {
@@ -47,6 +48,21 @@ StepperDescription describe_stepper(const System& system, const SimulationOption
     d.impact_loss = row.impact_loss;
     d.leaf_kinetic_energy = row.leaf_kinetic_energy;
     return d;
+}
+
+std::vector<Mode> modes_with(StepperFeature feature) {
+    std::vector<Mode> modes;
+    for (const detail::StepperCapabilities& row : detail::stepper_registry()) {
+        const bool has = feature == StepperFeature::massive_leaves ? row.massive_leaves : row.cvode_stats;
+        if (has && std::find(modes.begin(), modes.end(), row.mode) == modes.end()) modes.push_back(row.mode);
+    }
+    return modes;
+}
+
+std::string mode_list(const std::vector<Mode>& modes, const std::string& separator) {
+    std::string list;
+    for (const Mode m : modes) list += (list.empty() ? "" : separator) + to_string(m);
+    return list;
 }
 
 namespace {
@@ -94,30 +110,32 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
     RunSink& sink = request.sink ? *request.sink : none;
     const RunOutputs& out = request.outputs;
     try {
-        // the loop of simulate() (simulation.cpp), with the stop check before each record is handed over
-        const std::unique_ptr<Stepper> stepper = make_stepper(system, options);  // validates the options
-        summary.stepper = describe_stepper(system, options);
-        const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
-        if (out.keep_records) summary.records.reserve(static_cast<std::size_t>(n) + 1);
+        // the record loop of simulate() (time/record_loop.hpp), with the stop check before each record is handed over
         std::optional<StressMonitor> monitor;  // only when asked: no cost otherwise
         std::vector<InterfaceRunPeak> peaks;
-        if (out.stresses) monitor.emplace(system.model().spec(), monitor_options(options, static_cast<double>(n) * options.dt_s));
-        for (long i = 0; i <= n; ++i) {
-            const StepRecord& r = i == 0 ? stepper->current() : stepper->advance();
+        bool started = false;
+        summary.report = detail::run_records(system, options, [&](const Stepper& stepper, const StepRecord& r) {
+            if (!started) {  // record 0: make_stepper has validated the options
+                started = true;
+                summary.stepper = describe_stepper(system, options);
+                const long n = detail::record_steps(options);
+                if (out.keep_records) summary.records.reserve(static_cast<std::size_t>(n) + 1);
+                if (out.stresses)
+                    monitor.emplace(system.model().spec(), monitor_options(options, static_cast<double>(n) * options.dt_s));
+            }
             if (stop && stop()) throw StopSeen{};  // the record in progress is dropped
             if (out.keep_records) summary.records.push_back(r);
             summary.stats.add(r);
             sink.on_record(r);
-            if (out.pairs) sink.on_pairs(r.t_s, stepper->pairs());
-            if (out.nodes) sink.on_nodes(r.t_s, stepper->nodes());
+            if (out.pairs) sink.on_pairs(r.t_s, stepper.pairs());
+            if (out.nodes) sink.on_nodes(r.t_s, stepper.nodes());
             if (out.stresses) {
-                const Stresses st = stepper->stresses();
+                const Stresses st = stepper.stresses();
                 monitor->add(r.t_s, st);
                 add_peaks(peaks, r.t_s, st);
                 sink.on_stresses(r.t_s, st);
             }
-        }
-        summary.report = stepper->report();
+        });
         summary.loop = loop_figures(summary.records, options.loading.period_s());
         if (monitor) summary.stresses = RunStresses{monitor->summary(), std::move(peaks)};
     } catch (const StopSeen&) {

@@ -2,8 +2,8 @@
 // check of the bounds against the scenario (each bound made into a scenario by the sweep's
 // key-path editing, SweepPoints).
 #include "stackbeam/study/fit.hpp"
-#include "../io/toml_text.hpp"
 #include "fit_trial.hpp"
+#include "spec_toml.hpp"
 
 #include <toml.hpp>
 
@@ -16,9 +16,7 @@ namespace stackbeam {
 
 namespace {
 
-std::string line_of(const std::string& source, const toml::value& v) {
-    return source + ":" + std::to_string(v.location().line());
-}
+using detail::line_of;
 
 double number_of(const toml::value& v, const std::string& field, const std::string& where) {
     if (v.is_floating()) return v.as_floating();
@@ -39,11 +37,6 @@ void only_keys(const toml::value& table, const std::vector<std::string>& allowed
             for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
             throw InputError(prefix + kv.first, "unknown key: allowed here: " + list, line_of(source, kv.second));
         }
-}
-
-std::string directory_of(const std::string& path) {
-    const auto cut = path.find_last_of('/');
-    return cut == std::string::npos ? std::string() : path.substr(0, cut + 1);
 }
 
 std::vector<std::string> split_csv_line(const std::string& line) {
@@ -149,28 +142,17 @@ void read_loop_csv(const std::string& text, MeasuredLoop& loop, double closure_t
                          loop.location);
 }
 
-FitSpec parse_fit_spec(const std::string& text, const std::string& source_name) {
-    FitSpec spec;
-    spec.source = source_name;
-    detail::check_toml_text(text, source_name);
-    toml::value root;
-    try {
-        std::istringstream in(text);
-        root = toml::parse(in, source_name);
-    } catch (const std::exception& e) {
-        throw InputError("spec", std::string("is not a valid TOML file: ") + e.what(), source_name);
-    }
-    only_keys(root, {"scenario", "description", "starts", "max_iterations", "difference_step", "closure_tolerance",
-                     "parameters", "loops", "objective", "outputs"},
-              "", source_name);
-    const auto& top = root.as_table();
+namespace {
+
+/// The top-level settings: description, the base scenario (read), starts, max_iterations,
+/// difference_step, closure_tolerance.
+void read_fit_settings(const toml::table& top, const std::string& source_name, FitSpec& spec) {
     if (top.count("description")) spec.description = string_of(top.at("description"), "description", line_of(source_name, top.at("description")));
     if (!top.count("scenario"))
         throw InputError("scenario", "is required: the base scenario file (relative to the spec file)", source_name);
     spec.scenario_location = line_of(source_name, top.at("scenario"));
     const std::string name = string_of(top.at("scenario"), "scenario", spec.scenario_location);
-    const std::string dir = directory_of(source_name);
-    spec.scenario_path = name[0] == '/' ? name : dir + name;
+    spec.scenario_path = detail::beside_spec(name, source_name);
     spec.scenario_text = detail::read_input_file(spec.scenario_path, "the base scenario file", "scenario", spec.scenario_location);
     auto integer = [&](const char* key, int lo, int hi, int& out) {
         if (!top.count(key)) return;
@@ -195,123 +177,111 @@ FitSpec parse_fit_spec(const std::string& text, const std::string& source_name) 
     };
     fraction("difference_step", 0.0, 0.1, spec.difference_step);
     fraction("closure_tolerance", 0.0, 1.0, spec.closure_tolerance);
+}
 
-    if (!top.count("parameters") || !top.at("parameters").is_array() || top.at("parameters").as_array().empty())
-        throw InputError("parameters", "at least one [[parameters]] table is required (key, lower, upper)",
-                         top.count("parameters") ? line_of(source_name, top.at("parameters")) : source_name);
-    const auto& params = top.at("parameters").as_array();
-    for (std::size_t j = 0; j < params.size(); ++j) {
-        const std::string base = "parameters[" + std::to_string(j) + "]";
-        const auto& t = params[j];
-        const std::string where = line_of(source_name, t);
-        if (!t.is_table()) throw InputError(base, "must be a table ([[parameters]])", where);
-        only_keys(t, {"key", "lower", "upper", "start"}, base + ".", source_name);
-        const auto& tab = t.as_table();
-        FitParameter p;
-        p.location = where;
-        for (const char* k : {"key", "lower", "upper"})
-            if (!tab.count(k)) throw InputError(base + "." + k, "is required (key, lower, upper; start optional)", where);
-        p.key = string_of(tab.at("key"), base + ".key", line_of(source_name, tab.at("key")));
-        p.location = line_of(source_name, tab.at("key"));
-        for (const auto& other : spec.parameters)
-            if (other.key == p.key)
-                throw InputError(base + ".key", "value '" + p.key + "' is a parameter already (" + other.location + ")",
-                                 p.location);
-        p.lower = number_of(tab.at("lower"), base + ".lower", line_of(source_name, tab.at("lower")));
-        p.upper = number_of(tab.at("upper"), base + ".upper", line_of(source_name, tab.at("upper")));
-        if (!std::isfinite(p.lower) || !std::isfinite(p.upper) || !(p.upper > p.lower))
-            throw InputError(base + ".upper", "bounds [" + format_value(p.lower) + ", " + format_value(p.upper) +
-                                                  "] are not allowed: finite, with upper > lower",
-                             line_of(source_name, tab.at("upper")));
-        if (tab.count("start")) {
-            p.start = number_of(tab.at("start"), base + ".start", line_of(source_name, tab.at("start")));
-            if (!(p.start >= p.lower && p.start <= p.upper))
-                throw InputError(base + ".start", "value " + format_value(p.start) + " is not allowed: must lie in [" +
-                                                      format_value(p.lower) + ", " + format_value(p.upper) + "]",
-                                 line_of(source_name, tab.at("start")));
-        }
-        spec.parameters.push_back(p);
+/// One [[parameters]] table (`base` = "parameters[j]"): key, lower, upper, start; a key fitted
+/// twice is refused.
+FitParameter read_fit_parameter(const toml::value& t, const std::string& base, const std::string& source_name,
+                                const std::vector<FitParameter>& earlier) {
+    const std::string where = line_of(source_name, t);
+    only_keys(t, {"key", "lower", "upper", "start"}, base + ".", source_name);
+    const auto& tab = t.as_table();
+    FitParameter p;
+    for (const char* k : {"key", "lower", "upper"})
+        if (!tab.count(k)) throw InputError(base + "." + k, "is required (key, lower, upper; start optional)", where);
+    p.key = string_of(tab.at("key"), base + ".key", line_of(source_name, tab.at("key")));
+    p.location = line_of(source_name, tab.at("key"));
+    for (const auto& other : earlier)
+        if (other.key == p.key)
+            throw InputError(base + ".key", "value '" + p.key + "' is a parameter already (" + other.location + ")",
+                             p.location);
+    p.lower = number_of(tab.at("lower"), base + ".lower", line_of(source_name, tab.at("lower")));
+    p.upper = number_of(tab.at("upper"), base + ".upper", line_of(source_name, tab.at("upper")));
+    if (!std::isfinite(p.lower) || !std::isfinite(p.upper) || !(p.upper > p.lower))
+        throw InputError(base + ".upper", "bounds [" + format_value(p.lower) + ", " + format_value(p.upper) +
+                                              "] are not allowed: finite, with upper > lower",
+                         line_of(source_name, tab.at("upper")));
+    if (tab.count("start")) {
+        p.start = number_of(tab.at("start"), base + ".start", line_of(source_name, tab.at("start")));
+        if (!(p.start >= p.lower && p.start <= p.upper))
+            throw InputError(base + ".start", "value " + format_value(p.start) + " is not allowed: must lie in [" +
+                                                  format_value(p.lower) + ", " + format_value(p.upper) + "]",
+                             line_of(source_name, tab.at("start")));
     }
+    return p;
+}
 
-    if (!top.count("loops") || !top.at("loops").is_array() || top.at("loops").as_array().empty())
-        throw InputError("loops", "at least one [[loops]] table is required (csv, displacement_column, force_column)",
-                         top.count("loops") ? line_of(source_name, top.at("loops")) : source_name);
-    const auto& loops = top.at("loops").as_array();
-    for (std::size_t l = 0; l < loops.size(); ++l) {
-        const std::string base = "loops[" + std::to_string(l) + "]";
-        const auto& t = loops[l];
-        const std::string where = line_of(source_name, t);
-        if (!t.is_table()) throw InputError(base, "must be a table ([[loops]])", where);
-        only_keys(t, {"name", "csv", "displacement_column", "force_column", "weight", "set"}, base + ".", source_name);
-        const auto& tab = t.as_table();
-        MeasuredLoop loop;
-        loop.name = base;
-        loop.location = where;
-        for (const char* k : {"csv", "displacement_column", "force_column"})
-            if (!tab.count(k)) throw InputError(base + "." + k, "is required (csv, displacement_column, force_column)", where);
-        if (tab.count("name")) loop.name = string_of(tab.at("name"), base + ".name", line_of(source_name, tab.at("name")));
-        const std::string csv = string_of(tab.at("csv"), base + ".csv", line_of(source_name, tab.at("csv")));
-        loop.csv_path = csv[0] == '/' ? csv : dir + csv;
-        loop.displacement_column = string_of(tab.at("displacement_column"), base + ".displacement_column", where);
-        loop.force_column = string_of(tab.at("force_column"), base + ".force_column", where);
-        if (tab.count("weight")) {
-            loop.weight = number_of(tab.at("weight"), base + ".weight", line_of(source_name, tab.at("weight")));
-            if (!(loop.weight > 0.0 && std::isfinite(loop.weight)))
-                throw InputError(base + ".weight", "value " + format_value(loop.weight) + " is not allowed: must be > 0",
-                                 line_of(source_name, tab.at("weight")));
-        }
-        if (tab.count("set")) {
-            const auto& s = tab.at("set");
-            if (!s.is_table()) throw InputError(base + ".set", "must be a table of scenario keys and values", line_of(source_name, s));
-            for (const auto& kv : s.as_table()) {
-                const std::string f = base + ".set." + kv.first, w = line_of(source_name, kv.second);
-                AxisValue v;
-                if (kv.second.is_floating()) v = kv.second.as_floating();
-                else if (kv.second.is_integer()) v = static_cast<long long>(kv.second.as_integer());
-                else if (kv.second.is_boolean()) v = kv.second.as_boolean();
-                else if (kv.second.is_string()) v = kv.second.as_string().str;
-                else throw InputError(f, "is not a number, boolean or string (one scenario value)", w);
-                for (const auto& p : spec.parameters)
-                    if (p.key == kv.first)
-                        throw InputError(f, "is a fitted parameter (" + p.location + "): a loop cannot set it", w);
-                loop.settings.emplace_back(kv.first, v);
-            }
-        }
-        const std::string csv_text = detail::read_input_file(loop.csv_path, "the measured loop's CSV file", base + ".csv",
-                                                             line_of(source_name, tab.at("csv")));
-        read_loop_csv(csv_text, loop, spec.closure_tolerance, base);
-        spec.loops.push_back(std::move(loop));
+/// A loop's `set` table: the scenario values its run holds fixed (none a fitted parameter).
+void read_loop_settings(const toml::value& s, const std::string& base, const std::string& source_name,
+                        const std::vector<FitParameter>& parameters, MeasuredLoop& loop) {
+    if (!s.is_table()) throw InputError(base + ".set", "must be a table of scenario keys and values", line_of(source_name, s));
+    for (const auto& kv : s.as_table()) {
+        const std::string f = base + ".set." + kv.first, w = line_of(source_name, kv.second);
+        AxisValue v;
+        if (kv.second.is_floating()) v = kv.second.as_floating();
+        else if (kv.second.is_integer()) v = static_cast<long long>(kv.second.as_integer());
+        else if (kv.second.is_boolean()) v = kv.second.as_boolean();
+        else if (kv.second.is_string()) v = kv.second.as_string().str;
+        else throw InputError(f, "is not a number, boolean or string (one scenario value)", w);
+        for (const auto& p : parameters)
+            if (p.key == kv.first)
+                throw InputError(f, "is a fitted parameter (" + p.location + "): a loop cannot set it", w);
+        loop.settings.emplace_back(kv.first, v);
     }
+}
 
-    if (top.count("objective")) {
-        const auto& o = top.at("objective");
-        if (!o.is_table()) throw InputError("objective", "must be a table of weights", line_of(source_name, o));
-        only_keys(o, {"force", "loop_area", "secant_stiffness", "dynamic_rate"}, "objective.", source_name);
-        auto weight = [&](const char* key, double& out) {
-            if (!o.as_table().count(key)) return;
-            const auto& v = o.as_table().at(key);
-            out = number_of(v, std::string("objective.") + key, line_of(source_name, v));
-            if (!(out >= 0.0 && std::isfinite(out)))
-                throw InputError(std::string("objective.") + key, "value " + format_value(out) + " is not allowed: a weight >= 0",
-                                 line_of(source_name, v));
-        };
-        weight("force", spec.weights.force);
-        weight("loop_area", spec.weights.loop_area);
-        weight("secant_stiffness", spec.weights.secant_stiffness);
-        weight("dynamic_rate", spec.weights.dynamic_rate);
-        const FitWeights& w = spec.weights;
-        if (w.force + w.loop_area + w.secant_stiffness + w.dynamic_rate <= 0.0)
-            throw InputError("objective", "every weight is 0: nothing to fit", line_of(source_name, o));
+/// One [[loops]] table (`base` = "loops[l]"): its keys, then its CSV file read and checked.
+MeasuredLoop read_measured_loop(const toml::value& t, const std::string& base, const std::string& source_name,
+                                const FitSpec& spec) {
+    const std::string where = line_of(source_name, t);
+    only_keys(t, {"name", "csv", "displacement_column", "force_column", "weight", "set"}, base + ".", source_name);
+    const auto& tab = t.as_table();
+    MeasuredLoop loop;
+    loop.name = base;
+    loop.location = where;
+    for (const char* k : {"csv", "displacement_column", "force_column"})
+        if (!tab.count(k)) throw InputError(base + "." + k, "is required (csv, displacement_column, force_column)", where);
+    if (tab.count("name")) loop.name = string_of(tab.at("name"), base + ".name", line_of(source_name, tab.at("name")));
+    const std::string csv = string_of(tab.at("csv"), base + ".csv", line_of(source_name, tab.at("csv")));
+    loop.csv_path = detail::beside_spec(csv, source_name);
+    loop.displacement_column = string_of(tab.at("displacement_column"), base + ".displacement_column", where);
+    loop.force_column = string_of(tab.at("force_column"), base + ".force_column", where);
+    if (tab.count("weight")) {
+        loop.weight = number_of(tab.at("weight"), base + ".weight", line_of(source_name, tab.at("weight")));
+        if (!(loop.weight > 0.0 && std::isfinite(loop.weight)))
+            throw InputError(base + ".weight", "value " + format_value(loop.weight) + " is not allowed: must be > 0",
+                             line_of(source_name, tab.at("weight")));
     }
-    if (top.count("outputs")) {
-        const auto& o = top.at("outputs");
-        if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
-        only_keys(o, {"directory"}, "outputs.", source_name);
-        if (o.as_table().count("directory"))
-            spec.output_directory = string_of(o.as_table().at("directory"), "outputs.directory", line_of(source_name, o));
-    }
+    if (tab.count("set")) read_loop_settings(tab.at("set"), base, source_name, spec.parameters, loop);
+    const std::string csv_text = detail::read_input_file(loop.csv_path, "the measured loop's CSV file", base + ".csv",
+                                                         line_of(source_name, tab.at("csv")));
+    read_loop_csv(csv_text, loop, spec.closure_tolerance, base);
+    return loop;
+}
 
-    // every bound must make a scenario the reader accepts (the others at their starts)
+/// The [objective] table: the weights of the figures; not all of them 0.
+void read_objective(const toml::value& o, const std::string& source_name, FitWeights& weights) {
+    if (!o.is_table()) throw InputError("objective", "must be a table of weights", line_of(source_name, o));
+    only_keys(o, {"force", "loop_area", "secant_stiffness", "dynamic_rate"}, "objective.", source_name);
+    auto weight = [&](const char* key, double& out) {
+        if (!o.as_table().count(key)) return;
+        const auto& v = o.as_table().at(key);
+        out = number_of(v, std::string("objective.") + key, line_of(source_name, v));
+        if (!(out >= 0.0 && std::isfinite(out)))
+            throw InputError(std::string("objective.") + key, "value " + format_value(out) + " is not allowed: a weight >= 0",
+                             line_of(source_name, v));
+    };
+    weight("force", weights.force);
+    weight("loop_area", weights.loop_area);
+    weight("secant_stiffness", weights.secant_stiffness);
+    weight("dynamic_rate", weights.dynamic_rate);
+    if (weights.force + weights.loop_area + weights.secant_stiffness + weights.dynamic_rate <= 0.0)
+        throw InputError("objective", "every weight is 0: nothing to fit", line_of(source_name, o));
+}
+
+/// Every bound must make a scenario the reader accepts (the other parameters at their starts),
+/// with each loop's settings.
+void check_bounds(const FitSpec& spec) {
     for (std::size_t j = 0; j < spec.parameters.size(); ++j) {
         std::vector<double> values;
         for (const auto& p : spec.parameters) values.push_back(std::isnan(p.start) ? 0.5 * (p.lower + p.upper) : p.start);
@@ -330,6 +300,37 @@ FitSpec parse_fit_spec(const std::string& text, const std::string& source_name) 
             }
         }
     }
+}
+
+}  // namespace
+
+FitSpec parse_fit_spec(const std::string& text, const std::string& source_name) {
+    FitSpec spec;
+    spec.source = source_name;
+    const toml::value root = detail::parse_spec_toml(text, source_name);
+    only_keys(root, {"scenario", "description", "starts", "max_iterations", "difference_step", "closure_tolerance",
+                     "parameters", "loops", "objective", "outputs"},
+              "", source_name);
+    const auto& top = root.as_table();
+    read_fit_settings(top, source_name, spec);
+    const auto& params = detail::required_tables(top, "parameters", "key, lower, upper", source_name);
+    for (std::size_t j = 0; j < params.size(); ++j)
+        spec.parameters.push_back(read_fit_parameter(detail::table_element(params, j, "parameters", source_name),
+                                                     "parameters[" + std::to_string(j) + "]", source_name,
+                                                     spec.parameters));
+    const auto& loops = detail::required_tables(top, "loops", "csv, displacement_column, force_column", source_name);
+    for (std::size_t l = 0; l < loops.size(); ++l)
+        spec.loops.push_back(read_measured_loop(detail::table_element(loops, l, "loops", source_name),
+                                                "loops[" + std::to_string(l) + "]", source_name, spec));
+    if (top.count("objective")) read_objective(top.at("objective"), source_name, spec.weights);
+    if (top.count("outputs")) {
+        const auto& o = top.at("outputs");
+        if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
+        only_keys(o, {"directory"}, "outputs.", source_name);
+        if (o.as_table().count("directory"))
+            spec.output_directory = string_of(o.as_table().at("directory"), "outputs.directory", line_of(source_name, o));
+    }
+    check_bounds(spec);
     return spec;
 }
 

@@ -1,7 +1,7 @@
 // Sweeps: the spec file, the points (the base scenario's TOML document edited at the
 // axes' key paths, then read by parse_scenario), one point's run, the thread scheduler.
 #include "stackbeam/study/sweep.hpp"
-#include "../io/toml_text.hpp"
+#include "spec_toml.hpp"
 
 #include <toml.hpp>
 
@@ -32,9 +32,7 @@ namespace {
 
 using Document = toml::basic_value<toml::discard_comments, std::map, std::vector>;
 
-std::string line_of(const std::string& source, const toml::value& v) {
-    return source + ":" + std::to_string(v.location().line());
-}
+using detail::line_of;
 
 /// One part of a key path: a table key, optionally followed by [i] or [*].
 struct PathPart {
@@ -156,11 +154,6 @@ std::string read_file(const std::string& path, const std::string& field, const s
     return detail::read_input_file(path, what, field, location);
 }
 
-std::string directory_of(const std::string& path) {
-    const auto cut = path.find_last_of('/');
-    return cut == std::string::npos ? std::string() : path.substr(0, cut + 1);
-}
-
 /// Reads one scalar of an axis' values array.
 AxisValue axis_value(const toml::value& v, const std::string& field, const std::string& where) {
     switch (v.type()) {
@@ -213,16 +206,22 @@ std::string to_string(const AxisValue& value) {
     return std::get<std::string>(value);
 }
 
-const char* to_string(Combine combine) { return combine == Combine::zip ? "zip" : "product"; }
-
-const char* to_string(PointStatus status) {
-    switch (status) {
-        case PointStatus::ok: return "ok";
-        case PointStatus::failed: return "failed";
-        case PointStatus::input_error: return "input-error";
-    }
-    return "?";
+template <>
+const std::vector<EnumWord<Combine>>& enum_words<Combine>() {
+    static const std::vector<EnumWord<Combine>> words = {{Combine::product, "product"}, {Combine::zip, "zip"}};
+    return words;
 }
+
+const char* to_string(Combine combine) { return word_of(combine); }
+
+template <>
+const std::vector<EnumWord<PointStatus>>& enum_words<PointStatus>() {
+    static const std::vector<EnumWord<PointStatus>> words = {
+        {PointStatus::ok, "ok"}, {PointStatus::failed, "failed"}, {PointStatus::input_error, "input-error"}};
+    return words;
+}
+
+const char* to_string(PointStatus status) { return word_of(status); }
 
 SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name) {
     return parse_sweep_spec(text, source_name, [&](const std::string& path, const std::string& location) {
@@ -236,23 +235,11 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
     });
 }
 
-SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name, const ScenarioReader& read_scenario) {
-    SweepSpec spec;
-    spec.source = source_name;
-    toml::value root;
-    detail::check_toml_text(text, source_name);
-    try {
-        std::istringstream in(text);
-        root = toml::parse(in, source_name);
-    } catch (const std::exception& e) {
-        throw InputError("spec", std::string("is not a valid TOML file: ") + e.what(), source_name);
-    }
-    const auto& top = root.as_table();
-    for (const auto& kv : top)
-        if (kv.first != "scenario" && kv.first != "description" && kv.first != "combine" && kv.first != "axes" &&
-            kv.first != "outputs")
-            throw InputError(kv.first, "unknown key: a sweep spec has scenario, description, combine, [[axes]], [outputs]",
-                             line_of(source_name, kv.second));
+namespace {
+
+/// The base scenario (`scenario`, read by `read_scenario`), `description` and `combine`.
+void read_sweep_settings(const toml::table& top, const std::string& source_name, const ScenarioReader& read_scenario,
+                         SweepSpec& spec) {
     if (top.count("description")) {
         const auto& d = top.at("description");
         if (!d.is_string()) throw InputError("description", "must be a string", line_of(source_name, d));
@@ -265,129 +252,163 @@ SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_na
     if (!sc.is_string() || sc.as_string().str.empty())
         throw InputError("scenario", "must be a file name (a string): the base scenario, relative to the spec file",
                          spec.scenario_location);
-    const std::string& name = sc.as_string().str;
-    spec.scenario_path = name[0] == '/' ? name : directory_of(source_name) + name;
+    spec.scenario_path = detail::beside_spec(sc.as_string().str, source_name);
     spec.scenario_text = read_scenario(spec.scenario_path, spec.scenario_location);
     if (top.count("combine")) {
         const auto& c = top.at("combine");
         const std::string word = c.is_string() ? c.as_string().str : "";
-        if (word == "product") spec.combine = Combine::product;
-        else if (word == "zip") spec.combine = Combine::zip;
+        if (const auto combine = find_word<Combine>(word)) spec.combine = *combine;
         else
             throw InputError("combine", "value '" + (c.is_string() ? word : toml::format(c)) +
                                             "' is not allowed: must be 'product' (every combination) or 'zip' (the "
                                             "i-th values together)",
                              line_of(source_name, c));
     }
-    if (top.count("outputs")) {
-        const auto& o = top.at("outputs");
-        if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
-        for (const auto& kv : o.as_table()) {
-            if (kv.first == "stresses") {
-                if (!kv.second.is_boolean())
-                    throw InputError("outputs.stresses", "value " + toml::format(kv.second) +
-                                                             " is not allowed: must be true or false",
-                                     line_of(source_name, kv.second));
-                spec.stresses = kv.second.as_boolean();
-                continue;
-            }
-            if (kv.first != "directory")
-                throw InputError("outputs." + kv.first, "unknown key: [outputs] has directory and stresses",
+}
+
+/// The [outputs] table: directory and stresses.
+void read_sweep_outputs(const toml::value& o, const std::string& source_name, SweepSpec& spec) {
+    if (!o.is_table()) throw InputError("outputs", "must be a table", line_of(source_name, o));
+    for (const auto& kv : o.as_table()) {
+        if (kv.first == "stresses") {
+            if (!kv.second.is_boolean())
+                throw InputError("outputs.stresses", "value " + toml::format(kv.second) +
+                                                         " is not allowed: must be true or false",
                                  line_of(source_name, kv.second));
-            if (!kv.second.is_string() || kv.second.as_string().str.empty())
-                throw InputError("outputs.directory", "must be a directory name (a string)", line_of(source_name, kv.second));
-            spec.output_directory = kv.second.as_string().str;
+            spec.stresses = kv.second.as_boolean();
+            continue;
         }
+        if (kv.first != "directory")
+            throw InputError("outputs." + kv.first, "unknown key: [outputs] has directory and stresses",
+                             line_of(source_name, kv.second));
+        if (!kv.second.is_string() || kv.second.as_string().str.empty())
+            throw InputError("outputs.directory", "must be a directory name (a string)", line_of(source_name, kv.second));
+        spec.output_directory = kv.second.as_string().str;
     }
-    if (!top.count("axes") || !top.at("axes").is_array() || top.at("axes").as_array().empty())
-        throw InputError("axes", "at least one [[axes]] table is required (key and values)",
-                         top.count("axes") ? line_of(source_name, top.at("axes")) : source_name);
-    const auto& axes = top.at("axes").as_array();
+}
+
+/// An axis' key (`base` = "axes[a]"): a key path, not under [outputs], not an axis already.
+void read_axis_key(const toml::table& tab, const std::string& base, const std::string& where,
+                   const std::string& source_name, const std::vector<SweepAxis>& earlier, SweepAxis& axis) {
+    if (!tab.count("key") || !tab.at("key").is_string())
+        throw InputError(base + ".key", "is required: the scenario key path (a string)", where);
+    axis.key = tab.at("key").as_string().str;
+    axis.location = line_of(source_name, tab.at("key"));
+    split_key(axis.key, axis.location, base + ".key");
+    if (axis.key.rfind("outputs", 0) == 0 && (axis.key.size() == 7 || axis.key[7] == '.'))
+        throw InputError(base + ".key", "value '" + axis.key + "': [outputs] cannot be an axis (the sweep writes its own)",
+                         axis.location);
+    for (const auto& other : earlier)
+        if (other.key == axis.key)
+            throw InputError(base + ".key", "value '" + axis.key + "' is an axis already (" + other.location + ")",
+                             axis.location);
+}
+
+/// An axis' values given as a list, `values = [...]`.
+void read_listed_values(const toml::table& tab, const std::string& base, const std::string& source_name,
+                        SweepAxis& axis) {
+    const auto& v = tab.at("values");
+    const std::string vw = line_of(source_name, v);
+    if (!v.is_array()) throw InputError(base + ".values", "must be an array of values", vw);
+    const auto& arr = v.as_array();
+    if (arr.empty())
+        throw InputError(base + ".values", "is empty: an axis needs at least one value (axis " + axis.key + ")", vw);
+    for (std::size_t i = 0; i < arr.size(); ++i)
+        axis.values.push_back(axis_value(arr[i], base + ".values[" + std::to_string(i) + "]", vw));
+}
+
+/// An axis' values given as a range, `from`, `to`, `count` and `spacing` (linear or log): the
+/// ends exactly as written, integers when both ends are and the step is whole.
+void read_ranged_values(const toml::table& tab, const std::string& base, const std::string& where,
+                        const std::string& source_name, SweepAxis& axis) {
+    for (const char* k : {"from", "to", "count"})
+        if (!tab.count(k))
+            throw InputError(base + "." + k, "is required with from/to/count (axis " + axis.key + ")", where);
+    const double from = number_of(tab.at("from"), base + ".from", line_of(source_name, tab.at("from")));
+    const double to = number_of(tab.at("to"), base + ".to", line_of(source_name, tab.at("to")));
+    const auto& c = tab.at("count");
+    const std::string cw = line_of(source_name, c);
+    if (!c.is_integer() || c.as_integer() < 1 || c.as_integer() > 1000000)
+        throw InputError(base + ".count",
+                         "value " + toml::format(c) + " is not allowed: must be an integer from 1 to 1000000 "
+                         "(axis " + axis.key + ")",
+                         cw);
+    const int count = static_cast<int>(c.as_integer());
+    bool log = false;
+    if (tab.count("spacing")) {
+        const auto& s = tab.at("spacing");
+        const std::string word = s.is_string() ? s.as_string().str : toml::format(s);
+        if (word == "log") log = true;
+        else if (word != "linear")
+            throw InputError(base + ".spacing", "value '" + word + "' is not allowed: must be 'linear' or 'log'",
+                             line_of(source_name, s));
+    }
+    if (!std::isfinite(from) || !std::isfinite(to))
+        throw InputError(base + ".from", "from and to must be finite (axis " + axis.key + ")", where);
+    if (log && !(from > 0.0 && to > 0.0))
+        throw InputError(base + ".from", "spacing 'log' needs from > 0 and to > 0 (axis " + axis.key + ")", where);
+    if (count == 1 && from != to)
+        throw InputError(base + ".count", "value 1 needs from = to (one value)", cw);
+    const bool integers = !log && tab.at("from").is_integer() && tab.at("to").is_integer() && count > 1 &&
+                          (static_cast<long long>(to - from)) % (count - 1) == 0;
+    for (int i = 0; i < count; ++i) {
+        const double f = count == 1 ? 0.0 : static_cast<double>(i) / (count - 1);
+        double x = log ? std::exp(std::log(from) + f * (std::log(to) - std::log(from))) : from + f * (to - from);
+        if (i == 0) x = from;
+        if (i == count - 1) x = to;  // the ends exactly as written
+        if (integers) axis.values.push_back(static_cast<long long>(std::llround(x)));
+        else axis.values.push_back(x);
+    }
+}
+
+/// One [[axes]] table (`base` = "axes[a]"): its key, and its values listed or ranged.
+SweepAxis read_axis(const toml::value& t, const std::string& base, const std::string& source_name,
+                    const std::vector<SweepAxis>& earlier) {
+    const std::string where = line_of(source_name, t);
+    SweepAxis axis;
+    const auto& tab = t.as_table();
+    for (const auto& kv : tab)
+        if (kv.first != "key" && kv.first != "values" && kv.first != "from" && kv.first != "to" &&
+            kv.first != "count" && kv.first != "spacing")
+            throw InputError(base + "." + kv.first, "unknown key: an axis has key, and values or from, to, count, spacing",
+                             line_of(source_name, kv.second));
+    read_axis_key(tab, base, where, source_name, earlier, axis);
+    const bool listed = tab.count("values") > 0;
+    const bool ranged = tab.count("from") || tab.count("to") || tab.count("count") || tab.count("spacing");
+    if (listed == ranged)
+        throw InputError(base, "give either values = [...] or from, to and count (and spacing), not " +
+                                   std::string(listed ? "both" : "neither"),
+                         where);
+    if (listed) read_listed_values(tab, base, source_name, axis);
+    else read_ranged_values(tab, base, where, source_name, axis);
+    return axis;
+}
+
+}  // namespace
+
+SweepSpec parse_sweep_spec(const std::string& text, const std::string& source_name, const ScenarioReader& read_scenario) {
+    SweepSpec spec;
+    spec.source = source_name;
+    const toml::value root = detail::parse_spec_toml(text, source_name);
+    const auto& top = root.as_table();
+    for (const auto& kv : top)
+        if (kv.first != "scenario" && kv.first != "description" && kv.first != "combine" && kv.first != "axes" &&
+            kv.first != "outputs")
+            throw InputError(kv.first, "unknown key: a sweep spec has scenario, description, combine, [[axes]], [outputs]",
+                             line_of(source_name, kv.second));
+    read_sweep_settings(top, source_name, read_scenario, spec);
+    if (top.count("outputs")) read_sweep_outputs(top.at("outputs"), source_name, spec);
+    const auto& axes = detail::required_tables(top, "axes", "key and values", source_name);
     std::size_t total_values = 0;
     for (std::size_t a = 0; a < axes.size(); ++a) {
         const std::string base = "axes[" + std::to_string(a) + "]";
-        const auto& t = axes[a];
-        const std::string where = line_of(source_name, t);
-        if (!t.is_table()) throw InputError(base, "must be a table ([[axes]])", where);
-        SweepAxis axis;
-        const auto& tab = t.as_table();
-        for (const auto& kv : tab)
-            if (kv.first != "key" && kv.first != "values" && kv.first != "from" && kv.first != "to" &&
-                kv.first != "count" && kv.first != "spacing")
-                throw InputError(base + "." + kv.first, "unknown key: an axis has key, and values or from, to, count, spacing",
-                                 line_of(source_name, kv.second));
-        if (!tab.count("key") || !tab.at("key").is_string())
-            throw InputError(base + ".key", "is required: the scenario key path (a string)", where);
-        axis.key = tab.at("key").as_string().str;
-        axis.location = line_of(source_name, tab.at("key"));
-        split_key(axis.key, axis.location, base + ".key");
-        if (axis.key.rfind("outputs", 0) == 0 && (axis.key.size() == 7 || axis.key[7] == '.'))
-            throw InputError(base + ".key", "value '" + axis.key + "': [outputs] cannot be an axis (the sweep writes its own)",
-                             axis.location);
-        for (const auto& other : spec.axes)
-            if (other.key == axis.key)
-                throw InputError(base + ".key", "value '" + axis.key + "' is an axis already (" + other.location + ")",
-                                 axis.location);
-        const bool listed = tab.count("values") > 0;
-        const bool ranged = tab.count("from") || tab.count("to") || tab.count("count") || tab.count("spacing");
-        if (listed == ranged)
-            throw InputError(base, "give either values = [...] or from, to and count (and spacing), not " +
-                                       std::string(listed ? "both" : "neither"),
-                             where);
-        if (listed) {
-            const auto& v = tab.at("values");
-            const std::string vw = line_of(source_name, v);
-            if (!v.is_array()) throw InputError(base + ".values", "must be an array of values", vw);
-            const auto& arr = v.as_array();
-            if (arr.empty())
-                throw InputError(base + ".values", "is empty: an axis needs at least one value (axis " + axis.key + ")", vw);
-            for (std::size_t i = 0; i < arr.size(); ++i)
-                axis.values.push_back(axis_value(arr[i], base + ".values[" + std::to_string(i) + "]", vw));
-        } else {
-            for (const char* k : {"from", "to", "count"})
-                if (!tab.count(k))
-                    throw InputError(base + "." + k, "is required with from/to/count (axis " + axis.key + ")", where);
-            const double from = number_of(tab.at("from"), base + ".from", line_of(source_name, tab.at("from")));
-            const double to = number_of(tab.at("to"), base + ".to", line_of(source_name, tab.at("to")));
-            const auto& c = tab.at("count");
-            const std::string cw = line_of(source_name, c);
-            if (!c.is_integer() || c.as_integer() < 1 || c.as_integer() > 1000000)
-                throw InputError(base + ".count",
-                                 "value " + toml::format(c) + " is not allowed: must be an integer from 1 to 1000000 "
-                                 "(axis " + axis.key + ")",
-                                 cw);
-            const int count = static_cast<int>(c.as_integer());
-            bool log = false;
-            if (tab.count("spacing")) {
-                const auto& s = tab.at("spacing");
-                const std::string word = s.is_string() ? s.as_string().str : toml::format(s);
-                if (word == "log") log = true;
-                else if (word != "linear")
-                    throw InputError(base + ".spacing", "value '" + word + "' is not allowed: must be 'linear' or 'log'",
-                                     line_of(source_name, s));
-            }
-            if (!std::isfinite(from) || !std::isfinite(to))
-                throw InputError(base + ".from", "from and to must be finite (axis " + axis.key + ")", where);
-            if (log && !(from > 0.0 && to > 0.0))
-                throw InputError(base + ".from", "spacing 'log' needs from > 0 and to > 0 (axis " + axis.key + ")", where);
-            if (count == 1 && from != to)
-                throw InputError(base + ".count", "value 1 needs from = to (one value)", cw);
-            const bool integers = !log && tab.at("from").is_integer() && tab.at("to").is_integer() && count > 1 &&
-                                  (static_cast<long long>(to - from)) % (count - 1) == 0;
-            for (int i = 0; i < count; ++i) {
-                const double f = count == 1 ? 0.0 : static_cast<double>(i) / (count - 1);
-                double x = log ? std::exp(std::log(from) + f * (std::log(to) - std::log(from))) : from + f * (to - from);
-                if (i == 0) x = from;
-                if (i == count - 1) x = to;  // the ends exactly as written
-                if (integers) axis.values.push_back(static_cast<long long>(std::llround(x)));
-                else axis.values.push_back(x);
-            }
-        }
+        SweepAxis axis = read_axis(detail::table_element(axes, a, "axes", source_name), base, source_name, spec.axes);
         // the values themselves are held: many long axes (a zip of them) must not exhaust memory
         // before point_count's limit is checked
         total_values += axis.values.size();
         if (total_values > 10000000)
-            throw InputError(base, "more than 10 million values over the axes (axis " + axis.key + ")", where);
+            throw InputError(base, "more than 10 million values over the axes (axis " + axis.key + ")",
+                             line_of(source_name, axes[a]));
         spec.axes.push_back(std::move(axis));
     }
     point_count(spec);  // empty axis, unequal zip

@@ -294,10 +294,8 @@ PointResult parse_row(const SweepSpec& spec, const std::string& row, std::vector
     if (axis_cells) axis_cells->assign(cells.begin() + 1, cells.begin() + 1 + static_cast<std::ptrdiff_t>(spec.axes.size()));
     k += spec.axes.size();
     const std::string& status = cells[k++];
-    if (status == "ok") r.status = PointStatus::ok;
-    else if (status == "failed") r.status = PointStatus::failed;
-    else if (status == "input-error") r.status = PointStatus::input_error;
-    else throw std::invalid_argument("status '" + status + "' is not ok, failed or input-error");
+    if (const auto s = find_word<PointStatus>(status)) r.status = *s;
+    else throw std::invalid_argument("status '" + status + "' is not " + word_list<PointStatus>("", ", ", " or "));
     r.message = cells[k++];
     for (std::size_t i = 0; i < figures; ++i) r.figures.push_back(parse_cell(cells[k++]));
     r.wall_s = parse_cell(cells[k++]);
@@ -333,6 +331,189 @@ void release_on_throw(int& lock_fd, Open&& open) {
         throw;
     }
 }
+
+/// Creates `directory` (and its parents) if it is not there.
+void create_sweep_directory(const std::string& directory) {
+    std::error_code ec;
+    fs::create_directories(fs::path(directory), ec);
+    if (ec || !fs::is_directory(fs::path(directory)))
+        throw InputError("--out-dir", "cannot create the directory '" + directory + "'" + (ec ? ": " + ec.message() : ""));
+}
+
+/// Takes the owner's advisory lock on DIR/lock (held while `lock_fd` is open, or until the
+/// process dies) and writes who holds it; a directory another sweep holds is refused naming
+/// that holder. `lock_fd` is the lock file's descriptor (-1 when refused before it was locked).
+void lock_sweep_directory(const std::string& directory, const std::string& spec_source, int& lock_fd) {
+    const std::string lock_path = (fs::path(directory) / "lock").string();
+    lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd < 0)
+        throw InputError("--out-dir", "cannot open the lock file '" + lock_path + "': " + system_reason());
+    if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+        const std::string why = errno == EWOULDBLOCK ? "" : system_reason();
+        std::string holder;
+        char buffer[1024];
+        const ssize_t n = ::pread(lock_fd, buffer, sizeof buffer - 1, 0);
+        if (n > 0) holder.assign(buffer, static_cast<std::size_t>(n));
+        while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+        ::close(lock_fd);
+        lock_fd = -1;
+        if (!why.empty()) throw InputError("--out-dir", "cannot lock '" + lock_path + "': " + why);
+        throw InputError("--out-dir", "'" + directory + "' is in use by another sweep (" +
+                                          (holder.empty() ? std::string("its holder has not written its name yet") : holder) +
+                                          "): wait for it to end or stop it, or use another directory");
+    }
+    char host[256] = "?";
+    ::gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = '\0';
+    char when[32] = "?";
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    if (::gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &utc);
+    const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + ", started " + when + ", spec " +
+                           spec_source + "\n";
+    if (::ftruncate(lock_fd, 0) != 0 || ::pwrite(lock_fd, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size()))
+        throw InputError("--out-dir", "cannot write the lock file '" + lock_path + "': " + system_reason());
+}
+
+/// --restart: deletes the results of the sweep in `dir` (the lock stays).
+void discard_results(const fs::path& dir) {
+    auto remove = [&](const fs::path& path, bool tree) {
+        std::error_code rec;
+        if (tree) fs::remove_all(path, rec);
+        else fs::remove(path, rec);
+        if (rec)
+            throw InputError("--restart", "cannot delete '" + path.string() + "': " + rec.message() +
+                                              " (nothing was run; the old results are still there)");
+    };
+    for (const char* f : {kJournal, "spec.json", "points.csv", "sweep.json"}) remove(dir / f, false);
+    for (const char* d : {"scenarios", "loops", "series", "figures"}) remove(dir / d, true);
+}
+
+/// Refuses a directory that holds another sweep's results: its spec.json differs from `now`,
+/// or it has results without a spec.json.
+void check_same_sweep(const std::string& directory, const nlohmann::json& now) {
+    const fs::path dir(directory);
+    const fs::path spec_file = dir / "spec.json";
+    if (fs::exists(spec_file)) {
+        nlohmann::json old_spec;
+        try {
+            old_spec = nlohmann::json::parse(read_text(spec_file.string()));
+        } catch (const std::exception&) {
+            throw InputError("--out-dir", "'" + spec_file.string() + "' is not readable JSON: use --restart to start over");
+        }
+        const std::string diff = spec_difference(old_spec, now);
+        if (!diff.empty())
+            throw InputError("--out-dir", "'" + directory + "' holds the results of another sweep: " + diff +
+                                              "; use another directory, or --restart to discard them");
+    } else if (fs::exists(dir / kJournal) || fs::exists(dir / "points.csv")) {
+        throw InputError("--out-dir", "'" + directory + "' holds sweep results without spec.json: use another "
+                                      "directory, or --restart to discard them");
+    }
+}
+
+/// A new journal's first two lines: the id line naming the spec, and the points table's header.
+std::string journal_start(const SweepSpec& spec) {
+    return kJournalId + sweep_spec_id(spec) + " (" + spec.source + ")\n" + point_table_header(spec) + "\n";
+}
+
+/// What a journal read back holds: the finished points' rows, and the journal's text to keep
+/// when it must be repaired (a damaged or cut row dropped, an older version's id line added).
+struct JournalReplay {
+    std::vector<bool> finished;
+    std::vector<PointResult> results;
+    std::vector<std::string> notes;
+    bool repaired = false;
+    std::string kept;
+};
+
+/// Reads the journal `path` back: every whole row whose values are its point's (values_at) is a
+/// finished point; a damaged row is dropped (named by line) and the rows after it kept; a line
+/// cut by a crash is dropped. A journal of another spec, or with other columns, is refused.
+JournalReplay replay_journal(const std::string& path, const SweepSpec& spec, int count,
+                             const std::function<std::vector<AxisValue>(int)>& values_at) {
+    JournalReplay replay;
+    replay.finished.assign(static_cast<std::size_t>(count), false);
+    replay.results.resize(static_cast<std::size_t>(count));
+    const std::string header = point_table_header(spec);
+    const std::string text = read_text(path);
+    replay.kept = journal_start(spec);
+    bool header_seen = false;
+    std::size_t start = 0;
+    for (long line_no = 1; start < text.size(); ++line_no) {
+        const std::size_t end = text.find('\n', start);
+        const std::string at_line = path + " line " + std::to_string(line_no);
+        if (end == std::string::npos) {  // no newline: cut by a crash
+            replay.notes.push_back(at_line +
+                                   ": a row cut short (the run was stopped while writing it) was dropped; its point runs again");
+            replay.repaired = true;
+            break;
+        }
+        const std::string line = text.substr(start, end - start);
+        start = end + 1;
+        if (!header_seen) {
+            if (line.rfind(kJournalId, 0) == 0) {
+                if (line_no != 1 || line.rfind(kJournalId + sweep_spec_id(spec), 0) != 0)
+                    throw InputError("--out-dir", at_line + " says '" + line + "', this spec is " + sweep_spec_id(spec) +
+                                                      " (" + spec.source +
+                                                      "): the journal holds another spec's results; use another "
+                                                      "directory, or --restart to discard them");
+                continue;
+            }
+            if (line != header)
+                throw InputError("--out-dir", "'" + path + "' " + header_difference(line, header) +
+                                                  ": its rows cannot be resumed; use --restart to discard them and "
+                                                  "run every point again, or another --out-dir");
+            header_seen = true;
+            if (line_no == 1) replay.repaired = true;  // a journal of an older version: its id line is added
+            continue;
+        }
+        PointResult r;
+        std::vector<std::string> cells;
+        try {
+            r = parse_row(spec, line, &cells);
+            if (r.index < 0 || r.index >= count)
+                throw std::invalid_argument("point " + std::to_string(r.index) + " does not exist (the spec has " +
+                                            std::to_string(count) + ")");
+        } catch (const std::invalid_argument& e) {
+            replay.notes.push_back(at_line + ": a damaged row was dropped (" + e.what() +
+                                   "); the rows after it are kept, its point runs again");
+            replay.repaired = true;
+            continue;
+        }
+        check_row_values(spec, values_at(r.index), cells, r.index, at_line);
+        replay.finished[static_cast<std::size_t>(r.index)] = true;
+        replay.results[static_cast<std::size_t>(r.index)] = r;
+        replay.kept += line + "\n";
+    }
+    if (!header_seen) replay.repaired = true;  // empty, or only the id line
+    return replay;
+}
+
+/// Removes the per-point files of points without a row (another run's: never reused), then
+/// makes the per-point folders this run writes.
+void prepare_point_folders(const fs::path& dir, const std::vector<bool>& finished, bool keep_series) {
+    std::error_code ec;
+    for (const char* kind : {"scenarios", "loops", "series"}) {
+        const fs::path folder = dir / kind;
+        if (!fs::is_directory(folder, ec)) continue;
+        for (const auto& entry : fs::directory_iterator(folder, ec)) {
+            const long long index = point_index_of(entry.path().filename().string());
+            if (index >= 0 && index < static_cast<long long>(finished.size()) && finished[static_cast<std::size_t>(index)])
+                continue;
+            std::error_code rec;
+            fs::remove(entry.path(), rec);
+            if (rec)
+                throw InputError("--out-dir", "cannot delete the stale file '" + entry.path().string() +
+                                                  "' (no row of this sweep owns it): " + rec.message());
+        }
+    }
+    std::vector<const char*> kinds = {"scenarios", "loops"};
+    if (keep_series) kinds.push_back("series");
+    for (const char* kind : kinds) {
+        fs::create_directories(dir / kind, ec);
+        if (ec) throw InputError("--out-dir", "cannot create '" + (dir / kind).string() + "': " + ec.message());
+    }
+}
 }  // namespace
 
 SweepDirectory::SweepDirectory(std::string directory, const SweepSpec& spec, const std::vector<SweepPoint>& points,
@@ -355,162 +536,29 @@ SweepDirectory::~SweepDirectory() {
 }
 
 void SweepDirectory::open(bool restart) {
-    const std::size_t count = static_cast<std::size_t>(count_);
-    finished_.assign(count, false);
-    results_.resize(count);
+    finished_.assign(static_cast<std::size_t>(count_), false);
+    results_.resize(static_cast<std::size_t>(count_));
     const fs::path dir(directory_);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir))
-        throw InputError("--out-dir", "cannot create the directory '" + directory_ + "'" + (ec ? ": " + ec.message() : ""));
-
-    // the owner: an advisory lock on DIR/lock, held until this object goes (or the process dies)
-    const std::string lock_path = (dir / "lock").string();
-    lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lock_fd_ < 0)
-        throw InputError("--out-dir", "cannot open the lock file '" + lock_path + "': " + system_reason());
-    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-        const std::string why = errno == EWOULDBLOCK ? "" : system_reason();
-        std::string holder;
-        char buffer[1024];
-        const ssize_t n = ::pread(lock_fd_, buffer, sizeof buffer - 1, 0);
-        if (n > 0) holder.assign(buffer, static_cast<std::size_t>(n));
-        while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
-        ::close(lock_fd_);
-        lock_fd_ = -1;
-        if (!why.empty()) throw InputError("--out-dir", "cannot lock '" + lock_path + "': " + why);
-        throw InputError("--out-dir", "'" + directory_ + "' is in use by another sweep (" +
-                                          (holder.empty() ? std::string("its holder has not written its name yet") : holder) +
-                                          "): wait for it to end or stop it, or use another directory");
-    }
-    {
-        char host[256] = "?";
-        ::gethostname(host, sizeof host - 1);
-        host[sizeof host - 1] = '\0';
-        char when[32] = "?";
-        const std::time_t now = std::time(nullptr);
-        std::tm utc{};
-        if (::gmtime_r(&now, &utc)) std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &utc);
-        const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + ", started " + when + ", spec " +
-                               spec_.source + "\n";
-        if (::ftruncate(lock_fd_, 0) != 0 || ::pwrite(lock_fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size()))
-            throw InputError("--out-dir", "cannot write the lock file '" + lock_path + "': " + system_reason());
-    }
-
+    create_sweep_directory(directory_);
+    lock_sweep_directory(directory_, spec_.source, lock_fd_);
     const nlohmann::json now = spec_json(spec_);
     const fs::path spec_file = dir / "spec.json";
     const fs::path journal = dir / kJournal;
-    const std::string id_line = kJournalId + sweep_spec_id(spec_) + " (" + spec_.source + ")";
-    if (restart) {
-        auto remove = [&](const fs::path& path, bool tree) {
-            std::error_code rec;
-            if (tree) fs::remove_all(path, rec);
-            else fs::remove(path, rec);
-            if (rec)
-                throw InputError("--restart", "cannot delete '" + path.string() + "': " + rec.message() +
-                                                  " (nothing was run; the old results are still there)");
-        };
-        for (const char* f : {kJournal, "spec.json", "points.csv", "sweep.json"}) remove(dir / f, false);
-        for (const char* d : {"scenarios", "loops", "series", "figures"}) remove(dir / d, true);
-    } else if (fs::exists(spec_file)) {
-        nlohmann::json old_spec;
-        try {
-            old_spec = nlohmann::json::parse(read_text(spec_file.string()));
-        } catch (const std::exception&) {
-            throw InputError("--out-dir", "'" + spec_file.string() + "' is not readable JSON: use --restart to start over");
-        }
-        const std::string diff = spec_difference(old_spec, now);
-        if (!diff.empty())
-            throw InputError("--out-dir", "'" + directory_ + "' holds the results of another sweep: " + diff +
-                                              "; use another directory, or --restart to discard them");
-    } else if (fs::exists(journal) || fs::exists(dir / "points.csv")) {
-        throw InputError("--out-dir", "'" + directory_ + "' holds sweep results without spec.json: use another "
-                                      "directory, or --restart to discard them");
-    }
-    const std::string header = point_table_header(spec_);
+    if (restart) discard_results(dir);
+    else check_same_sweep(directory_, now);
     if (fs::exists(journal)) {
-        // the finished points: every whole row whose values are its point's; a damaged row is
-        // dropped (named by line) and the rows after it kept; a line cut by a crash is dropped
-        const std::string text = read_text(journal.string());
-        const std::string where = journal.string();
-        std::string kept = id_line + "\n" + header + "\n";
-        bool repaired = false, header_seen = false;
-        std::size_t start = 0;
-        for (long line_no = 1; start < text.size(); ++line_no) {
-            const std::size_t end = text.find('\n', start);
-            if (end == std::string::npos) {  // no newline: cut by a crash
-                notes_.push_back(where + " line " + std::to_string(line_no) +
-                                 ": a row cut short (the run was stopped while writing it) was dropped; its point runs again");
-                repaired = true;
-                break;
-            }
-            const std::string line = text.substr(start, end - start);
-            start = end + 1;
-            if (!header_seen) {
-                if (line.rfind(kJournalId, 0) == 0) {
-                    if (line_no != 1 || line.rfind(kJournalId + sweep_spec_id(spec_), 0) != 0)
-                        throw InputError("--out-dir", where + " line " + std::to_string(line_no) + " says '" + line +
-                                                          "', this spec is " + sweep_spec_id(spec_) + " (" + spec_.source +
-                                                          "): the journal holds another spec's results; use another "
-                                                          "directory, or --restart to discard them");
-                    continue;
-                }
-                if (line != header)
-                    throw InputError("--out-dir", "'" + where + "' " + header_difference(line, header) +
-                                                      ": its rows cannot be resumed; use --restart to discard them and "
-                                                      "run every point again, or another --out-dir");
-                header_seen = true;
-                if (line_no == 1) repaired = true;  // a journal of an older version: its id line is added
-                continue;
-            }
-            PointResult r;
-            std::vector<std::string> cells;
-            try {
-                r = parse_row(spec_, line, &cells);
-                if (r.index < 0 || r.index >= count_)
-                    throw std::invalid_argument("point " + std::to_string(r.index) + " does not exist (the spec has " +
-                                                std::to_string(count_) + ")");
-            } catch (const std::invalid_argument& e) {
-                notes_.push_back(where + " line " + std::to_string(line_no) + ": a damaged row was dropped (" + e.what() +
-                                 "); the rows after it are kept, its point runs again");
-                repaired = true;
-                continue;
-            }
-            check_row_values(spec_, values_at_(r.index), cells, r.index, where + " line " + std::to_string(line_no));
-            finished_[static_cast<std::size_t>(r.index)] = true;
-            results_[static_cast<std::size_t>(r.index)] = r;
-            kept += line + "\n";
-        }
-        if (!header_seen) repaired = true;  // empty, or only the id line
+        JournalReplay replay = replay_journal(journal.string(), spec_, count_, values_at_);
+        finished_ = std::move(replay.finished);
+        results_ = std::move(replay.results);
+        notes_.insert(notes_.end(), replay.notes.begin(), replay.notes.end());
         // a repaired journal is replaced whole (renamed over), so that new rows follow whole ones
-        if (repaired) write_whole(journal.string(), kept);
+        if (replay.repaired) write_whole(journal.string(), replay.kept);
     } else {
         write_whole(spec_file.string(), now.dump(2) + "\n");
-        write_whole(journal.string(), id_line + "\n" + header + "\n");
+        write_whole(journal.string(), journal_start(spec_));
     }
     if (!fs::exists(spec_file)) write_whole(spec_file.string(), now.dump(2) + "\n");
-    // the files of points without a row are another run's: removed, never reused
-    for (const char* kind : {"scenarios", "loops", "series"}) {
-        const fs::path folder = dir / kind;
-        if (!fs::is_directory(folder, ec)) continue;
-        for (const auto& entry : fs::directory_iterator(folder, ec)) {
-            const long long index = point_index_of(entry.path().filename().string());
-            if (index >= 0 && index < count_ && finished_[static_cast<std::size_t>(index)]) continue;
-            std::error_code rec;
-            fs::remove(entry.path(), rec);
-            if (rec)
-                throw InputError("--out-dir", "cannot delete the stale file '" + entry.path().string() +
-                                                  "' (no row of this sweep owns it): " + rec.message());
-        }
-    }
-    for (const char* kind : {"scenarios", "loops"}) {
-        fs::create_directories(dir / kind, ec);
-        if (ec) throw InputError("--out-dir", "cannot create '" + (dir / kind).string() + "': " + ec.message());
-    }
-    if (keep_series_) {
-        fs::create_directories(dir / "series", ec);
-        if (ec) throw InputError("--out-dir", "cannot create '" + (dir / "series").string() + "': " + ec.message());
-    }
+    prepare_point_folders(dir, finished_, keep_series_);
 }
 
 int SweepDirectory::finished_count() const {

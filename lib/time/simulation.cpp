@@ -7,6 +7,7 @@
 
 #include "stackbeam/errors.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "time/record_loop.hpp"
 
 namespace stackbeam {
 
@@ -143,24 +144,36 @@ void require_loading_fits(const ModelSpec& model, const Loading& loading) {
     }
 }
 
-std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
-                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report,
-                                 const PairObserver& on_pairs, const NodeObserver& on_nodes) {
+long detail::record_steps(const SimulationOptions& options) {
+    return static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
+}
+
+RunReport detail::run_records(const System& system, const SimulationOptions& options,
+                              const std::function<void(const Stepper&, const StepRecord&)>& on_record) {
     const std::unique_ptr<Stepper> stepper = make_stepper(system, options);  // validates the options
-    const long n = static_cast<long>(std::ceil(options.t_end_s / options.dt_s - 1e-9));
-    std::vector<StepRecord> out;
-    out.reserve(static_cast<std::size_t>(n) + 1);
+    const long n = record_steps(options);
     for (long i = 0; i <= n; ++i) {
         // the caller's stop check between outputs (mode cvode also polls it inside a step: event_driver.hpp)
         if (i > 0 && options.stop_requested && options.stop_requested())
-            throw RunStopped("stopped on request at t = " + format_value(out.back().t_s) + " s (the last output)",
-                             stepper->report().steps, out.back().t_s);
-        out.push_back(i == 0 ? stepper->current() : stepper->advance());
-        if (on_step) on_step(out.back());
-        if (on_pairs) on_pairs(out.back().t_s, stepper->pairs());
-        if (on_nodes) on_nodes(out.back().t_s, stepper->nodes());
+            throw RunStopped("stopped on request at t = " + format_value(stepper->current().t_s) + " s (the last output)",
+                             stepper->report().steps, stepper->current().t_s);
+        on_record(*stepper, i == 0 ? stepper->current() : stepper->advance());
     }
-    if (report) *report = stepper->report();
+    return stepper->report();
+}
+
+std::vector<StepRecord> simulate(const System& system, const SimulationOptions& options,
+                                 const std::function<void(const StepRecord&)>& on_step, RunReport* report,
+                                 const PairObserver& on_pairs, const NodeObserver& on_nodes) {
+    std::vector<StepRecord> out;
+    const RunReport r = detail::run_records(system, options, [&](const Stepper& stepper, const StepRecord& record) {
+        if (out.empty()) out.reserve(static_cast<std::size_t>(detail::record_steps(options)) + 1);  // options valid now
+        out.push_back(record);
+        if (on_step) on_step(record);
+        if (on_pairs) on_pairs(record.t_s, stepper.pairs());
+        if (on_nodes) on_nodes(record.t_s, stepper.nodes());
+    });
+    if (report) *report = r;
     return out;
 }
 

@@ -73,6 +73,12 @@ Shared<T> deep_copy(const Shared<T>& from) {
     return to;
 }
 
+/// `v` as a one-dimensional numpy array (a copy).
+template <class T>
+py::array_t<T> array_of(const std::vector<T>& v) {
+    return py::array_t<T>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
 /// A scenario and the first line of its summary ("setup", as the command line writes it).
 /// The model's lists and its probe are kept as shared objects, so that a Python reference to
 /// an entry (`leaf = s.model.leaves[0]`) stays valid whatever happens to the list (the
@@ -257,17 +263,10 @@ struct PairTable {
         }
     }
     py::dict to_dict() const {
-        py::dict d;
-        d["t"] = py::array_t<double>(t.size(), t.data());
-        d["pair"] = py::array_t<int>(pair.size(), pair.data());
-        d["interface"] = py::array_t<int>(interface_index.size(), interface_index.data());
-        d["x"] = py::array_t<double>(x.size(), x.data());
-        d["state"] = py::module_::import("numpy").attr("array")(state);
-        d["p_n"] = py::array_t<double>(p_n.size(), p_n.data());
-        d["p_t"] = py::array_t<double>(p_t.size(), p_t.data());
-        d["gap"] = py::array_t<double>(gap.size(), gap.data());
-        d["slip"] = py::array_t<double>(slip.size(), slip.data());
-        return d;
+        return py::dict("t"_a = array_of(t), "pair"_a = array_of(pair), "interface"_a = array_of(interface_index),
+                        "x"_a = array_of(x), "state"_a = py::module_::import("numpy").attr("array")(state),
+                        "p_n"_a = array_of(p_n), "p_t"_a = array_of(p_t), "gap"_a = array_of(gap),
+                        "slip"_a = array_of(slip));
     }
 };
 
@@ -286,13 +285,8 @@ struct NodeTable {
             }
     }
     py::dict to_dict() const {
-        py::dict d;
-        d["t"] = py::array_t<double>(t.size(), t.data());
-        d["leaf"] = py::array_t<int>(leaf.size(), leaf.data());
-        d["x"] = py::array_t<double>(x.size(), x.data());
-        d["w"] = py::array_t<double>(w.size(), w.data());
-        d["theta"] = py::array_t<double>(theta.size(), theta.data());
-        return d;
+        return py::dict("t"_a = array_of(t), "leaf"_a = array_of(leaf), "x"_a = array_of(x), "w"_a = array_of(w),
+                        "theta"_a = array_of(theta));
     }
 };
 

@@ -19,44 +19,19 @@ py::dict fit(const std::string& spec_path, const py::object& jobs_arg) {
         options.jobs = jobs;
         r = stackbeam::fit(spec, options);
     }
-    auto array = [](const std::vector<double>& v) { return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data()); };
-    py::list parameters;
-    for (const FitParameterResult& p : r.parameters) {
-        py::dict d;
-        d["key"] = p.key;
-        d["value"] = p.value;
-        d["standard_error"] = p.standard_error;
-        d["lower"] = p.lower;
-        d["upper"] = p.upper;
-        d["at_bound"] = p.at_bound;
-        d["identifiable"] = p.identifiable;
-        d["note"] = p.note;
-        parameters.append(d);
-    }
-    py::list loops;
-    for (const FitLoopResult& l : r.loops) {
-        py::dict d;
-        d["name"] = l.name;
-        d["w_m"] = array(l.w_m);
-        d["measured_force_n"] = array(l.measured_force_n);
-        d["fitted_force_n"] = array(l.fitted_force_n);
-        d["branch"] = py::array_t<int>(static_cast<py::ssize_t>(l.branch.size()), l.branch.data());
-        d["measured_area_j"] = l.measured_area_j;
-        d["fitted_area_j"] = l.fitted_area_j;
-        d["rms_force_error_n"] = l.rms_force_error_n;
-        loops.append(d);
-    }
-    py::list history;
-    for (const FitIteration& it : r.history) {
-        py::dict d;
-        d["start"] = it.start;
-        d["iteration"] = it.iteration;
-        d["cost"] = it.cost;
-        d["values"] = it.values;
-        d["runs"] = it.runs;
-        d["accepted"] = it.accepted;
-        history.append(d);
-    }
+    py::list parameters, loops, history;
+    for (const FitParameterResult& p : r.parameters)
+        parameters.append(py::dict("key"_a = p.key, "value"_a = p.value, "standard_error"_a = p.standard_error,
+                                   "lower"_a = p.lower, "upper"_a = p.upper, "at_bound"_a = p.at_bound,
+                                   "identifiable"_a = p.identifiable, "note"_a = p.note));
+    for (const FitLoopResult& l : r.loops)
+        loops.append(py::dict("name"_a = l.name, "w_m"_a = array_of(l.w_m), "measured_force_n"_a = array_of(l.measured_force_n),
+                              "fitted_force_n"_a = array_of(l.fitted_force_n), "branch"_a = array_of(l.branch),
+                              "measured_area_j"_a = l.measured_area_j, "fitted_area_j"_a = l.fitted_area_j,
+                              "rms_force_error_n"_a = l.rms_force_error_n));
+    for (const FitIteration& it : r.history)
+        history.append(py::dict("start"_a = it.start, "iteration"_a = it.iteration, "cost"_a = it.cost,
+                                "values"_a = it.values, "runs"_a = it.runs, "accepted"_a = it.accepted));
     py::dict out;
     out["parameters"] = parameters;
     out["correlation"] = r.correlation;

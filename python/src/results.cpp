@@ -73,17 +73,9 @@ py::dict events_dict(const std::vector<ContactEvent>& events) {
         w_dot.push_back(e.w_dot_m_per_s);
     }
     const py::object array = py::module_::import("numpy").attr("array");
-    py::dict d;
-    d["t"] = py::array_t<double>(t.size(), t.data());
-    d["interface"] = py::array_t<int>(interface_index.size(), interface_index.data());
-    d["x"] = py::array_t<double>(x.size(), x.data());
-    d["pair"] = py::array_t<int>(pair.size(), pair.data());
-    d["from"] = array(from, "dtype"_a = "U8");
-    d["to"] = array(to, "dtype"_a = "U8");
-    d["cause"] = array(cause, "dtype"_a = "U8");
-    d["w"] = py::array_t<double>(w.size(), w.data());
-    d["w_dot"] = py::array_t<double>(w_dot.size(), w_dot.data());
-    return d;
+    return py::dict("t"_a = array_of(t), "interface"_a = array_of(interface_index), "x"_a = array_of(x),
+                    "pair"_a = array_of(pair), "from"_a = array(from, "dtype"_a = "U8"), "to"_a = array(to, "dtype"_a = "U8"),
+                    "cause"_a = array(cause, "dtype"_a = "U8"), "w"_a = array_of(w), "w_dot"_a = array_of(w_dot));
 }
 
 py::dict report_dict(const RunReport& r) {

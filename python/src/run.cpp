@@ -94,9 +94,9 @@ struct StressTable {
             };
             py::dict d;
             d["leaf"] = k.leaf;
-            d["t"] = py::array_t<double>(t.size(), t.data());
-            d["x"] = py::array_t<double>(k.x.size(), k.x.data());
-            d["thickness"] = py::array_t<double>(k.thickness.size(), k.thickness.data());
+            d["t"] = array_of(t);
+            d["x"] = array_of(k.x);
+            d["thickness"] = array_of(k.thickness);
             d["sigma_top"] = grid(k.top);
             d["sigma_bottom"] = grid(k.bottom);
             d["N"] = grid(k.n);
@@ -210,19 +210,11 @@ public:
     double dt_s() const { return options_.dt_s; }
     py::dict pairs() const {
         idle("pairs");
-        PairTable t;
-        t.add(stepper_->current().t_s, stepper_->pairs());
-        py::dict d = t.to_dict();
-        d.attr("pop")("t");
-        return d;
+        return at_current<PairTable>(stepper_->pairs());
     }
     py::dict nodes() const {
         idle("nodes");
-        NodeTable t;
-        t.add(stepper_->current().t_s, stepper_->nodes());
-        py::dict d = t.to_dict();
-        d.attr("pop")("t");
-        return d;
+        return at_current<NodeTable>(stepper_->nodes());
     }
     py::dict report() const {
         idle("report");
@@ -233,6 +225,15 @@ public:
     }
 
 private:
+    /// The table (PairTable, NodeTable) of `rows` at the current record, without its t column.
+    template <class Table, class Rows>
+    py::dict at_current(const Rows& rows) const {
+        Table t;
+        t.add(stepper_->current().t_s, rows);
+        py::dict d = t.to_dict();
+        d.attr("pop")("t");
+        return d;
+    }
     /// Marks the stepper busy for advance()'s time; RuntimeError if another thread is inside it.
     struct Busy {
         Busy(std::atomic<bool>& flag, const char* what) : flag_(flag) {

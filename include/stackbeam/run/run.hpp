@@ -7,7 +7,8 @@
 /// The library writes nothing here: every row goes to the caller's sink.
 ///
 /// Adding an output: a flag in RunOutputs, a callback in RunSink (default: ignore), one
-/// line in run_scenario's record loop; a figure of the summary: a member of RunSummary (or
+/// line in run_scenario's per-record callback (to the record loop it shares with simulate(),
+/// lib/time/record_loop.hpp); a figure of the summary: a member of RunSummary (or
 /// of RunStats, gathered per record) and its key in summary_json. Every front-end then has it.
 ///
 /// Interruption: the stop check (RunRequest::stop) is polled before each record is handed to
@@ -101,6 +102,20 @@ struct StepperDescription {
 /// The registry's row for `system` and `options` (make_stepper's choice); throws InputError as
 /// make_stepper for a combination no stepper takes.
 StepperDescription describe_stepper(const System& system, const SimulationOptions& options);
+
+/// What some stepper of the registry takes or gives, for the checks a front-end makes before it
+/// has a system (StepperCapabilities' fields of the same meaning).
+enum class StepperFeature {
+    massive_leaves,  ///< leaves with density > 0
+    event_log,       ///< RunReport::cvode and the event log
+};
+
+/// The modes with at least one stepper that has `feature`, each once, in the registry's order
+/// (massive_leaves: newmark, cvode; event_log: cvode).
+std::vector<Mode> modes_with(StepperFeature feature);
+
+/// The words of `modes` joined by `separator` ("newmark or cvode").
+std::string mode_list(const std::vector<Mode>& modes, const std::string& separator);
 
 /// One interface's largest pressure over the run (clamps included, clips not): InterfacePeak
 /// at the time t_s [s] it was reached (NaN: no pair on the interface).

@@ -29,6 +29,7 @@
 #include "stackbeam/errors.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "stackbeam/words.hpp"
 
 namespace stackbeam {
 
@@ -58,6 +59,8 @@ enum class Combine {
     product,  ///< every combination; the last axis varies fastest
     zip,      ///< the i-th value of every axis together (axes of equal length)
 };
+template <>
+const std::vector<EnumWord<Combine>>& enum_words<Combine>();  ///< the spec's combine: product, zip
 const char* to_string(Combine combine);
 
 /// A sweep: the base scenario, the axes, how they combine.
@@ -152,6 +155,8 @@ enum class PointStatus {
     failed,       ///< a solver failure (SolverError): the message says where
     input_error,  ///< refused when its run started (an option the mode cannot take)
 };
+template <>
+const std::vector<EnumWord<PointStatus>>& enum_words<PointStatus>();  ///< the table's status: ok, failed, input-error
 const char* to_string(PointStatus status);
 
 /// The per-point figures, the columns of points.csv after point, the axes, status and
