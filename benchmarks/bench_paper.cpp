@@ -37,7 +37,7 @@ const Recorded& recorded(PaperCase c) {
     r.p0 = st.contact_forces();
     for (int i = 0; i < 600; ++i) {
         st.advance();
-        r.problems.push_back(st.last_problem());
+        r.problems.push_back(st.contact_solver().last_dense_problem());
     }
     return cache.emplace(c, std::move(r)).first->second;
 }
