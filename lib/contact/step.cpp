@@ -147,7 +147,7 @@ SolveResult StepContactSolver::solve(const StepProblem& problem, Eigen::VectorXd
             v = D->ldlt.solve(D->B.size() > 0 ? Eigen::VectorXd(D->B * problem.u) : problem.u);
             pr.q = D->G * v - problem.d;
             if (D->E.size() > 0) pr.q += D->E * problem.u;
-        } else if (D->Q.size() > 0) {
+        } else if (D->Q.cols() > 0) {  // (a form with no contact rows has a 0 x r Q, not the identity)
             pr.q = D->Q * problem.u - problem.d;
         } else {
             pr.q = problem.u - problem.d;

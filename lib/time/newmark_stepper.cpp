@@ -481,7 +481,7 @@ const StepRecord& NewmarkStepper::Impl::advance() {
             // needed: M, K and C are symmetric, so row h is column h.
             double lambda_bar = detail::accurate_dot(Eigen::VectorXd(M_.col(h)), Eigen::VectorXd((v1 - v_) / dt)) +
                                 0.5 * detail::accurate_dot(Eigen::VectorXd(K_.col(h)), Eigen::VectorXd(z_ + z1)) -
-                                G.col(h).dot(p_);
+                                (p_.size() > 0 ? G.col(h).dot(p_) : 0.0);  // (a single leaf has no contact rows)
             if (loaded) lambda_bar -= 0.5 * (q0[h] + q1[h]);
             if (damped) lambda_bar += detail::accurate_dot(Eigen::VectorXd(C_.col(h)), Eigen::VectorXd((z1 - z_) / dt));
             external_work_ += lambda_bar * (z1[h] - z_[h]);
