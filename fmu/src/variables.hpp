@@ -106,7 +106,7 @@ inline Windup windup_of(const System& system, const SimulationOptions& scenario_
         make_stepper(system, o);
     } catch (const std::exception& e) {
         out.note = std::string("The seat's rotation is not an input of this FMU and its moment not an output "
-                               "(the scenario's stepper does not take the windup rig with the vertical rig: ") +
+                               "(the library does not take the windup rig with the vertical rig on this scenario: ") +
                    e.what() + ")";
         return out;
     }
