@@ -68,6 +68,7 @@ std::string default_binary_path() {
 std::string model_description(const Scenario& scenario, const std::string& scenario_text) {
     const ModelSpec& m = scenario.model;
     const SimulationOptions& o = scenario.simulation;
+    const Windup windup = windup_of(System(Model::build(m)), o);
     std::vector<Var> vars = {
         {"seat.displacement_m", vr_seat_displacement, "input", "continuous", "", "m",
          "seat (axle seat, rigid body R) displacement w relative to the spring's supports, +y up", true, 0.0},
@@ -90,6 +91,27 @@ std::string model_description(const Scenario& scenario, const std::string& scena
          "largest |seat.displacement_m| the importer will set (the cvode steppers' error and event scales), > 0",
          true, default_max_stroke_m(o.loading.displacement_m, seat_moves(o.loading))},
     };
+    if (windup.carried) {
+        vars.insert(vars.begin() + 3,
+                    {{"seat.rotation_rad", vr_seat_rotation, "input", "continuous", "", "rad",
+                      "seat (axle) rotation theta_R relative to the spring's supports, counter-clockwise (x forward "
+                      "along the spring, y up); 0 at the start",
+                      true, 0.0},
+                     {"seat.angular_velocity_rad_per_s", vr_seat_angular_velocity, "input", "continuous", "", "rad/s",
+                      "d theta_R/dt, counter-clockwise (leaf mass: the stepper uses it; 0 at the start)", true, 0.0},
+                     {"seat.angular_acceleration_rad_per_s2", vr_seat_angular_acceleration, "input", "continuous", "",
+                      "rad/s2", "d2 theta_R/dt2, counter-clockwise (leaf mass: the inertial load of the leaves)", true,
+                      0.0}});
+        vars.insert(vars.begin() + 7,
+                    {"seat.moment_n_m", vr_seat_moment, "output", "continuous", "", "N.m",
+                     "moment of the spring on the seat, counter-clockwise, whole spring (= -seat_moment, the "
+                     "windup rig's moment on the spring)", false, 0.0});
+        if (windup.axial)
+            vars.insert(vars.begin() + 8,
+                        {"seat.axial_displacement_m", vr_seat_axial, "output", "continuous", "", "m",
+                         "the seat's axial displacement u_R, +x, as the spring locates it (no longitudinal force on "
+                         "the seat: there is no axial input)", false, 0.0});
+    }
     for (std::size_t i = 0; i < m.interfaces.size() && i < kMaxListed; ++i)
         vars.push_back({"interfaces[" + std::to_string(i) + "].friction_coefficient", vr_friction0 + unsigned(i), "parameter",
                         "fixed", "exact", "1", "Coulomb friction coefficient mu between leaves " + std::to_string(i) +
@@ -101,7 +123,9 @@ std::string model_description(const Scenario& scenario, const std::string& scena
     std::ostringstream x;
     x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"stackbeam_spring\" guid=\"" << guid_of(scenario_text)
-      << "\"\n  description=\"" << xml_escape(scenario.description.empty() ? "stackbeam leaf spring" : scenario.description)
+      << "\"\n  description=\""
+      << xml_escape((scenario.description.empty() ? std::string("stackbeam leaf spring") : scenario.description) +
+                    (windup.note.empty() ? "" : "\n" + windup.note))
       << "\"\n  generationTool=\"stackbeam\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">\n"
       << "  <CoSimulation modelIdentifier=\"" << model_identifier() << "\" needsExecutionTool=\"false\""
       << " canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\""
@@ -115,6 +139,10 @@ std::string model_description(const Scenario& scenario, const std::string& scena
       << "    <Unit name=\"m/s\"><BaseUnit m=\"1\" s=\"-1\"/></Unit>\n"
       << "    <Unit name=\"m/s2\"><BaseUnit m=\"1\" s=\"-2\"/></Unit>\n"
       << "    <Unit name=\"N\"><BaseUnit kg=\"1\" m=\"1\" s=\"-2\"/></Unit>\n"
+      << "    <Unit name=\"N.m\"><BaseUnit kg=\"1\" m=\"2\" s=\"-2\"/></Unit>\n"
+      << "    <Unit name=\"rad\"><BaseUnit rad=\"1\"/></Unit>\n"
+      << "    <Unit name=\"rad/s\"><BaseUnit s=\"-1\" rad=\"1\"/></Unit>\n"
+      << "    <Unit name=\"rad/s2\"><BaseUnit s=\"-2\" rad=\"1\"/></Unit>\n"
       << "    <Unit name=\"J\"><BaseUnit kg=\"1\" m=\"2\" s=\"-2\"/></Unit>\n"
       << "    <Unit name=\"Pa\"><BaseUnit kg=\"1\" m=\"-1\" s=\"-2\"/></Unit>\n"
       << "  </UnitDefinitions>\n"

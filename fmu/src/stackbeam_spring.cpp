@@ -10,16 +10,24 @@
 // exactly as the rig's record at t depends on w(t). Between two communication points the inputs
 // are interpolated linearly (the stepper's records inside a longer communication step).
 //
+// Where the scenario's stepper takes the windup rig with the vertical rig (windup_of, variables.hpp:
+// the library's own check, decided once from the scenario), the seat's rotation theta_R(t), its rate
+// and acceleration are inputs too, read by the windup rig's TimeFunction (Loading::seat_rotation_rad)
+// from a second ExternalSamples table, and the moment (and, where the seat slides, u_R) are outputs.
+// Elsewhere those value references do not exist: setting one is refused.
+//
 // FMU states (fmi2GetFMUstate) are the inputs' history, not a copy of the stepper: setting one
 // rebuilds the stepper and replays the history from t = 0, which gives the same records bit for
 // bit (the steppers are deterministic) at a cost linear in the time reached (decision 060).
 //
 // Every function catches every exception: an error is fmi2Error with a message through the
 // importer's logger, never a crash. Instances share nothing mutable: each may run on its own thread.
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <new>
 #include <sstream>
@@ -57,8 +65,9 @@ struct Snapshot {
     double dt_s = 0.0;
     double max_stroke_m = 0.0;
     ExternalSamples samples;
+    ExternalSamples rotation_samples;
     long comm_index = 0;
-    double u[3] = {0.0, 0.0, 0.0};
+    double u[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
 };
 
 struct Instance {
@@ -76,10 +85,13 @@ struct Instance {
     double stop_s = 0.0;  // stop time - start time when the experiment defines it [s], 0: none
 
     std::unique_ptr<System> system;
+    Windup windup;  // whether the windup variables exist (windup_of, from the scenario)
     std::shared_ptr<ExternalSamples> samples = std::make_shared<ExternalSamples>();
+    std::shared_ptr<ExternalSamples> rotation_samples = std::make_shared<ExternalSamples>();
     std::unique_ptr<Stepper> stepper;
-    long comm_index = 0;              // the current communication point is start + comm_index dt
-    double u[3] = {0.0, 0.0, 0.0};    // inputs at the current communication point (w, w', w'')
+    long comm_index = 0;  // the current communication point is start + comm_index dt
+    // inputs at the current communication point (w, w', w'', theta_R, theta_R', theta_R''), by value reference - 1
+    double u[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     bool stale = false;               // the stepper's record at comm_index was made with other inputs
     long stress_index = -1;           // record whose largest stress is cached
     double stress_pa = 0.0;
@@ -89,6 +101,10 @@ struct Instance {
             logger(env, name.c_str(), status, category, "%s", message.c_str());
     }
 };
+
+/// The seat's rotation [rad] and its rate [rad/s] at the first communication point taken as the unwound
+/// seat at rest (0) when within this of 0: the rounding of an importer's shape.
+constexpr double kStartRoundoff = 1e-12;
 
 /// An error to report as fmi2Error (the message names the cause).
 struct FmuError : std::runtime_error {
@@ -144,17 +160,34 @@ double record_time(const Instance& in, long index) { return static_cast<double>(
 void ensure_current(Instance& in) {
     if (in.stepper && !in.stale && in.stepper->record_index() == in.comm_index) return;
     in.samples->set(record_time(in, in.comm_index), in.u[0], in.u[1], in.u[2]);
+    if (in.windup.carried) {
+        double theta = in.u[3], rate = in.u[4];
+        if (in.comm_index == 0) {
+            // The run starts unwound and, with leaf mass, at rest (Loading::validate, exactly: the samples have
+            // no shape whose rounding it could allow for). An importer's own shape rounds there (a harmonic from
+            // rest: sin(-pi/2) + 1, cos(-pi/2) = 6e-17): |theta| <= 1e-12 rad, |theta'| <= 1e-12 rad/s are 0.
+            if (std::abs(theta) <= kStartRoundoff) theta = 0.0;
+            if (std::abs(rate) <= kStartRoundoff) rate = 0.0;
+        }
+        in.rotation_samples->set(record_time(in, in.comm_index), theta, rate, in.u[5]);
+    }
     if (!in.stepper || in.stale || in.stepper->record_index() > in.comm_index) {
         SimulationOptions options = in.options;
         // the importer decides when to stop: the experiment's stop time, else 1e8 steps (validate() allows 1e9)
         options.t_end_s = in.stop_s > 0.0 ? std::max(in.stop_s, record_time(in, in.comm_index)) : 1e8 * options.dt_s;
-        options.loading = Loading{};
-        options.loading.kind = LoadingKind::prescribed_displacement;
-        options.loading.displacement_m.external = in.samples;
-        // The seat's declared stroke stands for the samples' largest |w| in the cvode steppers' scales
-        // (event_driver.cpp: largest_value = |mean| + amplitude, EventScales' motion_max); value() and
-        // its derivatives are the samples' whatever the shape (TimeFunction::external).
-        options.loading.displacement_m.amplitude = in.max_stroke_m;
+        options.loading = rig_loading(in.samples, in.windup.carried ? in.rotation_samples : nullptr, in.max_stroke_m);
+        if (in.windup.carried) {
+            // the run starts from the unwound seat (Loading::validate, by the scenario's key): say it by the inputs
+            const ExternalSamples& r = *in.rotation_samples;
+            const bool leaf_mass = in.spec.leaves[0].density_kg_per_m3 > 0.0;
+            if (r.values.front() != 0.0 || (leaf_mass && r.derivatives.front() != 0.0))
+                throw FmuError("input seat.rotation_rad = " + fmt(r.values.front()) + " rad" +
+                               (leaf_mass ? ", seat.angular_velocity_rad_per_s = " + fmt(r.derivatives.front()) + " rad/s" : "") +
+                               " at the start is not allowed: the spring starts unwound, so the rotation must be 0" +
+                               (leaf_mass ? " and, with leaf mass (the leaves start at rest), its rate 0" : "") +
+                               " (to 1e-12)" +
+                               " at the first communication point (give the rotation relative to the start)");
+        }
         if (!in.system) rebuild_system(in);
         in.stepper.reset();
         in.stepper = make_stepper(*in.system, options);
@@ -172,6 +205,12 @@ double output(Instance& in, fmi2ValueReference vr) {
         case vr_dissipated: return r.dissipated_energy_j;
         case vr_strain_energy: return r.strain_energy_j;
         case vr_external_work: return r.external_work_j;
+        case vr_seat_moment:
+            if (in.windup.carried) return -r.seat_moment_n_m;
+            break;
+        case vr_seat_axial:
+            if (in.windup.axial) return r.seat_axial_m;
+            break;
         case vr_max_stress:
             if (in.stress_index != in.stepper->record_index()) {
                 double m = 0.0;
@@ -188,7 +227,10 @@ double output(Instance& in, fmi2ValueReference vr) {
     throw FmuError("value reference " + std::to_string(vr) + " is not an output");
 }
 
-bool is_input(fmi2ValueReference vr) { return vr >= vr_seat_displacement && vr <= vr_seat_acceleration; }
+bool is_input(const Instance& in, fmi2ValueReference vr) {
+    const fmi2ValueReference last = in.windup.carried ? vr_seat_angular_acceleration : vr_seat_acceleration;
+    return vr >= vr_seat_displacement && vr <= last;
+}
 
 /// Index of a friction (preload) parameter, or -1.
 long friction_index(const Instance& in, fmi2ValueReference vr) {
@@ -201,7 +243,7 @@ long preload_index(const Instance& in, fmi2ValueReference vr) {
 }
 
 double get_real(Instance& in, fmi2ValueReference vr) {
-    if (is_input(vr)) return in.u[vr - vr_seat_displacement];
+    if (is_input(in, vr)) return in.u[vr - vr_seat_displacement];
     if (vr == vr_dt) return in.options.dt_s;
     if (vr == vr_max_stroke) return in.max_stroke_m;
     if (const long i = friction_index(in, vr); i >= 0) return in.spec.interfaces[i].friction_coefficient;
@@ -211,7 +253,7 @@ double get_real(Instance& in, fmi2ValueReference vr) {
 }
 
 void set_real(Instance& in, fmi2ValueReference vr, double v) {
-    if (is_input(vr)) {
+    if (is_input(in, vr)) {
         if (!std::isfinite(v))
             throw FmuError("input " + std::to_string(vr) + " (seat motion) = " + fmt(v) + " is not allowed: it must be finite");
         double& slot = in.u[vr - vr_seat_displacement];
@@ -220,7 +262,12 @@ void set_real(Instance& in, fmi2ValueReference vr, double v) {
         return;
     }
     const bool parameter = vr == vr_dt || vr == vr_max_stroke || friction_index(in, vr) >= 0 || preload_index(in, vr) >= 0;
-    if (!parameter) throw FmuError("value reference " + std::to_string(vr) + " cannot be set (not an input or parameter)");
+    if (!parameter) {
+        if (vr >= vr_seat_rotation && vr <= vr_seat_angular_acceleration)  // !in.windup.carried
+            throw FmuError("value reference " + std::to_string(vr) + " (the seat's rotation) is not an input of this FMU: " +
+                           in.windup.note);
+        throw FmuError("value reference " + std::to_string(vr) + " cannot be set (not an input or parameter)");
+    }
     require_phase(in, "fmi2SetReal of a parameter (variability fixed)", {Phase::instantiated, Phase::initialization});
     if (vr == vr_max_stroke) {
         if (!(std::isfinite(v) && v > 0.0))
@@ -290,11 +337,13 @@ void reset_instance(Instance& in) {
     in.stop_s = 0.0;
     in.stepper.reset();
     in.samples = std::make_shared<ExternalSamples>();
+    in.rotation_samples = std::make_shared<ExternalSamples>();
     in.comm_index = 0;
-    in.u[0] = in.u[1] = in.u[2] = 0.0;
+    std::fill(std::begin(in.u), std::end(in.u), 0.0);
     in.stale = false;
     in.stress_index = -1;
     rebuild_system(in);
+    in.windup = windup_of(*in.system, in.options);
     in.phase = Phase::instantiated;
 }
 
@@ -437,6 +486,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
         s->dt_s = in.options.dt_s;
         s->max_stroke_m = in.max_stroke_m;
         s->samples = *in.samples;
+        s->rotation_samples = *in.rotation_samples;
         s->comm_index = in.comm_index;
         std::memcpy(s->u, in.u, sizeof in.u);
         *state = s;
@@ -457,6 +507,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
         rebuild_system(in);
         in.stepper.reset();  // rebuilt and replayed on demand (ensure_current)
         in.samples = std::make_shared<ExternalSamples>(s.samples);
+        in.rotation_samples = std::make_shared<ExternalSamples>(s.rotation_samples);
         in.comm_index = s.comm_index;
         std::memcpy(in.u, s.u, sizeof in.u);
         in.stale = false;
@@ -483,7 +534,7 @@ void put_vec(std::vector<char>& b, const std::vector<double>& v) {
 }
 std::vector<char> serialize(const Snapshot& s) {
     std::vector<char> b;
-    const char magic[8] = {'S', 'B', 'F', 'M', 'U', 'S', '2', '\0'};
+    const char magic[8] = {'S', 'B', 'F', 'M', 'U', 'S', '3', '\0'};  // 3: with the rotation's samples
     put(b, magic, sizeof magic);
     put_vec(b, s.friction);
     put_vec(b, s.preload);
@@ -493,6 +544,10 @@ std::vector<char> serialize(const Snapshot& s) {
     put_vec(b, s.samples.values);
     put_vec(b, s.samples.derivatives);
     put_vec(b, s.samples.second_derivatives);
+    put_vec(b, s.rotation_samples.times_s);
+    put_vec(b, s.rotation_samples.values);
+    put_vec(b, s.rotation_samples.derivatives);
+    put_vec(b, s.rotation_samples.second_derivatives);
     put(b, &s.comm_index, sizeof s.comm_index);
     put(b, s.u, sizeof s.u);
     return b;
@@ -541,7 +596,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
         Reader r{serializedState, size};
         char magic[8];
         r.get(magic, sizeof magic);
-        if (std::memcmp(magic, "SBFMUS2", 8) != 0) throw FmuError("the serialized FMU state is not one of this FMU's");
+        if (std::memcmp(magic, "SBFMUS3", 8) != 0) throw FmuError("the serialized FMU state is not one of this FMU's");
         auto s = std::make_unique<Snapshot>();
         s->friction = r.vec();
         s->preload = r.vec();
@@ -551,6 +606,10 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
         s->samples.values = r.vec();
         s->samples.derivatives = r.vec();
         s->samples.second_derivatives = r.vec();
+        s->rotation_samples.times_s = r.vec();
+        s->rotation_samples.values = r.vec();
+        s->rotation_samples.derivatives = r.vec();
+        s->rotation_samples.second_derivatives = r.vec();
         r.get(&s->comm_index, sizeof s->comm_index);
         r.get(s->u, sizeof s->u);
         if (*state != nullptr) delete static_cast<Snapshot*>(*state);
