@@ -35,7 +35,9 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::closed_form;
     c.applied_force = c.base_excitation = c.gravity = c.rig = c.rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
-    c.seat_loads = true;  // condensed with theta_R (System::SeatCondensation): no J, not with the rig
+    // seat loads condensed with theta_R (System::SeatCondensation), also with the vertical rig; the windup
+    // rig as theta_R held in that condensation (decision 069); no J (theta_R is not a DOF of its own)
+    c.seat_loads = c.seat_loads_with_rig = c.windup_rig = c.windup_rig_on_rigid_contact = true;
     c.start = StartKind::massless_stack;
     c.build = &ClosedFormStepperAccess::build;
     rows.push_back(c);
