@@ -104,6 +104,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
     c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M
     c.windup_rig = true;                    // theta_R's acceleration prescribed as the rig's w'' (decision 069)
+    c.seat_loads_with_rig = true;           // the rig's and the seat loads' work both booked (decision 069)
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;

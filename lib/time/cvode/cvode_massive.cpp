@@ -41,7 +41,8 @@
 // DOFs H (theta_R, and w where the vertical rig holds it too): z'' = M^-1 (r + E_H lambda) with
 // U_HH lambda = z_H''(t) - (M^-1 r)_H, U = M^-1 E_H (prescribe_accelerations); quasi-static as
 // newmark's: R's inertia (m on w and u_R, J) is out of M (System::mass_reduced(false)); its work
-// W' = q^T v + lambda^T z_H'. The vertical rig alone keeps its single-DOF form above.
+// W' = q^T v + lambda^T z_H'. Seat loads with the vertical rig take the same form (H = {w}: their
+// work q^T v besides the rig's). The vertical rig alone keeps its single-DOF form above.
 //
 // At an event the driver makes the decided modes hold at the event's state itself
 // (settle_at_state): the look-ahead may keep a pair closed that is still in tension at y (its
@@ -100,7 +101,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     mutable double rig_lambda_rhs = 0.0;  // the rig's lambda [N] at the last right-hand side (its Newton row)
     // the windup rig: the prescribed DOFs H (ascending: theta_R, then w with the vertical rig), their
     // motions, U = M^-1 E_H, the reactions lambda [N m, N] at the last right-hand side; R's mass on w in M
-    bool windup = false;
+    bool windup = false, held_rig = false;  // held_rig: the prescribed DOFs' form (the windup rig, or seat loads with the vertical rig)
     std::vector<int> held;
     std::vector<const TimeFunction*> held_f;
     Eigen::MatrixXd U_h;
@@ -183,7 +184,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     /// The rig: R's row of the Newton matrix becomes e_w^T (x_vw = r_vw: w'' does not depend on
     /// the state). Compresses A.
     void prescribe_w_row(SpMat& A) const {
-        if (windup) {  // every prescribed DOF's row (the windup rig)
+        if (held_rig) {  // every prescribed DOF's row
             std::vector<char> is_held(static_cast<std::size_t>(A.rows()), 0);
             for (const int h : held) is_held[static_cast<std::size_t>(h)] = 1;
             A.prune([&is_held](const Eigen::Index& row, const Eigen::Index&, const double&) {
@@ -215,7 +216,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         if (!load->none()) r += load->at(t_s);
         if (damped()) r -= C * v;
         Eigen::VectorXd a = mass.solve(r);
-        if (windup) {
+        if (held_rig) {
             const Eigen::VectorXd lambda = prescribe_accelerations(a, U_h, held, held_acceleration(t_s));
             if (rig_n) *rig_n = rig ? lambda[lambda.size() - 1] : 0.0;
             if (held_n) *held_n = lambda;
@@ -288,7 +289,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
             r3 += (load->at(te + h) - load->at(te - h)) / (2.0 * h);
         }
         Eigen::VectorXd jerk = mass.solve(r3);
-        if (windup) prescribe_accelerations(jerk, U_h, held, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(held.size())));
+        if (held_rig) prescribe_accelerations(jerk, U_h, held, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(held.size())));
         else if (rig) prescribe_w_acceleration(jerk, u_w, 0.0);
         const double jmax = (Grow * jerk).lpNorm<Eigen::Infinity>();
         if (jmax > 0.0)
@@ -330,13 +331,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
         double lambda = 0.0;
-        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = acceleration(t, z, v, &lambda, windup ? &held_lambda_rhs : nullptr);
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = acceleration(t, z, v, &lambda, held_rig ? &held_lambda_rhs : nullptr);
         rig_lambda_rhs = lambda;
         double pw = 0.0;
         for (int rt : slip_rows) pw -= (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(v);
         D[2 * n_] = pw;
         D[2 * n_ + 1] = damped() ? v.dot(C * v) : 0.0;
-        D[2 * n_ + 2] = windup ? held_power(t, v, held_lambda_rhs) : external_power(t, v, lambda);
+        D[2 * n_ + 2] = held_rig ? held_power(t, v, held_lambda_rhs) : external_power(t, v, lambda);
     }
 
     /// Factorises M + gamma C + gamma^2 K_eff (the Newton matrix after block elimination).
@@ -361,7 +362,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const int n_ = ndof();
         const Eigen::Map<const Eigen::VectorXd> rz(R, n_), rvel(R + n_, n_);
         Eigen::VectorXd rhs_v = M * rvel - gamma * (Keff * rz);  // (M + g C + g^2 Keff) x_v
-        if (windup)
+        if (held_rig)
             for (const int h : held) rhs_v[h] = rvel[h];           // z_H'' prescribed: x_vH = r_vH
         else if (rig)
             rhs_v[w_dof()] = rvel[w_dof()];                        // w'' prescribed: x_vw = r_vw
@@ -379,7 +380,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         // d(q^T v) = q^T dv (the rig's lambda w': lambda dw' with the lambda of the last right-hand
         // side, lambda's own change left out of this row of the Newton matrix, which nothing else
         // depends on)
-        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * (windup ? held_power(t, xvel, held_lambda_rhs)
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * (held_rig ? held_power(t, xvel, held_lambda_rhs)
                                                        : external_power(t, xvel, rig_lambda_rhs));
         return 0;
     }
@@ -442,10 +443,13 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     if (rig) u_w = mass.solve(Eigen::VectorXd::Unit(ndof(), w_dof()));
     const Loading& L = options().loading;
     windup = L.windup_rig();
+    held_rig = windup || (rig && L.has_seat_load());  // the seat loads' work: q^T v besides the rig's
     m_on_w = windup ? 0.0 : body_mass_kg();
-    if (windup) {
-        held = {system.seat_rotation_dof()};
-        held_f = {&*L.seat_rotation_rad};
+    if (held_rig) {
+        if (windup) {
+            held = {system.seat_rotation_dof()};
+            held_f = {&*L.seat_rotation_rad};
+        }
         if (rig) {
             held.push_back(w_dof());
             held_f.push_back(&L.displacement_m);
