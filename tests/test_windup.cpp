@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "single_leaf.hpp"
+#include "windup_cases.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/io/scenario.hpp"
@@ -36,20 +37,8 @@ ModelSpec leaf(double a, SupportKind left = SupportKind::pinned, SupportKind rig
     return testing::single_leaf(kL, kT, kB, kE, left, right, a, kL / 24);
 }
 
-/// A table from 0 at t = 0 to `end` at t = 1 s.
-TimeFunction ramp(double end) {
-    TimeFunction f;
-    f.shape = TimeFunction::Shape::table;
-    f.times_s = {0.0, 1.0};
-    f.values = {0.0, end};
-    return f;
-}
-
-TimeFunction constant(double value) {
-    TimeFunction f;
-    f.mean = value;
-    return f;
-}
+using testing::constant;
+using testing::ramp;
 
 /// Mode newmark, 10 steps to t = 1 s (massless leaves: each step a static solve).
 SimulationOptions newmark(const Loading& loading, double t_end_s = 1.0, double dt_s = 0.1) {
@@ -133,17 +122,7 @@ std::string refusal(const ModelSpec& spec, const SimulationOptions& o) {
 /// A two-leaf stack: the main leaf (0) from 0 to kL on pinned ends, a shorter leaf (1) of `lower_m`
 /// below it, centred on x = c, free ends; the seat at `seat_m` ties both; one interface of `law`, mu.
 ModelSpec two_leaves(double seat_m, double lower_m, double c, InterfaceLaw law, double mu = 0.0) {
-    ModelSpec s = leaf(seat_m);
-    LeafSpec lower = s.leaves[0];
-    lower.length_m = lower_m;
-    lower.x_start_m = c - 0.5 * lower_m;
-    lower.left_support = lower.right_support = SupportKind::free;
-    s.leaves.push_back(lower);
-    InterfaceSpec f;
-    f.law = law;
-    f.friction_coefficient = mu;
-    s.interfaces = {f};
-    return s;
+    return testing::with_lower_leaf(leaf(seat_m), lower_m, c, law, mu);
 }
 
 /// M / theta of the windup rig at theta [N m/rad] on `spec` (newmark, massless leaves), and the
@@ -413,17 +392,8 @@ BOOST_AUTO_TEST_CASE(friction_windup_loop_closes_and_its_area_is_the_friction_wo
     };
     const auto r = run(InterfaceLaw::coulomb, 0.3);
     BOOST_TEST_REQUIRE(r.size() == static_cast<std::size_t>(cycles * per_cycle + 1));
-    double amplitude = 0.0;
-    for (const auto& x : r) amplitude = std::max(amplitude, std::abs(x.seat_moment_n_m));
-    // the third cycle repeats the second
-    double repeat = 0.0;
-    for (int k = 0; k <= per_cycle; ++k)
-        repeat = std::max(repeat, std::abs(r[2 * per_cycle + k].seat_moment_n_m - r[per_cycle + k].seat_moment_n_m));
-    // the third cycle's area by the trapezoidal rule (the rig's work as the stepper books it)
-    double area = 0.0;
-    for (int k = 2 * per_cycle; k < 3 * per_cycle; ++k)
-        area += 0.5 * (r[k].seat_moment_n_m + r[k + 1].seat_moment_n_m) * (r[k + 1].seat_rotation_rad - r[k].seat_rotation_rad);
-    const double friction = r[3 * per_cycle].dissipated_energy_j - r[2 * per_cycle].dissipated_energy_j;
+    // the third cycle repeats the second; its area by the trapezoidal rule (the rig's work as the stepper books it)
+    const auto [amplitude, repeat, area, friction] = testing::windup_loop(r, per_cycle);
     BOOST_TEST_MESSAGE("moment amplitude " << amplitude << " N m, cycle 3 - cycle 2 " << repeat << " N m, area " << area
                                            << " J, friction work " << friction << " J, slipping pairs at the tip "
                                            << r[2 * per_cycle + per_cycle / 4].n_slip);

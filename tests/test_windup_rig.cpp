@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "single_leaf.hpp"
+#include "windup_cases.hpp"
 #include "stackbeam/errors.hpp"
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/simulation.hpp"
@@ -39,32 +40,11 @@ const double kEI = kE * kB * kT * kT * kT / 12.0;
 ModelSpec two_leaves(InterfaceLaw law, double mu) {
     ModelSpec s = testing::single_leaf(kL, kT, kB, kE, SupportKind::hinged, SupportKind::pinned, 0.5, kL / 24);
     s.leaves[0].left_end.eye_offset_m = 0.015;
-    LeafSpec lower = s.leaves[0];
-    lower.length_m = 0.8;
-    lower.x_start_m = 0.15;
-    lower.left_support = lower.right_support = SupportKind::free;
-    s.leaves.push_back(lower);
-    InterfaceSpec f;
-    f.law = law;
-    f.friction_coefficient = mu;
-    s.interfaces = {f};
-    return s;
+    return testing::with_lower_leaf(s, 0.8, 0.55, law, mu);
 }
 
-TimeFunction constant(double value) {
-    TimeFunction f;
-    f.mean = value;
-    return f;
-}
-
-/// A table from 0 at t = 0 to `end` at t = 1 s.
-TimeFunction ramp(double end) {
-    TimeFunction f;
-    f.shape = TimeFunction::Shape::table;
-    f.times_s = {0.0, 1.0};
-    f.values = {0.0, end};
-    return f;
-}
+using testing::constant;
+using testing::ramp;
 
 TimeFunction triangle(double amplitude) {
     TimeFunction f;
@@ -184,18 +164,12 @@ BOOST_AUTO_TEST_CASE(closed_form_friction_windup_loop_area_is_the_friction_work)
     const System sys(Model::build(two_leaves(InterfaceLaw::coulomb, 0.3)));
     const auto r = run(sys, windup_loading(0), Mode::closed_form, ContactPath::dense, cycles, 1.0 / per_cycle);
     BOOST_TEST_REQUIRE(r.size() == static_cast<std::size_t>(cycles * per_cycle + 1));
-    double amplitude = 0.0, repeat = 0.0, balance = 0.0, strain = 0.0;
+    const auto [amplitude, repeat, area, friction] = testing::windup_loop(r, per_cycle);
+    double balance = 0.0, strain = 0.0;
     for (const auto& x : r) {
-        amplitude = std::max(amplitude, std::abs(x.seat_moment_n_m));
         balance = std::max(balance, std::abs(x.energy_balance_error_j));
         strain = std::max(strain, x.strain_energy_j);
     }
-    for (int k = 0; k <= per_cycle; ++k)
-        repeat = std::max(repeat, std::abs(r[2 * per_cycle + k].seat_moment_n_m - r[per_cycle + k].seat_moment_n_m));
-    double area = 0.0;
-    for (int k = 2 * per_cycle; k < 3 * per_cycle; ++k)
-        area += 0.5 * (r[k].seat_moment_n_m + r[k + 1].seat_moment_n_m) * (r[k + 1].seat_rotation_rad - r[k].seat_rotation_rad);
-    const double friction = r[3 * per_cycle].dissipated_energy_j - r[2 * per_cycle].dissipated_energy_j;
     BOOST_TEST_MESSAGE("moment amplitude " << amplitude << " N m, cycle 3 - cycle 2 " << repeat << " N m, area " << area
                                            << " J, friction work " << friction << " J, balance " << balance << " J of "
                                            << strain << " J");

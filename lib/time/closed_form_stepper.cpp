@@ -83,6 +83,8 @@ struct ClosedFormStepper::Impl {
     Eigen::VectorXd held_seat_z(const Eigen::VectorXd& zf, const Eigen::VectorXd& u) const;
     StepSystem held_seat_system();
     const StepRecord& advance_held_seat();
+    /// The step's end: the state at t + dt (R at w1, w1'), the anchors, the record.
+    const StepRecord& finish_step(const Eigen::VectorXd& rel1, double w1, double wd1);
     /// SolverError (step, time, residual) where the step's solve failed and options_.stop_on_nonconvergence.
     void check_solve() const;
     /// Friction work [J, whole spring] over the step from p0 to p_, rel_ to rel1 (trapezoidal: p linear).
@@ -485,10 +487,14 @@ const StepRecord& ClosedFormStepper::Impl::advance_held_seat() {
     seat_full_ = S;
     seat_motion_ = motion1;
     fv_ = fv1;
+    return finish_step(rel1, w1, wd1);
+}
+
+const StepRecord& ClosedFormStepper::Impl::finish_step(const Eigen::VectorXd& rel1, double w1, double wd1) {
     rel_ = rel1;
     w_ = w1;
     wd_ = wd1;
-    t_ = step_ * dt;
+    t_ = step_ * options_.dt_s;
     detail::reanchor(problem_, p_, rel_, d_);
     fill_record(solve_.iterations, solve_.factorizations, contact_->strain_energy_j(p_, rel_));
     detail::count_step(record_, report_);
@@ -563,14 +569,7 @@ const StepRecord& ClosedFormStepper::Impl::advance() {
         fe_ = fe1;
     }
     if (!seat_ && system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w1;
-    rel_ = rel1;
-    w_ = w1;
-    wd_ = wd1;
-    t_ = step_ * dt;
-    detail::reanchor(problem_, p_, rel_, d_);
-    fill_record(solve_.iterations, solve_.factorizations, contact_->strain_energy_j(p_, rel_));
-    detail::count_step(record_, report_);
-    return record_;
+    return finish_step(rel1, w1, wd1);
 }
 
 }  // namespace stackbeam
