@@ -35,7 +35,9 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::closed_form;
     c.applied_force = c.base_excitation = c.gravity = c.rig = c.rig_on_rigid_contact = true;
     c.assembly = c.previous_step_tau = c.friction = c.rigid_rows = c.elastic_layer = true;
-    c.seat_loads = true;  // condensed with theta_R (System::SeatCondensation): no J, not with the rig
+    // seat loads condensed with theta_R (System::SeatCondensation), also with the vertical rig; the windup
+    // rig as theta_R held in that condensation (decision 069); no J (theta_R is not a DOF of its own)
+    c.seat_loads = c.seat_loads_with_rig = c.windup_rig = c.windup_rig_on_rigid_contact = true;
     c.start = StartKind::massless_stack;
     c.build = &ClosedFormStepperAccess::build;
     rows.push_back(c);
@@ -100,7 +102,9 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.massive_leaves = true;
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
-    c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M; not the windup rig
+    c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M
+    c.windup_rig = true;                    // theta_R's acceleration prescribed as the rig's w'' (decision 069)
+    c.seat_loads_with_rig = true;           // the rig's and the seat loads' work both booked (decision 069)
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
@@ -310,15 +314,16 @@ const StepperCapabilities& choose_stepper(const System& system, const Simulation
             // leaf inertia (docs/time-integration.md "Which leaf-inertia stepper"): with friction the
             // modal stepper (every loading but the rig, the assembly; cheap: the contact layer is
             // massless, so transitions excite no mesh-scale ringing) unless the whole massive stack
-            // is asked for, or needed for what only it takes (structural damping, the rig) and every
+            // is asked for, or needed for what only it takes (structural damping, the rigs) and every
             // row is elastic; without friction the held-for-good stepper under the paper's initial
             // conditions, else the massive stack on elastic rows (no transitions: cheap) or the modal one
             const LeafInertia li = options.cvode.leaf_inertia;
             const bool elastic = first_rigid_pair(system) < 0;
             const bool changes = has_mode_changes(system);
             const bool assembled = needs_assembly(system.model().spec());
-            const bool massive_only =
-                options.damping.active() || options.loading.kind == LoadingKind::prescribed_displacement;
+            const bool massive_only = options.damping.active() ||
+                                      options.loading.kind == LoadingKind::prescribed_displacement ||
+                                      options.loading.windup_rig();
             if (li == LeafInertia::massive || (li == LeafInertia::automatic && elastic && massive_only))
                 return registered_stepper("cvode-massive");
             if (changes || li == LeafInertia::modal) return registered_stepper("cvode-modal");

@@ -37,6 +37,12 @@
 // w'' = w_p''(t): z'' = M^-1 (r + lambda e_w), lambda = (w_p'' - (M^-1 r)_w) / (M^-1)_ww, the rig's
 // force on the meshed part including R's inertia and the leaves' (the load cell between R and the
 // spring reads lambda - m w_p''). The external work W' = q^T v (rig: lambda w') is a state.
+// The windup rig (loading.hpp; decision 069) imposes theta_R(t) the same way on a set of prescribed
+// DOFs H (theta_R, and w where the vertical rig holds it too): z'' = M^-1 (r + E_H lambda) with
+// U_HH lambda = z_H''(t) - (M^-1 r)_H, U = M^-1 E_H (prescribe_accelerations); quasi-static as
+// newmark's: R's inertia (m on w and u_R, J) is out of M (System::mass_reduced(false)); its work
+// W' = q^T v + lambda^T z_H'. Seat loads with the vertical rig take the same form (H = {w}: their
+// work q^T v besides the rig's). The vertical rig alone keeps its single-DOF form above.
 //
 // At an event the driver makes the decided modes hold at the event's state itself
 // (settle_at_state): the look-ahead may keep a pair closed that is still in tension at y (its
@@ -93,6 +99,20 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     bool rig = false;                   // w prescribed (LoadingKind::prescribed_displacement)
     Eigen::VectorXd u_w;                // M^-1 e_w [1/kg] (the rig's reaction per unit force)
     mutable double rig_lambda_rhs = 0.0;  // the rig's lambda [N] at the last right-hand side (its Newton row)
+    // the windup rig: the prescribed DOFs H (ascending: theta_R, then w with the vertical rig), their
+    // motions, U = M^-1 E_H, the reactions lambda [N m, N] at the last right-hand side; R's mass on w in M
+    bool windup = false, held_rig = false;  // held_rig: the prescribed DOFs' form (the windup rig, or seat loads with the vertical rig)
+    std::vector<int> held;
+    std::vector<const TimeFunction*> held_f;
+    Eigen::MatrixXd U_h;
+    mutable Eigen::VectorXd held_lambda_rhs;
+    double m_on_w = 0.0;  // [kg, whole spring]: 0 under the windup rig
+    /// z_H''(t) [rad/s^2, m/s^2] of the prescribed DOFs.
+    Eigen::VectorXd held_acceleration(double t_s) const {
+        Eigen::VectorXd a(static_cast<Eigen::Index>(held.size()));
+        for (std::size_t h = 0; h < held.size(); ++h) a[static_cast<Eigen::Index>(h)] = held_f[h]->second_derivative(t_s);
+        return a;
+    }
     // the current modes: p = P z + p0, s + d = Hs z + hs, M z'' = -Keff z + b0
     RowSpMat P, Hs;
     SpMat Keff;
@@ -164,7 +184,14 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     /// The rig: R's row of the Newton matrix becomes e_w^T (x_vw = r_vw: w'' does not depend on
     /// the state). Compresses A.
     void prescribe_w_row(SpMat& A) const {
-        if (rig) {
+        if (held_rig) {  // every prescribed DOF's row
+            std::vector<char> is_held(static_cast<std::size_t>(A.rows()), 0);
+            for (const int h : held) is_held[static_cast<std::size_t>(h)] = 1;
+            A.prune([&is_held](const Eigen::Index& row, const Eigen::Index&, const double&) {
+                return !is_held[static_cast<std::size_t>(row)];
+            });
+            for (const int h : held) A.coeffRef(h, h) = 1.0;
+        } else if (rig) {
             const int w = w_dof();
             A.prune([w](const Eigen::Index& row, const Eigen::Index&, const double&) { return row != w; });
             A.coeffRef(w, w) = 1.0;
@@ -182,13 +209,18 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 
     /// z'' = M^-1 (G^T p0 + q(t) - K_eff z - C z' + lambda e_w) [m/s^2, rad/s^2] of the current
     /// modes; lambda [N, meshed part] the rig's reaction (0 without a rig), returned in `rig_n`.
+    /// The windup rig: every prescribed DOF's reaction in `held_n` (theta_R's first; w's, the last, in rig_n).
     Vec acceleration(double t_s, const Eigen::Ref<const Eigen::VectorXd>& z, const Eigen::Ref<const Eigen::VectorXd>& v,
-                     double* rig_n = nullptr) const {
+                     double* rig_n = nullptr, Eigen::VectorXd* held_n = nullptr) const {
         Eigen::VectorXd r = b0 - Keff * z;
         if (!load->none()) r += load->at(t_s);
         if (damped()) r -= C * v;
         Eigen::VectorXd a = mass.solve(r);
-        if (rig) {
+        if (held_rig) {
+            const Eigen::VectorXd lambda = prescribe_accelerations(a, U_h, held, held_acceleration(t_s));
+            if (rig_n) *rig_n = rig ? lambda[lambda.size() - 1] : 0.0;
+            if (held_n) *held_n = lambda;
+        } else if (rig) {
             const double lambda = prescribe_w_acceleration(a, u_w, options().loading.displacement_m.second_derivative(t_s));
             if (rig_n) *rig_n = lambda;
         } else if (rig_n) {
@@ -213,6 +245,12 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     double external_power(double t_s, const Eigen::Ref<const Eigen::VectorXd>& v, double lambda) const {
         if (rig) return lambda * v[w_dof()];
         return load->none() ? 0.0 : load->at(t_s).dot(v);
+    }
+    /// The windup rig's: q^T v + lambda^T v_H [W, meshed part].
+    double held_power(double t_s, const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::VectorXd& lambda) const {
+        double pw = load->none() ? 0.0 : load->at(t_s).dot(v);
+        for (std::size_t h = 0; h < held.size(); ++h) pw += lambda[static_cast<Eigen::Index>(h)] * v[held[h]];
+        return pw;
     }
 
     void witnesses(const State& y, double* g) const override {
@@ -251,7 +289,8 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
             r3 += (load->at(te + h) - load->at(te - h)) / (2.0 * h);
         }
         Eigen::VectorXd jerk = mass.solve(r3);
-        if (rig) prescribe_w_acceleration(jerk, u_w, 0.0);
+        if (held_rig) prescribe_accelerations(jerk, U_h, held, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(held.size())));
+        else if (rig) prescribe_w_acceleration(jerk, u_w, 0.0);
         const double jmax = (Grow * jerk).lpNorm<Eigen::Infinity>();
         if (jmax > 0.0)
             delta = std::min(delta > 0.0 ? delta : std::numeric_limits<double>::infinity(), std::cbrt(6.0 * target / jmax));
@@ -292,13 +331,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const Eigen::Map<const Eigen::VectorXd> z(Y, n_), v(Y + n_, n_);
         Eigen::Map<Eigen::VectorXd>(D, n_) = v;
         double lambda = 0.0;
-        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = acceleration(t, z, v, &lambda);
+        Eigen::Map<Eigen::VectorXd>(D + n_, n_) = acceleration(t, z, v, &lambda, held_rig ? &held_lambda_rhs : nullptr);
         rig_lambda_rhs = lambda;
         double pw = 0.0;
         for (int rt : slip_rows) pw -= (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(v);
         D[2 * n_] = pw;
         D[2 * n_ + 1] = damped() ? v.dot(C * v) : 0.0;
-        D[2 * n_ + 2] = external_power(t, v, lambda);
+        D[2 * n_ + 2] = held_rig ? held_power(t, v, held_lambda_rhs) : external_power(t, v, lambda);
     }
 
     /// Factorises M + gamma C + gamma^2 K_eff (the Newton matrix after block elimination).
@@ -323,7 +362,10 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const int n_ = ndof();
         const Eigen::Map<const Eigen::VectorXd> rz(R, n_), rvel(R + n_, n_);
         Eigen::VectorXd rhs_v = M * rvel - gamma * (Keff * rz);  // (M + g C + g^2 Keff) x_v
-        if (rig) rhs_v[w_dof()] = rvel[w_dof()];                   // w'' prescribed: x_vw = r_vw
+        if (held_rig)
+            for (const int h : held) rhs_v[h] = rvel[h];           // z_H'' prescribed: x_vH = r_vH
+        else if (rig)
+            rhs_v[w_dof()] = rvel[w_dof()];                        // w'' prescribed: x_vw = r_vw
         const Eigen::VectorXd xvel = nlu.solve(rhs_v);
         const Eigen::VectorXd xz = rz + gamma * xvel;
         Eigen::Map<Eigen::VectorXd>(X, n_) = xz;
@@ -338,7 +380,8 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         // d(q^T v) = q^T dv (the rig's lambda w': lambda dw' with the lambda of the last right-hand
         // side, lambda's own change left out of this row of the Newton matrix, which nothing else
         // depends on)
-        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * external_power(t, xvel, rig_lambda_rhs);
+        X[2 * n_ + 2] = R[2 * n_ + 2] + gamma * (held_rig ? held_power(t, xvel, held_lambda_rhs)
+                                                       : external_power(t, xvel, rig_lambda_rhs));
         return 0;
     }
 
@@ -351,23 +394,24 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 
     StepRecord make_record(double tau, const State& Y, Vec& p, Vec& rel) const override {
         const int ndof = this->ndof(), w_dof = this->w_dof();
-        const double f = spring_factor(), m_body = body_mass_kg();
+        const double f = spring_factor(), m_body = body_mass_kg();  // (R's weight: its whole mass, also under the windup rig)
         const auto z = Y.head(ndof);
         const auto v = Y.segment(ndof, ndof);
         p = forces_z(z);
         rel = Grow * z + cL.cwiseProduct(p);
         double lambda = 0.0;
-        const Eigen::VectorXd a = acceleration(tau, z, v, &lambda);
+        Eigen::VectorXd held_n;
+        const Eigen::VectorXd a = acceleration(tau, z, v, &lambda, &held_n);
         const double strain = 0.5 * f * (z.dot(K * z) + p.dot(cL.cwiseProduct(p)));
         LoadState ls;  // the loading's force on R, whole spring, and the external work
         const Loading& L = options().loading;
-        ls.external_force_n = rig ? f * lambda - m_body * a[w_dof] : L.external_force_n(tau, m_body);
+        ls.external_force_n = rig ? f * lambda - m_on_w * a[w_dof] : L.external_force_n(tau, m_body);
         ls.external_work_j = f * Y[2 * ndof + 2];
         ls.base_displacement_m = L.base_displacement_m(tau);
         StepRecord rec;
         fill_state(system(), laws(), p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation_j(),
                    initial_energy_j(), ls, rec);
-        finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_body * a[w_dof], f * Y[2 * ndof + 1]);
+        finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_on_w * a[w_dof], f * Y[2 * ndof + 1]);
         // R's balance m w'' = F - spring force; the rig: the load cell between R and the spring reads
         // the force on the spring, lambda - m w'' (the leaves' inertia included)
         rec.spring_force_n = rig ? rec.external_force_n : rec.external_force_n - rec.force_on_mass_n;
@@ -375,7 +419,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const int theta = system().seat_rotation_dof(), axial = system().seat_axial_dof();
         rec.seat_rotation_rad = theta >= 0 ? z[theta] : 0.0;
         rec.seat_axial_m = axial >= 0 ? z[axial] : 0.0;
-        rec.seat_moment_n_m = L.seat_moment_n_m_at(tau);
+        rec.seat_moment_n_m = L.seat_moment_n_m_at(tau) + (windup ? held_n[0] : 0.0);  // and the windup rig's reaction
         return rec;
     }
 };
@@ -383,7 +427,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     : EventDriver(system, start.options, "cvode mode (massive leaves)"),
       K(system.stiffness_reduced()),
-      M(system.mass_reduced()),
+      M(system.mass_reduced(!start.options.loading.windup_rig())),  // the windup rig: R's inertia out (quasi-static)
       Gt(system.contact_rows().transpose()),
       Grow(system.contact_rows()),
       cL(system.layer_compliance_m_per_n()),
@@ -397,6 +441,24 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
     if (mass.info() != Eigen::Success || !(mass.vectorD().minCoeff() > 0.0))
         throw SolverError(who() + ": the mass matrix is not positive definite", 0, 0.0, 0.0);
     if (rig) u_w = mass.solve(Eigen::VectorXd::Unit(ndof(), w_dof()));
+    const Loading& L = options().loading;
+    windup = L.windup_rig();
+    held_rig = windup || (rig && L.has_seat_load());  // the seat loads' work: q^T v besides the rig's
+    m_on_w = windup ? 0.0 : body_mass_kg();
+    if (held_rig) {
+        if (windup) {
+            held = {system.seat_rotation_dof()};
+            held_f = {&*L.seat_rotation_rad};
+        }
+        if (rig) {
+            held.push_back(w_dof());
+            held_f.push_back(&L.displacement_m);
+        }
+        U_h.resize(ndof(), static_cast<Eigen::Index>(held.size()));
+        for (std::size_t h = 0; h < held.size(); ++h)
+            U_h.col(static_cast<Eigen::Index>(h)) = mass.solve(Eigen::VectorXd::Unit(ndof(), held[h]));
+        held_lambda_rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(held.size()));
+    }
     EventStart es;
     es.nstate = 2 * ndof() + 3;
     // the initial state (as mode newmark, initial_state.hpp): the assembly and the static
