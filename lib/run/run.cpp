@@ -137,6 +137,7 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
             }
         });
         summary.loop = loop_figures(summary.records, options.loading.period_s());
+        if (loads_the_seat(options.loading)) summary.windup = windup_figures(summary.records, options.loading, summary.loop);
         if (monitor) summary.stresses = RunStresses{monitor->summary(), std::move(peaks)};
     } catch (const StopSeen&) {
         summary.interrupted = true;

@@ -198,15 +198,28 @@ std::string axis_cell(const AxisValue& v) {
 }
 
 /// Why a journal's header `old` is not this program's `now`, in words: written before the stress
-/// columns (decision 061), or the first column that differs.
+/// columns (decision 061) or the windup columns (decision 068), or the first column that differs.
 std::string header_difference(const std::string& old, const std::string& now) {
     const std::vector<std::string> a = split_row(old), b = split_row(now);
-    const std::vector<std::string> stress = {"stress_max_abs_pa", "fatigue_least_safety_factor"};
+    // the columns later versions added, oldest first: an older header is this one without the last groups
+    struct Added {
+        const char* name;
+        std::vector<std::string> columns;
+    };
+    const std::vector<Added> added = {
+        {"stress", {"stress_max_abs_pa", "fatigue_least_safety_factor"}},
+        {"windup",
+         {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor", "longitudinal_compliance_m_per_n"}}};
     std::vector<std::string> without = b;
-    for (const std::string& c : stress) without.erase(std::remove(without.begin(), without.end(), c), without.end());
-    if (a == without)
-        return "was written before the points table had the stress columns " + stress[0] + " and " + stress[1] +
-               " (an older stackbeam)";
+    std::string missing;  // "the stress columns A and B and the windup columns C, D and E"
+    for (auto group = added.rbegin(); group != added.rend(); ++group) {
+        for (const std::string& c : group->columns) without.erase(std::remove(without.begin(), without.end(), c), without.end());
+        std::string list = std::string("the ") + group->name + " columns ";
+        for (std::size_t i = 0; i < group->columns.size(); ++i)
+            list += (i == 0 ? "" : i + 1 == group->columns.size() ? " and " : ", ") + group->columns[i];
+        missing = missing.empty() ? list : list + " and " + missing;
+        if (a == without) return "was written before the points table had " + missing + " (an older stackbeam)";
+    }
     for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i)
         if (i >= a.size() || i >= b.size() || a[i] != b[i])
             return "has other columns than this program writes (another version?): column " + std::to_string(i + 1) +

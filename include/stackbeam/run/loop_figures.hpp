@@ -2,12 +2,14 @@
 /// @file loop_figures.hpp
 /// The figures of a periodic run's last cycle, computed here once for every front-end: the
 /// command line's summary, the Python module's Result.summary, the sweep's point figures.
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "stackbeam/post/fancher.hpp"
+#include "stackbeam/model/loading.hpp"
 #include "stackbeam/post/hysteresis.hpp"
 #include "stackbeam/time/simulation.hpp"
 
@@ -29,5 +31,38 @@ struct LoopFigures {
 /// records hysteresis_metrics() read (t in [t_start, t_end]). Bad data (too few records in the
 /// cycle) gives a note, never an exception.
 LoopFigures loop_figures(const std::vector<StepRecord>& records, double period_s);
+
+/// The windup figures of a run loaded at the seat (docs/windup.md, "The windup figures"; decision
+/// 068): the loops of the last period of the seat's loading, by hysteresis_metrics (the vertical
+/// loop's code, on other record columns).
+struct WindupFigures {
+    /// The windup loop, seat_moment [N m] against seat_rotation [rad] (HysteresisMetrics' w_ members
+    /// hold theta_R [rad], force_ the moment [N m]): secant_stiffness_n_per_m is the windup stiffness
+    /// k_theta [N m/rad] (peak-to-peak moment over peak-to-peak rotation), loop_area_j the closed
+    /// integral of M dtheta [J per cycle], loss_factor and energy_loss_factor as the vertical loop's.
+    /// Over the last period of the windup rig, else of the seat moment, else of the longitudinal force
+    /// (its moment -H h); none (windup_note says why) when that loading is not periodic.
+    std::optional<HysteresisMetrics> windup;
+    std::string windup_note;
+    /// The longitudinal loop, the force H(t) [N] (the loading's, at each record) against seat_axial
+    /// u_R [m], over the last period of a periodic longitudinal force (w_ members: u_R [m], force_: H [N]).
+    std::optional<HysteresisMetrics> longitudinal;
+    std::string longitudinal_note;
+    /// The seat's longitudinal compliance [m/N]: peak-to-peak u_R over peak-to-peak H (1 / the
+    /// longitudinal loop's secant); NaN without that loop.
+    double longitudinal_compliance_m_per_n = std::numeric_limits<double>::quiet_NaN();
+    /// The vertical rate at the same state [N/m]: the secant of the same run's vertical loop (its
+    /// summary's "hysteresis"; a vertical loading of the same period as the seat's); NaN where the run
+    /// has no vertical loop (then a vertical rig at the same preload gives it: decision 068).
+    double vertical_rate_n_per_m = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Whether `loading` loads the seat (a windup rig, a seat moment or a longitudinal force): then a
+/// run has windup figures (the summary's "windup" section).
+bool loads_the_seat(const Loading& loading);
+
+/// The windup figures of `records` under `loading` (loads_the_seat), with the vertical rate from
+/// `vertical` (the same run's loop_figures). Bad data gives notes, never an exception.
+WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loading& loading, const LoopFigures& vertical);
 
 }  // namespace stackbeam
