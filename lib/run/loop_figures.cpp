@@ -76,7 +76,12 @@ WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loadi
     } else {
         f.longitudinal_note = "no longitudinal force";
     }
-    if (vertical.metrics) f.vertical_rate_n_per_m = vertical.metrics->secant_stiffness_n_per_m;
+    // the vertical rate where the vertical loading has a period of its own (Loading::period_s falls back
+    // to the windup rig's: then w only follows the windup, and its "loop" is no rate)
+    const double vertical_period_s = loading.kind == LoadingKind::applied_force      ? loading.force_n.period_s()
+                                     : loading.kind == LoadingKind::initial_conditions ? 0.0
+                                                                                       : loading.displacement_m.period_s();
+    if (vertical.metrics && vertical_period_s > 0.0) f.vertical_rate_n_per_m = vertical.metrics->secant_stiffness_n_per_m;
     return f;
 }
 

@@ -52,8 +52,8 @@ struct WindupFigures {
     /// longitudinal loop's secant); NaN without that loop.
     double longitudinal_compliance_m_per_n = std::numeric_limits<double>::quiet_NaN();
     /// The vertical rate at the same state [N/m]: the secant of the same run's vertical loop (its
-    /// summary's "hysteresis"; a vertical loading of the same period as the seat's); NaN where the run
-    /// has no vertical loop (then a vertical rig at the same preload gives it: decision 068).
+    /// summary's "hysteresis") where the vertical loading is periodic (of the same period as the
+    /// seat's); NaN otherwise (then a vertical rig at the same preload gives it: decision 068).
     double vertical_rate_n_per_m = std::numeric_limits<double>::quiet_NaN();
 };
 
