@@ -292,7 +292,7 @@ BOOST_AUTO_TEST_CASE(directory_from_before_the_stress_columns_named) {
     // the older journals, each as that program wrote it: without the windup columns (decision 068), and
     // from before both the stress columns and those; the newest journal's lines kept to write them from
     const std::vector<std::string> windup = {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor",
-                                             "longitudinal_compliance_m_per_n"};
+                                             "longitudinal_compliance_m_per_n", "tangent_vertical_rate_n_per_m"};
     const std::vector<std::string> stress = {"stress_max_abs_pa", "fatigue_least_safety_factor"};
     const auto newest = lines;
     for (const bool before_stresses : {false, true}) {
@@ -319,7 +319,8 @@ BOOST_AUTO_TEST_CASE(directory_from_before_the_stress_columns_named) {
             std::ofstream(dir + "/spec.json", std::ios::trunc) << text;
         }
         const std::string windup_named = "the windup columns windup_stiffness_n_m_per_rad, windup_loop_area_j, "
-                                         "windup_loss_factor and longitudinal_compliance_m_per_n";
+                                         "windup_loss_factor, longitudinal_compliance_m_per_n and "
+                                         "tangent_vertical_rate_n_per_m";
         const std::string e = error_of([&] { SweepDirectory d(dir, points, false, false); });
         BOOST_TEST(has(e, "--out-dir: '" + journal + "' was written before the points table had " +
                               (before_stresses ? "the stress columns stress_max_abs_pa and fatigue_least_safety_factor and " : "") +

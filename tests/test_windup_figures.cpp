@@ -157,6 +157,7 @@ BOOST_AUTO_TEST_CASE(sweep_columns_are_the_windup_figures) {
         BOOST_TEST(r.figures[column("windup_loop_area_j")] == m.loop_area_j);
         BOOST_TEST(r.figures[column("windup_loss_factor")] == m.loss_factor);
         BOOST_TEST(std::isnan(r.figures[column("longitudinal_compliance_m_per_n")]));
+        BOOST_TEST(r.figures[column("tangent_vertical_rate_n_per_m")] == s.windup->tangent->vertical_rate_n_per_m);
         BOOST_TEST(r.figures[column("windup_stiffness_n_m_per_rad")] == k, tt::tolerance(1e-9));
         // point_figures, the sweep's figures from the records alone, gives the same
         std::string note;
@@ -253,4 +254,64 @@ BOOST_AUTO_TEST_CASE(longitudinal_compliance_is_a_over_EA) {
     BOOST_TEST(j.at("windup").at("longitudinal_loop").at("secant_stiffness_n_per_m").get<double>() ==
                r.windup->longitudinal->secant_stiffness_n_per_m);
     BOOST_TEST(j.at("windup").at("stiffness_n_m_per_rad").is_null());
+}
+
+// The seat's tangent stiffness at the last record's state (loop_figures.hpp, SeatStiffness). A single
+// flat leaf (no pair): each half a beam built in at the seat and pinned at its eye, so with the other
+// motion held k_ww = 3 E I (1/a^3 + 1/b^3) (a propped cantilever's end stiffness), k_theta = 3 E I
+// (1/a + 1/b), k_w,theta = 3 E I (1/b^2 - 1/a^2) (the moment a unit lift makes at the built-in end,
+// opposite on the two halves); condensed with the seat free to turn, the simply supported beam's
+// 3 E I L / (a^2 b^2). The seat locates the stack (pinned eyes): no u_R, NaN. Exact elements: 1e-9.
+BOOST_AUTO_TEST_CASE(seat_tangent_stiffness_of_a_flat_leaf_is_the_beams) {
+    const RunSummary s = run(load_scenario(kWindupFile));
+    BOOST_TEST_REQUIRE(s.windup->tangent.has_value(), s.windup->tangent_note);
+    const SeatStiffness& t = *s.windup->tangent;
+    const double b = kL - kA;
+    BOOST_TEST(t.t_s == 2.0, tt::tolerance(1e-12));
+    BOOST_TEST(t.stick + t.slip + t.open == 0);
+    BOOST_TEST(t.matrix[0][0] == 3.0 * kEI * (1.0 / (kA * kA * kA) + 1.0 / (b * b * b)), tt::tolerance(1e-9));
+    BOOST_TEST(t.matrix[1][1] == 3.0 * kEI * (1.0 / kA + 1.0 / b), tt::tolerance(1e-9));
+    BOOST_TEST(std::abs(t.matrix[0][1]) == 3.0 * kEI * std::abs(1.0 / (b * b) - 1.0 / (kA * kA)), tt::tolerance(1e-9));
+    BOOST_TEST(t.matrix[0][1] == t.matrix[1][0], tt::tolerance(1e-9));
+    BOOST_TEST(t.vertical_rate_n_per_m == 3.0 * kEI * kL / (kA * kA * b * b), tt::tolerance(1e-9));
+    BOOST_TEST(std::isnan(t.matrix[2][2]));
+    BOOST_TEST(std::isnan(t.matrix[0][2]));
+    const auto j = nlohmann::json::parse(summary_json(s, Model::build(load_scenario(kWindupFile).model)));
+    const auto& js = j.at("windup").at("seat_tangent_stiffness");
+    BOOST_TEST(js.at("matrix").at(1).at(1).get<double>() == t.matrix[1][1]);
+    BOOST_TEST(js.at("matrix").at(2).at(2).is_null());
+    BOOST_TEST(js.at("vertical_rate_n_per_m").get<double>() == t.vertical_rate_n_per_m);
+}
+
+// The tangent of a stack: (1) bonded, every pair tied, so with the seat free to turn the vertical rate
+// is System::tied_stiffness_n_per_m() (C' condensed, another computation), and k_theta the windup
+// rig's secant (linear); both to 1e-9. (2) Frictionless, held at 50 mm and wound: every closed pair
+// held normally and free tangentially, the response linear while no pair opens or closes, so
+// k_theta is the last step's slope of the moment against the rotation (the records: 1e-6, the
+// contact solver's 1e-9 m tolerance on gaps the step moves by ~1e-4 m).
+BOOST_AUTO_TEST_CASE(seat_tangent_stiffness_of_a_stack_at_its_state) {
+    const std::string tri = triangle("loading.seat_rotation_rad", 0.01);
+    const RunSummary bonded = run(spring(kTwoLeaves, "[[interfaces]]\nlaw = \"bonded\"\n",
+                                         "[loading]\nkind = \"initial-conditions\"\n" + tri));
+    BOOST_TEST_REQUIRE(bonded.windup->tangent.has_value(), bonded.windup->tangent_note);
+    const Scenario sb = spring(kTwoLeaves, "[[interfaces]]\nlaw = \"bonded\"\n", "[loading]\nkind = \"initial-conditions\"\n" + tri);
+    const double tied = System(Model::build(sb.model)).tied_stiffness_n_per_m();
+    BOOST_TEST_MESSAGE("bonded: tangent vertical rate " << bonded.windup->tangent->vertical_rate_n_per_m << " N/m, tied "
+                                                        << tied << ", k_theta " << bonded.windup->tangent->matrix[1][1]);
+    BOOST_TEST(bonded.windup->tangent->vertical_rate_n_per_m == tied, tt::tolerance(1e-9));
+    BOOST_TEST(bonded.windup->tangent->matrix[1][1] == bonded.windup->windup->secant_stiffness_n_per_m, tt::tolerance(1e-9));
+
+    const std::string held = "[loading]\nkind = \"prescribed-displacement\"\n[loading.displacement_m]\nshape = \"constant\"\nmean = 0.05\n";
+    const RunSummary free = run(spring(kTwoLeaves, "[[interfaces]]\nlaw = \"coulomb\"\nfriction_coefficient = 0.0\n", held + tri));
+    BOOST_TEST_REQUIRE(free.windup->tangent.has_value(), free.windup->tangent_note);
+    const auto& r = free.records;
+    const std::size_t n = r.size() - 1;
+    const double slope = (r[n].seat_moment_n_m - r[n - 1].seat_moment_n_m) / (r[n].seat_rotation_rad - r[n - 1].seat_rotation_rad);
+    const SeatStiffness& t = *free.windup->tangent;
+    BOOST_TEST_MESSAGE("frictionless: " << t.stick << " stick, " << t.slip << " slip, " << t.open << " open; k_theta "
+                                        << t.matrix[1][1] << " N m/rad, last step's slope " << slope << ", states then "
+                                        << r[n - 1].n_slip << "/" << r[n].n_slip << " slipping");
+    BOOST_TEST(t.slip > 0);
+    BOOST_TEST(r[n - 1].n_open == r[n].n_open);  // no pair opened or closed in the last step
+    BOOST_TEST(t.matrix[1][1] == slope, tt::tolerance(1e-6));
 }

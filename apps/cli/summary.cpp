@@ -85,6 +85,12 @@ void print_summary(const SimulateRequest& request, const System& system, const R
             std::printf("longitudinal compliance    %.6g m/N\n", wf->longitudinal_compliance_m_per_n);
         if (!std::isnan(wf->vertical_rate_n_per_m))
             std::printf("vertical rate (same run)   %.6g N/m\n", wf->vertical_rate_n_per_m);
+        if (const auto& t = wf->tangent)
+            std::printf("seat tangent stiffness     at t %.6g s (%d stick, %d slip, %d open): k_ww %.6g N/m, k_theta %.6g N m/rad, "
+                        "vertical rate (seat free to turn) %.6g N/m\n",
+                        t->t_s, t->stick, t->slip, t->open, t->matrix[0][0], t->matrix[1][1], t->vertical_rate_n_per_m);
+        else
+            std::printf("seat tangent stiffness     none (%s)\n", wf->tangent_note.c_str());
     }
     if (summary.stepper.impact_loss)
         std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",

@@ -137,6 +137,20 @@ nlohmann::json windup_json(const WindupFigures& f) {
         j["longitudinal_note"] = f.longitudinal_note;
     }
     j["vertical_rate_n_per_m"] = number_json(f.vertical_rate_n_per_m);
+    if (const auto& t = f.tangent) {  // K_t over (w, theta_R, u_R): N/m, N/rad, N m/rad, ... (loop_figures.hpp)
+        nlohmann::json matrix = nlohmann::json::array();
+        for (const auto& row : t->matrix) matrix.push_back({number_json(row[0]), number_json(row[1]), number_json(row[2])});
+        j["seat_tangent_stiffness"] = {{"t_s", t->t_s},
+                                       {"stick", t->stick},
+                                       {"slip", t->slip},
+                                       {"open", t->open},
+                                       {"dofs", {"w_m", "seat_rotation_rad", "seat_axial_m"}},
+                                       {"matrix", matrix},
+                                       {"vertical_rate_n_per_m", number_json(t->vertical_rate_n_per_m)}};
+    } else {
+        j["seat_tangent_stiffness"] = nullptr;
+        j["seat_tangent_stiffness_note"] = f.tangent_note;
+    }
     return j;
 }
 

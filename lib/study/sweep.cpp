@@ -555,7 +555,7 @@ const std::vector<std::string>& point_figure_columns() {
         // the windup figures (run/loop_figures.hpp, simulate's summary "windup"): k_theta, the windup
         // loop's area and loss factor, the seat's longitudinal compliance; NaN where the run has none
         "windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor",
-        "longitudinal_compliance_m_per_n",
+        "longitudinal_compliance_m_per_n", "tangent_vertical_rate_n_per_m",
     };
     return columns;
 }
@@ -595,7 +595,8 @@ std::vector<double> figures_of(const LoopFigures& loop, long records, double max
     return f;
 }
 
-/// The windup columns (point_figure_columns 19 to 22) from a run's windup figures; NaN where none.
+/// The windup columns (point_figure_columns 19 to 23) from a run's windup figures; NaN where none
+/// (the tangent vertical rate: only from run_scenario, which keeps the last record's contact state).
 void add_windup_figures(const std::optional<WindupFigures>& windup, std::vector<double>& f) {
     if (!windup) return;
     if (const auto& m = windup->windup) {
@@ -604,6 +605,7 @@ void add_windup_figures(const std::optional<WindupFigures>& windup, std::vector<
         f[21] = m->loss_factor;
     }
     f[22] = windup->longitudinal_compliance_m_per_n;
+    if (windup->tangent) f[23] = windup->tangent->vertical_rate_n_per_m;
 }
 
 /// The stress columns (point_figure_columns 17, 18) from a run's stress figures; NaN where none

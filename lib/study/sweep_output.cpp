@@ -209,7 +209,8 @@ std::string header_difference(const std::string& old, const std::string& now) {
     const std::vector<Added> added = {
         {"stress", {"stress_max_abs_pa", "fatigue_least_safety_factor"}},
         {"windup",
-         {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor", "longitudinal_compliance_m_per_n"}}};
+         {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor", "longitudinal_compliance_m_per_n",
+          "tangent_vertical_rate_n_per_m"}}};
     std::vector<std::string> without = b;
     std::string missing;  // "the stress columns A and B and the windup columns C, D and E"
     for (auto group = added.rbegin(); group != added.rend(); ++group) {
