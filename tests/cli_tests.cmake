@@ -339,13 +339,14 @@ stackbeam_cli_test(NAME cli_windup_json
                    EXPECT_RC 0 EXPECT_TEXT "windup loop                t 1 to 2 s: stiffness 8828.57 N m/rad"
                    OUT ${_cli_out_dir}/cli_windup.json HEADER_PREFIX "{"
                    JSON ${_cli_out_dir}/cli_windup.json JSON_PATH "windup|stiffness_n_m_per_rad" JSON_RANGE "8828.57|8828.58")
-# The windup map example (examples/sweep/windup_map.toml): every point runs and the table has the windup columns.
+# The windup map example (examples/sweep/windup_map.toml): every point runs, and each writes its last
+# windup loop (the rig's last period: 1 s at dt 5 ms, 201 records and the header).
 stackbeam_cli_test(NAME cli_windup_map
                    ARGS sweep ${PROJECT_SOURCE_DIR}/examples/sweep/windup_map.toml --out-dir ${_cli_out_dir}/cli_windup_map
                         --restart --no-plot --jobs 1
                    EXPECT_RC 0 EXPECT_TEXT "12 of 12 finished: 12 ok, 0 failed"
-                   OUT ${_cli_out_dir}/cli_windup_map/points.csv MIN_LINES 13
-                   HEADER_PREFIX "point,loading.seat_rotation_rad.amplitude,loading.displacement_m.mean,status")
+                   OUT ${_cli_out_dir}/cli_windup_map/loops/point-0011-windup.csv MIN_LINES 202
+                   HEADER_PREFIX "t_s,seat_rotation_rad,seat_moment_n_m")
 stackbeam_cli_test(NAME cli_pairs_csv
                    ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"

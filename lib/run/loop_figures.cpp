@@ -56,14 +56,17 @@ std::optional<HysteresisMetrics> last_loop(const std::vector<StepRecord>& record
 
 }  // namespace
 
+double windup_period_s(const Loading& loading) {
+    if (loading.seat_rotation_rad) return loading.seat_rotation_rad->period_s();
+    if (loading.seat_moment_n_m && loading.seat_moment_n_m->period_s() > 0.0) return loading.seat_moment_n_m->period_s();
+    if (loading.longitudinal_force_n && loading.longitudinal_force_height_m != 0.0)
+        return loading.longitudinal_force_n->period_s();  // its moment -H h
+    return 0.0;
+}
+
 WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loading& loading, const LoopFigures& vertical) {
     WindupFigures f;
-    // the windup loop: the rig's period, else the seat moment's, else the longitudinal force's (its -H h)
-    double period_s = 0.0;
-    if (loading.seat_rotation_rad) period_s = loading.seat_rotation_rad->period_s();
-    else if (loading.seat_moment_n_m && loading.seat_moment_n_m->period_s() > 0.0) period_s = loading.seat_moment_n_m->period_s();
-    else if (loading.longitudinal_force_n && loading.longitudinal_force_height_m != 0.0)
-        period_s = loading.longitudinal_force_n->period_s();
+    const double period_s = windup_period_s(loading);
     LoopColumns windup;
     windup.displacement_name = "seat_rotation";
     windup.displacement = [](const StepRecord& r) { return r.seat_rotation_rad; };

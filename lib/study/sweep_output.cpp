@@ -30,6 +30,7 @@
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/run/loop_figures.hpp"
 
 #ifndef STACKBEAM_VERSION
 #define STACKBEAM_VERSION "unknown"
@@ -606,7 +607,8 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                     "(stackbeam simulate --scenario FILE --out OUT.csv runs it)\n" + point.scenario_text);
     // an older run's files of this point go first: those written below are this row's
     for (const auto& [kind, ext, suffix] : {std::tuple<const char*, const char*, const char*>{"loops", "csv", ""},
-                                            {"loops", "csv", "-fancher"}, {"series", "csv", ""}}) {
+                                            {"loops", "csv", "-fancher"}, {"loops", "csv", "-windup"},
+                                            {"series", "csv", ""}}) {
         std::error_code ec;
         fs::remove(point_file(directory, kind, r.index, ext, suffix), ec);
     }
@@ -651,6 +653,23 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                 }
             } catch (const InputError&) {
                 // no whole cycle: the row's message says so, no loop file
+            }
+        }
+        // a windup run: its windup loop's last cycle (windup_figures' cycle), the moment against the rotation
+        const Loading& loading = point.scenario.simulation.loading;
+        const double windup_period = loads_the_seat(loading) ? windup_period_s(loading) : 0.0;
+        if (windup_period > 0.0) {
+            try {
+                const auto cycle = last_cycle(records, windup_period);
+                std::ostringstream loop;
+                loop << "t_s,seat_rotation_rad,seat_moment_n_m\n";
+                for (const StepRecord& s : records)
+                    if (s.t_s >= cycle.first && s.t_s <= cycle.second)
+                        loop << number_cell(s.t_s) << ',' << number_cell(s.seat_rotation_rad) << ','
+                             << number_cell(s.seat_moment_n_m) << '\n';
+                write_whole(point_file(directory, "loops", r.index, "csv", "-windup"), loop.str());
+            } catch (const InputError&) {
+                // no whole cycle: no windup loop file
             }
         }
         if (keep_series) {

@@ -90,6 +90,10 @@ struct WindupFigures {
 /// run has windup figures (the summary's "windup" section).
 bool loads_the_seat(const Loading& loading);
 
+/// The period of the windup loop's cycle [s]: the windup rig's, else the seat moment's (when > 0), else
+/// the longitudinal force's where it has a moment (h != 0); 0 when none of them is periodic.
+double windup_period_s(const Loading& loading);
+
 /// The windup figures of `records` under `loading` (loads_the_seat), with the vertical rate from
 /// `vertical` (the same run's loop_figures). Bad data gives notes, never an exception.
 WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loading& loading, const LoopFigures& vertical);
