@@ -330,6 +330,23 @@ stackbeam_cli_test(NAME cli_rig_fancher
                         --summary ${_cli_out_dir}/cli_rigf.json
                    EXPECT_RC 0 EXPECT_TEXT "fancher fit                upper 1195" OUT ${_cli_out_dir}/cli_rigf.json HEADER_PREFIX "{"
                    JSON ${_cli_out_dir}/cli_rigf.json JSON_PATH "fancher|rms_error_relative" JSON_RANGE "0.0047|0.0048")
+# The windup figures (issue 44, decision 068): the windup rig of a flat leaf with the seat held
+# (tests/sweep/windup_small.toml), its windup stiffness in the text summary and the JSON's "windup"
+# section: 3 E I (1/a + 1/b) = 8828.57 N m/rad (tests/test_windup_figures.cpp proves it to 1e-9).
+stackbeam_cli_test(NAME cli_windup_json
+                   ARGS simulate --scenario ${PROJECT_SOURCE_DIR}/tests/sweep/windup_small.toml --out ${_cli_out_dir}/cli_windup.csv
+                        --summary ${_cli_out_dir}/cli_windup.json
+                   EXPECT_RC 0 EXPECT_TEXT "windup loop                t 1 to 2 s: stiffness 8828.57 N m/rad"
+                   OUT ${_cli_out_dir}/cli_windup.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_windup.json JSON_PATH "windup|stiffness_n_m_per_rad" JSON_RANGE "8828.57|8828.58")
+# The windup map example (examples/sweep/windup_map.toml): every point runs, and each writes its last
+# windup loop (the rig's last period: 1 s at dt 5 ms, 201 records and the header).
+stackbeam_cli_test(NAME cli_windup_map
+                   ARGS sweep ${PROJECT_SOURCE_DIR}/examples/sweep/windup_map.toml --out-dir ${_cli_out_dir}/cli_windup_map
+                        --restart --no-plot --jobs 1
+                   EXPECT_RC 0 EXPECT_TEXT "12 of 12 finished: 12 ok, 0 failed"
+                   OUT ${_cli_out_dir}/cli_windup_map/loops/point-0011-windup.csv MIN_LINES 202
+                   HEADER_PREFIX "t_s,seat_rotation_rad,seat_moment_n_m")
 stackbeam_cli_test(NAME cli_pairs_csv
                    ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"

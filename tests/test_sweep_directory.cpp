@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -262,7 +263,8 @@ BOOST_AUTO_TEST_CASE(bad_inputs_named) {
     fs::remove_all(dir);
 }
 
-// Issue 43 (decision 061): a sweep directory begun before the points table had the stress columns
+// Issue 43 (decision 061), issue 44 (decision 068): a sweep directory begun before the points table had
+// the windup columns, or also the stress columns
 // (stress_max_abs_pa, fatigue_least_safety_factor) cannot be resumed, its rows two cells short: a
 // named error that says so and what to do (--restart, or another --out-dir), never a row dropped as
 // "damaged" one by one; --restart then starts it over. The old directory is made from a new one by
@@ -287,31 +289,46 @@ BOOST_AUTO_TEST_CASE(directory_from_before_the_stress_columns_named) {
         return c;
     };
     const auto header = cells(lines[1]);
-    std::vector<std::size_t> keep;
-    for (std::size_t i = 0; i < header.size(); ++i)
-        if (header[i] != "stress_max_abs_pa" && header[i] != "fatigue_least_safety_factor") keep.push_back(i);
-    BOOST_REQUIRE_EQUAL(keep.size() + 2, header.size());
-    {
-        std::ofstream old(journal, std::ios::trunc);
-        old << lines[0] << "\n";
-        for (std::size_t k = 1; k < lines.size(); ++k) {
-            const auto c = cells(lines[k]);
-            for (std::size_t i = 0; i < keep.size(); ++i) old << (i ? "," : "") << c[keep[i]];
-            old << "\n";
+    // the older journals, each as that program wrote it: without the windup columns (decision 068), and
+    // from before both the stress columns and those; the newest journal's lines kept to write them from
+    const std::vector<std::string> windup = {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor",
+                                             "longitudinal_compliance_m_per_n", "tangent_vertical_rate_n_per_m"};
+    const std::vector<std::string> stress = {"stress_max_abs_pa", "fatigue_least_safety_factor"};
+    const auto newest = lines;
+    for (const bool before_stresses : {false, true}) {
+        std::vector<std::string> dropped = windup;
+        if (before_stresses) dropped.insert(dropped.end(), stress.begin(), stress.end());
+        std::vector<std::size_t> keep;
+        for (std::size_t i = 0; i < header.size(); ++i)
+            if (std::find(dropped.begin(), dropped.end(), header[i]) == dropped.end()) keep.push_back(i);
+        BOOST_REQUIRE_EQUAL(keep.size() + dropped.size(), header.size());
+        {
+            std::ofstream old(journal, std::ios::trunc);
+            old << newest[0] << "\n";
+            for (std::size_t k = 1; k < newest.size(); ++k) {
+                const auto c = cells(newest[k]);
+                for (std::size_t i = 0; i < keep.size(); ++i) old << (i ? "," : "") << c[keep[i]];
+                old << "\n";
+            }
         }
+        if (before_stresses) {
+            std::string text = read(dir + "/spec.json");
+            const std::size_t at = text.find(",\n  \"stresses\": false");
+            BOOST_REQUIRE(at != std::string::npos);
+            text.erase(at, std::string(",\n  \"stresses\": false").size());
+            std::ofstream(dir + "/spec.json", std::ios::trunc) << text;
+        }
+        const std::string windup_named = "the windup columns windup_stiffness_n_m_per_rad, windup_loop_area_j, "
+                                         "windup_loss_factor, longitudinal_compliance_m_per_n and "
+                                         "tangent_vertical_rate_n_per_m";
+        const std::string e = error_of([&] { SweepDirectory d(dir, points, false, false); });
+        BOOST_TEST(has(e, "--out-dir: '" + journal + "' was written before the points table had " +
+                              (before_stresses ? "the stress columns stress_max_abs_pa and fatigue_least_safety_factor and " : "") +
+                              windup_named +
+                              " (an older stackbeam): its rows cannot be resumed; use --restart to discard them and run "
+                              "every point again, or another --out-dir"),
+                   e);
     }
-    {
-        std::string text = read(dir + "/spec.json");
-        const std::size_t at = text.find(",\n  \"stresses\": false");
-        BOOST_REQUIRE(at != std::string::npos);
-        text.erase(at, std::string(",\n  \"stresses\": false").size());
-        std::ofstream(dir + "/spec.json", std::ios::trunc) << text;
-    }
-    const std::string e = error_of([&] { SweepDirectory d(dir, points, false, false); });
-    BOOST_TEST(has(e, "--out-dir: '" + journal + "' was written before the points table had the stress columns "
-                      "stress_max_abs_pa and fatigue_least_safety_factor (an older stackbeam): its rows cannot be "
-                      "resumed; use --restart to discard them and run every point again, or another --out-dir"),
-               e);
     {
         SweepDirectory again(dir, points, true, false);  // --restart
         BOOST_TEST(again.finished_count() == 0);

@@ -62,7 +62,8 @@ int run_request(const SimulateRequest& request) {
         print_summary(request, system, result);
         if (!request.plot.empty()) {
             std::string note;
-            const auto files = plot_run(request.out, request.plot, note, result.summary.loop.fancher_loop);
+            const auto files = plot_run(request.out, request.plot, note, result.summary.loop.fancher_loop,
+                                        result.summary.windup.has_value());
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
             if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)

@@ -41,7 +41,7 @@ std::optional<std::string> plot_terminal(std::string& note) {
 }
 
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
-                                  const std::vector<std::pair<double, double>>& fitted_loop) {
+                                  const std::vector<std::pair<double, double>>& fitted_loop, bool windup) {
     using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
@@ -84,6 +84,10 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
     fig("loop", "force-deflection loop", "w [mm]", "spring force [N]",
         f + " using (1000*$" + std::to_string(w) + "):" + std::to_string(sf) + " with lines lw 1.5 " +
             (fitted.empty() ? "notitle" : "title 'run'") + fitted);
+    if (windup)  // the windup loop: the moment on the spring at the seat against the seat's rotation
+        fig("windup_loop", "windup loop", "seat rotation [mrad]", "seat moment [N m]",
+            f + " using (1000*$" + std::to_string(column_of("seat_rotation")) + "):" +
+                std::to_string(column_of("seat_moment")) + " with lines lw 1.5 notitle");
     g.close();
     if (!g) throw std::runtime_error("writing '" + script_path + "' failed");
     if (std::system(("gnuplot " + shell_quote(script_path)).c_str()) != 0) {
@@ -130,7 +134,8 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
     const bool half = model.spec().symmetry == Symmetry::half;
     double stack_height = 0.0, max_w = 0.0;
     for (const auto& leaf : leaves) stack_height += leaf_thickness_m(leaf, x_r);
-    const StackSnapshot* shots[2] = {&result.stack_at_w_max, &result.stack_at_w_min};
+    const StackSnapshot* shots[2] = {&result.stack_at_max, &result.stack_at_min};
+    const bool windup = result.snapshots_by_seat_rotation;
     for (const StackSnapshot* s : shots)
         for (const auto& leaf : s->nodes)
             for (double w : leaf.w_m) max_w = std::max(max_w, std::abs(w));
@@ -166,6 +171,31 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
     axes.close();
     pairs.close();
     if (!axes || !pairs) throw std::runtime_error("writing the deformed stack's data '" + axes_path + "' failed");
+    // a windup run: the seat, a segment through each leaf's drawn axis at the seat of slope scale x theta_R
+    // (the tied leaves turn with the seat), 6 % of the spring's length either side
+    const std::string seat_path = prefix + "_stack_seat.dat";
+    if (windup) {
+        std::ofstream seat(seat_path);
+        if (!seat) throw ArgumentError("--plot: cannot write '" + seat_path + "'");
+        seat << "# x [mm], y [mm]: the seat on each leaf at it, slope " << scale << " x theta_R; one index per figure\n";
+        double x_min = x_r, x_max = x_r;
+        for (const auto& leaf : shots[0]->nodes)
+            for (double x : leaf.x_m) x_min = std::min(x_min, x), x_max = std::max(x_max, x);
+        const double half_m = 0.06 * (x_max - x_min);
+        for (const StackSnapshot* s : shots) {
+            for (const auto& leaf : s->nodes)
+                for (std::size_t j = 0; j < leaf.x_m.size(); ++j)
+                    if (std::abs(leaf.x_m[j] - x_r) <= model.x_tolerance_m()) {
+                        const double y = heights[leaf.leaf] + scale * leaf.w_m[j], dy = scale * s->seat_rotation_rad * half_m;
+                        seat << 1000.0 * (x_r - half_m) << ' ' << 1000.0 * (y - dy) << '\n'
+                             << 1000.0 * (x_r + half_m) << ' ' << 1000.0 * (y + dy) << "\n\n";
+                        break;
+                    }
+            seat << "\n";  // with the block's blank line, two: the next index
+        }
+        seat.close();
+        if (!seat) throw std::runtime_error("writing the deformed stack's data '" + seat_path + "' failed");
+    }
 
     // --stack-color stress: each leaf a band from its bottom to its top fibre (its drawn axis -+ half
     // its local thickness), a grid of two scans for gnuplot's pm3d: one index per figure and leaf
@@ -211,7 +241,11 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
           << sigma_max_mpa << "]\nset cblabel 'fibre stress [MPa], tension positive'\n";
     for (int i = 0; i < 2; ++i) {
         std::ostringstream title;
-        title << (i == 0 ? "largest" : "smallest") << " w = " << 1000.0 * shots[i]->w_m << " mm at t = " << shots[i]->t_s << " s";
+        if (windup)
+            title << (i == 0 ? "largest" : "smallest") << " seat rotation " << 1000.0 * shots[i]->seat_rotation_rad
+                  << " mrad (w = " << 1000.0 * shots[i]->w_m << " mm) at t = " << shots[i]->t_s << " s";
+        else
+            title << (i == 0 ? "largest" : "smallest") << " w = " << 1000.0 * shots[i]->w_m << " mm at t = " << shots[i]->t_s << " s";
         g << "set title '" << title.str() << "'\nset xlabel 'x [mm]'\nset ylabel 'height + " << scale_text.str()
           << " x deflection [mm]'\n";
         if (stress) {  // a map of the bands, linear between the nodes and through the thickness (pm3d)
@@ -223,7 +257,9 @@ std::vector<std::string> plot_stack(const System& system, const RunResult& resul
         g << "plot '" << axes_path << "' index " << i << " using 1:2 with lines lw 2 lc rgb 'black' title 'leaf axes', '"
           << pairs_path << "' index " << i << " using 1:($3==0?$2:1/0) with points pt 7 ps 0.8 lc rgb '#1a9850' title 'stick', '"
           << pairs_path << "' index " << i << " using 1:($3==1?$2:1/0) with points pt 7 ps 0.8 lc rgb '#d73027' title 'slip', '"
-          << pairs_path << "' index " << i << " using 1:($3==2?$2:1/0) with points pt 6 ps 0.8 lc rgb '#4575b4' title 'open'\n";
+          << pairs_path << "' index " << i << " using 1:($3==2?$2:1/0) with points pt 6 ps 0.8 lc rgb '#4575b4' title 'open'"
+          << (windup ? ", '" + seat_path + "' index " + std::to_string(i) + " using 1:2 with lines lw 4 lc rgb '#ff7f0e' title 'seat'" : "")
+          << "\n";
     }
     g << "unset multiplot\n";
     g.close();

@@ -19,12 +19,15 @@ std::optional<std::string> plot_terminal(std::string& note);
 /// w) as PREFIX_*.png. Returns the files written, or none and a note why in `note`.
 /// `fitted_loop`: Fancher's model fitted to the last cycle, (w [m], F [N]) (summary.hpp's
 /// LoopFigures::fancher_loop), drawn over the loop (written to PREFIX_fancher_loop.csv);
-/// empty: none.
+/// empty: none. `windup` (the loading loads the seat): also the windup loop, seat_moment against
+/// seat_rotation, as PREFIX_windup_loop.png.
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
-                                  const std::vector<std::pair<double, double>>& fitted_loop = {});
+                                  const std::vector<std::pair<double, double>>& fitted_loop = {}, bool windup = false);
 
 /// The deformed stack at the run's extreme deflections (the records of the largest and the
-/// smallest w, RunResult::stack_at_w_max / _min), PREFIX_stack.png: each leaf's axis at its height
+/// smallest w, RunResult::stack_at_max / _min; of the seat's rotation theta_R in a windup run, the
+/// seat then drawn as a segment of slope scale x theta_R on each leaf at the seat, from
+/// PREFIX_stack_seat.dat), PREFIX_stack.png: each leaf's axis at its height
 /// in the stack plus its deflection times a scale (stack_figure_scale, printed on the figure),
 /// every pair a point coloured by its state (stick, slip, open); the half model mirrored. The
 /// data in PREFIX_stack_axes.dat and PREFIX_stack_pairs.dat (mm). `stress` (--stack-color stress,

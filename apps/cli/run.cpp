@@ -158,6 +158,7 @@ public:
           stresses_csv(request.stresses, "--stresses"),
           progress(!request.quiet, request.options.t_end_s), snapshots_(!request.plot.empty()),
           snapshot_stresses_(snapshots_ && request.stack_stress), result_(result) {
+        result_.snapshots_by_seat_rotation = loads_the_seat(request.options.loading);
         write_csv_header(csv.stream());
         if (pairs_csv.active()) pairs_csv.stream() << "t,pair,interface,x,state,p_n,p_t,gap,slip\n";
         pairs_csv.stream().precision(17);
@@ -182,17 +183,20 @@ public:
         pairs_csv.check();
         nodes_csv.check();
         stresses_csv.check();
-        // --plot: a new max or min of w marks the record; its pairs and nodes follow in on_pairs, on_nodes
+        // --plot: a new max or min of w (of theta_R in a windup run) marks the record; its pairs and nodes
+        // follow in on_pairs, on_nodes
         marked_.clear();
         if (snapshots_) {
-            if (records_ == 0 || r.w_m > w_max_m_) marked_.push_back(&result_.stack_at_w_max);
-            if (records_ == 0 || r.w_m < w_min_m_) marked_.push_back(&result_.stack_at_w_min);
+            const double v = result_.snapshots_by_seat_rotation ? r.seat_rotation_rad : r.w_m;
+            if (records_ == 0 || v > max_) marked_.push_back(&result_.stack_at_max);
+            if (records_ == 0 || v < min_) marked_.push_back(&result_.stack_at_min);
             for (StackSnapshot* s : marked_) {
                 s->t_s = r.t_s;
                 s->w_m = r.w_m;
+                s->seat_rotation_rad = r.seat_rotation_rad;
             }
-            w_max_m_ = records_ == 0 ? r.w_m : std::max(w_max_m_, r.w_m);
-            w_min_m_ = records_ == 0 ? r.w_m : std::min(w_min_m_, r.w_m);
+            max_ = records_ == 0 ? v : std::max(max_, v);
+            min_ = records_ == 0 ? v : std::min(min_, v);
         }
         ++records_;
         progress.update(r.t_s);
@@ -235,7 +239,7 @@ private:
     RunResult& result_;
     std::vector<StackSnapshot*> marked_;  // the snapshots the current record replaces
     long records_ = 0;
-    double w_min_m_ = 0.0, w_max_m_ = 0.0;
+    double min_ = 0.0, max_ = 0.0;  ///< the extremes of w [m] (theta_R [rad] in a windup run) so far
 };
 
 }  // namespace

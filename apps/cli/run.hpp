@@ -26,7 +26,7 @@ namespace stackbeam::cli {
 
 /// The stack at one record: every leaf's nodes and every pair (the deformed stack figure).
 struct StackSnapshot {
-    double t_s = 0.0, w_m = 0.0;
+    double t_s = 0.0, w_m = 0.0, seat_rotation_rad = 0.0;  ///< the record's t [s], w [m], theta_R [rad]
     std::vector<LeafNodes> nodes;
     std::vector<PairRecord> pairs;
     std::vector<LeafStresses> stresses;  ///< --stack-color stress: every leaf's stresses (whole leaves); else empty
@@ -39,8 +39,10 @@ struct RunResult {
     /// FILE.partial when interrupted), likewise pairs_file, nodes_file, stresses_file ("" none);
     /// events_file the event log written ("" none)
     SummaryContext files;
-    /// With --plot: the stack at the records of the largest and the smallest w (the first such record).
-    StackSnapshot stack_at_w_max, stack_at_w_min;
+    /// With --plot: the stack at the records of the largest and the smallest w (the first such record),
+    /// or of the seat's rotation theta_R where the loading loads the seat (a windup run: loads_the_seat).
+    StackSnapshot stack_at_max, stack_at_min;
+    bool snapshots_by_seat_rotation = false;  ///< stack_at_max / _min are theta_R's
 };
 
 /// Installs the SIGINT / SIGTERM handlers that ask the run to stop.

@@ -1,6 +1,7 @@
 // The results of a run: the text summary on stdout and the --summary JSON file.
 #include "summary.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -71,6 +72,25 @@ void print_summary(const SimulateRequest& request, const System& system, const R
                     fit->converged ? "" : ", NOT converged");
     } else if (!loop.fancher_note.empty()) {
         std::printf("fancher fit                none (%s)\n", loop.fancher_note.c_str());
+    }
+    if (const auto& wf = summary.windup) {  // docs/windup.md, "The windup figures"
+        if (const auto& m = wf->windup)
+            std::printf("windup loop                t %.6g to %.6g s: stiffness %.6g N m/rad, area %.6g J per cycle "
+                        "(friction work %.6g J), loss factor %.4g\n",
+                        m->t_start_s, m->t_end_s, m->secant_stiffness_n_per_m, m->loop_area_j, m->dissipated_j,
+                        m->loss_factor);
+        else
+            std::printf("windup loop                none (%s)\n", wf->windup_note.c_str());
+        if (wf->longitudinal)
+            std::printf("longitudinal compliance    %.6g m/N\n", wf->longitudinal_compliance_m_per_n);
+        if (!std::isnan(wf->vertical_rate_n_per_m))
+            std::printf("vertical rate (same run)   %.6g N/m\n", wf->vertical_rate_n_per_m);
+        if (const auto& t = wf->tangent)
+            std::printf("seat tangent stiffness     at t %.6g s (%d stick, %d slip, %d open): k_ww %.6g N/m, k_theta %.6g N m/rad, "
+                        "vertical rate (seat free to turn) %.6g N/m\n",
+                        t->t_s, t->stick, t->slip, t->open, t->matrix[0][0], t->matrix[1][1], t->vertical_rate_n_per_m);
+        else
+            std::printf("seat tangent stiffness     none (%s)\n", wf->tangent_note.c_str());
     }
     if (summary.stepper.impact_loss)
         std::printf("impact loss                %.6g J (kinetic energy of the leaves at the end %.6g J)\n",

@@ -36,7 +36,8 @@ std::pair<double, double> last_cycle(const std::vector<StepRecord>& records, dou
     return {records[maxima[maxima.size() - 2]].t_s, records[maxima.back()].t_s};
 }
 
-HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, double t_start_s, double t_end_s) {
+HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, double t_start_s, double t_end_s,
+                                     const LoopColumns& columns) {
     const double eps = 1e-9 * std::max(1.0, std::abs(t_end_s));
     std::vector<const StepRecord*> c;
     for (const auto& r : records)
@@ -44,26 +45,28 @@ HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, dou
     if (c.size() < 8)
         throw InputError("cycle", "[" + format_value(t_start_s) + ", " + format_value(t_end_s) + "] s holds " +
                                       std::to_string(c.size()) + " records: a loop needs at least 8");
+    // the pair's values along the cycle: x the displacement, f the force doing work on it
+    std::vector<double> x(c.size()), f(c.size());
+    for (std::size_t j = 0; j < c.size(); ++j) {
+        x[j] = columns.displacement(*c[j]);
+        f[j] = columns.force(*c[j]);
+    }
     HysteresisMetrics h;
     h.t_start_s = c.front()->t_s;
     h.t_end_s = c.back()->t_s;
     h.samples = static_cast<int>(c.size());
-    h.w_min_m = h.w_max_m = c.front()->w_m;
-    h.force_min_n = h.force_max_n = c.front()->spring_force_n;
-    for (const auto* r : c) {
-        h.w_min_m = std::min(h.w_min_m, r->w_m);
-        h.w_max_m = std::max(h.w_max_m, r->w_m);
-        h.force_min_n = std::min(h.force_min_n, r->spring_force_n);
-        h.force_max_n = std::max(h.force_max_n, r->spring_force_n);
-    }
+    h.w_min_m = *std::min_element(x.begin(), x.end());
+    h.w_max_m = *std::max_element(x.begin(), x.end());
+    h.force_min_n = *std::min_element(f.begin(), f.end());
+    h.force_max_n = *std::max_element(f.begin(), f.end());
     const double dw = h.w_max_m - h.w_min_m;
-    if (!(dw > 0.0)) throw InputError("cycle", "w does not move over the cycle: no loop");
+    if (!(dw > 0.0)) throw InputError("cycle", columns.displacement_name + " does not move over the cycle: no loop");
     // Loop area, trapezoidal over the recorded path (closed by the last segment back to
     // the start when the cycle is not exactly closed, e.g. a decaying free vibration).
     double area = 0.0;
-    for (std::size_t j = 0; j + 1 < c.size(); ++j)
-        area += 0.5 * (c[j]->spring_force_n + c[j + 1]->spring_force_n) * (c[j + 1]->w_m - c[j]->w_m);
-    area += 0.5 * (c.back()->spring_force_n + c.front()->spring_force_n) * (c.front()->w_m - c.back()->w_m);
+    const std::size_t n = c.size();
+    for (std::size_t j = 0; j + 1 < n; ++j) area += 0.5 * (f[j] + f[j + 1]) * (x[j + 1] - x[j]);
+    area += 0.5 * (f[n - 1] + f[0]) * (x[0] - x[n - 1]);
     h.loop_area_j = area;
     h.secant_stiffness_n_per_m = (h.force_max_n - h.force_min_n) / dw;
     // First harmonics over the cycle (trapezoidal rule on a periodic integrand).
@@ -74,8 +77,8 @@ HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, dou
         const double h_t = c[j + 1]->t_s - c[j]->t_s;
         const auto e0 = std::exp(std::complex<double>(0.0, -om * (c[j]->t_s - h.t_start_s)));
         const auto e1 = std::exp(std::complex<double>(0.0, -om * (c[j + 1]->t_s - h.t_start_s)));
-        F1 += 0.5 * h_t * (c[j]->spring_force_n * e0 + c[j + 1]->spring_force_n * e1);
-        W1 += 0.5 * h_t * (c[j]->w_m * e0 + c[j + 1]->w_m * e1);
+        F1 += 0.5 * h_t * (f[j] * e0 + f[j + 1] * e1);
+        W1 += 0.5 * h_t * (x[j] * e0 + x[j + 1] * e1);
     }
     if (std::abs(W1) > 0.0) {
         const std::complex<double> K = F1 / W1;

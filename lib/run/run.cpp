@@ -114,6 +114,11 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
         std::optional<StressMonitor> monitor;  // only when asked: no cost otherwise
         std::vector<InterfaceRunPeak> peaks;
         bool started = false;
+        // a windup run: the contact state of the last record, for the seat's tangent stiffness
+        const bool windup = loads_the_seat(options.loading);
+        const long last_record = detail::record_steps(options);
+        long index = 0;
+        std::vector<PairRecord> last_pairs;
         summary.report = detail::run_records(system, options, [&](const Stepper& stepper, const StepRecord& r) {
             if (!started) {  // record 0: make_stepper has validated the options
                 started = true;
@@ -128,6 +133,7 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
             summary.stats.add(r);
             sink.on_record(r);
             if (out.pairs) sink.on_pairs(r.t_s, stepper.pairs());
+            if (windup && index++ == last_record) last_pairs = stepper.pairs();
             if (out.nodes) sink.on_nodes(r.t_s, stepper.nodes());
             if (out.stresses) {
                 const Stresses st = stepper.stresses();
@@ -137,6 +143,14 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
             }
         });
         summary.loop = loop_figures(summary.records, options.loading.period_s());
+        if (windup) {
+            summary.windup = windup_figures(summary.records, options.loading, summary.loop);
+            try {
+                summary.windup->tangent = seat_tangent_stiffness(system, last_pairs, summary.stats.last.t_s);
+            } catch (const SolverError& e) {
+                summary.windup->tangent_note = e.what();
+            }
+        }
         if (monitor) summary.stresses = RunStresses{monitor->summary(), std::move(peaks)};
     } catch (const StopSeen&) {
         summary.interrupted = true;

@@ -96,6 +96,64 @@ nlohmann::json stresses_json(const RunStresses& rs) {
             {"interfaces", interfaces}};
 }
 
+/// A loop's figures as the "hysteresis" section names them, with its pair's own names (`x`: the
+/// displacement's key with its unit, e.g. "seat_rotation_rad"; `f`: the force's; `rate`: the
+/// stiffness's unit, e.g. "n_m_per_rad").
+nlohmann::json loop_json(const HysteresisMetrics& m, const std::string& x, const std::string& f, const std::string& rate) {
+    return {{"t_start_s", m.t_start_s},
+            {"t_end_s", m.t_end_s},
+            {"loop_area_j", m.loop_area_j},
+            {"friction_work_j", m.dissipated_j},
+            {"secant_stiffness_" + rate, m.secant_stiffness_n_per_m},
+            {"dynamic_rate_" + rate, m.dynamic_rate_n_per_m},
+            {"loss_factor", m.loss_factor},
+            {"energy_loss_factor", m.energy_loss_factor},
+            {"equivalent_damping_ratio", m.equivalent_damping_ratio},
+            {x + "_min", m.w_min_m},
+            {x + "_max", m.w_max_m},
+            {f + "_min", m.force_min_n},
+            {f + "_max", m.force_max_n}};
+}
+
+/// The windup section (RunSummary::windup; docs/windup.md, "The windup figures"): k_theta [N m/rad],
+/// the loop's area [J per cycle] and loss factors, the longitudinal compliance [m/N], the vertical
+/// rate [N/m]; null and a note for a figure the run does not give.
+nlohmann::json windup_json(const WindupFigures& f) {
+    nlohmann::json j;
+    if (const auto& m = f.windup) {
+        j["stiffness_n_m_per_rad"] = m->secant_stiffness_n_per_m;
+        j["loop_area_j"] = m->loop_area_j;
+        j["loss_factor"] = m->loss_factor;
+        j["energy_loss_factor"] = m->energy_loss_factor;
+        j["loop"] = loop_json(*m, "seat_rotation_rad", "seat_moment_n_m", "n_m_per_rad");
+    } else {
+        for (const char* k : {"stiffness_n_m_per_rad", "loop_area_j", "loss_factor", "energy_loss_factor", "loop"}) j[k] = nullptr;
+        j["note"] = f.windup_note;
+    }
+    j["longitudinal_compliance_m_per_n"] = number_json(f.longitudinal_compliance_m_per_n);
+    if (const auto& m = f.longitudinal) j["longitudinal_loop"] = loop_json(*m, "seat_axial_m", "longitudinal_force_n", "n_per_m");
+    else {
+        j["longitudinal_loop"] = nullptr;
+        j["longitudinal_note"] = f.longitudinal_note;
+    }
+    j["vertical_rate_n_per_m"] = number_json(f.vertical_rate_n_per_m);
+    if (const auto& t = f.tangent) {  // K_t over (w, theta_R, u_R): N/m, N/rad, N m/rad, ... (loop_figures.hpp)
+        nlohmann::json matrix = nlohmann::json::array();
+        for (const auto& row : t->matrix) matrix.push_back({number_json(row[0]), number_json(row[1]), number_json(row[2])});
+        j["seat_tangent_stiffness"] = {{"t_s", t->t_s},
+                                       {"stick", t->stick},
+                                       {"slip", t->slip},
+                                       {"open", t->open},
+                                       {"dofs", {"w_m", "seat_rotation_rad", "seat_axial_m"}},
+                                       {"matrix", matrix},
+                                       {"vertical_rate_n_per_m", number_json(t->vertical_rate_n_per_m)}};
+    } else {
+        j["seat_tangent_stiffness"] = nullptr;
+        j["seat_tangent_stiffness_note"] = f.tangent_note;
+    }
+    return j;
+}
+
 }  // namespace
 
 std::string summary_json(const RunSummary& summary, const Model& model, const SummaryContext& context) {
@@ -187,6 +245,7 @@ std::string summary_json(const RunSummary& summary, const Model& model, const Su
         j["fancher"] = nullptr;
         if (!loop.fancher_note.empty()) j["fancher_note"] = loop.fancher_note;
     }
+    j["windup"] = summary.windup ? windup_json(*summary.windup) : nullptr;
     if (summary.stresses) j["stresses"] = stresses_json(*summary.stresses);
     else if (!summary.stresses_note.empty()) {  // asked, none made
         j["stresses"] = nullptr;

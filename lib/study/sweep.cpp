@@ -552,6 +552,10 @@ const std::vector<std::string>& point_figure_columns() {
         // the stresses ([outputs] stresses = true, RunOutputs::stresses): the largest |fibre stress| of
         // any leaf over the run [Pa] and the least fatigue safety factor over the leaves with a material
         "stress_max_abs_pa", "fatigue_least_safety_factor",
+        // the windup figures (run/loop_figures.hpp, simulate's summary "windup"): k_theta, the windup
+        // loop's area and loss factor, the seat's longitudinal compliance; NaN where the run has none
+        "windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor",
+        "longitudinal_compliance_m_per_n", "tangent_vertical_rate_n_per_m",
     };
     return columns;
 }
@@ -591,6 +595,19 @@ std::vector<double> figures_of(const LoopFigures& loop, long records, double max
     return f;
 }
 
+/// The windup columns (point_figure_columns 19 to 23) from a run's windup figures; NaN where none
+/// (the tangent vertical rate: only from run_scenario, which keeps the last record's contact state).
+void add_windup_figures(const std::optional<WindupFigures>& windup, std::vector<double>& f) {
+    if (!windup) return;
+    if (const auto& m = windup->windup) {
+        f[19] = m->secant_stiffness_n_per_m;
+        f[20] = m->loop_area_j;
+        f[21] = m->loss_factor;
+    }
+    f[22] = windup->longitudinal_compliance_m_per_n;
+    if (windup->tangent) f[23] = windup->tangent->vertical_rate_n_per_m;
+}
+
 /// The stress columns (point_figure_columns 17, 18) from a run's stress figures; NaN where none
 /// (not asked, or no leaf with a material whose endurance limit gives a safety factor).
 void add_stress_figures(const std::optional<RunStresses>& stresses, std::vector<double>& f) {
@@ -612,8 +629,10 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
     // the loop figures of simulate's summary, from the same function (run/loop_figures.hpp)
     double balance = 0.0;
     for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
-    return figures_of(loop_figures(records, options.loading.period_s()), static_cast<long>(records.size()), balance,
-                      note);
+    const LoopFigures loop = loop_figures(records, options.loading.period_s());
+    std::vector<double> f = figures_of(loop, static_cast<long>(records.size()), balance, note);
+    if (loads_the_seat(options.loading)) add_windup_figures(windup_figures(records, options.loading, loop), f);
+    return f;
 }
 
 PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
@@ -638,6 +657,7 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         records = std::move(summary.records);
         result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
         add_stress_figures(summary.stresses, result.figures);
+        add_windup_figures(summary.windup, result.figures);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
         result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +

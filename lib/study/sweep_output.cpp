@@ -30,6 +30,7 @@
 #include "stackbeam/io/csv.hpp"
 #include "stackbeam/post/fancher.hpp"
 #include "stackbeam/post/hysteresis.hpp"
+#include "stackbeam/run/loop_figures.hpp"
 
 #ifndef STACKBEAM_VERSION
 #define STACKBEAM_VERSION "unknown"
@@ -198,15 +199,29 @@ std::string axis_cell(const AxisValue& v) {
 }
 
 /// Why a journal's header `old` is not this program's `now`, in words: written before the stress
-/// columns (decision 061), or the first column that differs.
+/// columns (decision 061) or the windup columns (decision 068), or the first column that differs.
 std::string header_difference(const std::string& old, const std::string& now) {
     const std::vector<std::string> a = split_row(old), b = split_row(now);
-    const std::vector<std::string> stress = {"stress_max_abs_pa", "fatigue_least_safety_factor"};
+    // the columns later versions added, oldest first: an older header is this one without the last groups
+    struct Added {
+        const char* name;
+        std::vector<std::string> columns;
+    };
+    const std::vector<Added> added = {
+        {"stress", {"stress_max_abs_pa", "fatigue_least_safety_factor"}},
+        {"windup",
+         {"windup_stiffness_n_m_per_rad", "windup_loop_area_j", "windup_loss_factor", "longitudinal_compliance_m_per_n",
+          "tangent_vertical_rate_n_per_m"}}};
     std::vector<std::string> without = b;
-    for (const std::string& c : stress) without.erase(std::remove(without.begin(), without.end(), c), without.end());
-    if (a == without)
-        return "was written before the points table had the stress columns " + stress[0] + " and " + stress[1] +
-               " (an older stackbeam)";
+    std::string missing;  // "the stress columns A and B and the windup columns C, D and E"
+    for (auto group = added.rbegin(); group != added.rend(); ++group) {
+        for (const std::string& c : group->columns) without.erase(std::remove(without.begin(), without.end(), c), without.end());
+        std::string list = std::string("the ") + group->name + " columns ";
+        for (std::size_t i = 0; i < group->columns.size(); ++i)
+            list += (i == 0 ? "" : i + 1 == group->columns.size() ? " and " : ", ") + group->columns[i];
+        missing = missing.empty() ? list : list + " and " + missing;
+        if (a == without) return "was written before the points table had " + missing + " (an older stackbeam)";
+    }
     for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i)
         if (i >= a.size() || i >= b.size() || a[i] != b[i])
             return "has other columns than this program writes (another version?): column " + std::to_string(i + 1) +
@@ -592,7 +607,8 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                     "(stackbeam simulate --scenario FILE --out OUT.csv runs it)\n" + point.scenario_text);
     // an older run's files of this point go first: those written below are this row's
     for (const auto& [kind, ext, suffix] : {std::tuple<const char*, const char*, const char*>{"loops", "csv", ""},
-                                            {"loops", "csv", "-fancher"}, {"series", "csv", ""}}) {
+                                            {"loops", "csv", "-fancher"}, {"loops", "csv", "-windup"},
+                                            {"series", "csv", ""}}) {
         std::error_code ec;
         fs::remove(point_file(directory, kind, r.index, ext, suffix), ec);
     }
@@ -637,6 +653,23 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                 }
             } catch (const InputError&) {
                 // no whole cycle: the row's message says so, no loop file
+            }
+        }
+        // a windup run: its windup loop's last cycle (windup_figures' cycle), the moment against the rotation
+        const Loading& loading = point.scenario.simulation.loading;
+        const double windup_period = loads_the_seat(loading) ? windup_period_s(loading) : 0.0;
+        if (windup_period > 0.0) {
+            try {
+                const auto cycle = last_cycle(records, windup_period);
+                std::ostringstream loop;
+                loop << "t_s,seat_rotation_rad,seat_moment_n_m\n";
+                for (const StepRecord& s : records)
+                    if (s.t_s >= cycle.first && s.t_s <= cycle.second)
+                        loop << number_cell(s.t_s) << ',' << number_cell(s.seat_rotation_rad) << ','
+                             << number_cell(s.seat_moment_n_m) << '\n';
+                write_whole(point_file(directory, "loops", r.index, "csv", "-windup"), loop.str());
+            } catch (const InputError&) {
+                // no whole cycle: no windup loop file
             }
         }
         if (keep_series) {

@@ -154,6 +154,9 @@ class _Stack:
         self.x_tolerance = geometry["x_tolerance_m"]
         self.times = _np.asarray(result["t"])
         self.w_record = _np.asarray(result["w"])
+        self.seat_rotation = _np.asarray(result["seat_rotation"])  # theta_R [rad], counter-clockwise
+        summary = getattr(result, "summary", None) or {}
+        self.windup = summary.get("windup") is not None  # the loading turns or pushes the seat
         nodes = result.nodes
         self._node_t, self._leaf = nodes["t"], nodes["leaf"]
         self._x, self._w = nodes["x"], nodes["w"]
@@ -171,6 +174,12 @@ class _Stack:
         """{leaf: (x [m], w [m])} at record i."""
         at = self._node_t == self.times[i]
         return {leaf: (self._x[at & (self._leaf == leaf)], self._w[at & (self._leaf == leaf)]) for leaf in self.leaves}
+
+    def extreme_records(self):
+        """The records of the largest and the smallest w, or of theta_R where the loading loads the
+        seat (a windup run: the S shapes wound either way)."""
+        v = self.seat_rotation if self.windup else self.w_record
+        return [int(_np.argmax(v)), int(_np.argmin(v))]
 
     def max_abs_w(self, records):
         at = _np.isin(self._node_t, self.times[records])
@@ -198,12 +207,35 @@ class _Stack:
         return points
 
 
+def _draw_seat(ax, stack, i, axes, scale):
+    """The seat at record i: on every leaf with a node at the seat, a short segment through its drawn
+    axis there, of the drawn slope scale x theta_R (the record's seat_rotation: the tied leaves turn
+    with it), so that the windup's turn of the seat shows; one Line2D of gid "seat". Returns it."""
+    theta = float(stack.seat_rotation[i])
+    span = max(float(_np.max(x)) - float(_np.min(x)) for x, _ in axes.values())
+    half = 0.06 * span  # [m] along x each side of the seat
+    xs, ys = [], []
+    for leaf, (x, w) in axes.items():
+        at = _np.nonzero(_np.abs(x - stack.seat_x) <= stack.x_tolerance)[0]
+        if len(at) == 0:
+            continue
+        y = stack.heights[leaf] + scale * float(w[at[0]])
+        xs += [stack.seat_x - half, stack.seat_x + half, _np.nan]
+        ys += [y - scale * theta * half, y + scale * theta * half, _np.nan]
+    (line,) = ax.plot(1000 * _np.asarray(xs), 1000 * _np.asarray(ys), color="tab:orange", lw=3.0, alpha=0.8, zorder=4,
+                      label="seat, theta_R %.4g mrad" % (1000 * theta))
+    line.set_gid("seat")
+    return line
+
+
 def _draw_stack(ax, stack, i, scale):
     """Draws record i of `stack` on ax; returns the artists."""
     axes = stack.leaf_axes(i)
     artists = []
     for leaf, (x, w) in axes.items():
         artists += ax.plot(1000 * x, 1000 * (stack.heights[leaf] + scale * w), color="black", lw=1.8)
+    if stack.windup:
+        artists.append(_draw_seat(ax, stack, i, axes, scale))
     points = stack.pair_points(i, axes, scale)
     for state, colour in STATE_COLOURS.items():
         chosen = [(x, y) for x, y, s in points if s == state]
@@ -244,7 +276,10 @@ def _draw_stress_stack(ax, stack, i, scale, leaves, norm):
 
 def deformed_stack(result, times=None, scale=None, ax=None, color_by="state"):
     """The deformed stack at the records nearest to `times` [s] (default: the records of the
-    largest and the smallest w, as the command line's --plot): each leaf's axis at its height in
+    largest and the smallest w, or of the seat's rotation theta_R where the loading loads the seat
+    (a windup run, result.summary["windup"]), as the command line's --plot; there the seat is
+    drawn too: a short segment of the drawn slope scale x theta_R on each leaf at the seat, the
+    S shape's turn): each leaf's axis at its height in
     the stack plus its deflection times `scale` (default: stack_scale's rule; the scale is printed
     on the figure), every pair a point midway between its two leaves coloured by its state
     (stick green, slip red, open hollow blue), the half model mirrored to the whole stack.
@@ -266,7 +301,7 @@ def deformed_stack(result, times=None, scale=None, ax=None, color_by="state"):
             raise _error("result.stresses", "is None: color_by='stress' needs simulate(..., nodes=True, stresses=True)")
     stack = _Stack(result)
     if times is None:
-        records = [int(_np.argmax(stack.w_record)), int(_np.argmin(stack.w_record))]
+        records = stack.extreme_records()
     else:
         records = [stack.record(t) for t in _np.atleast_1d(times)]
     if not records:
@@ -300,10 +335,12 @@ def deformed_stack(result, times=None, scale=None, ax=None, color_by="state"):
         else:
             drawn = _draw_stress_stack(a, stack, i, scale, leaves, norm)
             fig.colorbar(drawn[0], ax=a, label="fibre stress [MPa], tension positive")
-        a.set(title="t = %.4g s, w = %.4g mm" % (stack.times[i], 1000 * stack.w_record[i]),
-              xlabel="x [mm]", ylabel="height + %g x deflection [mm]" % scale)
+        title = "t = %.4g s, w = %.4g mm" % (stack.times[i], 1000 * stack.w_record[i])
+        if stack.windup:
+            title += ", theta_R = %.4g mrad" % (1000 * stack.seat_rotation[i])
+        a.set(title=title, xlabel="x [mm]", ylabel="height + %g x deflection [mm]" % scale)
         a.grid(True)
-        if leaves is None and stack.pairs is not None:
+        if leaves is None and (stack.pairs is not None or stack.windup):
             a.legend(loc="upper right", fontsize="small")
     fig.suptitle("deformed stack: deflection drawn x %g" % scale)
     fig.tight_layout()

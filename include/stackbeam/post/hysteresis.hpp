@@ -17,6 +17,14 @@
 ///  - the energy loss factor A/(2 pi E_s) = 2 zeta, comparable with eta.
 /// For a steady cycle the loop area equals the friction work of the cycle
 /// (dissipated_j below) up to the discretisation: a check of the run.
+///
+/// The same figures of any other pair of a record's values (LoopColumns): the windup loop,
+/// the moment on the spring at the seat against the seat's rotation (k_s then in N m/rad, the
+/// windup stiffness; A in J, the closed integral of M dtheta), or the seat's axial displacement
+/// against the longitudinal force. The members named w_ and force_ then hold the pair's
+/// displacement and force in their units (run/loop_figures.hpp names them).
+#include <functional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,6 +48,15 @@ struct HysteresisMetrics {
     double strain_energy_change_j = 0.0;            ///< strain energy at the end minus at the start [J]
 };
 
+/// The two values of a record a loop is drawn from: a displacement (generalised: m, rad) and
+/// the force on the spring that does work on it (N, N m), with the displacement's name for the
+/// notes. The default is the vertical loop (w, spring_force_n).
+struct LoopColumns {
+    std::string displacement_name = "w";
+    std::function<double(const StepRecord&)> displacement = [](const StepRecord& r) { return r.w_m; };
+    std::function<double(const StepRecord&)> force = [](const StepRecord& r) { return r.spring_force_n; };
+};
+
 /// The last complete cycle of `records` as [t_start, t_end] [s]: with period_s > 0
 /// (a periodic loading, Loading::period_s) the last whole period before the last
 /// record, on the record grid; otherwise between the last two maxima of w (a free
@@ -47,8 +64,10 @@ struct HysteresisMetrics {
 /// when the records do not hold one (too short a run).
 std::pair<double, double> last_cycle(const std::vector<StepRecord>& records, double period_s);
 
-/// The loop figures over [t_start_s, t_end_s] (records with t in it, inclusive).
-/// Throws InputError("cycle", ...) when fewer than 8 records fall in it or w does not move.
-HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, double t_start_s, double t_end_s);
+/// The loop figures over [t_start_s, t_end_s] (records with t in it, inclusive) of the pair
+/// `columns` (default: the vertical loop). Throws InputError("cycle", ...) when fewer than 8
+/// records fall in it or the displacement does not move.
+HysteresisMetrics hysteresis_metrics(const std::vector<StepRecord>& records, double t_start_s, double t_end_s,
+                                     const LoopColumns& columns = LoopColumns());
 
 }  // namespace stackbeam

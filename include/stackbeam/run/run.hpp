@@ -143,6 +143,9 @@ struct RunSummary {
     std::vector<StepRecord> records; ///< every record (RunOutputs::keep_records), also when interrupted
     RunReport report;                ///< the stepper's counters and event log (default when interrupted)
     LoopFigures loop;                ///< the last cycle's figures (none when interrupted)
+    /// The windup figures (loop_figures.hpp) of a run whose loading loads the seat (loads_the_seat);
+    /// none otherwise and when interrupted
+    std::optional<WindupFigures> windup;
     /// RunOutputs::stresses: the stress figures (none when not asked; when interrupted: stresses_note says)
     std::optional<RunStresses> stresses;
     std::string stresses_note;
