@@ -102,6 +102,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.applied_force = c.base_excitation = c.gravity = c.rig = true;
     c.seat_loads = c.pitch_inertia = true;  // through q(t) (ReducedLoad) and M; not the windup rig
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
+    c.layer_damping = true;  // its contact points carry mass: only they vibrate on the layer
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
     rows.push_back(c);
@@ -271,6 +272,11 @@ void check_options(const StepperCapabilities& s, const SimulationOptions& o) {
                              ": structural damping is not taken by " + s.description + " (give 0); it is " +
                              taken_by([](auto& r) { return r.damping; }));
     }
+    if (!s.layer_damping && o.damping.layer_normal_time_s > 0.0)
+        throw InputError("damping.layer_normal_time_s",
+                         "value " + format_value(o.damping.layer_normal_time_s) + ": the elastic layer's normal dashpots "
+                             "are not taken by " + s.description + " (give 0; a massless contact layer does not vibrate "
+                             "on it); they are " + taken_by([](auto& r) { return r.layer_damping; }));
     if (!s.previous_step_tau && o.tau_rule == TauRule::previous_step)
         throw InputError("tau_rule", "value 'previous-step' is not available in " + std::string(s.description) +
                                          ", which takes the friction limit from the current normal force (tau rule "
@@ -318,7 +324,8 @@ const StepperCapabilities& choose_stepper(const System& system, const Simulation
             const bool changes = has_mode_changes(system);
             const bool assembled = needs_assembly(system.model().spec());
             const bool massive_only =
-                options.damping.active() || options.loading.kind == LoadingKind::prescribed_displacement;
+                options.damping.active() || options.damping.layer_normal_time_s > 0.0 ||
+                options.loading.kind == LoadingKind::prescribed_displacement;
             if (li == LeafInertia::massive || (li == LeafInertia::automatic && elastic && massive_only))
                 return registered_stepper("cvode-massive");
             if (changes || li == LeafInertia::modal) return registered_stepper("cvode-modal");

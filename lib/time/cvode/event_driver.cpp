@@ -622,7 +622,8 @@ void EventDriver::note_pair_switch(int kk, double te) {
                           " times within " + format_value(te - times.front()) + " s (a hundredth of the stack's period is " +
                           format_value(window) + " s) up to t = " + format_value(te) + " s, the last " + e.from + " -> " +
                           e.to + ": the contact chatters (a contact point vibrating on the elastic layer, each switch a "
-                          "restart); leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
+                          "restart); damping.layer_normal_time_s > 0 damps that vibration (a dashpot on the layer, e.g. "
+                          "1e-6 s), or leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
                       stats_.steps, te, 0.0);
 }
 
@@ -654,8 +655,9 @@ std::string EventDriver::step_limit_diagnostics() const {
     }
     d += ")";
     if (pair_chatter_limit_)  // the massive stack: its layer's vibrations are what takes the steps
-        d += ": the whole massive stack follows its elastic layer's own vibrations; leaf_inertia = modal (a "
-             "massless contact layer) or mode newmark follow such a stack at the stack's time scale";
+        d += ": the whole massive stack follows its elastic layer's own vibrations; damping.layer_normal_time_s > 0 "
+             "damps them (a dashpot on the layer, e.g. 1e-6 s), or leaf_inertia = modal (a massless contact layer) or "
+             "mode newmark follow such a stack at the stack's time scale";
     return d;
 }
 
