@@ -27,7 +27,12 @@
 // rate (correct_decision). No sliding mode arises: a slip that stops reverses its rate.
 //
 // Structural damping (SimulationOptions::damping, off by default): C = alpha M + beta K of the
-// leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j).
+// leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j). The
+// layer's normal dashpots (damping.layer_normal_time_s tau_L, off by default; decision 071): on
+// each closed normal row i with a layer a dashpot eta_i = tau_L / c_i [N s/m] in parallel with
+// its spring, the force -eta_i ds_i/dt = -eta_i G_i z', i.e. G_i^T eta_i G_i added to the mode's
+// damping matrix (Cd); its work joins the damping energy. The forces p, the witnesses and the
+// mode decisions are the springs' (a pair opens when its spring's force reaches 0).
 //
 // Loadings (loading.hpp) with the leaves' own inertia: q(t) = e_w F(t)/f - (g + y_b''(t)) l on the
 // right-hand side (ReducedLoad; l = System::vertical_inertia_kg(): the leaves' weight and R's, and
