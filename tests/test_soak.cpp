@@ -278,9 +278,9 @@ const KnownFailure kKnownFailures[] = {
     // The whole massive stack (cvode-massive), its layer damped (tau_L = 1e-6 s; undamped, each
     // chattered or reached the step limit, decisions 062, 065), measured (decision 071):
     //  - the step limit (200,000 steps) at t = 2.6 ms (8), 2.8 ms (18), 6.9 ms (36): steps of
-    //    1-3e-8 s, 250-300 events, not the layer's normal bounce (a dashpot on the layers' shear
-    //    as well moved them to 4.3 / 5.4 ms only); at 24 ms (23) and 27 ms (28): 4,376 and
-    //    16,707 events, 1.2-1.3e-7 s a step;
+    //    1-3e-8 s, 250-300 events, set by the leaves' own modes, not the layer (Rayleigh beta =
+    //    1e-5 s takes 8 through, 18 to 25 ms, 36 to 40 ms); at 24 ms (23) and 27 ms (28): 4,376
+    //    and 16,707 events, 1.2-1.3e-7 s a step;
     //  - a named chatter: pair 4 of seed 14 reverses its slip (slip+ <-> slip-) every 6e-14 s at
     //    t = 1.4e-7 s; pair 18 of seed 25 100 mode changes within 2.8e-5 s.
     {8, "cvode-massive"}, {14, "cvode-massive"}, {18, "cvode-massive"}, {23, "cvode-massive"},
