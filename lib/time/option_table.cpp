@@ -146,6 +146,12 @@ std::vector<OptionSpec> make_table() {
              0.0, false, kInf, false, "0: none",
              [](const O& o) { return o.damping.rayleigh_beta_s; },
              [](O& o, double v) { o.damping.rayleigh_beta_s = v; }),
+        real("damping.layer_normal_time_s", "integrator.damping.layer_normal_time_s", "--layer-normal-time", "", "s",
+             "the elastic layer's normal retardation time tau_L: a dashpot tau_L k_n on every closed pair with a layer, "
+             "in parallel with its spring (mode cvode, massive stack: damps the contact points' own vibration on the layer)",
+             0.0, false, kInf, false, "0: none",
+             [](const O& o) { return o.damping.layer_normal_time_s; },
+             [](O& o, double v) { o.damping.layer_normal_time_s = v; }),
         real("loading.gravity_m_per_s2", "loading.gravity_m_per_s2", "--gravity", "", "m/s^2",
              "gravity on R, acting in -y (static equilibrium first)", 0.0, false, kInf, false, "0: none",
              [](const O& o) { return o.loading.gravity_m_per_s2; },

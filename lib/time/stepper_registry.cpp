@@ -106,6 +106,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.windup_rig = true;                    // theta_R's acceleration prescribed as the rig's w'' (decision 069)
     c.seat_loads_with_rig = true;           // the rig's and the seat loads' work both booked (decision 069)
     c.assembly = c.damping = c.friction = c.elastic_layer = c.leaf_kinetic_energy = c.cvode_stats = true;
+    c.layer_damping = true;  // its contact points carry mass: only they vibrate on the layer
     c.start = StartKind::whole_stack_static;
     c.build = &build<CvodeMassiveStepper>;
     rows.push_back(c);
@@ -275,6 +276,11 @@ void check_options(const StepperCapabilities& s, const SimulationOptions& o) {
                              ": structural damping is not taken by " + s.description + " (give 0); it is " +
                              taken_by([](auto& r) { return r.damping; }));
     }
+    if (!s.layer_damping && o.damping.layer_normal_time_s > 0.0)
+        throw InputError("damping.layer_normal_time_s",
+                         "value " + format_value(o.damping.layer_normal_time_s) + ": the elastic layer's normal dashpots "
+                             "are not taken by " + s.description + " (give 0; a massless contact layer does not vibrate "
+                             "on it); they are " + taken_by([](auto& r) { return r.layer_damping; }));
     if (!s.previous_step_tau && o.tau_rule == TauRule::previous_step)
         throw InputError("tau_rule", "value 'previous-step' is not available in " + std::string(s.description) +
                                          ", which takes the friction limit from the current normal force (tau rule "
@@ -321,9 +327,9 @@ const StepperCapabilities& choose_stepper(const System& system, const Simulation
             const bool elastic = first_rigid_pair(system) < 0;
             const bool changes = has_mode_changes(system);
             const bool assembled = needs_assembly(system.model().spec());
-            const bool massive_only = options.damping.active() ||
-                                      options.loading.kind == LoadingKind::prescribed_displacement ||
-                                      options.loading.windup_rig();
+            const bool massive_only =
+                options.damping.active() || options.damping.layer_normal_time_s > 0.0 ||
+                options.loading.kind == LoadingKind::prescribed_displacement || options.loading.windup_rig();
             if (li == LeafInertia::massive || (li == LeafInertia::automatic && elastic && massive_only))
                 return registered_stepper("cvode-massive");
             if (changes || li == LeafInertia::modal) return registered_stepper("cvode-modal");

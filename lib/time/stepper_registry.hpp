@@ -52,6 +52,7 @@ struct StepperCapabilities {
     bool windup_rig_on_rigid_contact;  ///< the windup rig with a contact row that has no elastic layer
     bool assembly;              ///< free camber, clips, interference (needs_assembly)
     bool damping;               ///< structural (Rayleigh) damping
+    bool layer_damping;         ///< the elastic layer's normal dashpots (damping.layer_normal_time_s)
     bool restitution;           ///< the impact law's restitution > 0
     bool previous_step_tau;     ///< TauRule::previous_step
     // contact laws and rows

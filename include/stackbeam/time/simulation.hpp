@@ -108,6 +108,15 @@ struct CvodeOptions {
 struct StructuralDamping {
     double rayleigh_alpha_per_s = 0.0;  ///< alpha [1/s], >= 0
     double rayleigh_beta_s = 0.0;       ///< beta [s], >= 0
+    /// The elastic layer's normal retardation time tau_L [s], >= 0 (Kelvin-Voigt): on every closed
+    /// pair with a layer a normal dashpot eta = tau_L k_n [N s/m] (k_n = 1 / c_n the pair's layer
+    /// stiffness [N/m]; per unit area tau_L times the layer's normal stiffness [Pa/m]) in parallel
+    /// with the spring, its force -eta ds_n/dt. Damps a contact point's own vibration on the layer
+    /// (zeta = tau_L omega / 2 at omega ~ 1e5-1e6 rad/s) and leaves the stack's motion (omega < 1e2
+    /// rad/s) undamped to ~1e-4 at tau_L = 1e-6 s. Its work is damping energy. Taken by mode cvode
+    /// with the whole massive stack only (docs/time-integration.md, "Structural damping"). 0: none.
+    double layer_normal_time_s = 0.0;
+    /// Rayleigh damping of the leaves on (the layer's dashpots apart).
     bool active() const noexcept { return rayleigh_alpha_per_s > 0.0 || rayleigh_beta_s > 0.0; }
 };
 

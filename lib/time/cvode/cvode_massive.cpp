@@ -27,7 +27,12 @@
 // rate (correct_decision). No sliding mode arises: a slip that stops reverses its rate.
 //
 // Structural damping (SimulationOptions::damping, off by default): C = alpha M + beta K of the
-// leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j).
+// leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j). The
+// layer's normal dashpots (damping.layer_normal_time_s tau_L, off by default; decision 071): on
+// each closed normal row i with a layer a dashpot eta_i = tau_L / c_i [N s/m] in parallel with
+// its spring, the force -eta_i ds_i/dt = -eta_i G_i z', i.e. G_i^T eta_i G_i added to the mode's
+// damping matrix (Cd); its work joins the damping energy. The forces p, the witnesses and the
+// mode decisions are the springs' (a pair opens when its spring's force reaches 0).
 //
 // Loadings (loading.hpp) with the leaves' own inertia: q(t) = e_w F(t)/f - (g + y_b''(t)) l on the
 // right-hand side (ReducedLoad; l = System::vertical_inertia_kg(): the leaves' weight and R's, and
@@ -91,7 +96,13 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 
     SpMat K, M, Gt;
     SpMat C;                  // structural damping alpha M + beta K [N s/m] (empty: none)
-    bool damped() const { return options().damping.active(); }
+    // The elastic layer's normal dashpots (SimulationOptions::damping.layer_normal_time_s tau_L):
+    // eta_i = tau_L / c_i [N s/m] on each normal row i with a layer (0 elsewhere and without tau_L)
+    Eigen::VectorXd eta_n;
+    // the damping of the current modes: C plus G_i^T eta_i G_i of every closed normal row [N s/m]
+    SpMat Cd;
+    bool damped_ = false;     // Cd has an entry
+    bool damped() const { return damped_; }
     RowSpMat Grow;            // G, row-major [-]
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
@@ -168,6 +179,19 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         Keff = K - SpMat(Gt * P);
         Keff.makeCompressed();
         b0 = Gt * p0;
+        // the layer's normal dashpots on the closed rows: the force -eta_i ds_i/dt = -eta_i G_i z'
+        // on row i, in parallel with its spring (Kelvin-Voigt); its work is damping (D_c)
+        std::vector<Eigen::Triplet<double>> td;
+        for (int row : lin.S)
+            if (eta_n.size() > 0 && eta_n[row] > 0.0)
+                for (RowSpMat::InnerIterator a(Grow, row); a; ++a)
+                    for (RowSpMat::InnerIterator b(Grow, row); b; ++b)
+                        td.emplace_back(a.col(), b.col(), eta_n[row] * a.value() * b.value());
+        Cd.resize(ndof(), ndof());
+        Cd.setFromTriplets(td.begin(), td.end());
+        if (C.size() > 0 && C.nonZeros() > 0) Cd += C;
+        Cd.makeCompressed();
+        damped_ = Cd.nonZeros() > 0;
         slip_rows.clear();
         for (int kk = 0; kk < num_pairs(); ++kk) {
             const int rt = pairs()[kk].row_t;
@@ -175,7 +199,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         }
         // the Newton matrix's pattern (M + K_eff: the same for every gamma)
         SpMat A = M + Keff;
-        if (damped()) A += C;
+        if (damped()) A += Cd;
         prescribe_w_row(A);
         nlu.analyzePattern(A);
         gamma_lu = -1.0;
@@ -214,7 +238,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
                      double* rig_n = nullptr, Eigen::VectorXd* held_n = nullptr) const {
         Eigen::VectorXd r = b0 - Keff * z;
         if (!load->none()) r += load->at(t_s);
-        if (damped()) r -= C * v;
+        if (damped()) r -= Cd * v;
         Eigen::VectorXd a = mass.solve(r);
         if (held_rig) {
             const Eigen::VectorXd lambda = prescribe_accelerations(a, U_h, held, held_acceleration(t_s));
@@ -283,7 +307,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         // rate), where a pair left at the friction cone's edge by the static solve would otherwise be
         // decided by round-off.
         Eigen::VectorXd r3 = -(Keff * v);
-        if (damped()) r3 -= C * a;
+        if (damped()) r3 -= Cd * a;
         if (!load->none()) {
             const double h = 1e-7;  // [s] q'(t) by central differences (smooth loadings)
             r3 += (load->at(te + h) - load->at(te - h)) / (2.0 * h);
@@ -336,7 +360,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         double pw = 0.0;
         for (int rt : slip_rows) pw -= (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(v);
         D[2 * n_] = pw;
-        D[2 * n_ + 1] = damped() ? v.dot(C * v) : 0.0;
+        D[2 * n_ + 1] = damped() ? v.dot(Cd * v) : 0.0;
         D[2 * n_ + 2] = held_rig ? held_power(t, v, held_lambda_rhs) : external_power(t, v, lambda);
     }
 
@@ -344,7 +368,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     int newton_setup(double gamma) override {
         if (gamma == gamma_lu) return 0;
         SpMat A = M + (gamma * gamma) * Keff;
-        if (damped()) A += gamma * C;
+        if (damped()) A += gamma * Cd;
         prescribe_w_row(A);
         nlu.factorize(A);
         if (nlu.info() != Eigen::Success) {
@@ -376,7 +400,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         for (int rt : slip_rows)
             dpw -= P.row(rt).dot(xz) * Hs.row(rt).dot(v) + (P.row(rt).dot(z) + p0[rt]) * Hs.row(rt).dot(xvel);
         X[2 * n_] = R[2 * n_] + gamma * dpw;
-        X[2 * n_ + 1] = R[2 * n_ + 1] + (damped() ? gamma * 2.0 * (C * v).dot(xvel) : 0.0);  // d(v^T C v)
+        X[2 * n_ + 1] = R[2 * n_ + 1] + (damped() ? gamma * 2.0 * (Cd * v).dot(xvel) : 0.0);  // d(v^T C v)
         // d(q^T v) = q^T dv (the rig's lambda w': lambda dw' with the lambda of the last right-hand
         // side, lambda's own change left out of this row of the Newton matrix, which nothing else
         // depends on)
@@ -433,9 +457,15 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
       cL(system.layer_compliance_m_per_n()),
       load(std::make_unique<ReducedLoad>(system, start.options.loading)),
       rig(start.rig) {
-    if (damped()) {
+    if (options().damping.active()) {
         C = options().damping.rayleigh_alpha_per_s * M + options().damping.rayleigh_beta_s * K;
         C.makeCompressed();
+    }
+    if (options().damping.layer_normal_time_s > 0.0) {
+        eta_n = Eigen::VectorXd::Zero(cL.size());
+        for (const ContactPair& cp : system.pairs()) {
+            if (cp.row_n >= 0 && cL[cp.row_n] > 0.0) eta_n[cp.row_n] = options().damping.layer_normal_time_s / cL[cp.row_n];
+        }
     }
     mass.compute(M);
     if (mass.info() != Eigen::Success || !(mass.vectorD().minCoeff() > 0.0))

@@ -402,6 +402,7 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
         ev_->correct_decision(y, rel, nm, tm);
     };
     if (!decided) decide_by_solving("deciding the modes");
+    if (cause != "start" && engage_clamps_by_slider_rate(y, rel, nm, tm)) decided = false;
 
     // A stepper whose state decides every pair by itself (settle_at_state: the massive stack,
     // where only the layer is instantaneous) restarts only in modes that hold at y itself: a
@@ -478,6 +479,37 @@ void EventDriver::decide_modes(double te, const Vec& y, const Vec& p_cur, const 
     ev_->after_event(cause, p_cur, ev_->forces(y));
     reset_check_anchors(y);
     stats_.event_time_s += seconds_since(t_start) - (stats_.contact_time_s - contact_before);
+}
+
+bool EventDriver::engage_clamps_by_slider_rate(const Vec& y, const Vec& rel, std::vector<signed char>& nm,
+                                               std::vector<signed char>& tm) {
+    // A clamp engages (released -> engaged) where its normal force falls through its preload
+    // F_c: p_n is continuous there, so its friction limit mu (F_c - p_n) starts from 0 and cannot
+    // stop a slide at once. It enters slip against its slider rate ds_t/dt (SLIP_POS: the rate
+    // negative, the friction force positive) and sticks only where that rate is within the
+    // motion margin (kMotionMargin V_ref): later, at the rate witness's root. Entered stuck, the
+    // clamp's shear loads it past its preload at once (its release witness negative after the
+    // next step) while released it falls back below: a loop at one instant (soak seed 29 under
+    // cvode-modal, docs/decisions/071-soak-clamps-mesh-layer.md).
+    std::vector<int> engaging;
+    for (int kk = 0; kk < np_; ++kk) {
+        const auto& cp = pairs()[kk];
+        if (cp.kind != PairKind::clamp || cp.row_t < 0 || modes_.tmode[kk] != FREE || tm[kk] != STICK) continue;
+        engaging.push_back(kk);
+        tm[kk] = SLIP_POS;
+    }
+    if (engaging.empty()) return false;
+    // The rate of each engaging clamp in the candidate modes at y: its SLIP_POS witness is
+    // -rate / V_ref + kMotionMargin (witnesses_from).
+    std::vector<double> g(slots_.size());
+    in_candidate_modes(rel, nm, tm, true, [&] { ev_->witnesses(y, g.data()); });
+    for (std::size_t i = 0; i < slots_.size(); ++i) {
+        const int kk = slots_[i].pair;
+        if (slots_[i].normal || std::find(engaging.begin(), engaging.end(), kk) == engaging.end()) continue;
+        const double rate = kMotionMargin - g[i];  // ds_t/dt / V_ref
+        tm[kk] = rate < -kMotionMargin ? SLIP_POS : rate > kMotionMargin ? SLIP_NEG : STICK;
+    }
+    return true;
 }
 
 void EventDriver::reset_check_anchors(const State& y) {
@@ -590,7 +622,8 @@ void EventDriver::note_pair_switch(int kk, double te) {
                           " times within " + format_value(te - times.front()) + " s (a hundredth of the stack's period is " +
                           format_value(window) + " s) up to t = " + format_value(te) + " s, the last " + e.from + " -> " +
                           e.to + ": the contact chatters (a contact point vibrating on the elastic layer, each switch a "
-                          "restart); leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
+                          "restart); damping.layer_normal_time_s > 0 damps that vibration (a dashpot on the layer, e.g. "
+                          "1e-6 s), or leaf_inertia = modal (a massless contact layer) or mode newmark follow such a stack",
                       stats_.steps, te, 0.0);
 }
 
@@ -622,8 +655,9 @@ std::string EventDriver::step_limit_diagnostics() const {
     }
     d += ")";
     if (pair_chatter_limit_)  // the massive stack: its layer's vibrations are what takes the steps
-        d += ": the whole massive stack follows its elastic layer's own vibrations; leaf_inertia = modal (a "
-             "massless contact layer) or mode newmark follow such a stack at the stack's time scale";
+        d += ": the whole massive stack follows its elastic layer's own vibrations; damping.layer_normal_time_s > 0 "
+             "damps them (a dashpot on the layer, e.g. 1e-6 s), or leaf_inertia = modal (a massless contact layer) or "
+             "mode newmark follow such a stack at the stack's time scale";
     return d;
 }
 

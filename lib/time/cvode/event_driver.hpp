@@ -341,6 +341,11 @@ private:
                             bool build, const std::function<void()>& body);
     bool apply_slot_transitions(const std::function<bool(std::size_t)>& take, const Vec& p,
                                 std::vector<signed char>& nm, std::vector<signed char>& tm) const;
+    /// At an event after the start: every clamp that (nm, tm) engages (released -> stuck) enters slip against its
+    /// slider rate at y instead, stuck only where that rate is within the motion margin. True
+    /// when it changed (nm, tm) (the candidate modes must then be built again).
+    bool engage_clamps_by_slider_rate(const Vec& y, const Vec& rel, std::vector<signed char>& nm,
+                                      std::vector<signed char>& tm);
     void decide_modes(double te, const Vec& y, const Vec& p_cur, const std::string& cause,
                       const std::vector<int>* triggered = nullptr);
     static int rhs_of(sunrealtype t, N_Vector y, N_Vector ydot, void* user);
