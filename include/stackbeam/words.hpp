@@ -3,7 +3,7 @@
 /// One word table per enum: the words a user writes for its values (scenario files, command-line
 /// flags, the Python module), used to parse them, print them and write them back. Each enum's
 /// table is a specialisation of enum_words<E>(), declared in the enum's header and defined once
-/// next to its to_string; every reader, writer and front-end goes through it, so a word is
+/// next to its to_string (STACKBEAM_ENUM_WORDS); every reader, writer and front-end goes through it, so a word is
 /// spelled in one place. Each parser keeps its own message (and names its field), built with
 /// word_list().
 #include <optional>
@@ -22,6 +22,16 @@ struct EnumWord {
 /// The word table of the enum E (in the order messages list them).
 template <class E>
 const std::vector<EnumWord<E>>& enum_words();
+
+/// Defines the specialisation enum_words<E>() (in a .cpp, once), its rows {E::value, "word"} in the
+/// order messages list them (the form of nlohmann::json's NLOHMANN_JSON_SERIALIZE_ENUM):
+///     STACKBEAM_ENUM_WORDS(Mode, {Mode::closed_form, "closed-form"}, {Mode::cvode, "cvode"}, {Mode::newmark, "newmark"})
+#define STACKBEAM_ENUM_WORDS(E, ...)                                 \
+    template <>                                                      \
+    const std::vector<EnumWord<E>>& enum_words<E>() {                \
+        static const std::vector<EnumWord<E>> words = {__VA_ARGS__}; \
+        return words;                                                \
+    }
 
 /// The word of `value` ("?" for a value without one).
 template <class E>

@@ -8,15 +8,8 @@
 
 namespace stackbeam {
 
-template <>
-const std::vector<EnumWord<ContactPath>>& enum_words<ContactPath>() {
-    static const std::vector<EnumWord<ContactPath>> words = {
-        {ContactPath::automatic, "auto"},
-        {ContactPath::dense, "dense"},
-        {ContactPath::sparse, "sparse"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(ContactPath, {ContactPath::automatic, "auto"}, {ContactPath::dense, "dense"},
+    {ContactPath::sparse, "sparse"})
 
 const char* to_string(ContactPath path) { return word_of(path); }
 

@@ -12,57 +12,19 @@
 
 namespace stackbeam {
 
-template <>
-const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>() {
-    static const std::vector<EnumWord<SupportKind>> words = {
-        {SupportKind::free, "free"},
-        {SupportKind::pinned, "pinned"},
-        {SupportKind::fixed, "fixed"},
-        {SupportKind::hinged, "hinged"},
-        {SupportKind::shackle, "shackle"},
-        {SupportKind::bushing, "bushing"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(SupportKind, {SupportKind::free, "free"}, {SupportKind::pinned, "pinned"},
+    {SupportKind::fixed, "fixed"}, {SupportKind::hinged, "hinged"}, {SupportKind::shackle, "shackle"},
+    {SupportKind::bushing, "bushing"})
 
-template <>
-const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>() {
-    static const std::vector<EnumWord<InterfaceContact>> words = {
-        {InterfaceContact::rigid, "rigid"},
-        {InterfaceContact::elastic, "elastic"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(InterfaceContact, {InterfaceContact::rigid, "rigid"}, {InterfaceContact::elastic, "elastic"})
 
-template <>
-const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>() {
-    static const std::vector<EnumWord<Symmetry>> words = {
-        {Symmetry::full, "full"},
-        {Symmetry::half, "half"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(Symmetry, {Symmetry::full, "full"}, {Symmetry::half, "half"})
 
-template <>
-const std::vector<EnumWord<SeatAxial>>& enum_words<SeatAxial>() {
-    static const std::vector<EnumWord<SeatAxial>> words = {
-        {SeatAxial::automatic, "auto"},
-        {SeatAxial::held, "held"},
-        {SeatAxial::free, "free"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(SeatAxial, {SeatAxial::automatic, "auto"}, {SeatAxial::held, "held"}, {SeatAxial::free, "free"})
 
-template <>
-const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>() {
-    static const std::vector<EnumWord<MeanStressCorrection>> words = {
-        {MeanStressCorrection::goodman, "goodman"},
-        {MeanStressCorrection::gerber, "gerber"},
-        {MeanStressCorrection::soderberg, "soderberg"},
-        {MeanStressCorrection::morrow, "morrow"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(MeanStressCorrection, {MeanStressCorrection::goodman, "goodman"},
+    {MeanStressCorrection::gerber, "gerber"}, {MeanStressCorrection::soderberg, "soderberg"},
+    {MeanStressCorrection::morrow, "morrow"})
 
 const char* to_string(SupportKind kind) { return word_of(kind); }
 const char* to_string(InterfaceContact contact) { return word_of(contact); }

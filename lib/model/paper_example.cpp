@@ -10,15 +10,8 @@ constexpr double kLength = 0.5, kWidth = 0.05, kHeight = 0.005;
 constexpr int kLeaves = 3;
 }  // namespace
 
-template <>
-const std::vector<EnumWord<PaperCase>>& enum_words<PaperCase>() {
-    static const std::vector<EnumWord<PaperCase>> words = {
-        {PaperCase::bonded, "bonded"},
-        {PaperCase::friction, "friction"},
-        {PaperCase::frictionless, "frictionless"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(PaperCase, {PaperCase::bonded, "bonded"}, {PaperCase::friction, "friction"},
+    {PaperCase::frictionless, "frictionless"})
 
 const char* to_string(PaperCase c) { return word_of(c); }
 

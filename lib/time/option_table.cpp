@@ -25,14 +25,7 @@ std::string number_text(double v) {
 
 }  // namespace
 
-template <>
-const std::vector<EnumWord<TauRule>>& enum_words<TauRule>() {
-    static const std::vector<EnumWord<TauRule>> words = {
-        {TauRule::current, "current"},
-        {TauRule::previous_step, "previous-step"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(TauRule, {TauRule::current, "current"}, {TauRule::previous_step, "previous-step"})
 
 namespace {
 

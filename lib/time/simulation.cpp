@@ -47,25 +47,10 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.seat_axial_m};
 }
 
-template <>
-const std::vector<EnumWord<Mode>>& enum_words<Mode>() {
-    static const std::vector<EnumWord<Mode>> words = {
-        {Mode::closed_form, "closed-form"},
-        {Mode::cvode, "cvode"},
-        {Mode::newmark, "newmark"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(Mode, {Mode::closed_form, "closed-form"}, {Mode::cvode, "cvode"}, {Mode::newmark, "newmark"})
 
-template <>
-const std::vector<EnumWord<LeafInertia>>& enum_words<LeafInertia>() {
-    static const std::vector<EnumWord<LeafInertia>> words = {
-        {LeafInertia::automatic, "auto"},
-        {LeafInertia::massive, "massive"},
-        {LeafInertia::modal, "modal"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(LeafInertia, {LeafInertia::automatic, "auto"}, {LeafInertia::massive, "massive"},
+    {LeafInertia::modal, "modal"})
 
 const char* to_string(Mode m) { return word_of(m); }
 const char* to_string(LeafInertia kind) { return word_of(kind); }
