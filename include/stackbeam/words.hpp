@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "stackbeam/errors.hpp"
+
 namespace stackbeam {
 
 /// One value of an enum and its word.
@@ -49,6 +51,12 @@ std::optional<E> find_word(const std::string& text) {
     return std::nullopt;
 }
 
+/// The value whose word is `text`, else InputError naming `field`: "value '<text>' is not a <what>:
+/// allowed <word_list<E>()>" (the one message of parse_mode, parse_leaf_inertia, parse_solver_kind,
+/// parse_contact_path, parse_tau_rule and parse_paper_case).
+template <class E>
+E parse_word(const std::string& text, const std::string& field, const char* what);
+
 /// The words for a message: each in `quote`, separated by `separator` and the last by
 /// `last_separator` (nullptr: `separator`): word_list<Mode>() is "closed-form, cvode, newmark",
 /// word_list<Symmetry>("'", ", ", " or ") is "'full' or 'half'", word_list<Mode>("", " | ") is
@@ -62,6 +70,12 @@ std::string word_list(const char* quote = "", const char* separator = ", ", cons
         out += std::string(quote) + words[i].word + quote;
     }
     return out;
+}
+
+template <class E>
+E parse_word(const std::string& text, const std::string& field, const char* what) {
+    if (const auto value = find_word<E>(text)) return *value;
+    throw InputError(field, "value '" + text + "' is not a " + what + ": allowed " + word_list<E>());
 }
 
 }  // namespace stackbeam

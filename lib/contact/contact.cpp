@@ -24,8 +24,7 @@ STACKBEAM_ENUM_WORDS(SolverKind, {SolverKind::exact, "exact"}, {SolverKind::acce
 const char* to_string(SolverKind kind) { return word_of(kind); }
 
 SolverKind parse_solver_kind(const std::string& text, const std::string& field) {
-    if (const auto kind = find_word<SolverKind>(text)) return *kind;
-    throw InputError(field, "value '" + text + "' is not a solver: allowed " + word_list<SolverKind>());
+    return parse_word<SolverKind>(text, field, "solver");
 }
 
 void ContactProblem::validate() const {

@@ -14,8 +14,7 @@ STACKBEAM_ENUM_WORDS(ContactPath, {ContactPath::automatic, "auto"}, {ContactPath
 const char* to_string(ContactPath path) { return word_of(path); }
 
 ContactPath parse_contact_path(const std::string& text, const std::string& field) {
-    if (const auto path = find_word<ContactPath>(text)) return *path;
-    throw InputError(field, "value '" + text + "' is not a contact path: allowed " + word_list<ContactPath>());
+    return parse_word<ContactPath>(text, field, "contact path");
 }
 
 ContactPath resolve_contact_path(ContactPath requested, int rows, SolverKind kind) {

@@ -16,8 +16,7 @@ STACKBEAM_ENUM_WORDS(PaperCase, {PaperCase::bonded, "bonded"}, {PaperCase::frict
 const char* to_string(PaperCase c) { return word_of(c); }
 
 PaperCase parse_paper_case(const std::string& text, const std::string& field) {
-    if (const auto c = find_word<PaperCase>(text)) return *c;
-    throw InputError(field, "value '" + text + "' is not a case: allowed " + word_list<PaperCase>());
+    return parse_word<PaperCase>(text, field, "case");
 }
 
 ModelSpec paper_example(PaperCase c, const PaperExampleOptions& o) {

@@ -32,8 +32,7 @@ namespace {
 const char* to_word(TauRule rule) { return word_of(rule); }
 
 TauRule parse_tau_rule(const std::string& text, const std::string& field) {
-    if (const auto rule = find_word<TauRule>(text)) return *rule;
-    throw InputError(field, "value '" + text + "' is not a tau rule: allowed " + word_list<TauRule>());
+    return parse_word<TauRule>(text, field, "tau rule");
 }
 
 /// A keyword option's choices for the table and --help: "a | b | c" from the enum's word table.

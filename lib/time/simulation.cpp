@@ -56,13 +56,11 @@ const char* to_string(Mode m) { return word_of(m); }
 const char* to_string(LeafInertia kind) { return word_of(kind); }
 
 Mode parse_mode(const std::string& text, const std::string& field) {
-    if (const auto mode = find_word<Mode>(text)) return *mode;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed " + word_list<Mode>());
+    return parse_word<Mode>(text, field, "mode");
 }
 
 LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field) {
-    if (const auto kind = find_word<LeafInertia>(text)) return *kind;
-    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed " + word_list<LeafInertia>());
+    return parse_word<LeafInertia>(text, field, "leaf-inertia formulation");
 }
 
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {
