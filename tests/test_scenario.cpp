@@ -12,6 +12,7 @@
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "test_support.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -108,14 +109,7 @@ void check_reproduces(const char* file, PaperCase c, double t_end_s) {
 }
 
 /// The InputError of parsing `text`: its field and message ("accepted" if none).
-std::pair<std::string, std::string> rejection(const std::string& text) {
-    try {
-        parse_scenario(text, "test.toml");
-    } catch (const InputError& e) {
-        return {e.field(), e.what()};
-    }
-    return {"accepted", ""};
-}
+const auto rejection = stackbeam::testing::scenario_refusal;
 
 /// A small valid scenario: two cantilever leaves (fixed at x = 0), a clamp, the body at the tip of the longer.
 const std::string kGood = R"(

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stackbeam/errors.hpp"
+#include "stackbeam/io/scenario.hpp"
 #include "stackbeam/model/paper_example.hpp"
 #include "stackbeam/time/closed_form_stepper.hpp"
 #include "stackbeam/time/simulation.hpp"
@@ -16,6 +18,17 @@ namespace stackbeam::testing {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kSteel = 7850.0;  ///< steel's density [kg/m^3]
+
+/// The InputError of parsing the scenario `text` as "test.toml": its field and message
+/// ("accepted" if none).
+inline std::pair<std::string, std::string> scenario_refusal(const std::string& text) {
+    try {
+        parse_scenario(text, "test.toml");
+    } catch (const InputError& e) {
+        return {e.field(), e.what()};
+    }
+    return {"accepted", ""};
+}
 
 inline std::vector<StepRecord> run_paper(PaperCase c, double t_end_s, double dt_s,
                                          Symmetry sym = Symmetry::half, double tol_m = 1e-10,

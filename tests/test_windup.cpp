@@ -22,6 +22,7 @@
 #include "stackbeam/io/scenario.hpp"
 #include "stackbeam/time/simulation.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "test_support.hpp"
 
 using namespace stackbeam;
 namespace tt = boost::test_tools;
@@ -62,14 +63,7 @@ Loading windup_rig(double theta_end, bool held_vertically) {
 }
 
 /// The InputError of parsing `text` as "test.toml": its field and message ("accepted" if none).
-std::pair<std::string, std::string> file_refusal(const std::string& text) {
-    try {
-        parse_scenario(text, "test.toml");
-    } catch (const InputError& e) {
-        return {e.field(), e.what()};
-    }
-    return {"accepted", ""};
-}
+const auto file_refusal = stackbeam::testing::scenario_refusal;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

@@ -12,40 +12,19 @@
 
 namespace stackbeam {
 
-const char* to_string(PairKind kind) {
-    switch (kind) {
-        case PairKind::bonded: return "bonded";
-        case PairKind::coulomb: return "coulomb";
-        case PairKind::clamp: return "clamp";
-    }
-    return "?";
-}
+STACKBEAM_ENUM_WORDS(PairKind, {PairKind::bonded, "bonded"}, {PairKind::coulomb, "coulomb"}, {PairKind::clamp, "clamp"})
+STACKBEAM_ENUM_WORDS(PairState, {PairState::stick, "stick"}, {PairState::slip, "slip"}, {PairState::open, "open"})
 
-const char* to_string(PairState state) {
-    switch (state) {
-        case PairState::stick: return "stick";
-        case PairState::slip: return "slip";
-        case PairState::open: return "open";
-    }
-    return "?";
-}
+const char* to_string(PairKind kind) { return word_of(kind); }
+const char* to_string(PairState state) { return word_of(state); }
 
-template <>
-const std::vector<EnumWord<SolverKind>>& enum_words<SolverKind>() {
-    static const std::vector<EnumWord<SolverKind>> words = {
-        {SolverKind::exact, "exact"},
-        {SolverKind::accelerated, "accelerated"},
-        {SolverKind::block_jacobi, "block-jacobi"},
-        {SolverKind::paper, "paper"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(SolverKind, {SolverKind::exact, "exact"}, {SolverKind::accelerated, "accelerated"},
+    {SolverKind::block_jacobi, "block-jacobi"}, {SolverKind::paper, "paper"})
 
 const char* to_string(SolverKind kind) { return word_of(kind); }
 
 SolverKind parse_solver_kind(const std::string& text, const std::string& field) {
-    if (const auto kind = find_word<SolverKind>(text)) return *kind;
-    throw InputError(field, "value '" + text + "' is not a solver: allowed " + word_list<SolverKind>());
+    return parse_word<SolverKind>(text, field, "solver");
 }
 
 void ContactProblem::validate() const {

@@ -8,21 +8,13 @@
 
 namespace stackbeam {
 
-template <>
-const std::vector<EnumWord<ContactPath>>& enum_words<ContactPath>() {
-    static const std::vector<EnumWord<ContactPath>> words = {
-        {ContactPath::automatic, "auto"},
-        {ContactPath::dense, "dense"},
-        {ContactPath::sparse, "sparse"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(ContactPath, {ContactPath::automatic, "auto"}, {ContactPath::dense, "dense"},
+    {ContactPath::sparse, "sparse"})
 
 const char* to_string(ContactPath path) { return word_of(path); }
 
 ContactPath parse_contact_path(const std::string& text, const std::string& field) {
-    if (const auto path = find_word<ContactPath>(text)) return *path;
-    throw InputError(field, "value '" + text + "' is not a contact path: allowed " + word_list<ContactPath>());
+    return parse_word<ContactPath>(text, field, "contact path");
 }
 
 ContactPath resolve_contact_path(ContactPath requested, int rows, SolverKind kind) {

@@ -24,86 +24,80 @@ struct System::LazyCompliance {
 namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
+using Terms = std::vector<std::pair<int, double>>;  // (DOF, coefficient)
 
-}  // namespace
+// The constructor's steps, in order (each a function of what the previous ones made).
 
-int System::node_dof(int leaf, int node) const {
-    if (!model_.leaf_has_node(leaf, node)) return -1;
-    return node_offset_[leaf] + node;
+/// The leaves' element stiffness on the full DOFs (3 per node, System::node_dof).
+Triplets leaf_stiffness(const System& sys, const Model& model) {
+    const auto& spec = model.spec();
+    const auto& xs = model.nodes_x();
+    Triplets kt;
+    for (int l = 0; l < static_cast<int>(spec.leaves.size()); ++l) {
+        for (int j = model.first_node(l); j < model.last_node(l); ++j)
+            detail::add_matrix(kt, sys.node_dof(l, j), sys.node_dof(l, j + 1), detail::element_stiffness(spec.leaves[l], xs[j], xs[j + 1]));
+    }
+    return kt;
 }
 
-System::System(const Model& model) : model_(model) {
-    const auto& spec = model_.spec();
-    const int nleaf = static_cast<int>(spec.leaves.size());
-    const auto& xs = model_.nodes_x();
+/// Each full DOF's role in the constraints: -1 fixed, -2 seat w, -3 seat theta, -4 seat axial
+/// (-y theta_R), >= 0 its own master, -5 a combination of other full DOFs (an eye or a shackle:
+/// dependent[dof]).
+struct DofRoles {
+    std::vector<int> role;
+    std::vector<Terms> dependent;
+};
+
+/// A support of kind `s` at the leaf end whose node's first full DOF is `b`: the support point at
+/// height e above the axis moves (u - e theta, v) (small deflection). A bushing's springs go to `kt`.
+void add_support(SupportKind s, const LeafEndSpec& end, int b, DofRoles& roles, Triplets& kt) {
+    auto& role = roles.role;
+    const double e = end.eye_offset_m;
+    if (s == SupportKind::pinned) role[b + 1] = -1;
+    if (s == SupportKind::fixed) role[b] = role[b + 1] = role[b + 2] = -1;
+    if (s == SupportKind::hinged) {  // v = 0, u - e theta = 0
+        role[b + 1] = -1;
+        role[b] = e == 0.0 ? -1 : -5;
+        roles.dependent[b] = {{b + 2, e}};
+    }
+    if (s == SupportKind::shackle) {  // along the link (sin a, cos a): sin a (u - e theta) + cos a v = 0
+        const double tan_a = std::tan(end.shackle_angle_rad);
+        role[b + 1] = tan_a == 0.0 ? -1 : -5;
+        roles.dependent[b + 1] = {{b, -tan_a}, {b + 2, tan_a * e}};
+    }
+    if (s == SupportKind::bushing) {  // springs from the support point to the ground
+        const double kx = end.bushing_x_n_per_m;
+        const int d[3] = {b, b + 1, b + 2};
+        const double ax[3] = {1.0, 0.0, -e};  // its axial displacement u - e theta
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                if (ax[r] * ax[c] != 0.0 && kx > 0.0) kt.emplace_back(d[r], d[c], kx * ax[r] * ax[c]);
+        if (end.bushing_y_n_per_m > 0.0) kt.emplace_back(b + 1, b + 1, end.bushing_y_n_per_m);
+        if (end.bushing_rotation_n_m_per_rad > 0.0) kt.emplace_back(b + 2, b + 2, end.bushing_rotation_n_m_per_rad);
+    }
+}
+
+/// The roles of the supports, the seat (on the tied leaves' attachment node) and the half model's
+/// symmetry plane; the bushings' springs go to `kt`.
+DofRoles constraint_roles(const System& sys, const Model& model, int num_full, Triplets& kt) {
+    const auto& spec = model.spec();
+    const auto& xs = model.nodes_x();
     const bool half = spec.symmetry == Symmetry::half;
-    const double tol = model_.x_tolerance_m();
-    const int attach = model_.attachment_node();
-    const auto& tied = model_.tied_leaves();
-    const auto& yc = model_.centroid_heights_m();
-
-    // --- full DOF numbering: leaf by leaf, 3 per node ---------------------------
-    node_offset_.resize(nleaf);
-    int nfull_nodes = 0;
-    for (int l = 0; l < nleaf; ++l) {
-        node_offset_[l] = nfull_nodes - model_.first_node(l);
-        nfull_nodes += model_.last_node(l) - model_.first_node(l) + 1;
-    }
-    num_full_ = 3 * nfull_nodes;
-
-    Triplets kt;
-    for (int l = 0; l < nleaf; ++l) {
-        for (int j = model_.first_node(l); j < model_.last_node(l); ++j)
-            detail::add_matrix(kt, node_dof(l, j), node_dof(l, j + 1), detail::element_stiffness(spec.leaves[l], xs[j], xs[j + 1]));
-    }
-
-    // --- constraints: each full DOF = sum of coef * master ------------------------
-    // kind per full dof: -1 fixed, -2 seat w, -3 seat theta, -4 seat axial (-y theta_R), >=0 own master,
-    // -5 a combination of other full DOFs (an eye or a shackle: dependent[dof])
     const bool seat_rotates = !half;
-    // The seat locates the stack axially unless an end's eye does (a hinged eye, a shackle, a bushing):
-    // then it slides, with the axial displacement u_R of its own (docs/model-and-scenarios.md).
-    // rigid_body.axial: 'auto' as described, 'held' never slides, 'free' always does.
-    const SeatAxial axial = spec.rigid_body.axial;
-    const bool ends_locate = ends_locate_axially(spec);
-    const bool seat_slides = stackbeam::seat_slides(spec);
-    std::vector<int> role(num_full_, 0);
-    std::vector<std::vector<std::pair<int, double>>> dependent(num_full_);
-    for (int l = 0; l < nleaf; ++l) {
+    const double tol = model.x_tolerance_m();
+    const int attach = model.attachment_node();
+    const auto& tied = model.tied_leaves();
+    DofRoles roles{std::vector<int>(num_full, 0), std::vector<Terms>(num_full)};
+    auto& role = roles.role;
+    for (int l = 0; l < static_cast<int>(spec.leaves.size()); ++l) {
         const auto& leaf = spec.leaves[l];
         const bool is_tied = std::find(tied.begin(), tied.end(), l) != tied.end();
-        for (int j = model_.first_node(l); j <= model_.last_node(l); ++j) {
-            const int b = 3 * node_dof(l, j);
-            // The support point at height e above the axis moves (u - e theta, v) (small deflection).
-            auto support = [&](SupportKind s, const LeafEndSpec& end) {
-                const double e = end.eye_offset_m;
-                if (s == SupportKind::pinned) role[b + 1] = -1;
-                if (s == SupportKind::fixed) role[b] = role[b + 1] = role[b + 2] = -1;
-                if (s == SupportKind::hinged) {  // v = 0, u - e theta = 0
-                    role[b + 1] = -1;
-                    role[b] = e == 0.0 ? -1 : -5;
-                    dependent[b] = {{b + 2, e}};
-                }
-                if (s == SupportKind::shackle) {  // along the link (sin a, cos a): sin a (u - e theta) + cos a v = 0
-                    const double tan_a = std::tan(end.shackle_angle_rad);
-                    role[b + 1] = tan_a == 0.0 ? -1 : -5;
-                    dependent[b + 1] = {{b, -tan_a}, {b + 2, tan_a * e}};
-                }
-                if (s == SupportKind::bushing) {  // springs from the support point to the ground
-                    const double kx = end.bushing_x_n_per_m;
-                    const int d[3] = {b, b + 1, b + 2};
-                    const double ax[3] = {1.0, 0.0, -e};  // its axial displacement u - e theta
-                    for (int r = 0; r < 3; ++r)
-                        for (int c = 0; c < 3; ++c)
-                            if (ax[r] * ax[c] != 0.0 && kx > 0.0) kt.emplace_back(d[r], d[c], kx * ax[r] * ax[c]);
-                    if (end.bushing_y_n_per_m > 0.0) kt.emplace_back(b + 1, b + 1, end.bushing_y_n_per_m);
-                    if (end.bushing_rotation_n_m_per_rad > 0.0) kt.emplace_back(b + 2, b + 2, end.bushing_rotation_n_m_per_rad);
-                }
-            };
+        for (int j = model.first_node(l); j <= model.last_node(l); ++j) {
+            const int b = 3 * sys.node_dof(l, j);
             const bool left_end = std::abs(xs[j] - leaf.x_start_m) <= tol;
             const bool right_end = std::abs(xs[j] - (leaf.x_start_m + leaf.length_m)) <= tol;
-            if (left_end) support(leaf.left_support, leaf.left_end);
-            if (right_end) support(leaf.right_support, leaf.right_end);
+            if (left_end) add_support(leaf.left_support, leaf.left_end, b, roles, kt);
+            if (right_end) add_support(leaf.right_support, leaf.right_end, b, roles, kt);
             if (j == attach && is_tied) {
                 if ((left_end && leaf.left_support != SupportKind::free) ||
                     (right_end && leaf.right_support != SupportKind::free))
@@ -120,78 +114,107 @@ System::System(const Model& model) : model_(model) {
             }
         }
     }
-    // masters: node-major order for a narrow band, then theta_R, then w
-    int nm = 0;
-    std::vector<int> master(num_full_, -1);
-    for (int j = 0; j < static_cast<int>(xs.size()); ++j)
+    return roles;
+}
+
+/// The reduced DOFs (masters): node-major order for a narrow band, then u_R (when the seat
+/// slides), theta_R (when it rotates), then w.
+struct Masters {
+    std::vector<int> of_full;  // the master of a full DOF of role 0, else -1
+    int count = 0;
+    int slide = -1, theta = -1, w = -1;
+};
+
+Masters number_masters(const System& sys, const Model& model, const std::vector<int>& role, bool seat_slides,
+                       bool seat_rotates) {
+    Masters m;
+    m.of_full.assign(role.size(), -1);
+    const int nleaf = static_cast<int>(model.spec().leaves.size());
+    for (int j = 0; j < static_cast<int>(model.nodes_x().size()); ++j)
         for (int l = 0; l < nleaf; ++l) {
-            if (!model_.leaf_has_node(l, j)) continue;
+            if (!model.leaf_has_node(l, j)) continue;
             for (int d = 0; d < 3; ++d)
-                if (role[3 * node_dof(l, j) + d] == 0) master[3 * node_dof(l, j) + d] = nm++;
+                if (role[3 * sys.node_dof(l, j) + d] == 0) m.of_full[3 * sys.node_dof(l, j) + d] = m.count++;
         }
-    const int slide_master = seat_slides ? nm++ : -1;
-    const int theta_master = seat_rotates ? nm++ : -1;
-    const int w_master = nm++;
-    seat_axial_dof_ = slide_master;
-    seat_rotation_dof_ = theta_master;
+    m.slide = seat_slides ? m.count++ : -1;
+    m.theta = seat_rotates ? m.count++ : -1;
+    m.w = m.count++;
+    return m;
+}
+
+/// P's entries (full DOFs <- masters): each full DOF as a sum of coefficient * master.
+Triplets reduction_entries(const System& sys, const Model& model, const DofRoles& roles, const Masters& masters) {
+    const auto& yc = model.centroid_heights_m();
+    const auto& master = masters.of_full;
     Triplets pt;
-    for (int l = 0; l < nleaf; ++l)
-        for (int j = model_.first_node(l); j <= model_.last_node(l); ++j)
+    for (int l = 0; l < static_cast<int>(model.spec().leaves.size()); ++l)
+        for (int j = model.first_node(l); j <= model.last_node(l); ++j)
             for (int d = 0; d < 3; ++d) {
-                const int i = 3 * node_dof(l, j) + d;
-                switch (role[i]) {
+                const int i = 3 * sys.node_dof(l, j) + d;
+                switch (roles.role[i]) {
                     case 0: pt.emplace_back(i, master[i], 1.0); break;
-                    case -2: pt.emplace_back(i, w_master, 1.0); break;
-                    case -3: pt.emplace_back(i, theta_master, 1.0); break;
+                    case -2: pt.emplace_back(i, masters.w, 1.0); break;
+                    case -3: pt.emplace_back(i, masters.theta, 1.0); break;
                     case -4:
-                        if (yc[l] != 0.0) pt.emplace_back(i, theta_master, -yc[l]);
-                        if (seat_slides) pt.emplace_back(i, slide_master, 1.0);
+                        if (yc[l] != 0.0) pt.emplace_back(i, masters.theta, -yc[l]);
+                        if (masters.slide >= 0) pt.emplace_back(i, masters.slide, 1.0);
                         break;
                     case -5:
-                        for (const auto& [dof, coef] : dependent[i])
+                        for (const auto& [dof, coef] : roles.dependent[i])
                             if (coef != 0.0 && master[dof] >= 0) pt.emplace_back(i, master[dof], coef);
                         break;
                     default: break;
                 }
             }
-    Eigen::SparseMatrix<double> K(num_full_, num_full_);  // the leaves and the bushings
-    K.setFromTriplets(kt.begin(), kt.end());
-    P_.resize(num_full_, nm);
-    P_.setFromTriplets(pt.begin(), pt.end());
-    K_red_ = (P_.transpose() * K * P_).pruned();
+    return pt;
+}
 
-    // --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
-    const auto& cand = model_.candidate_pairs();
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P_;
-    Triplets gt;
+/// A contact row on the full DOFs as a row on the reduced ones: each full DOF is a few masters
+/// times coefficients (a row of P), so a row is a few (master, value) terms; near-zero sums are
+/// dropped (1e-12).
+Terms reduce_row(const Eigen::SparseMatrix<double, Eigen::RowMajor>& Prow, std::initializer_list<std::pair<int, double>> full) {
+    Terms out;
+    for (const auto& [dof, g] : full)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Prow, dof); it; ++it) {
+            auto f = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == it.col(); });
+            if (f == out.end()) out.emplace_back(static_cast<int>(it.col()), g * it.value());
+            else f->second += g * it.value();
+        }
+    out.erase(std::remove_if(out.begin(), out.end(), [](const auto& e) { return std::abs(e.second) < 1e-12; }), out.end());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/// The contact rows of the candidate pairs that carry something: G's entries, per row its gap and
+/// layer compliance, the pairs and the candidate each came from.
+struct ContactRows {
+    Triplets g;
+    int rows = 0;
     std::vector<double> gaps, layer;
-    int row = 0;
+    std::vector<ContactPair> pairs;
+    std::vector<int> candidate;
+    int probe = -1;
+};
+
+// --- contact rows: surface kinematics (eq. 1), normal from upper A into lower B ---
+ContactRows carrying_rows(const System& sys, const Model& model, const Eigen::SparseMatrix<double>& P) {
+    const auto& spec = model.spec();
+    const auto& cand = model.candidate_pairs();
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> Prow = P;
+    ContactRows out;
+    int& row = out.rows;
     for (int ci = 0; ci < static_cast<int>(cand.size()); ++ci) {
         const auto& cp = cand[ci];
         const int a = cp.interface_index, b = a + 1;
-        const int da = 3 * node_dof(a, cp.node), db = 3 * node_dof(b, cp.node);
+        const int da = 3 * sys.node_dof(a, cp.node), db = 3 * sys.node_dof(b, cp.node);
         // the moment arms: half the local thickness (a profiled leaf's axis lies midway between its surfaces)
         const double ha = leaf_thickness_m(spec.leaves[a], cp.x_m), hb = leaf_thickness_m(spec.leaves[b], cp.x_m);
         // s_n = -v_A + v_B - d_n ; s_t = (u_A + h_A/2 th_A) - (u_B - h_B/2 th_B) - d_t
-        // On the reduced DOFs: each full DOF is a few masters times coefficients (a row
-        // of P), so a row is a few (master, value) terms; near-zero sums are dropped (1e-12).
-        auto reduce = [&](std::initializer_list<std::pair<int, double>> full) {
-            std::vector<std::pair<int, double>> out;
-            for (const auto& [dof, g] : full)
-                for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Prow, dof); it; ++it) {
-                    auto f = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == it.col(); });
-                    if (f == out.end()) out.emplace_back(static_cast<int>(it.col()), g * it.value());
-                    else f->second += g * it.value();
-                }
-            out.erase(std::remove_if(out.begin(), out.end(), [](const auto& e) { return std::abs(e.second) < 1e-12; }), out.end());
-            std::sort(out.begin(), out.end());
-            return out;
-        };
-        auto rn = reduce({{da + 1, -1.0}, {db + 1, 1.0}});
-        auto rt = reduce({{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
+        auto rn = reduce_row(Prow, {{da + 1, -1.0}, {db + 1, 1.0}});
+        auto rt = reduce_row(Prow, {{da, 1.0}, {da + 2, 0.5 * ha}, {db, -1.0}, {db + 2, 0.5 * hb}});
         if (cp.clip_index >= 0) {  // rebound clip: s = v_first - v_last - d (opening beyond the clearance), no tangent
             const int last = spec.clips[cp.clip_index].last_leaf;
-            rn = reduce({{da + 1, 1.0}, {3 * node_dof(last, cp.node) + 1, -1.0}});
+            rn = reduce_row(Prow, {{da + 1, 1.0}, {3 * sys.node_dof(last, cp.node) + 1, -1.0}});
             rt.clear();
             if (rn.empty())
                 throw InputError("clips[" + std::to_string(cp.clip_index) + "].x_m",
@@ -218,24 +241,99 @@ System::System(const Model& model) : model_(model) {
         p.preload_n = cp.preload_n;
         if (has_n) {
             p.row_n = row++;
-            for (const auto& [col, v] : rn) gt.emplace_back(p.row_n, col, v);
-            gaps.push_back(cp.initial_gap_m);
-            layer.push_back(cp.normal_compliance_m_per_n);
+            for (const auto& [col, v] : rn) out.g.emplace_back(p.row_n, col, v);
+            out.gaps.push_back(cp.initial_gap_m);
+            out.layer.push_back(cp.normal_compliance_m_per_n);
         }
         if (has_t) {
             p.row_t = row++;
-            for (const auto& [col, v] : rt) gt.emplace_back(p.row_t, col, v);
-            gaps.push_back(0.0);
-            layer.push_back(cp.tangential_compliance_m_per_n);
+            for (const auto& [col, v] : rt) out.g.emplace_back(p.row_t, col, v);
+            out.gaps.push_back(0.0);
+            out.layer.push_back(cp.tangential_compliance_m_per_n);
         }
-        if (ci == model_.probe_pair()) probe_ = static_cast<int>(pairs_.size());
-        pairs_.push_back(p);
-        pair_candidate_.push_back(ci);
+        if (ci == model.probe_pair()) out.probe = static_cast<int>(out.pairs.size());
+        out.pairs.push_back(p);
+        out.candidate.push_back(ci);
     }
-    gaps_ = Eigen::Map<Eigen::VectorXd>(gaps.data(), static_cast<Eigen::Index>(gaps.size()));
-    layer_ = Eigen::Map<Eigen::VectorXd>(layer.data(), static_cast<Eigen::Index>(layer.size()));
+    return out;
+}
+
+/// C' = G_r K_rr^-1 G_r^T + C_L is SPD when the rows without a layer (c_L = 0) of G_r have
+/// full row rank (K_rr is SPD; a layer row adds c_L > 0 to the diagonal), i.e.
+/// when their G_r G_r^T is: checked by a sparse LDL^T of it (the rows are local, so it is
+/// sparse and cheap) rather than by factorising the dense C', which is built only on demand.
+/// A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
+/// are 1 and h/2, so an independent set of rows stays far above that).
+void check_rigid_rows_independent(const Eigen::SparseMatrix<double>& Gr, const Eigen::VectorXd& layer) {
+    const int row = static_cast<int>(layer.size());
+    std::vector<Eigen::Triplet<double>> rigid_rows;
+    int n_rigid = 0;
+    for (int r = 0; r < row; ++r)
+        if (layer[r] == 0.0) rigid_rows.emplace_back(n_rigid++, r, 1.0);
+    if (n_rigid > 0) {
+        Eigen::SparseMatrix<double> R(n_rigid, row);
+        R.setFromTriplets(rigid_rows.begin(), rigid_rows.end());
+        const Eigen::SparseMatrix<double> Gr_rigid = R * Gr;
+        const Eigen::SparseMatrix<double> GGt = Gr_rigid * Gr_rigid.transpose();
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
+        const double scale = GGt.diagonal().maxCoeff();
+        if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
+            throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
+    }
+}
+
+}  // namespace
+
+int System::node_dof(int leaf, int node) const {
+    if (!model_.leaf_has_node(leaf, node)) return -1;
+    return node_offset_[leaf] + node;
+}
+
+System::System(const Model& model) : model_(model) {
+    const auto& spec = model_.spec();
+    const int nleaf = static_cast<int>(spec.leaves.size());
+    const bool half = spec.symmetry == Symmetry::half;
+
+    // --- full DOF numbering: leaf by leaf, 3 per node ---------------------------
+    node_offset_.resize(nleaf);
+    int nfull_nodes = 0;
+    for (int l = 0; l < nleaf; ++l) {
+        node_offset_[l] = nfull_nodes - model_.first_node(l);
+        nfull_nodes += model_.last_node(l) - model_.first_node(l) + 1;
+    }
+    num_full_ = 3 * nfull_nodes;
+
+    // --- constraints: each full DOF = sum of coef * master ------------------------
+    Triplets kt = leaf_stiffness(*this, model_);
+    const bool seat_rotates = !half;
+    // The seat locates the stack axially unless an end's eye does (a hinged eye, a shackle, a bushing):
+    // then it slides, with the axial displacement u_R of its own (docs/model-and-scenarios.md).
+    // rigid_body.axial: 'auto' as described, 'held' never slides, 'free' always does.
+    const SeatAxial axial = spec.rigid_body.axial;
+    const bool ends_locate = ends_locate_axially(spec);
+    const bool seat_slides = stackbeam::seat_slides(spec);
+    const DofRoles roles = constraint_roles(*this, model_, num_full_, kt);
+    const Masters masters = number_masters(*this, model_, roles.role, seat_slides, seat_rotates);
+    const int nm = masters.count;
+    seat_axial_dof_ = masters.slide;
+    seat_rotation_dof_ = masters.theta;
+    const Triplets pt = reduction_entries(*this, model_, roles, masters);
+    Eigen::SparseMatrix<double> K(num_full_, num_full_);  // the leaves and the bushings
+    K.setFromTriplets(kt.begin(), kt.end());
+    P_.resize(num_full_, nm);
+    P_.setFromTriplets(pt.begin(), pt.end());
+    K_red_ = (P_.transpose() * K * P_).pruned();
+
+    // --- contact rows ----------------------------------------------------------------
+    ContactRows rows = carrying_rows(*this, model_, P_);
+    const int row = rows.rows;
+    pairs_ = std::move(rows.pairs);
+    pair_candidate_ = std::move(rows.candidate);
+    probe_ = rows.probe;
+    gaps_ = Eigen::Map<Eigen::VectorXd>(rows.gaps.data(), static_cast<Eigen::Index>(rows.gaps.size()));
+    layer_ = Eigen::Map<Eigen::VectorXd>(rows.layer.data(), static_cast<Eigen::Index>(rows.layer.size()));
     Eigen::SparseMatrix<double> G(row, nm);
-    G.setFromTriplets(gt.begin(), gt.end());
+    G.setFromTriplets(rows.g.begin(), rows.g.end());
 
     // --- condensation with R held ------------------------------------------------
     const int nr = nm - 1;
@@ -263,26 +361,7 @@ System::System(const Model& model) : model_(model) {
     if (!(k_ > 0.0))
         throw InputError("rigid_body.x_m", "the stack has no stiffness at the attachment (k = " + format_value(k_) +
                                                " N/m): the rigid body must be carried by supported leaves");
-    // C' = G_r K_rr^-1 G_r^T + C_L is SPD when the rows without a layer (c_L = 0) of G_r have
-    // full row rank (K_rr is SPD; a layer row adds c_L > 0 to the diagonal), i.e.
-    // when their G_r G_r^T is: checked by a sparse LDL^T of it (the rows are local, so it is
-    // sparse and cheap) rather than by factorising the dense C', which is built only on demand.
-    // A pivot below 1e-10 of the largest diagonal entry counts as zero (the entries of G
-    // are 1 and h/2, so an independent set of rows stays far above that).
-    std::vector<Eigen::Triplet<double>> rigid_rows;
-    int n_rigid = 0;
-    for (int r = 0; r < row; ++r)
-        if (layer_[r] == 0.0) rigid_rows.emplace_back(n_rigid++, r, 1.0);
-    if (n_rigid > 0) {
-        Eigen::SparseMatrix<double> R(n_rigid, row);
-        R.setFromTriplets(rigid_rows.begin(), rigid_rows.end());
-        const Eigen::SparseMatrix<double> Gr_rigid = R * Gr_;
-        const Eigen::SparseMatrix<double> GGt = Gr_rigid * Gr_rigid.transpose();
-        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(GGt);
-        const double scale = GGt.diagonal().maxCoeff();
-        if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-10 * scale))
-            throw InputError("interfaces", "the contact compliance C' is singular: contact components are not independent");
-    }
+    check_rigid_rows_independent(Gr_, layer_);
     mass_ = spec.rigid_body.mass_kg / model_.whole_spring_factor();
 }
 

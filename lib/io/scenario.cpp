@@ -26,15 +26,8 @@
 
 namespace stackbeam {
 
-template <>
-const std::vector<EnumWord<InterfaceLawWord>>& enum_words<InterfaceLawWord>() {
-    static const std::vector<EnumWord<InterfaceLawWord>> words = {
-        {InterfaceLawWord::coulomb, "coulomb"},
-        {InterfaceLawWord::frictionless, "frictionless"},
-        {InterfaceLawWord::bonded, "bonded"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(InterfaceLawWord, {InterfaceLawWord::coulomb, "coulomb"},
+    {InterfaceLawWord::frictionless, "frictionless"}, {InterfaceLawWord::bonded, "bonded"})
 
 namespace {
 

@@ -29,27 +29,13 @@ void require_finite(const std::string& field, double v, const std::string& what)
 
 }  // namespace
 
-template <>
-const std::vector<EnumWord<TimeFunction::Shape>>& enum_words<TimeFunction::Shape>() {
-    static const std::vector<EnumWord<TimeFunction::Shape>> words = {
-        {TimeFunction::Shape::constant, "constant"},
-        {TimeFunction::Shape::harmonic, "harmonic"},
-        {TimeFunction::Shape::triangle, "triangle"},
-        {TimeFunction::Shape::table, "table"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(TimeFunction::Shape, {TimeFunction::Shape::constant, "constant"},
+    {TimeFunction::Shape::harmonic, "harmonic"}, {TimeFunction::Shape::triangle, "triangle"},
+    {TimeFunction::Shape::table, "table"})
 
-template <>
-const std::vector<EnumWord<LoadingKind>>& enum_words<LoadingKind>() {
-    static const std::vector<EnumWord<LoadingKind>> words = {
-        {LoadingKind::initial_conditions, "initial-conditions"},
-        {LoadingKind::applied_force, "applied-force"},
-        {LoadingKind::prescribed_displacement, "prescribed-displacement"},
-        {LoadingKind::base_excitation, "base-excitation"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(LoadingKind, {LoadingKind::initial_conditions, "initial-conditions"},
+    {LoadingKind::applied_force, "applied-force"}, {LoadingKind::prescribed_displacement, "prescribed-displacement"},
+    {LoadingKind::base_excitation, "base-excitation"})
 
 const char* to_string(TimeFunction::Shape shape) { return word_of(shape); }
 const char* to_string(LoadingKind kind) { return word_of(kind); }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -11,57 +12,19 @@
 
 namespace stackbeam {
 
-template <>
-const std::vector<EnumWord<SupportKind>>& enum_words<SupportKind>() {
-    static const std::vector<EnumWord<SupportKind>> words = {
-        {SupportKind::free, "free"},
-        {SupportKind::pinned, "pinned"},
-        {SupportKind::fixed, "fixed"},
-        {SupportKind::hinged, "hinged"},
-        {SupportKind::shackle, "shackle"},
-        {SupportKind::bushing, "bushing"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(SupportKind, {SupportKind::free, "free"}, {SupportKind::pinned, "pinned"},
+    {SupportKind::fixed, "fixed"}, {SupportKind::hinged, "hinged"}, {SupportKind::shackle, "shackle"},
+    {SupportKind::bushing, "bushing"})
 
-template <>
-const std::vector<EnumWord<InterfaceContact>>& enum_words<InterfaceContact>() {
-    static const std::vector<EnumWord<InterfaceContact>> words = {
-        {InterfaceContact::rigid, "rigid"},
-        {InterfaceContact::elastic, "elastic"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(InterfaceContact, {InterfaceContact::rigid, "rigid"}, {InterfaceContact::elastic, "elastic"})
 
-template <>
-const std::vector<EnumWord<Symmetry>>& enum_words<Symmetry>() {
-    static const std::vector<EnumWord<Symmetry>> words = {
-        {Symmetry::full, "full"},
-        {Symmetry::half, "half"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(Symmetry, {Symmetry::full, "full"}, {Symmetry::half, "half"})
 
-template <>
-const std::vector<EnumWord<SeatAxial>>& enum_words<SeatAxial>() {
-    static const std::vector<EnumWord<SeatAxial>> words = {
-        {SeatAxial::automatic, "auto"},
-        {SeatAxial::held, "held"},
-        {SeatAxial::free, "free"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(SeatAxial, {SeatAxial::automatic, "auto"}, {SeatAxial::held, "held"}, {SeatAxial::free, "free"})
 
-template <>
-const std::vector<EnumWord<MeanStressCorrection>>& enum_words<MeanStressCorrection>() {
-    static const std::vector<EnumWord<MeanStressCorrection>> words = {
-        {MeanStressCorrection::goodman, "goodman"},
-        {MeanStressCorrection::gerber, "gerber"},
-        {MeanStressCorrection::soderberg, "soderberg"},
-        {MeanStressCorrection::morrow, "morrow"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(MeanStressCorrection, {MeanStressCorrection::goodman, "goodman"},
+    {MeanStressCorrection::gerber, "gerber"}, {MeanStressCorrection::soderberg, "soderberg"},
+    {MeanStressCorrection::morrow, "morrow"})
 
 const char* to_string(SupportKind kind) { return word_of(kind); }
 const char* to_string(InterfaceContact contact) { return word_of(contact); }
@@ -240,7 +203,6 @@ void validate_end(SupportKind kind, const LeafEndSpec& e, std::size_t i, const c
                          "the half model takes supports 'free', 'pinned' or 'fixed' without an eye offset: use mesh.symmetry = 'full'");
 }
 
-
 /// The mesh's rule for close clamps (docs/model-and-scenarios.md, "Mesh"; decision 071): two
 /// nodes a small fraction of element_length_m h apart make an element of length l << h whose
 /// bending stiffness 12 EI / l^3 is (h / l)^3 times the others' (two clamps 0.35 mm apart on
@@ -335,12 +297,18 @@ bool Model::leaf_has_node(int leaf, int node) const {
     return node >= first_node_[leaf] && node <= last_node_[leaf];
 }
 
-Model Model::build(ModelSpec spec) {
-    Model m;
-    const auto& leaves = spec.leaves;
-    if (leaves.empty()) throw InputError("leaves", "the stack has no leaf: at least 1 is required");
+namespace {
 
-    // --- leaves -----------------------------------------------------------
+// Model::build's steps, in order: the checks of the spec (each InputError names the key), then
+// the mesh (node_grid), the leaves' node ranges, the centroid heights and the candidate pairs.
+
+/// Whether x [m] lies on leaves[leaf] (within the model's x tolerance of its ends).
+using Present = std::function<bool(std::size_t, double)>;
+
+/// Each leaf's fields (length, position, section, ends, material); returns the stack's extent
+/// [x_min, x_max] [m].
+std::pair<double, double> validate_leaves(const ModelSpec& spec) {
+    const auto& leaves = spec.leaves;
     double x_min = std::numeric_limits<double>::infinity();
     double x_max = -x_min;
     for (std::size_t i = 0; i < leaves.size(); ++i) {
@@ -359,12 +327,12 @@ Model Model::build(ModelSpec spec) {
         x_min = std::min(x_min, l.x_start_m);
         x_max = std::max(x_max, leaf_end(l));
     }
-    detail::validate_free_shapes(spec);
-    const double extent = x_max - x_min;
-    const double tol = 1e-9 * std::max(extent, std::abs(x_max));
-    m.x_tol_ = tol;
+    return {x_min, x_max};
+}
 
-    // --- interfaces -------------------------------------------------------
+/// One interface between each pair of adjacent leaves, its fields, and the leaves' overlap.
+void validate_interfaces(const ModelSpec& spec, double tol) {
+    const auto& leaves = spec.leaves;
     if (spec.interfaces.size() != leaves.size() - 1)
         throw InputError("interfaces", "has " + std::to_string(spec.interfaces.size()) +
                                            " entries: a stack of " + std::to_string(leaves.size()) +
@@ -388,48 +356,53 @@ Model Model::build(ModelSpec spec) {
                              "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) +
                                  "] do not overlap along x: adjacent leaves must touch over a positive length");
     }
+}
 
-    // --- rigid body -------------------------------------------------------
-    auto& rb = spec.rigid_body;
+/// The rigid body's fields; returns the leaves it ties, in increasing order (rigid_body.tied_leaves,
+/// or every leaf present at its attachment x_m).
+std::vector<int> validate_rigid_body(const ModelSpec& spec, const Present& present) {
+    const auto& leaves = spec.leaves;
+    const auto& rb = spec.rigid_body;
     require_positive("rigid_body.mass_kg", rb.mass_kg, "[kg]");
     require_finite("rigid_body.x_m", rb.x_m);
     require_finite("rigid_body.initial_displacement_m", rb.initial_displacement_m);
     require_finite("rigid_body.initial_velocity_m_per_s", rb.initial_velocity_m_per_s);
     require_nonnegative("rigid_body.pitch_inertia_kg_m2", rb.pitch_inertia_kg_m2, "[kg m^2]");
-    auto present = [&](std::size_t leaf, double x) {
-        return x >= leaves[leaf].x_start_m - tol && x <= leaf_end(leaves[leaf]) + tol;
-    };
+    std::vector<int> tied;
     if (rb.tied_leaves.empty()) {
         for (std::size_t i = 0; i < leaves.size(); ++i)
-            if (present(i, rb.x_m)) m.tied_.push_back(static_cast<int>(i));
-        if (m.tied_.empty())
+            if (present(i, rb.x_m)) tied.push_back(static_cast<int>(i));
+        if (tied.empty())
             throw InputError("rigid_body.x_m", "value " + format_value(rb.x_m) +
                                                    " is off every leaf: the attachment must lie on a leaf");
-    } else {
-        for (std::size_t k = 0; k < rb.tied_leaves.size(); ++k) {
-            const int leaf = rb.tied_leaves[k];
-            const std::string field = "rigid_body.tied_leaves[" + std::to_string(k) + "]";
-            if (leaf < 0 || leaf >= static_cast<int>(leaves.size()))
-                throw InputError(field, "value " + std::to_string(leaf) + " is not a leaf index: allowed 0.." +
-                                            std::to_string(leaves.size() - 1));
-            if (!present(leaf, rb.x_m))
-                throw InputError(field, "leaf " + std::to_string(leaf) + " does not reach the attachment x = " +
-                                            format_value(rb.x_m) + " m");
-            if (std::find(m.tied_.begin(), m.tied_.end(), leaf) != m.tied_.end())
-                throw InputError(field, "leaf " + std::to_string(leaf) + " is listed twice");
-            m.tied_.push_back(leaf);
-        }
-        std::sort(m.tied_.begin(), m.tied_.end());
+        return tied;
     }
+    for (std::size_t k = 0; k < rb.tied_leaves.size(); ++k) {
+        const int leaf = rb.tied_leaves[k];
+        const std::string field = "rigid_body.tied_leaves[" + std::to_string(k) + "]";
+        if (leaf < 0 || leaf >= static_cast<int>(leaves.size()))
+            throw InputError(field, "value " + std::to_string(leaf) + " is not a leaf index: allowed 0.." +
+                                        std::to_string(leaves.size() - 1));
+        if (!present(leaf, rb.x_m))
+            throw InputError(field, "leaf " + std::to_string(leaf) + " does not reach the attachment x = " +
+                                        format_value(rb.x_m) + " m");
+        if (std::find(tied.begin(), tied.end(), leaf) != tied.end())
+            throw InputError(field, "leaf " + std::to_string(leaf) + " is listed twice");
+        tied.push_back(leaf);
+    }
+    std::sort(tied.begin(), tied.end());
+    return tied;
+}
 
-    // --- clamps -----------------------------------------------------------
+/// Each clamp's fields, on an interface, at a position of its own.
+void validate_clamps(const ModelSpec& spec, double tol, const Present& present) {
     for (std::size_t c = 0; c < spec.clamps.size(); ++c) {
         const auto& cl = spec.clamps[c];
         require_finite(idx("clamps", c, "x_m"), cl.x_m);
         require_nonnegative(idx("clamps", c, "preload_n"), cl.preload_n, "[N]");
         require_nonnegative(idx("clamps", c, "length_m"), cl.length_m, "[m] (0: a point tie)");
         bool crosses = false;
-        for (std::size_t i = 0; i + 1 < leaves.size(); ++i) crosses = crosses || (present(i, cl.x_m) && present(i + 1, cl.x_m));
+        for (std::size_t i = 0; i + 1 < spec.leaves.size(); ++i) crosses = crosses || (present(i, cl.x_m) && present(i + 1, cl.x_m));
         if (!crosses)
             throw InputError(idx("clamps", c, "x_m"), "value " + format_value(cl.x_m) +
                                                           " crosses no interface: a clamp must lie where two adjacent leaves overlap");
@@ -438,75 +411,82 @@ Model Model::build(ModelSpec spec) {
                 throw InputError(idx("clamps", c, "x_m"), "value " + format_value(cl.x_m) + " duplicates clamps[" +
                                                               std::to_string(d) + "]: clamps must be at distinct positions");
     }
+}
 
-    // --- mesh -------------------------------------------------------------
+/// The mesh's element length over the stack's extent [m].
+void validate_mesh(const ModelSpec& spec, double extent) {
     require_positive("mesh.element_length_m", spec.mesh.element_length_m, "[m]");
     if (extent / spec.mesh.element_length_m > 1e6)
         throw InputError("mesh.element_length_m", "value " + format_value(spec.mesh.element_length_m) +
                                                       " gives more than 1e6 elements along the stack: use a longer element");
+}
 
-    // --- symmetry ---------------------------------------------------------
-    const bool half = spec.symmetry == Symmetry::half;
-    if (half) {
-        const double xr = rb.x_m;
-        // the symmetry plane holds the seat's rotation and axial motion (theta = u = 0 there)
-        if (rb.pitch_inertia_kg_m2 > 0.0)
-            throw InputError("rigid_body.pitch_inertia_kg_m2",
-                             "value " + format_value(rb.pitch_inertia_kg_m2) +
-                                 " is not used by the half model, whose seat does not rotate (give 0, or use mesh.symmetry = 'full')");
-        if (rb.axial == SeatAxial::free)
-            throw InputError("rigid_body.axial", "value 'free' is not available on the half model, whose symmetry plane "
-                                                 "locates the seat axially (use mesh.symmetry = 'full')");
-        for (std::size_t i = 0; i < leaves.size(); ++i) {
-            const auto& l = leaves[i];
-            if (std::abs(l.x_start_m + 0.5 * l.length_m - xr) > tol)
-                throw InputError(idx("leaves", i, "x_start_m"),
-                                 "the half model needs every leaf centred on the attachment x = " + format_value(xr) +
-                                     " m; this leaf's centre is at " + format_value(l.x_start_m + 0.5 * l.length_m) + " m");
-            if (l.left_support != l.right_support)
-                throw InputError(idx("leaves", i, "right_support"), "the half model needs equal supports at both ends");
-            for (double px : l.profile.x_m) {  // a profile mirrored about the attachment
-                const double x = l.x_start_m + px, xm = 2.0 * xr - x;
-                if (std::abs(leaf_thickness_m(l, x) - leaf_thickness_m(l, xm)) > 1e-9 * leaf_thickness_m(l, x) ||
-                    std::abs(leaf_width_m(l, x) - leaf_width_m(l, xm)) > 1e-9 * leaf_width_m(l, x))
-                    throw InputError(idx("leaves", i, "profile"), "the half model needs each profile mirrored about the attachment x = " +
-                                                                      format_value(xr) + " m; at x = " + format_value(x) + " m it is not");
-            }
-        }
-        if (m.tied_.size() != leaves.size())
-            throw InputError("rigid_body.tied_leaves", "the half model needs the seat to tie every leaf");
-        for (std::size_t c = 0; c < spec.clamps.size(); ++c) {
-            const auto& cl = spec.clamps[c];
-            if (std::abs(cl.x_m - xr) <= tol) continue;
-            const bool mirrored = std::any_of(spec.clamps.begin(), spec.clamps.end(), [&](const ClampSpec& o) {
-                return std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol && o.preload_n == cl.preload_n &&
-                       o.length_m == cl.length_m;
-            });
-            if (!mirrored)
-                throw InputError(idx("clamps", c, "x_m"), "the half model needs each clamp mirrored about x = " +
-                                                              format_value(xr) + " m with the same preload and length");
+/// The half model: the stack mirrored about the attachment (leaves centred, equal supports,
+/// profiles and clamps mirrored), the seat tying every leaf, neither rotating nor sliding.
+void validate_half_model(const ModelSpec& spec, const std::vector<int>& tied, double tol) {
+    const auto& leaves = spec.leaves;
+    const auto& rb = spec.rigid_body;
+    const double xr = rb.x_m;
+    // the symmetry plane holds the seat's rotation and axial motion (theta = u = 0 there)
+    if (rb.pitch_inertia_kg_m2 > 0.0)
+        throw InputError("rigid_body.pitch_inertia_kg_m2",
+                         "value " + format_value(rb.pitch_inertia_kg_m2) +
+                             " is not used by the half model, whose seat does not rotate (give 0, or use mesh.symmetry = 'full')");
+    if (rb.axial == SeatAxial::free)
+        throw InputError("rigid_body.axial", "value 'free' is not available on the half model, whose symmetry plane "
+                                             "locates the seat axially (use mesh.symmetry = 'full')");
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        const auto& l = leaves[i];
+        if (std::abs(l.x_start_m + 0.5 * l.length_m - xr) > tol)
+            throw InputError(idx("leaves", i, "x_start_m"),
+                             "the half model needs every leaf centred on the attachment x = " + format_value(xr) +
+                                 " m; this leaf's centre is at " + format_value(l.x_start_m + 0.5 * l.length_m) + " m");
+        if (l.left_support != l.right_support)
+            throw InputError(idx("leaves", i, "right_support"), "the half model needs equal supports at both ends");
+        for (double px : l.profile.x_m) {  // a profile mirrored about the attachment
+            const double x = l.x_start_m + px, xm = 2.0 * xr - x;
+            if (std::abs(leaf_thickness_m(l, x) - leaf_thickness_m(l, xm)) > 1e-9 * leaf_thickness_m(l, x) ||
+                std::abs(leaf_width_m(l, x) - leaf_width_m(l, xm)) > 1e-9 * leaf_width_m(l, x))
+                throw InputError(idx("leaves", i, "profile"), "the half model needs each profile mirrored about the attachment x = " +
+                                                                  format_value(xr) + " m; at x = " + format_value(x) + " m it is not");
         }
     }
-    const double x_hi = half ? rb.x_m : x_max;
-    detail::validate_clips(spec, tol, present);
-
-    // --- probe ------------------------------------------------------------
-    if (spec.probe) {
-        const auto& pr = *spec.probe;
-        if (pr.interface_index < 0 || pr.interface_index + 1 >= static_cast<int>(leaves.size()))
-            throw InputError("probe.interface_index", "value " + std::to_string(pr.interface_index) +
-                                                          " is not an interface: allowed 0.." +
-                                                          std::to_string(static_cast<int>(leaves.size()) - 2));
-        require_finite("probe.x_m", pr.x_m);
-        if (!present(pr.interface_index, pr.x_m) || !present(pr.interface_index + 1, pr.x_m) || pr.x_m > x_hi + tol)
-            throw InputError("probe.x_m", "value " + format_value(pr.x_m) + " is not on interface " +
-                                              std::to_string(pr.interface_index) + " (within the meshed region)");
+    if (tied.size() != leaves.size())
+        throw InputError("rigid_body.tied_leaves", "the half model needs the seat to tie every leaf");
+    for (std::size_t c = 0; c < spec.clamps.size(); ++c) {
+        const auto& cl = spec.clamps[c];
+        if (std::abs(cl.x_m - xr) <= tol) continue;
+        const bool mirrored = std::any_of(spec.clamps.begin(), spec.clamps.end(), [&](const ClampSpec& o) {
+            return std::abs(o.x_m - (2.0 * xr - cl.x_m)) <= tol && o.preload_n == cl.preload_n &&
+                   o.length_m == cl.length_m;
+        });
+        if (!mirrored)
+            throw InputError(idx("clamps", c, "x_m"), "the half model needs each clamp mirrored about x = " +
+                                                          format_value(xr) + " m with the same preload and length");
     }
+}
 
-    // --- node grid ----------------------------------------------------------
-    merge_close_clamps(spec, tol);
+/// The probe, when given: on an interface, within the meshed region (x <= x_hi [m]).
+void validate_probe(const ModelSpec& spec, const Present& present, double x_hi, double tol) {
+    if (!spec.probe) return;
+    const auto& pr = *spec.probe;
+    if (pr.interface_index < 0 || pr.interface_index + 1 >= static_cast<int>(spec.leaves.size()))
+        throw InputError("probe.interface_index", "value " + std::to_string(pr.interface_index) +
+                                                      " is not an interface: allowed 0.." +
+                                                      std::to_string(static_cast<int>(spec.leaves.size()) - 2));
+    require_finite("probe.x_m", pr.x_m);
+    if (!present(pr.interface_index, pr.x_m) || !present(pr.interface_index + 1, pr.x_m) || pr.x_m > x_hi + tol)
+        throw InputError("probe.x_m", "value " + format_value(pr.x_m) + " is not on interface " +
+                                          std::to_string(pr.interface_index) + " (within the meshed region)");
+}
+
+/// The mesh: the nodes' x [m] up to x_hi, increasing. Every break (a leaf's ends and profile
+/// points, a clamp, a clip, the attachment, the probe) is a node; between two breaks, elements
+/// of at most mesh.element_length_m, equal.
+std::vector<double> node_grid(const ModelSpec& spec, double tol, double x_hi) {
+    const auto& rb = spec.rigid_body;
     std::vector<double> breaks;
-    for (const auto& l : leaves) {
+    for (const auto& l : spec.leaves) {
         breaks.push_back(l.x_start_m);
         breaks.push_back(leaf_end(l));
         for (double px : l.profile.x_m) breaks.push_back(l.x_start_m + px);  // a profile's breakpoints are nodes
@@ -521,124 +501,150 @@ Model Model::build(ModelSpec spec) {
         if (b > x_hi + tol) continue;
         if (uniq.empty() || b - uniq.back() > tol) uniq.push_back(b);
     }
-    if (half && std::abs(uniq.back() - rb.x_m) > tol) uniq.push_back(rb.x_m);
-    m.nodes_x_.push_back(uniq.front());
+    if (spec.symmetry == Symmetry::half && std::abs(uniq.back() - rb.x_m) > tol) uniq.push_back(rb.x_m);
+    std::vector<double> nodes_x{uniq.front()};
     for (std::size_t s = 1; s < uniq.size(); ++s) {
         const double a = uniq[s - 1], b = uniq[s];
         const int n = std::max(1, static_cast<int>(std::ceil((b - a) / spec.mesh.element_length_m - 1e-6)));
-        for (int k = 1; k <= n; ++k) m.nodes_x_.push_back(k == n ? b : a + (b - a) * k / n);
+        for (int k = 1; k <= n; ++k) nodes_x.push_back(k == n ? b : a + (b - a) * k / n);
     }
-    auto node_at = [&](double x) {
-        const auto it = std::lower_bound(m.nodes_x_.begin(), m.nodes_x_.end(), x - tol);
-        return static_cast<int>(it - m.nodes_x_.begin());
-    };
-    const int nn = static_cast<int>(m.nodes_x_.size());
-    for (const auto& l : leaves) {
-        m.first_node_.push_back(node_at(l.x_start_m));
-        m.last_node_.push_back(std::min(nn - 1, node_at(leaf_end(l))));
-    }
-    m.attach_node_ = node_at(rb.x_m);
+    return nodes_x;
+}
 
-    // --- centroid heights (y up, leaf 0 on top) ------------------------------
-    // at the seat: a profiled leaf's axis lies half its local thickness from its surfaces
-    std::vector<double> yc(leaves.size()), ts(leaves.size());
+/// The index of the first node at or after x - tol.
+int node_at(const std::vector<double>& nodes_x, double x, double tol) {
+    const auto it = std::lower_bound(nodes_x.begin(), nodes_x.end(), x - tol);
+    return static_cast<int>(it - nodes_x.begin());
+}
+
+/// Each leaf's thickness at the seat [m].
+std::vector<double> seat_thicknesses(const ModelSpec& spec) {
+    std::vector<double> ts(spec.leaves.size());
+    for (std::size_t i = 0; i < spec.leaves.size(); ++i) ts[i] = leaf_thickness_m(spec.leaves[i], spec.rigid_body.x_m);
+    return ts;
+}
+
+/// The leaves' centroid heights [m] (y up, leaf 0 on top), stacked at the seat with the
+/// interfaces' gaps, zero midway across the tied leaves. At the seat a profiled leaf's axis lies
+/// half its local thickness `ts` from its surfaces.
+std::vector<double> centroid_heights(const ModelSpec& spec, const std::vector<double>& ts, const std::vector<int>& tied) {
+    std::vector<double> yc(spec.leaves.size());
     double top = 0.0;
-    for (std::size_t i = 0; i < leaves.size(); ++i) {
-        ts[i] = leaf_thickness_m(leaves[i], rb.x_m);
+    for (std::size_t i = 0; i < spec.leaves.size(); ++i) {
         yc[i] = top - 0.5 * ts[i];
         top -= ts[i] + (i < spec.interfaces.size() ? spec.interfaces[i].initial_gap_m : 0.0);
     }
-    const int t0 = m.tied_.front(), t1 = m.tied_.back();
+    const int t0 = tied.front(), t1 = tied.back();
     const double mid = 0.5 * ((yc[t0] + 0.5 * ts[t0]) + (yc[t1] - 0.5 * ts[t1]));
     for (auto& y : yc) y -= mid;
-    m.y_centroid_ = yc;
+    return yc;
+}
 
-    // --- candidate pairs ------------------------------------------------------
-    for (std::size_t i = 0; i + 1 < leaves.size(); ++i) {
-        const int lo = std::max(m.first_node_[i], m.first_node_[i + 1]);
-        const int hi = std::min(m.last_node_[i], m.last_node_[i + 1]);
-        const bool elastic = spec.interfaces[i].contact == InterfaceContact::elastic;
-        const bool profiled = !leaves[i].profile.x_m.empty() || !leaves[i + 1].profile.x_m.empty();
-        InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
-        for (int n = lo; n <= hi; ++n) {
-            if (elastic && profiled) layer = interface_layer(spec, static_cast<int>(i), m.nodes_x_[n]);  // the local sections
-            PairSpec p;
-            p.interface_index = static_cast<int>(i);
-            p.node = n;
-            p.x_m = m.nodes_x_[n];
-            p.friction_coefficient = spec.interfaces[i].friction_coefficient;
-            p.initial_gap_m = spec.interfaces[i].initial_gap_m;
-            double taper_gap = 0.0;
-            if (profiled) {  // straight axes, stacked at the seat: sections thinner than there leave a gap
-                const double here = leaf_thickness_m(leaves[i], p.x_m) + leaf_thickness_m(leaves[i + 1], p.x_m);
-                taper_gap = 0.5 * (ts[i] + ts[i + 1] - here);
-                // the profiles may not overlap unless a positive gap makes room (an explicit
-                // interference, a negative gap, is the gap's own and adds to the taper's gap)
-                const double room = std::max(0.0, p.initial_gap_m);
-                if (room + taper_gap < -1e-9 * here)
-                    throw InputError(idx("interfaces", i, "initial_gap_m"),
-                                     "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) + "] would overlap by " +
-                                         format_value(-taper_gap - room) + " m at x = " + format_value(p.x_m) +
-                                         " m: the leaves are stacked at the seat (rigid_body.x_m) on straight axes, so their "
-                                         "profiles must not be thicker elsewhere than there, or the gap must make room");
-                p.initial_gap_m = p.initial_gap_m >= 0.0 ? std::max(0.0, p.initial_gap_m + taper_gap)
-                                                         : p.initial_gap_m + std::max(0.0, taper_gap);
-            }
-            p.kind = PairKind::coulomb;
-            if (spec.interfaces[i].law == InterfaceLaw::bonded) {
-                p.kind = PairKind::bonded;
-                p.friction_coefficient = 0.0;
-            } else {
-                for (const auto& cl : spec.clamps)
-                    if (std::abs(cl.x_m - p.x_m) <= tol) {  // clamps merged at one point add up (merge_close_clamps)
-                        p.kind = PairKind::clamp;
-                        p.preload_n += cl.preload_n;
-                    }
-            }
-            if (elastic) {
-                // The layer over the pair's area A = b L: L the tributary length (half of each
-                // neighbouring element of the interface; lumped, node to node), or a clamp's own
-                // length (half of it on the symmetry plane of the half model). A point clamp stays rigid.
-                double L = 0.0;
-                if (p.kind == PairKind::clamp) {
-                    for (const auto& cl : spec.clamps)
-                        if (std::abs(cl.x_m - p.x_m) <= tol) L += cl.length_m;
-                    if (half && n == m.attach_node_) L *= 0.5;
-                } else {
-                    if (n < hi) L += 0.5 * (m.nodes_x_[n + 1] - m.nodes_x_[n]);
-                    if (n > lo) L += 0.5 * (m.nodes_x_[n] - m.nodes_x_[n - 1]);
-                }
-                if (L > 0.0) {
-                    const double area = layer.contact_width_m * L;
-                    p.normal_compliance_m_per_n = 1.0 / (layer.normal_stiffness_pa_per_m * area);
-                    p.tangential_compliance_m_per_n = 1.0 / (layer.tangential_stiffness_pa_per_m * area);
-                }
-            }
-            if (p.kind == PairKind::clamp && taper_gap > 1e-12) {
-                std::size_t c = 0;
-                while (std::abs(spec.clamps[c].x_m - p.x_m) > tol) ++c;
-                throw InputError(idx("clamps", c, "x_m"), "value " + format_value(p.x_m) + " crosses interfaces[" + std::to_string(i) +
-                                                              "] where the leaves' profiles leave a gap of " + format_value(taper_gap) +
-                                                              " m (they are stacked at the seat, x = " + format_value(rb.x_m) +
-                                                              " m): a clamp needs the leaves' sections there as thick as at the seat");
-            }
-            if (p.kind == PairKind::clamp && p.initial_gap_m > 0.0)
-                throw InputError(idx("interfaces", i, "initial_gap_m"),
-                                 "value " + format_value(p.initial_gap_m) +
-                                     " is not allowed where a clamp crosses the interface: a clamp closes the gap (use 0)");
-            p.initial_gap_m += detail::free_shape_m(spec, static_cast<int>(i), p.x_m) -
-                               detail::free_shape_m(spec, static_cast<int>(i) + 1, p.x_m);  // free camber
-            m.pairs_.push_back(p);
-        }
+/// Where the leaves' profiles are thinner than at the seat (straight axes, stacked there) they
+/// leave a taper gap: it is added to p.initial_gap_m; returns it [m]. The profiles may not overlap
+/// unless a positive gap makes room (an explicit interference, a negative gap, is the gap's own
+/// and adds to the taper's gap).
+double add_taper_gap(const ModelSpec& spec, std::size_t i, const std::vector<double>& ts, PairSpec& p) {
+    const auto& leaves = spec.leaves;
+    const double here = leaf_thickness_m(leaves[i], p.x_m) + leaf_thickness_m(leaves[i + 1], p.x_m);
+    const double taper_gap = 0.5 * (ts[i] + ts[i + 1] - here);
+    const double room = std::max(0.0, p.initial_gap_m);
+    if (room + taper_gap < -1e-9 * here)
+        throw InputError(idx("interfaces", i, "initial_gap_m"),
+                         "leaves[" + std::to_string(i) + "] and leaves[" + std::to_string(i + 1) + "] would overlap by " +
+                             format_value(-taper_gap - room) + " m at x = " + format_value(p.x_m) +
+                             " m: the leaves are stacked at the seat (rigid_body.x_m) on straight axes, so their "
+                             "profiles must not be thicker elsewhere than there, or the gap must make room");
+    p.initial_gap_m = p.initial_gap_m >= 0.0 ? std::max(0.0, p.initial_gap_m + taper_gap)
+                                             : p.initial_gap_m + std::max(0.0, taper_gap);
+    return taper_gap;
+}
+
+/// The pair's kind: bonded by the interface's law, a clamp (with its preload) where one crosses,
+/// else Coulomb.
+void set_pair_kind(const ModelSpec& spec, std::size_t i, double tol, PairSpec& p) {
+    p.kind = PairKind::coulomb;
+    if (spec.interfaces[i].law == InterfaceLaw::bonded) {
+        p.kind = PairKind::bonded;
+        p.friction_coefficient = 0.0;
+        return;
     }
+    for (const auto& cl : spec.clamps)
+        if (std::abs(cl.x_m - p.x_m) <= tol) {  // clamps merged at one point add up (merge_close_clamps)
+            p.kind = PairKind::clamp;
+            p.preload_n += cl.preload_n;
+        }
+}
 
-    // --- probe pair -------------------------------------------------------------
+/// The candidate pairs of interfaces[i], one per node both leaves share (x <= the meshed region).
+void add_interface_pairs(const ModelSpec& spec, const Model& m, std::size_t i, const std::vector<double>& ts,
+                         std::vector<PairSpec>& pairs) {
+    const auto& leaves = spec.leaves;
+    const auto& nodes_x = m.nodes_x();
+    const double tol = m.x_tolerance_m();
+    const bool half = spec.symmetry == Symmetry::half;
+    const int lo = std::max(m.first_node(static_cast<int>(i)), m.first_node(static_cast<int>(i) + 1));
+    const int hi = std::min(m.last_node(static_cast<int>(i)), m.last_node(static_cast<int>(i) + 1));
+    const bool elastic = spec.interfaces[i].contact == InterfaceContact::elastic;
+    const bool profiled = !leaves[i].profile.x_m.empty() || !leaves[i + 1].profile.x_m.empty();
+    InterfaceLayer layer = interface_layer(spec, static_cast<int>(i));
+    for (int n = lo; n <= hi; ++n) {
+        if (elastic && profiled) layer = interface_layer(spec, static_cast<int>(i), nodes_x[n]);  // the local sections
+        PairSpec p;
+        p.interface_index = static_cast<int>(i);
+        p.node = n;
+        p.x_m = nodes_x[n];
+        p.friction_coefficient = spec.interfaces[i].friction_coefficient;
+        p.initial_gap_m = spec.interfaces[i].initial_gap_m;
+        const double taper_gap = profiled ? add_taper_gap(spec, i, ts, p) : 0.0;
+        set_pair_kind(spec, i, tol, p);
+        if (elastic) {
+            // The layer over the pair's area A = b L: L the tributary length (half of each
+            // neighbouring element of the interface; lumped, node to node), or a clamp's own
+            // length (half of it on the symmetry plane of the half model). A point clamp stays rigid.
+            double L = 0.0;
+            if (p.kind == PairKind::clamp) {
+                for (const auto& cl : spec.clamps)
+                    if (std::abs(cl.x_m - p.x_m) <= tol) L += cl.length_m;
+                if (half && n == m.attachment_node()) L *= 0.5;
+            } else {
+                if (n < hi) L += 0.5 * (nodes_x[n + 1] - nodes_x[n]);
+                if (n > lo) L += 0.5 * (nodes_x[n] - nodes_x[n - 1]);
+            }
+            if (L > 0.0) {
+                const double area = layer.contact_width_m * L;
+                p.normal_compliance_m_per_n = 1.0 / (layer.normal_stiffness_pa_per_m * area);
+                p.tangential_compliance_m_per_n = 1.0 / (layer.tangential_stiffness_pa_per_m * area);
+            }
+        }
+        if (p.kind == PairKind::clamp && taper_gap > 1e-12) {
+            std::size_t c = 0;
+            while (std::abs(spec.clamps[c].x_m - p.x_m) > tol) ++c;
+            throw InputError(idx("clamps", c, "x_m"), "value " + format_value(p.x_m) + " crosses interfaces[" + std::to_string(i) +
+                                                          "] where the leaves' profiles leave a gap of " + format_value(taper_gap) +
+                                                          " m (they are stacked at the seat, x = " + format_value(spec.rigid_body.x_m) +
+                                                          " m): a clamp needs the leaves' sections there as thick as at the seat");
+        }
+        if (p.kind == PairKind::clamp && p.initial_gap_m > 0.0)
+            throw InputError(idx("interfaces", i, "initial_gap_m"),
+                             "value " + format_value(p.initial_gap_m) +
+                                 " is not allowed where a clamp crosses the interface: a clamp closes the gap (use 0)");
+        p.initial_gap_m += detail::free_shape_m(spec, static_cast<int>(i), p.x_m) -
+                           detail::free_shape_m(spec, static_cast<int>(i) + 1, p.x_m);  // free camber
+        pairs.push_back(p);
+    }
+}
+
+/// The probe pair's index in `pairs` (-1: none): the given probe, else the first clamp on
+/// interface 0 within the meshed region.
+int probe_pair_index(const ModelSpec& spec, const Present& present, double x_hi, double tol,
+                     const std::vector<double>& nodes_x, const std::vector<PairSpec>& pairs) {
     ProbeSpec probe;
     bool have_probe = false;
     if (spec.probe) {
         probe = *spec.probe;
         have_probe = true;
-    } else if (leaves.size() > 1) {
+    } else if (spec.leaves.size() > 1) {
         double best = std::numeric_limits<double>::infinity();
         for (const auto& cl : spec.clamps)
             if (present(0, cl.x_m) && present(1, cl.x_m) && cl.x_m < best && cl.x_m <= x_hi + tol) best = cl.x_m;
@@ -647,11 +653,56 @@ Model Model::build(ModelSpec spec) {
             have_probe = true;
         }
     }
+    int found = -1;
     if (have_probe) {
-        const int n = node_at(probe.x_m);
-        for (std::size_t k = 0; k < m.pairs_.size(); ++k)
-            if (m.pairs_[k].interface_index == probe.interface_index && m.pairs_[k].node == n) m.probe_pair_ = static_cast<int>(k);
+        const int n = node_at(nodes_x, probe.x_m, tol);
+        for (std::size_t k = 0; k < pairs.size(); ++k)
+            if (pairs[k].interface_index == probe.interface_index && pairs[k].node == n) found = static_cast<int>(k);
     }
+    return found;
+}
+
+}  // namespace
+
+Model Model::build(ModelSpec spec) {
+    Model m;
+    const auto& leaves = spec.leaves;
+    if (leaves.empty()) throw InputError("leaves", "the stack has no leaf: at least 1 is required");
+
+    // --- the spec's checks, in the order of its keys ----------------------------------
+    const auto [x_min, x_max] = validate_leaves(spec);
+    detail::validate_free_shapes(spec);
+    const double extent = x_max - x_min;
+    const double tol = 1e-9 * std::max(extent, std::abs(x_max));
+    m.x_tol_ = tol;
+    validate_interfaces(spec, tol);
+    const auto present = [&](std::size_t leaf, double x) {
+        return x >= leaves[leaf].x_start_m - tol && x <= leaf_end(leaves[leaf]) + tol;
+    };
+    m.tied_ = validate_rigid_body(spec, present);
+    validate_clamps(spec, tol, present);
+    validate_mesh(spec, extent);
+    const bool half = spec.symmetry == Symmetry::half;
+    if (half) validate_half_model(spec, m.tied_, tol);
+    const double x_hi = half ? spec.rigid_body.x_m : x_max;
+    detail::validate_clips(spec, tol, present);
+    validate_probe(spec, present, x_hi, tol);
+
+    // --- the mesh and each leaf's node range -------------------------------------------
+    merge_close_clamps(spec, tol);
+    m.nodes_x_ = node_grid(spec, tol, x_hi);
+    const int nn = static_cast<int>(m.nodes_x_.size());
+    for (const auto& l : leaves) {
+        m.first_node_.push_back(node_at(m.nodes_x_, l.x_start_m, tol));
+        m.last_node_.push_back(std::min(nn - 1, node_at(m.nodes_x_, leaf_end(l), tol)));
+    }
+    m.attach_node_ = node_at(m.nodes_x_, spec.rigid_body.x_m, tol);
+
+    // --- centroid heights, candidate pairs, the probe pair, the clips' pairs -------------
+    const std::vector<double> ts = seat_thicknesses(spec);
+    m.y_centroid_ = centroid_heights(spec, ts, m.tied_);
+    for (std::size_t i = 0; i + 1 < leaves.size(); ++i) add_interface_pairs(spec, m, i, ts, m.pairs_);
+    m.probe_pair_ = probe_pair_index(spec, present, x_hi, tol, m.nodes_x_, m.pairs_);
     detail::add_clip_pairs(spec, m.nodes_x_, tol, m.pairs_);  // after the probe's: never the probe pair
     m.spec_ = std::move(spec);
     return m;

@@ -10,21 +10,13 @@ constexpr double kLength = 0.5, kWidth = 0.05, kHeight = 0.005;
 constexpr int kLeaves = 3;
 }  // namespace
 
-template <>
-const std::vector<EnumWord<PaperCase>>& enum_words<PaperCase>() {
-    static const std::vector<EnumWord<PaperCase>> words = {
-        {PaperCase::bonded, "bonded"},
-        {PaperCase::friction, "friction"},
-        {PaperCase::frictionless, "frictionless"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(PaperCase, {PaperCase::bonded, "bonded"}, {PaperCase::friction, "friction"},
+    {PaperCase::frictionless, "frictionless"})
 
 const char* to_string(PaperCase c) { return word_of(c); }
 
 PaperCase parse_paper_case(const std::string& text, const std::string& field) {
-    if (const auto c = find_word<PaperCase>(text)) return *c;
-    throw InputError(field, "value '" + text + "' is not a case: allowed " + word_list<PaperCase>());
+    return parse_word<PaperCase>(text, field, "case");
 }
 
 ModelSpec paper_example(PaperCase c, const PaperExampleOptions& o) {

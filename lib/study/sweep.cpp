@@ -206,20 +206,12 @@ std::string to_string(const AxisValue& value) {
     return std::get<std::string>(value);
 }
 
-template <>
-const std::vector<EnumWord<Combine>>& enum_words<Combine>() {
-    static const std::vector<EnumWord<Combine>> words = {{Combine::product, "product"}, {Combine::zip, "zip"}};
-    return words;
-}
+STACKBEAM_ENUM_WORDS(Combine, {Combine::product, "product"}, {Combine::zip, "zip"})
 
 const char* to_string(Combine combine) { return word_of(combine); }
 
-template <>
-const std::vector<EnumWord<PointStatus>>& enum_words<PointStatus>() {
-    static const std::vector<EnumWord<PointStatus>> words = {
-        {PointStatus::ok, "ok"}, {PointStatus::failed, "failed"}, {PointStatus::input_error, "input-error"}};
-    return words;
-}
+STACKBEAM_ENUM_WORDS(PointStatus, {PointStatus::ok, "ok"}, {PointStatus::failed, "failed"},
+    {PointStatus::input_error, "input-error"})
 
 const char* to_string(PointStatus status) { return word_of(status); }
 

@@ -25,22 +25,14 @@ std::string number_text(double v) {
 
 }  // namespace
 
-template <>
-const std::vector<EnumWord<TauRule>>& enum_words<TauRule>() {
-    static const std::vector<EnumWord<TauRule>> words = {
-        {TauRule::current, "current"},
-        {TauRule::previous_step, "previous-step"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(TauRule, {TauRule::current, "current"}, {TauRule::previous_step, "previous-step"})
 
 namespace {
 
 const char* to_word(TauRule rule) { return word_of(rule); }
 
 TauRule parse_tau_rule(const std::string& text, const std::string& field) {
-    if (const auto rule = find_word<TauRule>(text)) return *rule;
-    throw InputError(field, "value '" + text + "' is not a tau rule: allowed " + word_list<TauRule>());
+    return parse_word<TauRule>(text, field, "tau rule");
 }
 
 /// A keyword option's choices for the table and --help: "a | b | c" from the enum's word table.

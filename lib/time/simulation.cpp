@@ -47,37 +47,20 @@ std::vector<double> step_record_values(const StepRecord& r) {
             r.seat_axial_m};
 }
 
-template <>
-const std::vector<EnumWord<Mode>>& enum_words<Mode>() {
-    static const std::vector<EnumWord<Mode>> words = {
-        {Mode::closed_form, "closed-form"},
-        {Mode::cvode, "cvode"},
-        {Mode::newmark, "newmark"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(Mode, {Mode::closed_form, "closed-form"}, {Mode::cvode, "cvode"}, {Mode::newmark, "newmark"})
 
-template <>
-const std::vector<EnumWord<LeafInertia>>& enum_words<LeafInertia>() {
-    static const std::vector<EnumWord<LeafInertia>> words = {
-        {LeafInertia::automatic, "auto"},
-        {LeafInertia::massive, "massive"},
-        {LeafInertia::modal, "modal"},
-    };
-    return words;
-}
+STACKBEAM_ENUM_WORDS(LeafInertia, {LeafInertia::automatic, "auto"}, {LeafInertia::massive, "massive"},
+    {LeafInertia::modal, "modal"})
 
 const char* to_string(Mode m) { return word_of(m); }
 const char* to_string(LeafInertia kind) { return word_of(kind); }
 
 Mode parse_mode(const std::string& text, const std::string& field) {
-    if (const auto mode = find_word<Mode>(text)) return *mode;
-    throw InputError(field, "value '" + text + "' is not a mode: allowed " + word_list<Mode>());
+    return parse_word<Mode>(text, field, "mode");
 }
 
 LeafInertia parse_leaf_inertia(const std::string& text, const std::string& field) {
-    if (const auto kind = find_word<LeafInertia>(text)) return *kind;
-    throw InputError(field, "value '" + text + "' is not a leaf-inertia formulation: allowed " + word_list<LeafInertia>());
+    return parse_word<LeafInertia>(text, field, "leaf-inertia formulation");
 }
 
 ContactPath choose_contact_path(const System& system, const SimulationOptions& options) {

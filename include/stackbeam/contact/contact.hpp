@@ -43,6 +43,8 @@ struct ContactProblem : ContactLaws {
 /// State of a pair at a solution.
 enum class PairState { stick, slip, open };
 const char* to_string(PairState state);
+template <>
+const std::vector<EnumWord<PairState>>& enum_words<PairState>();
 
 /// tau [N] of pair `k` for the force vector p, by the problem's tau rule.
 double friction_normal_force(const ContactLaws& problem, int k, const Eigen::VectorXd& p);

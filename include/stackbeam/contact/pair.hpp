@@ -14,6 +14,8 @@ enum class PairKind {
     clamp,    ///< bilateral normal (never opens), Coulomb friction with limit mu*max(0, F_c - p_n)
 };
 const char* to_string(PairKind kind);
+template <>
+const std::vector<EnumWord<PairKind>>& enum_words<PairKind>();
 
 /// One contact pair of a contact problem: its law and which rows of the problem are its
 /// normal and tangential components (-1: the component is absent, e.g. fixed by a support).

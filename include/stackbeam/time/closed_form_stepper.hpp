@@ -32,26 +32,19 @@ namespace stackbeam {
 /// which is exact: eliminating z gives W = G K_aug^-1 G^T = C' + (gamma/k) c c^T and
 /// q = c w_free - d (the w row reads (k + k_R) w = (k/gamma) w_free + c^T p, and
 /// k + k_R = k/gamma). So both paths solve the same problem, to round-off.
+///
+/// Its Stepper outputs: advance() is one step of dt (SolverError: step, time, residual, when the
+/// contact solve fails and options.stop_on_nonconvergence); nodes() are z of the sparse path, or of
+/// the forces and w on the dense path (System::reduced_displacements: the massless leaves are in
+/// equilibrium with p and w); stresses() of that z and pairs(); report() the steps, and the contact
+/// iterations and factorisations summed over the records.
 class ClosedFormStepper final : public Stepper {
 public:
     /// Checks `options` (SimulationOptions::validate and what the mode takes: InputError) and
     /// starts from the shared initial state (the assembly, gravity, R held at w(0)).
     ClosedFormStepper(const System& system, const SimulationOptions& options);
     ~ClosedFormStepper() override;
-
-    /// Advances one step of dt. Throws SolverError (step, time, residual) if the
-    /// contact solve fails and options.stop_on_nonconvergence.
-    const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    std::vector<PairRecord> pairs() const override;
-    /// The leaves' nodes: z of the sparse path, or of the forces and w on the dense path
-    /// (System::reduced_displacements: the massless leaves are in equilibrium with p and w).
-    std::vector<LeafNodes> nodes() const override;
-    /// The stresses of the z nodes() uses and of pairs() (compute_stresses).
-    Stresses stresses() const override;
-    /// Steps, and the contact iterations and factorisations summed over the records.
-    RunReport report() const override;
+    STACKBEAM_STEPPER_OVERRIDES
 
     /// Contact forces p [N] per component row (paper sign: p_n < 0 compression).
     const Eigen::VectorXd& contact_forces() const noexcept;

@@ -61,29 +61,20 @@ namespace stackbeam {
 
 /// The CVODE integration (mode "cvode"). Outputs come on the grid t = i * dt_s
 /// (SimulationOptions::dt_s is the output interval here, not a step).
+///
+/// Its Stepper outputs: advance() integrates to the next output time (SolverError: CVODE's flag,
+/// the time, the step count and the last step size, on a CVODE failure or a contact solve that
+/// fails); current(), pairs() (forces, relative positions C'p + c w) and nodes() are of the last
+/// output time, the nodes of its forces and w (the massless leaves are in equilibrium with them:
+/// System::reduced_displacements); stresses() of those nodes and pairs(); report() CVODE's steps,
+/// the contact iterations and mode factorisations, the stats and the events.
 class CvodeStepper final : public Stepper {
 public:
     /// Throws InputError for bad options (e.g. rtol <= 0), SolverError if the initial
     /// contact state cannot be resolved.
     CvodeStepper(const System& system, const SimulationOptions& options);
     ~CvodeStepper() override;
-
-    /// Integrates to the next output time and returns its record. Throws SolverError
-    /// (CVODE's flag, the time, the step count and the last step size) on a CVODE failure
-    /// or a contact solve that fails.
-    const StepRecord& advance() override;
-    /// The record of the last output time (the initial state before the first advance()).
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    /// The pairs at the last output time (forces, relative positions C'p + c w).
-    std::vector<PairRecord> pairs() const override;
-    /// The leaves' nodes at the last output time, of its forces and w (the massless leaves are
-    /// in equilibrium with them: System::reduced_displacements).
-    std::vector<LeafNodes> nodes() const override;
-    /// The stresses of the z nodes() uses and of pairs() (compute_stresses).
-    Stresses stresses() const override;
-    /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
-    RunReport report() const override;
+    STACKBEAM_STEPPER_OVERRIDES
     /// Number of output intervals to t_end, as in the closed-form mode.
     long num_outputs() const noexcept;
 

@@ -75,6 +75,10 @@
 
 namespace stackbeam {
 
+/// Its Stepper outputs: advance() is one step of dt (SolverError: step, time, residual, when the
+/// contact solve fails and options.stop_on_nonconvergence); nodes() and stresses() are of
+/// displacements() (and pairs()); report() the steps, and the contact iterations and
+/// factorisations summed over the records.
 class NewmarkStepper final : public Stepper {
 public:
     /// Throws InputError for bad options (SimulationOptions::validate and what the mode takes with
@@ -82,19 +86,7 @@ public:
     /// shared initial state (the assembly, gravity, R held at w(0)).
     NewmarkStepper(const System& system, const SimulationOptions& options);
     ~NewmarkStepper() override;
-
-    /// Advances one step of dt. Throws SolverError (step, time, residual) if the
-    /// contact solve fails and options.stop_on_nonconvergence.
-    const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    std::vector<PairRecord> pairs() const override;
-    /// The leaves' nodes of displacements() (System::leaf_nodes).
-    std::vector<LeafNodes> nodes() const override;
-    /// The stresses of displacements() and pairs() (compute_stresses).
-    Stresses stresses() const override;
-    /// Steps, and the contact iterations and factorisations summed over the records.
-    RunReport report() const override;
+    STACKBEAM_STEPPER_OVERRIDES
 
     /// Reduced displacements z [m, rad] (w last), velocities [m/s, rad/s], accelerations [m/s^2, rad/s^2].
     const Eigen::VectorXd& displacements() const noexcept;

@@ -47,6 +47,24 @@ public:
     virtual RunReport report() const = 0;
 };
 
+/// Declares, in a concrete stepper's class body (public), its override of each output above:
+///     class MyStepper final : public Stepper {
+///     public:
+///         STACKBEAM_STEPPER_OVERRIDES
+///         // the stepper's own accessors
+///     };
+/// Stepper's comments are the contract of each; a stepper says in its class comment what its own
+/// outputs are made of. An output added to every stepper: its pure virtual and comment in Stepper,
+/// its line here, its definition in each stepper's .cpp (the linker names a stepper that lacks one).
+#define STACKBEAM_STEPPER_OVERRIDES                      \
+    const StepRecord& advance() override;                \
+    const StepRecord& current() const noexcept override; \
+    long record_index() const noexcept override;         \
+    std::vector<PairRecord> pairs() const override;      \
+    std::vector<LeafNodes> nodes() const override;       \
+    Stresses stresses() const override;                  \
+    RunReport report() const override;
+
 /// The stepper of options.mode for `system`, the choice made once: closed-form ->
 /// ClosedFormStepper; newmark -> NewmarkStepper; cvode -> CvodeStepper with massless
 /// leaves, and with leaf mass (a density > 0) the leaf-inertia variants (docs/time-integration.md):

@@ -376,22 +376,14 @@ private:
 };
 
 /// The Stepper face of every cvode stepper with leaf inertia (held, modal, massive): every
-/// call forwards to its EventDriver.
+/// call forwards to its EventDriver. Its outputs: advance() integrates to the next output time
+/// (t = i dt_s); pairs() are contact_forces() and relative_positions() at the last output, nodes()
+/// EventDriver::displacements at its state, stresses() of those and pairs(); report() CVODE's
+/// steps, the contact iterations and mode factorisations, the stats and the events.
 class EventStepper : public Stepper {
 public:
     ~EventStepper() override;
-    /// Integrates to the next output time (t = i dt_s) and returns its record.
-    const StepRecord& advance() override;
-    const StepRecord& current() const noexcept override;
-    long record_index() const noexcept override;
-    /// The pairs at the last output (contact_forces(), relative_positions()).
-    std::vector<PairRecord> pairs() const override;
-    /// The leaves' nodes at the last output (EventDriver::displacements at its state).
-    std::vector<LeafNodes> nodes() const override;
-    /// The stresses at the last output (compute_stresses of nodes()' z and pairs()).
-    Stresses stresses() const override;
-    /// CVODE's steps, the contact iterations and mode factorisations, the stats and the events.
-    RunReport report() const override;
+    STACKBEAM_STEPPER_OVERRIDES
     const CvodeStats& stats() const noexcept;
     /// Every mode transition, in time order (cause "start", "root" or "check").
     const std::vector<ContactEvent>& events() const noexcept;
