@@ -45,9 +45,11 @@ void held_contact_state(const System& sys, InitialState& st, const SolverOptions
 ///     K_FF z_F = b_F - K_FH z_H + G_F^T p,   s = G_F z_F + c_L p - (d - G_H z_H),
 /// H = {theta_R, w}, F the rest; the stiffness form on the sparse path with the exact solver (a
 /// one-off solve, as static_state). The rig's moment at t = 0 is then the steppers' reaction on
-/// theta_R. d is re-anchored where `reanchor_d` (as static_state; the massless start does not).
-/// Returns false (nothing done) without the windup rig or on the half model.
-bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd& b, bool reanchor_d) {
+/// theta_R. The pairs that slipped into the held state are re-anchored where they are (reanchor, as
+/// after every step): left at their anchors from before this solve, a pair still slipping at step 1
+/// was measured against the stale anchor and its friction did work (negative friction work,
+/// decision 073). Returns false (nothing done) without the windup rig or on the half model.
+bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd& b) {
     const int theta = sys.seat_rotation_dof(), nz = sys.num_reduced_dofs(), w_dof = nz - 1;
     if (!st.options.loading.windup_rig() || theta < 0) return false;
     const double theta0_rad = st.options.loading.seat_rotation_rad->value(0.0);
@@ -93,7 +95,7 @@ bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd&
         require_converged(st.solve);
     }
     st.z = Eigen::VectorXd(S.transpose() * zf) + zh;
-    if (reanchor_d && sys.num_components() > 0) reanchor(st.laws, st.p, relative_positions(sys, st.z, st.p), st.d);
+    if (sys.num_components() > 0) reanchor(st.laws, st.p, relative_positions(sys, st.z, st.p), st.d);
     return true;
 }
 
@@ -117,7 +119,7 @@ void start_massless(const System& sys, InitialState& st, const SolverOptions& op
     }
     const auto& rb = sys.model().spec().rigid_body;
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
-    if (held_seat_start(sys, st, Eigen::VectorXd(), false)) return;  // the windup rig: theta_R held too
+    if (held_seat_start(sys, st, Eigen::VectorXd())) return;  // the windup rig: theta_R held too
     if (st.w0_m == st.w_static_m || n == 0) {  // z: the stages' (R at rest), or the unloaded stack's
         if (!st.pre_stressed || n == 0) st.z = sys.reduced_displacements(st.p, st.w0_m);
         return;
@@ -137,7 +139,7 @@ void start_whole_stack(const System& sys, InitialState& st, bool always_static) 
     st.w_static_m = st.pre_stressed ? st.z[w_dof] : 0.0;
     const auto& rb = sys.model().spec().rigid_body;
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
-    if (held_seat_start(sys, st, weight, st.pre_stressed || always_static)) {
+    if (held_seat_start(sys, st, weight)) {
         // the windup rig: R held at w0 and theta_R at theta_R(0) (z set)
     } else if (st.pre_stressed || always_static) {
         if (st.w0_m != st.w_static_m)
