@@ -79,6 +79,8 @@ struct ClosedFormStepper::Impl {
     double spring_ = 0.0;                                    // R's force on the stack at t [N, meshed part]
     /// The held-seat form's w [m] and seat loads [M_theta; H] for its u and the forces p.
     std::pair<double, Eigen::Vector2d> held_seat_state(const Eigen::VectorXd& u, const Eigen::VectorXd& p) const;
+    /// The seat loads [M_theta; H] [N m, N] at R's w [m], v = [theta_R or M; H] and the forces p.
+    Eigen::Vector2d held_seat_loads(double w, const Eigen::Vector2d& v, const Eigen::VectorXd& p) const;
     /// z (every DOF) from the held-seat form's free DOFs z_F and its u.
     Eigen::VectorXd held_seat_z(const Eigen::VectorXd& zf, const Eigen::VectorXd& u) const;
     StepSystem held_seat_system();
@@ -247,6 +249,11 @@ ClosedFormStepper::Impl::Impl(const System& system, const detail::InitialState& 
     fe_ = seat_ && !held_seat_ ? fv_ - seat_c_.g.dot(seat_loads(0.0)) : fv_;  // (seat loads: the full model, f = 1)
     if (system_.seat_rotation_dof() >= 0) seat_motion_ = seat_c_.B.transpose() * p_ - seat_c_.g * w_;
     spring_ = k * w_ - (p_.size() > 0 ? c.dot(p_) : 0.0);  // the start: no seat load on the stack
+    if (windup_) {  // ...but the windup rig's moment, which holds theta_R at theta_R(0) from the start (initial_state.cpp)
+        seat_full_ = held_seat_loads(w_, Eigen::Vector2d(load.seat_rotation_rad->value(0.0), 0.0), p_);
+        spring_ += seat_c_.g.dot(seat_full_);
+        seat_motion_ += seat_c_.F * seat_full_;
+    }
     fill_record(0, 0, strain_of(z_, p_));
     e0_ = record_.kinetic_energy_j + record_.strain_energy_j;
     record_.energy_balance_error_j = 0.0;
@@ -307,12 +314,16 @@ std::pair<double, Eigen::Vector2d> ClosedFormStepper::Impl::held_seat_state(cons
     const Eigen::Vector2d v = u.tail(2);
     const double chp = p.size() > 0 ? seat_ch_.dot(p) : 0.0;
     const double w = rig_ ? u[0] : (u[0] - seat_l_.dot(v) + chp) / seat_kh_;
+    return {w, held_seat_loads(w, v, p)};
+}
+
+Eigen::Vector2d ClosedFormStepper::Impl::held_seat_loads(double w, const Eigen::Vector2d& v, const Eigen::VectorXd& p) const {
     Eigen::Vector2d S(v[0], v[1]);
     if (windup_) {  // M_theta holds theta_R at v[0]: theta_R = b^T p - g_0 w + F_00 M_theta + F_01 H
         const double bp = p.size() > 0 ? seat_b_.dot(p) : 0.0;
         S[0] = seat_a_ * (v[0] - bp + seat_c_.g[0] * w - seat_c_.F(0, 1) * v[1]);
     }
-    return {w, S};
+    return S;
 }
 
 Eigen::VectorXd ClosedFormStepper::Impl::held_seat_z(const Eigen::VectorXd& zf, const Eigen::VectorXd& u) const {

@@ -1,8 +1,10 @@
 // The shared set-up stage of the steppers (initial_state.hpp).
 #include "time/initial_state.hpp"
 
+#include <Eigen/SparseCholesky>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "stackbeam/errors.hpp"
 #include "fe/tied_shape.hpp"
@@ -37,6 +39,66 @@ void held_contact_state(const System& sys, InitialState& st, const SolverOptions
     st.z[w_dof] = st.w0_m;
 }
 
+/// The windup rig holds theta_R from the start (loading.seat_rotation_rad, theta_R(0) = 0 by
+/// Loading::validate): on the full model the start's state is then the static one with R held at w0
+/// and theta_R at theta_R(0), both prescribed, under the load b [N, N m per reduced DOF] (empty: none):
+///     K_FF z_F = b_F - K_FH z_H + G_F^T p,   s = G_F z_F + c_L p - (d - G_H z_H),
+/// H = {theta_R, w}, F the rest; the stiffness form on the sparse path with the exact solver (a
+/// one-off solve, as static_state). The rig's moment at t = 0 is then the steppers' reaction on
+/// theta_R. The pairs that slipped into the held state are re-anchored where they are (reanchor, as
+/// after every step): left at their anchors from before this solve, a pair still slipping at step 1
+/// was measured against the stale anchor and its friction did work (negative friction work,
+/// decision 073). Returns false (nothing done) without the windup rig or on the half model.
+bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd& b) {
+    const int theta = sys.seat_rotation_dof(), nz = sys.num_reduced_dofs(), w_dof = nz - 1;
+    if (!st.options.loading.windup_rig() || theta < 0) return false;
+    const double theta0_rad = st.options.loading.seat_rotation_rad->value(0.0);
+    std::vector<int> index(static_cast<std::size_t>(nz), -1);  // reduced DOF -> free DOF
+    int nf = 0;
+    for (int i = 0; i < nz; ++i)
+        if (i != theta && i != w_dof) index[static_cast<std::size_t>(i)] = nf++;
+    Eigen::SparseMatrix<double> S(nf, nz);  // F <- all
+    std::vector<Eigen::Triplet<double>> sel;
+    for (int i = 0; i < nz; ++i)
+        if (index[static_cast<std::size_t>(i)] >= 0) sel.emplace_back(index[static_cast<std::size_t>(i)], i, 1.0);
+    S.setFromTriplets(sel.begin(), sel.end());
+    Eigen::VectorXd zh = Eigen::VectorXd::Zero(nz);  // the held DOFs' values, 0 elsewhere
+    zh[theta] = theta0_rad;
+    zh[w_dof] = st.w0_m;
+    const Eigen::SparseMatrix<double>& K = sys.stiffness_reduced();
+    const Eigen::SparseMatrix<double>& G = sys.contact_rows();
+    SparseStepForm form;
+    form.K = S * K * S.transpose();
+    form.G = G * S.transpose();
+    form.layer_compliance = sparse_layer(sys);
+    Eigen::VectorXd rhs = -(S * (K * zh));
+    if (b.size() > 0) rhs += S * b;
+    Eigen::VectorXd zf;
+    if (sys.num_components() == 0) {  // no contact (a single leaf): K_FF z_F = b_F - K_FH z_H
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(form.K);
+        zf = ldlt.solve(rhs);
+        st.solve = SolveResult{};
+        st.solve.converged = true;
+    } else {
+        StepSystem held;
+        held.rows = sys.num_components();
+        held.sparse = [&form] { return form; };
+        StepProblem pr;
+        pr.op = std::make_shared<const ContactOperator>(held, ContactPath::sparse, SolverKind::exact);
+        static_cast<ContactLaws&>(pr) = st.laws;
+        pr.u = rhs;
+        pr.d = st.d - G * zh;
+        SolverOptions exact = st.options.solver;
+        exact.kind = SolverKind::exact;
+        StepContactSolver solver(exact, st.options.sparse_tuning);
+        st.solve = solver.solve(pr, st.p, zf);
+        require_converged(st.solve);
+    }
+    st.z = Eigen::VectorXd(S.transpose() * zf) + zh;
+    if (sys.num_components() > 0) reanchor(st.laws, st.p, relative_positions(sys, st.z, st.p), st.d);
+    return true;
+}
+
 /// The massless stack: the assembly and R's weight -m g as static steps with R free (one solver
 /// over both, on the start's path), then the contact state with R held at w0 (no re-anchoring).
 void start_massless(const System& sys, InitialState& st, const SolverOptions& options) {
@@ -57,6 +119,7 @@ void start_massless(const System& sys, InitialState& st, const SolverOptions& op
     }
     const auto& rb = sys.model().spec().rigid_body;
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
+    if (held_seat_start(sys, st, Eigen::VectorXd())) return;  // the windup rig: theta_R held too
     if (st.w0_m == st.w_static_m || n == 0) {  // z: the stages' (R at rest), or the unloaded stack's
         if (!st.pre_stressed || n == 0) st.z = sys.reduced_displacements(st.p, st.w0_m);
         return;
@@ -76,7 +139,9 @@ void start_whole_stack(const System& sys, InitialState& st, bool always_static) 
     st.w_static_m = st.pre_stressed ? st.z[w_dof] : 0.0;
     const auto& rb = sys.model().spec().rigid_body;
     st.w0_m = st.rig ? L.displacement_m.value(0.0) : st.w_static_m + rb.initial_displacement_m;
-    if (st.pre_stressed || always_static) {
+    if (held_seat_start(sys, st, weight)) {
+        // the windup rig: R held at w0 and theta_R at theta_R(0) (z set)
+    } else if (st.pre_stressed || always_static) {
         if (st.w0_m != st.w_static_m)
             st.z = static_state(sys, st.laws, weight, st.w0_m, st.options, st.p, st.d, "initial contact state", &st.solve);
     } else {

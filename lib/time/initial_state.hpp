@@ -2,7 +2,8 @@
 // Internal: the one set-up stage of every stepper (stepper_registry.hpp): the options checked
 // against the chosen stepper's row, the loading prepared, and the state before t = 0 computed
 // once (the assembly, gravity's static step, the contact state with R held at w(0) or the
-// rig's w_p(0), the anchors, the leaves' initial velocity). A stepper's constructor starts
+// rig's w_p(0), and under the windup rig theta_R held at theta_R(0) as well, the anchors, the
+// leaves' initial velocity). A stepper's constructor starts
 // from it and builds its own operators only.
 #include <Eigen/Dense>
 

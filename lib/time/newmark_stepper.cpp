@@ -314,7 +314,9 @@ void NewmarkStepper::Impl::fill_record(int iterations, int factorizations) {
         record_.spring_force_n = f * (detail::accurate_dot(Eigen::VectorXd(K_.col(w_dof)), z_) -
                                       Eigen::VectorXd(system_.contact_rows().col(w_dof)).dot(p_));
     const double kinetic = 0.5 * f * detail::accurate_quadratic_form(M_, v_);
-    const double body_kinetic = record_.kinetic_energy_j;  // m w'^2 / 2 (fill_state)
+    // M_ holds R's mass but under the windup rig (R's inertia out of its loop): then the kinetic
+    // energy is the leaves' alone, else it holds R's m w'^2 / 2 (fill_state's)
+    const double body_kinetic = L.windup_rig() ? 0.0 : record_.kinetic_energy_j;
     record_.kinetic_energy_j = kinetic;
     record_.leaf_kinetic_energy_j = kinetic - body_kinetic;
     record_.impact_loss_j = impact_loss_;

@@ -25,6 +25,7 @@ struct StepRecord {
     int contact_iterations = 0;         ///< solver iterations of this step
     int n_stick = 0, n_slip = 0, n_open = 0;  ///< pairs by state (meshed part)
     double kinetic_energy_j = 0.0;      ///< kinetic energy [J]: m w_dot^2 / 2, plus the leaves' v^T M v / 2 in mode newmark
+                                        ///< (the windup rig leaves R's inertia out of its loop: then the leaves' alone)
     double strain_energy_j = 0.0;       ///< elastic energy of the leaves and of any elastic interface layer [J]
     double dissipated_energy_j = 0.0;   ///< cumulative friction work, sum of |p_t . slip increment| [J]
     double energy_balance_error_j = 0.0;///< initial energy - (kinetic + strain + dissipated + impact loss

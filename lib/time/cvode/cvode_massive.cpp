@@ -411,7 +411,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 
     // ---- records ----------------------------------------------------------------
 
-    /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R), strain
+    /// The record at state Y: w = z_w; energies: kinetic z'^T M z' / 2 (leaves and R; the windup rig: the leaves' alone), strain
     /// z^T K z / 2 + p^T C_L p / 2 (leaves and layer), whole spring.
     /// z is the state's first part.
     Vec displacements(const State& Y, const Vec&) const override { return Y.head(ndof()); }
@@ -436,6 +436,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         fill_state(system(), laws(), p, z[w_dof], v[w_dof], strain, f * Y[2 * ndof] + jump_dissipation_j(),
                    initial_energy_j(), ls, rec);
         finish_inertia_record(rec, 0.5 * f * v.dot(M * v), m_on_w * a[w_dof], f * Y[2 * ndof + 1]);
+        if (windup) rec.leaf_kinetic_energy_j = rec.kinetic_energy_j;  // M without R's mass: the leaves' alone
         // R's balance m w'' = F - spring force; the rig: the load cell between R and the spring reads
         // the force on the spring, lambda - m w'' (the leaves' inertia included)
         rec.spring_force_n = rig ? rec.external_force_n : rec.external_force_n - rec.force_on_mass_n;
