@@ -46,14 +46,7 @@ ModelSpec two_leaves(InterfaceLaw law, double mu) {
 
 using testing::constant;
 using testing::ramp;
-
-TimeFunction triangle(double amplitude) {
-    TimeFunction f;
-    f.shape = TimeFunction::Shape::triangle;
-    f.amplitude = amplitude;
-    f.frequency_hz = 1.0;
-    return f;
-}
+using testing::triangle;
 
 /// The three loadings of the windup rig: (0) the seat held vertically at 20 mm and wound +-0.01 rad
 /// (the FMU's: both rigs); (1) the seat free vertically under a 2 kN ramp, wound; (2) as (1) with a

@@ -16,6 +16,15 @@ inline TimeFunction constant(double value) {
     return f;
 }
 
+/// A triangle wave of `amplitude` at 1 Hz (0 at t = 0, rising: the rigs' loops).
+inline TimeFunction triangle(double amplitude) {
+    TimeFunction f;
+    f.shape = TimeFunction::Shape::triangle;
+    f.amplitude = amplitude;
+    f.frequency_hz = 1.0;
+    return f;
+}
+
 /// A table from 0 at t = 0 to `end` at t = 1 s.
 inline TimeFunction ramp(double end) {
     TimeFunction f;

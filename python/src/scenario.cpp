@@ -15,7 +15,7 @@ void enum_property(Cls& cls, const char* name, E C::*member) {
 }
 
 /// A property for an optional time function of the loading (a seat load, the windup rig): None when
-/// absent; assigning a TimeFunction gives it. The function returned is the loading's own (edits reach it).
+/// absent; assigning a TimeFunction gives it, assigning None removes it. The function returned is the loading's own (edits reach it).
 template <class Cls>
 void optional_time_function(Cls& cls, const char* name, std::optional<TimeFunction> Loading::*member) {
     cls.def_property(
@@ -26,7 +26,9 @@ void optional_time_function(Cls& cls, const char* name, std::optional<TimeFuncti
             return py::cast(&*f, py::return_value_policy::reference_internal, self);
         },
         [member, name](LoadingView& v, const py::object& f) {
-            v.s->scenario.simulation.loading.*member = checked<TimeFunction>(f, std::string("loading.") + name);
+            std::optional<TimeFunction>& target = v.s->scenario.simulation.loading.*member;
+            if (f.is_none()) target.reset();  // None removes it (as a scenario file without the table)
+            else target = checked<TimeFunction>(f, std::string("loading.") + name);
         });
 }
 

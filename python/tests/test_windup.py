@@ -72,3 +72,16 @@ def test_deformed_stack_draws_the_s_and_the_seat(windup):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_a_seat_load_and_the_rig_unset_by_none():
+    """None removes a seat load or the windup rig, as a scenario file without its table: the run is
+    then the same spring without it (the seat held at w = 0 and nothing else: it does not turn, no moment)."""
+    scenario = stackbeam.load_scenario(str(SOURCE_DIR / "tests" / "sweep" / "windup_small.toml"))
+    assert scenario.model.loading.seat_rotation_rad is not None
+    scenario.model.loading.seat_rotation_rad = None
+    assert scenario.model.loading.seat_rotation_rad is None
+    with pytest.raises(TypeError, match="loading.seat_moment_n_m"):
+        scenario.model.loading.seat_moment_n_m = 3.0
+    r = stackbeam.simulate(scenario, mode="closed-form")  # newmark massless takes the vertical rig only with the windup rig
+    assert np.all(np.asarray(r["seat_rotation"]) == 0.0) and np.all(np.asarray(r["seat_moment"]) == 0.0)
