@@ -61,12 +61,17 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
     Eigen::MatrixXd PS, hS;           // rows x 2
     Eigen::Vector2d aS = Eigen::Vector2d::Zero();
     std::vector<int> slip_rows;       // tangential rows of the slipping pairs (the friction power)
-    /// S(t) [N m, N] and its rate S'(t).
+    /// S(t) [N m, N], its rate S'(t) and S''(t) (0 where the shape has none: triangle's turning points).
     Eigen::Vector2d seat_load(double t_s) const { return {load.seat_moment_n_m_at(t_s), load.longitudinal_force_n_at(t_s)}; }
     Eigen::Vector2d seat_rate(double t_s) const {
         const double Hd = load.longitudinal_force_n ? load.longitudinal_force_n->derivative(t_s) : 0.0;
         const double Md = load.seat_moment_n_m ? load.seat_moment_n_m->derivative(t_s) : 0.0;
         return {Md - Hd * load.longitudinal_force_height_m, Hd};
+    }
+    Eigen::Vector2d seat_acceleration(double t_s) const {
+        const double Hdd = load.longitudinal_force_n ? load.longitudinal_force_n->second_derivative(t_s) : 0.0;
+        const double Mdd = load.seat_moment_n_m ? load.seat_moment_n_m->second_derivative(t_s) : 0.0;
+        return {Mdd - Hdd * load.longitudinal_force_height_m, Hdd};
     }
     Eigen::Vector2d seat_load(const State& y) const { return seat ? seat_load(y[kTime]) : Eigen::Vector2d::Zero(); }
     /// The seat's motion [theta_R; u_R] [rad, m] at w with forces p and seat loads S.
@@ -227,9 +232,11 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
         double delta = std::numeric_limits<double>::infinity();
         if (wd != 0.0) delta = std::min(delta, target / std::abs(wd));
         if (wdd != 0.0) delta = std::min(delta, std::sqrt(2.0 * target / std::abs(wdd)));
-        if (seat && rows() > 0) {
+        if (seat && rows() > 0) {  // B S(t) along S' and S'' as w along w' and w'' (a load from rest has S' ~ 0)
             const double vS = (sc.B * seat_rate(y[kTime])).lpNorm<Eigen::Infinity>();
+            const double aS_ = (sc.B * seat_acceleration(y[kTime])).lpNorm<Eigen::Infinity>();
             if (vS > 0.0) delta = std::min(delta, target / vS);
+            if (aS_ > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / aS_));
         }
         if (!std::isfinite(delta)) delta = 0.0;
         Vec yl = y;
