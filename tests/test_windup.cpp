@@ -359,8 +359,10 @@ BOOST_AUTO_TEST_CASE(bad_windup_input_is_refused_by_name) {
     closed.loading = windup_rig(0.01, true);
     BOOST_TEST(refusal(spec, closed) == "accepted");
     SimulationOptions cvode = newmark(moment);
-    cvode.mode = Mode::cvode;  // massless leaves: cvode-massless
-    BOOST_TEST(refusal(spec, cvode) == "loading.seat_moment_n_m");
+    cvode.mode = Mode::cvode;  // massless leaves: cvode-massless takes seat loads (decision 069), not the windup rig
+    BOOST_TEST(refusal(spec, cvode) == "accepted");
+    cvode.loading = windup_rig(0.01, false);
+    BOOST_TEST(refusal(spec, cvode) == "loading.seat_rotation_rad");
 }
 
 // A windup rig's loop with friction (the vertical rig holding a two-leaf spring at w0, so the leaves
@@ -622,8 +624,8 @@ BOOST_AUTO_TEST_CASE(asymmetric_springs_with_every_end_kind_are_reciprocal) {
 // a smooth seat moment and a longitudinal force at a height (a hinged eye locates the spring), 0.5 s.
 // Bounds: newmark books every work by its own trapezoidal rule, so to the contact solver's tolerance
 // (1e-9 of the external work); closed-form moves R exactly within a step but books the seat loads'
-// work by the trapezoidal rule (second order, decision 063): 1e-5 at dt = 0.5 ms; cvode's massive
-// and modal steppers integrate the work as a state to their tolerances: 1e-6.
+// work by the trapezoidal rule (second order, decision 063): 1e-5 at dt = 0.5 ms; cvode's massless,
+// massive and modal steppers integrate the work as a state to their tolerances: 1e-6.
 BOOST_AUTO_TEST_CASE(seat_loads_go_with_every_vertical_loading) {
     TimeFunction smooth;  // from rest: mean = amplitude, phase -pi/2
     smooth.shape = TimeFunction::Shape::harmonic;
@@ -652,7 +654,10 @@ BOOST_AUTO_TEST_CASE(seat_loads_go_with_every_vertical_loading) {
             L.longitudinal_force_n = push;
             L.longitudinal_force_height_m = -0.3;
             std::vector<std::pair<Mode, double>> modes = {{Mode::newmark, 1e-9}};
-            if (density == 0.0 && kind != LoadingKind::prescribed_displacement) modes.push_back({Mode::closed_form, 1e-5});
+            if (density == 0.0 && kind != LoadingKind::prescribed_displacement) {
+                modes.push_back({Mode::closed_form, 1e-5});
+                modes.push_back({Mode::cvode, 1e-6});  // cvode-massless
+            }
             if (density > 0.0 && kind != LoadingKind::prescribed_displacement) modes.push_back({Mode::cvode, 1e-6});
             if (density == 0.0 && kind == LoadingKind::prescribed_displacement)  // newmark massless has no vertical rig
                 modes = {{Mode::closed_form, 1e-5}};

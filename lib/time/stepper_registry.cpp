@@ -68,6 +68,7 @@ std::vector<StepperCapabilities> make_registry() {
     c.mode = Mode::cvode;
     c.applied_force = c.base_excitation = c.gravity = true;
     c.friction = c.rigid_rows = c.elastic_layer = c.cvode_stats = true;
+    c.seat_loads = true;  // condensed as closed-form's, t in the state (decision 069)
     c.start = StartKind::massless_stack;
     c.exact_start = true;
     c.build = &CvodeStepperAccess::build;

@@ -13,6 +13,10 @@
 /// motion of R is a smooth linear ODE:
 ///   m w'' = c^T p(w) - k w,         D' = -sum_slip p_t ds_t/dt  (friction power >= 0)
 /// (m, k, c of the meshed part). State y = [w, w', D]: D is the dissipated energy.
+/// Seat loads S(t) = [M - H h; H] (loading.hpp; full model) enter as closed-form's condensation
+/// (System::SeatCondensation): p = P w + r + P_S S(t), s gains (C'P_S + B) S(t), R feels -g^T S,
+/// so the witnesses depend on t as well; t is then one more state (y = [w, w', D, W_e, t]) and
+/// the seat loads' work S^T d[theta_R; u_R]/dt goes into W_e (decision 069).
 ///
 /// Witness (root) functions, one per possible transition, each scaled to order one
 /// and POSITIVE while its mode holds; the event is its DECREASING crossing of zero

@@ -47,6 +47,38 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
     double a1 = 0, a0 = 0, diss_a = 0, diss_b = 0;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;
 
+    // Seat loads S(t) = [M - H h; H] [N m, N] on theta_R, u_R (loading.hpp; decision 069), condensed as
+    // closed-form's (System::SeatCondensation): s = C'p + c w + B S - d, R's force on the stack
+    // k w - c^T p + g^T S, the seat's motion [theta_R; u_R] = B^T p - g w + F S. In a mode set the forces
+    // and relative positions gain a known function of time, p = P w + r + PS S(t), s = hs w + bs + hS S(t)
+    // (hS = C'PS + B), and m w'' = a1 w + a0 + aS^T S(t) + F_v(t) (aS = PS^T c - g). The witnesses then
+    // depend on t: t joins the state (y[kTime], t' = 1) so that every hook that reads the state (the
+    // driver's forces(y), relative(y), its bisection on CVODE's dense output, the look-ahead) reads S at
+    // the state's own time. Without seat loads none of this is built and the state is as before.
+    static constexpr int kTime = 4;  // y = [w, w', D, W_e, t] with seat loads
+    bool seat = false;
+    System::SeatCondensation sc;
+    Eigen::MatrixXd PS, hS;           // rows x 2
+    Eigen::Vector2d aS = Eigen::Vector2d::Zero();
+    std::vector<int> slip_rows;       // tangential rows of the slipping pairs (the friction power)
+    /// S(t) [N m, N], its rate S'(t) and S''(t) (0 where the shape has none: triangle's turning points).
+    Eigen::Vector2d seat_load(double t_s) const { return {load.seat_moment_n_m_at(t_s), load.longitudinal_force_n_at(t_s)}; }
+    Eigen::Vector2d seat_rate(double t_s) const {
+        const double Hd = load.longitudinal_force_n ? load.longitudinal_force_n->derivative(t_s) : 0.0;
+        const double Md = load.seat_moment_n_m ? load.seat_moment_n_m->derivative(t_s) : 0.0;
+        return {Md - Hd * load.longitudinal_force_height_m, Hd};
+    }
+    Eigen::Vector2d seat_acceleration(double t_s) const {
+        const double Hdd = load.longitudinal_force_n ? load.longitudinal_force_n->second_derivative(t_s) : 0.0;
+        const double Mdd = load.seat_moment_n_m ? load.seat_moment_n_m->second_derivative(t_s) : 0.0;
+        return {Mdd - Hdd * load.longitudinal_force_height_m, Hdd};
+    }
+    Eigen::Vector2d seat_load(const State& y) const { return seat ? seat_load(y[kTime]) : Eigen::Vector2d::Zero(); }
+    /// The seat's motion [theta_R; u_R] [rad, m] at w with forces p and seat loads S.
+    Eigen::Vector2d seat_motion(const Vec& p, double w, const Eigen::Vector2d& S) const {
+        return (p.size() > 0 ? Eigen::Vector2d(sc.B.transpose() * p) : Eigen::Vector2d::Zero()) - sc.g * w + sc.F * S;
+    }
+
     /// Builds R's operators (c, k, m, the loading) and starts the driver from the set-up stage.
     Impl(const System& s, const detail::InitialState& start)
         : EventDriver(s, start.options, "cvode mode"),
@@ -55,11 +87,14 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
           k(s.stiffness_n_per_m()),
           m(s.mass_kg()),
           load(start.options.loading) {
+        seat = load.has_seat_load();
+        if (seat) sc = s.seat_condensation();
         detail::EventStart es;
         // ODE size: [w, w', D], plus the external work W_e when a loading exerts a force (under
         // the paper's initial conditions it is identically zero and left out, so that CVODE's
         // error norm, an RMS over the states, is the same as without it).
-        es.nstate = load.is_free() ? 3 : 4;
+        // With seat loads also t (y[kTime], t' = 1: integrated exactly at every order).
+        es.nstate = seat ? kTime + 1 : load.is_free() ? 3 : 4;
         es.y0 = Eigen::VectorXd::Zero(es.nstate);
         es.y0[0] = start.w0_m;
         es.y0[1] = start.wd0_m_per_s;
@@ -70,6 +105,9 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
         es.event_tolerance_m = 1e-10 * es.scales.L_ref_m;
         es.events = this;  // contact events (ContactEventHooks)
         es.resolve_initial_forces = false;  // the stage solved the forces with R held at w(0) (exact)
+        // ... without seat loads: a seat load that does not start from 0 moves the stack from the
+        // stage's state, so the forces are solved again with S(0) (the event problem at motion(y0)).
+        if (seat && seat_load(0.0).squaredNorm() > 0.0) es.resolve_initial_forces = true;
         this->start(start, es);
     }
 
@@ -135,42 +173,76 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
         a1 = c.dot(P) - k;
         a0 = c.dot(r);
         diss_a = diss_b = 0.0;
+        slip_rows.clear();
         for (int kk = 0; kk < num_pairs(); ++kk) {
             const int rt = pairs()[kk].row_t;
             if (rt >= 0 && (modes().tmode[kk] == SLIP_POS || modes().tmode[kk] == SLIP_NEG)) {
                 diss_a += P[rt] * hs[rt];
                 diss_b += r[rt] * hs[rt];
+                slip_rows.push_back(rt);
             }
         }
+        if (!seat) return;
+        // the seat loads' columns: (C'_S: T) xS = -B_S, p += T xS S, s += (C' T xS + B) S
+        Eigen::MatrixXd xS = Eigen::MatrixXd::Zero(ms, 2);
+        if (ms > 0) {
+            Eigen::MatrixXd bS(ms, 2);
+            for (int i = 0; i < ms; ++i) bS.row(i) = -sc.B.row(S[i]);
+            xS = lu.solve(bS);
+            if (!xS.allFinite()) throw failure("the contact conditions of the current modes are singular");
+        }
+        PS = Eigen::MatrixXd::Zero(n, 2);
+        for (const auto& l : T.links) PS.row(l.row) += l.coef * xS.row(l.col);
+        hS = CT * xS + sc.B;
+        aS = PS.transpose() * c - sc.g;
     }
 
     Eigen::VectorXd forces(double w) const { return P * w + r; }
-    Vec forces(const State& y) const override { return forces(y[0]); }
-    Vec relative(const State& y) const override { return hs * y[0] + bs + anchors(); }
+    Vec forces(const State& y) const override { return seat ? Vec(forces(y[0]) + PS * seat_load(y)) : forces(y[0]); }
+    Vec relative(const State& y) const override {
+        return seat ? Vec(hs * y[0] + bs + anchors() + hS * seat_load(y)) : Vec(hs * y[0] + bs + anchors());
+    }
     Vec relative_at_event(const State& y, const Vec& p_cur) const override {
         // in a built mode affine in w (O(n)), else (t = 0) from the forces
-        return P.size() == rows() ? relative(y) : Vec(C * p_cur + c * y[0]);
+        return P.size() == rows() ? relative(y) : Vec(C * p_cur + motion(y));
     }
-    Vec motion(const State& y) const override { return c * y[0]; }
-    /// The witnesses of cvode_stepper.hpp at (w, w'): s = hs w + bs, ds_t/dt = hs_t w'.
+    Vec motion(const State& y) const override { return seat ? Vec(c * y[0] + sc.B * seat_load(y)) : Vec(c * y[0]); }
+    /// The witnesses of cvode_stepper.hpp at (w, w'): s = hs w + bs, ds_t/dt = hs_t w' (with seat loads
+    /// at (t, w, w'): s + hS S(t), ds_t/dt + hS_t S'(t)).
     void witnesses(const State& y, double* g) const override {
         const double w = y[0], wd = y[1];
+        if (seat) {
+            const Eigen::Vector2d S = seat_load(y), Sd = seat_rate(y[kTime]);
+            witnesses_from(
+                forces(y), [&](int row) { return hs[row] * w + bs[row] + hS.row(row).dot(S); },
+                [&](int row) { return hs[row] * wd + hS.row(row).dot(Sd); }, g);
+            return;
+        }
         witnesses_from(
             forces(w), [&](int row) { return hs[row] * w + bs[row]; }, [&](int row) { return hs[row] * wd; }, g);
     }
 
     /// R a short look-ahead on (cvode_stepper.hpp): |dw| = kLookahead L_ref along w' and w''.
+    /// With seat loads the contact points also move by B S(t) (the event problem's motion): the
+    /// look-ahead is then also at most kLookahead L_ref of that motion, |B S'| delta, and moves t.
     Vec look_ahead(double te, const State& y, const Vec& p_cur) const override {
         const double w = y[0], wd = y[1];
-        const double wdd = (c.dot(p_cur) - k * w + fe(te)) / m;
+        const double wdd = (c.dot(p_cur) - k * w + fe(te) - (seat ? sc.g.dot(seat_load(y)) : 0.0)) / m;
         const double target = kLookahead * scales().L_ref_m;
         double delta = std::numeric_limits<double>::infinity();
         if (wd != 0.0) delta = std::min(delta, target / std::abs(wd));
         if (wdd != 0.0) delta = std::min(delta, std::sqrt(2.0 * target / std::abs(wdd)));
+        if (seat && rows() > 0) {  // B S(t) along S' and S'' as w along w' and w'' (a load from rest has S' ~ 0)
+            const double vS = (sc.B * seat_rate(y[kTime])).lpNorm<Eigen::Infinity>();
+            const double aS_ = (sc.B * seat_acceleration(y[kTime])).lpNorm<Eigen::Infinity>();
+            if (vS > 0.0) delta = std::min(delta, target / vS);
+            if (aS_ > 0.0) delta = std::min(delta, std::sqrt(2.0 * target / aS_));
+        }
         if (!std::isfinite(delta)) delta = 0.0;
         Vec yl = y;
         yl[0] = w + (wd * delta + 0.5 * wdd * delta * delta);
         yl[1] = wd + wdd * delta;
+        if (seat) yl[kTime] = y[kTime] + delta;
         return yl;
     }
 
@@ -181,7 +253,9 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
 
     /// The massless leaves in equilibrium with the forces p and R at w = y[0] (the leaves carry no
     /// load of their own: gravity acts on R only).
-    Vec displacements(const State& y, const Vec& p) const override { return system().reduced_displacements(p, y[0]); }
+    Vec displacements(const State& y, const Vec& p) const override {
+        return seat ? system().reduced_displacements(p, y[0], seat_load(y)) : system().reduced_displacements(p, y[0]);
+    }
 
     /// The massless layer stores no energy of its own: a force jump is only noted.
     void after_event(const std::string&, const Vec& p_cur, const Vec& p_new) override { note_force_jump(p_cur, p_new); }
@@ -189,8 +263,25 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
     // ---- CVODE -------------------------------------------------------------------
 
     /// y = [w, w', D (, W_e)]: m w'' = a1 w + a0 + F_e(t), D' = -w' (diss_a w + diss_b), W_e' = F_e w'.
+    /// With seat loads (t = y[kTime]): m w'' += aS^T S, D' = -sum_slip p_t ds_t/dt at (t, w, w'), the seat
+    /// loads' power S^T d[theta_R; u_R]/dt into W_e (d/dt (B^T p - g w + F S), p' = P w' + PS S'), t' = 1.
     void derivatives(double tt, const double* yy, double* dy) const override {
         const double fe_t = fe(tt);
+        if (seat) {
+            const double w = yy[0], wd = yy[1];
+            const Eigen::Vector2d S = seat_load(tt), Sd = seat_rate(tt);
+            dy[0] = wd;
+            dy[1] = (a1 * w + a0 + aS.dot(S) + fe_t) / m;
+            double diss = 0.0;
+            for (int rt : slip_rows) diss -= (P[rt] * w + r[rt] + PS.row(rt).dot(S)) * (hs[rt] * wd + hS.row(rt).dot(Sd));
+            dy[2] = diss;
+            const Eigen::Vector2d motion_rate = (rows() > 0 ? Eigen::Vector2d(sc.B.transpose() * (P * wd + PS * Sd))
+                                                            : Eigen::Vector2d::Zero()) -
+                                                sc.g * wd + sc.F * Sd;
+            dy[3] = fe_t * wd + S.dot(motion_rate);
+            dy[kTime] = 1.0;
+            return;
+        }
         dy[0] = yy[1];
         dy[1] = (a1 * yy[0] + a0 + fe_t) / m;
         dy[2] = -yy[1] * (diss_a * yy[0] + diss_b);
@@ -203,6 +294,7 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
         at[1] = atol * scales().omega_rad_per_s;       // w' [m/s]
         at[2] = atol * scales().F_ref_n;               // D [J]
         if (nstate() > 3) at[3] = atol * scales().F_ref_n;  // external work [J]
+        if (seat) at[kTime] = atol / scales().L_ref_m / scales().omega_rad_per_s;  // t [s] (exact: t' = 1)
     }
 
     // ---- records -----------------------------------------------------------------
@@ -211,15 +303,28 @@ struct CvodeStepper::Impl final : detail::EventDriver, detail::ContactEventHooks
         const int n = rows();
         const double f = spring_factor();
         const double w = y[0], wd = y[1], D = y[2], We = nstate() > 3 ? y[3] : 0.0;
-        p = n > 0 ? forces(w) : Vec();
-        // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n))
-        const double strain = 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + anchors() - c * w) : 0.0) + k * w * w);
+        p = n > 0 ? forces(y) : Vec();
+        // U = (p^T C' p + k w^2) / 2 on the meshed part, with C'p = s + d - c w = hs w + bs + d - c w (O(n));
+        // with seat loads U = z^T K z / 2 = (p^T (s + d) + f_R w + S^T [theta_R; u_R]) / 2 (K z = G^T p + e_w f_R
+        // + E S, SeatCondensation's s, f_R and motion; the full model, f = 1).
+        const Eigen::Vector2d S = seat_load(y);
+        const Eigen::Vector2d seat_at = seat ? seat_motion(p, w, S) : Eigen::Vector2d::Zero();
+        const double strain =
+            seat ? 0.5 * ((n > 0 ? p.dot(relative(y) - c * w) : 0.0) + k * w * w + sc.g.dot(S) * w + S.dot(seat_at))
+                 : 0.5 * f * ((n > 0 ? p.dot(hs * w + bs + anchors() - c * w) : 0.0) + k * w * w);
         StepRecord rec;
         detail::LoadState ls;
         ls.external_force_n = f * fe(tau);
         ls.external_work_j = f * We;
         ls.base_displacement_m = load.base_displacement_m(tau);
         detail::fill_state(system(), laws(), p, w, wd, strain, f * D, initial_energy_j(), ls, rec);
+        if (seat) {  // R's force on the stack with the seat loads (SeatCondensation), and the seat's records
+            rec.spring_force_n += sc.g.dot(S);
+            rec.force_on_mass_n = rec.external_force_n - rec.spring_force_n;
+            rec.seat_moment_n_m = S[0];
+            rec.seat_rotation_rad = seat_at[0];
+            rec.seat_axial_m = seat_at[1];
+        }
         return rec;
     }
 };
@@ -242,7 +347,10 @@ long CvodeStepper::record_index() const noexcept { return impl_->record_index();
 std::vector<PairRecord> CvodeStepper::pairs() const {
     const Impl& s = *impl_;
     const Eigen::VectorXd& p = s.contact_forces();
-    return s.pair_records_at(p.size() > 0 ? Eigen::VectorXd(s.C * p + s.c * s.current().w_m) : Eigen::VectorXd());
+    if (p.size() == 0) return s.pair_records_at(Eigen::VectorXd());
+    Eigen::VectorXd rel = s.C * p + s.c * s.current().w_m;
+    if (s.seat) rel += s.sc.B * s.seat_load(s.current().t_s);  // s + d = C'p + c w + B S (SeatCondensation)
+    return s.pair_records_at(rel);
 }
 std::vector<LeafNodes> CvodeStepper::nodes() const { return impl_->nodes_at_output(); }
 Stresses CvodeStepper::stresses() const { return compute_stresses(impl_->system(), impl_->displacements_at_output(), pairs()); }
