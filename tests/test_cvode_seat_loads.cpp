@@ -34,13 +34,7 @@ namespace {
 
 constexpr double kL = 1.2, kT = 0.01, kB = 0.05, kE = 206e9, kPi = 3.14159265358979323846;
 
-/// The windup tests' asymmetric two-leaf spring: a hinged eye at x = 0 locates it (the seat slides:
-/// u_R a DOF), a pinned end at kL, a 0.8 m leaf below centred on 0.55 m, the seat at 0.5 m.
-ModelSpec two_leaves(InterfaceLaw law, double mu) {
-    ModelSpec s = testing::single_leaf(kL, kT, kB, kE, SupportKind::hinged, SupportKind::pinned, 0.5, kL / 24);
-    s.leaves[0].left_end.eye_offset_m = 0.015;
-    return testing::with_lower_leaf(s, 0.8, 0.55, law, mu);
-}
+using testing::two_leaves;  // windup_cases.hpp
 
 /// a (1 - cos 2 pi f t): from rest, so the massless start carries no step of the load.
 TimeFunction from_rest(double a, double f_hz) {

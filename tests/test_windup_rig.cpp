@@ -35,14 +35,7 @@ namespace {
 constexpr double kL = 1.2, kT = 0.01, kB = 0.05, kE = 206e9, kPi = 3.14159265358979323846;
 const double kEI = kE * kB * kT * kT * kT / 12.0;
 
-/// Two leaves: the main one (0) from 0 to kL, a hinged eye at x = 0 (it locates the spring, so the
-/// seat slides: u_R a DOF) and a pinned end at kL; a 0.8 m leaf (1) below it centred on 0.55 m, free
-/// ends; the seat at 0.5 m (asymmetric) ties both; one interface of `law` and mu.
-ModelSpec two_leaves(InterfaceLaw law, double mu) {
-    ModelSpec s = testing::single_leaf(kL, kT, kB, kE, SupportKind::hinged, SupportKind::pinned, 0.5, kL / 24);
-    s.leaves[0].left_end.eye_offset_m = 0.015;
-    return testing::with_lower_leaf(s, 0.8, 0.55, law, mu);
-}
+using testing::two_leaves;  // windup_cases.hpp
 
 using testing::constant;
 using testing::ramp;

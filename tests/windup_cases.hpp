@@ -3,6 +3,7 @@
 #include "stackbeam/model/loading.hpp"
 #include "stackbeam/model/model.hpp"
 #include "stackbeam/time/simulation.hpp"
+#include "single_leaf.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -47,6 +48,17 @@ inline ModelSpec with_lower_leaf(ModelSpec spec, double lower_m, double c, Inter
     f.friction_coefficient = mu;
     spec.interfaces = {f};
     return spec;
+}
+
+/// The windup tests' asymmetric two-leaf spring: the main leaf (0) 1.2 m, 10 x 50 mm steel
+/// (206 GPa), from 0 to 1.2 m, a hinged eye at x = 0 (offset 15 mm: it locates the spring, so the
+/// seat slides: u_R a DOF) and a pinned end at 1.2 m; a 0.8 m leaf (1) below it centred on 0.55 m,
+/// free ends; the seat at 0.5 m (asymmetric) ties both; one interface of `law` and mu; 24 elements.
+inline ModelSpec two_leaves(InterfaceLaw law, double mu) {
+    constexpr double L = 1.2;
+    ModelSpec s = single_leaf(L, 0.01, 0.05, 206e9, SupportKind::hinged, SupportKind::pinned, 0.5, L / 24);
+    s.leaves[0].left_end.eye_offset_m = 0.015;
+    return with_lower_leaf(s, 0.8, 0.55, law, mu);
 }
 
 /// A windup loop's figures from a run of 3 cycles of `per_cycle` steps each: the largest |seat moment|
