@@ -257,6 +257,16 @@ BOOST_AUTO_TEST_CASE(bending_moment_jumps_by_the_seat_moment) {
     BOOST_TEST(right - left == -M0, tt::tolerance(1e-9));
     BOOST_TEST(left == M0 * a / kL, tt::tolerance(1e-9));
     BOOST_TEST(std::abs(M[i] - 0.5 * (left + right)) < 1e-9 * M0);  // 0 here: the couple is antisymmetric
+    // The fibre stresses beside the seat are the statics' M c / I: the moment M0 x / L left of the
+    // seat, -M0 (L - x) / L right of it, sigma = -/+ 6 M / (b t^2) at the top/bottom fibre (sagging M
+    // positive compresses the top). Pinned ends carry no axial force: N = 0 (to round-off).
+    const LeafStresses& leaf0 = s.leaves[0];
+    for (const int j : {i - 1, i + 1}) {
+        const double m = j < i ? M0 * x[j] / kL : -M0 * (kL - x[j]) / kL, z = 6.0 / (kB * kT * kT);
+        BOOST_TEST(std::abs(leaf0.axial_force_n[j]) < 1e-9 * M0 / kT);
+        BOOST_TEST(leaf0.top_stress_pa[j] == -m * z, tt::tolerance(1e-9));
+        BOOST_TEST(leaf0.bottom_stress_pa[j] == m * z, tt::tolerance(1e-9));
+    }
 }
 
 // A longitudinal force H at height h above the seat on a seat that slides (the left end's hinged eye
