@@ -37,8 +37,7 @@ struct NewmarkStepper::Impl {
     SimulationOptions options_;
     Factor factor_;
     Eigen::SparseMatrix<double> K_, M_;
-    Eigen::SparseMatrix<double> keff_f_;  // K_eff on the free DOFs (the rig: without w), factorised in factor_.llt
-    Eigen::SparseMatrix<double> gt_f_;    // G^T on the free DOFs
+    Eigen::SparseMatrix<double> gt_;      // G^T (all DOFs: the step's residual, step_residual)
     std::shared_ptr<const ContactOperator> op_;  // the step's operator, dense or sparse (step.hpp)
     std::unique_ptr<StepContactSolver> contact_;
     ContactLaws problem_;        // the pair laws and the previous-step limits
@@ -75,6 +74,9 @@ struct NewmarkStepper::Impl {
     void factorise_step();
     /// Massive leaves with a rig: M a = r + E_H lambda with a_H = z_p''(t); lambda [N, N m] in lambda.
     Eigen::VectorXd accelerations_with_rig(double t_s, const Eigen::VectorXd& r, Eigen::VectorXd* lambda) const;
+    /// The residual of the step's equation at z1 (all DOFs, the rigs' rows included) from K, M, C
+    /// and p_ on z_, v_, a_ (the step's start), q0 and q1 the loading at t0, t1 (empty: none).
+    Eigen::VectorXd step_residual(const Eigen::VectorXd& z1, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1) const;
     /// The prescribed DOFs' values z_H(t) [m, rad] (derivative 0), velocities (1) or accelerations (2).
     Eigen::VectorXd prescribed_at(double t_s, int derivative) const;
     /// The free rows of a matrix on the reduced DOFs, S A S^T.
@@ -240,8 +242,7 @@ void NewmarkStepper::Impl::factorise_step() {
             g_h_.col(h) = Eigen::VectorXd(G.col(prescribed_[h]));
         }
     }
-    keff_f_ = KeffF;
-    gt_f_ = GF.transpose();
+    gt_ = G.transpose();
     factor_.llt.compute(KeffF);
     if (factor_.llt.info() != Eigen::Success)
         throw SolverError("newmark: K + 4 M / dt^2 is not positive definite", 0, 0.0, 0.0);
@@ -269,6 +270,34 @@ Eigen::VectorXd NewmarkStepper::Impl::accelerations_with_rig(double t_s, const E
     const Eigen::VectorXd l = detail::prescribe_accelerations(a, u_h_, prescribed_, prescribed_at(t_s, 2));
     if (lambda) *lambda = l;
     return a;
+}
+
+Eigen::VectorXd NewmarkStepper::Impl::step_residual(const Eigen::VectorXd& z1, const Eigen::VectorXd& q0,
+                                                    const Eigen::VectorXd& q1) const {
+    // The step's equation (factorise_step) with z1 = z0 + dz, as in the energy identity
+    // (newmark_stepper.hpp): K_eff z1 = r + kappa G^T p1 is, term by term,
+    //   massive:  K (z0 + z1) + c M dz + (2/dt) C dz = (4/dt) M v0 + q0 + q1 + 2 G^T p1,
+    //   massless: K z1 + c M dz + (2/dt) C dz = M ((4/dt) v0 + a0) + q1 + G^T p1,
+    // c = 4/dt^2 [1/s^2]. dz = z1 - z0 is exact in double where z1 and z0 are within a factor 2
+    // of each other (Sterbenz), so the inertia and damping terms round with |dz|, not |z|; the
+    // elastic and contact terms are summed in twice the working precision (their terms reach
+    // 2e11 N on a short stiff element, their sum is the step's force). Residual [N, N m], all DOFs.
+    const double dt = options_.dt_s, c = 4.0 / (dt * dt);
+    const Eigen::VectorXd dz = z1 - z_;
+    detail::AccurateVector rho(z1.size());
+    rho.add_product(K_, z1, -1.0);
+    Eigen::VectorXd inertia = (4.0 / dt) * v_ - c * dz;  // M times it: the inertia terms
+    if (massive_leaves_) {
+        rho.add_product(K_, z_, -1.0);
+        if (q0.size() > 0) rho.add(q0);
+    } else {
+        inertia += a_;
+    }
+    rho.add_product(M_, inertia);
+    if (q1.size() > 0) rho.add(q1);
+    if (C_.nonZeros() > 0) rho.add_product(C_, Eigen::VectorXd((-2.0 / dt) * dz));
+    if (p_.size() > 0) rho.add_product(gt_, p_, massive_leaves_ ? 2.0 : 1.0);
+    return rho.value();
 }
 
 Eigen::VectorXd NewmarkStepper::Impl::prescribed_at(double t_s, int derivative) const {
@@ -397,7 +426,6 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     // The loading q(t) (detail::ReducedLoad) by the trapezoidal rule with massive leaves (r gets
     // q0 + q1 = 2 qbar), at t1 with massless ones (Newmark as printed).
     const double t1 = (step_ + 1) * dt;
-    const int w_dof = static_cast<int>(z_.size()) - 1;
     const bool loaded = !load_.none();
     const Eigen::VectorXd q0 = loaded ? load_.at(t_) : Eigen::VectorXd();
     const Eigen::VectorXd q1 = loaded ? load_.at(t1) : Eigen::VectorXd();
@@ -424,20 +452,22 @@ const StepRecord& NewmarkStepper::Impl::advance() {
     // One step of iterative refinement with the residual in twice the working precision
     // (accurate_sum.hpp): K_eff's factor and z = v + Y p leave a residual ~ cond(K_eff) eps |b|, a
     // spurious force whose work showed in the balance (1e-8 of the run's energy on
-    // graduated_elastic.toml; 1.9e-13 after one pass; more passes measured no better, down to the
-    // rounding of z itself, eps |K_eff| |z|: decision 065).
+    // graduated_elastic.toml; 1.9e-13 after one pass; more passes measured no better: decision
+    // 065). The residual is the step's equation itself on K, M and C (step_residual), not on the
+    // matrix K_eff: K_eff's entries are rounded sums, and on a short stiff element that rounding,
+    // eps |K| ~ 3e-4 N/m an entry at 12 EI / l^3 = 2.5e12 N/m, times a deflection of 0.076 m is a
+    // force of 2e-5 N the energies (on K and M) do not see (decision 075).
+    const auto full = [&](const Eigen::VectorXd& zf) {
+        if (!held) return zf;
+        Eigen::VectorXd z = S_.transpose() * zf;
+        for (std::size_t h = 0; h < prescribed_.size(); ++h) z[prescribed_[h]] = zH1[h];
+        return z;
+    };
     if (solve_.converged) {
-        detail::AccurateVector rho(zF.size());
-        rho.add(rF);
-        rho.add_product(gt_f_, p_, kappa);
-        rho.add_product(keff_f_, zF, -1.0);
-        zF += factor_.llt.solve(rho.value());
+        const Eigen::VectorXd rho = step_residual(full(zF), q0, q1);
+        zF += factor_.llt.solve(held ? Eigen::VectorXd(S_ * rho) : rho);
     }
-    Eigen::VectorXd z1 = zF;
-    if (held) {
-        z1 = S_.transpose() * zF;
-        for (std::size_t h = 0; h < prescribed_.size(); ++h) z1[prescribed_[h]] = zH1[h];
-    }
+    Eigen::VectorXd z1 = full(zF);
     ++step_;
     if (!solve_.converged && options_.stop_on_nonconvergence) {
         throw SolverError("contact solve failed at step " + std::to_string(step_) + ", t = " +
