@@ -370,6 +370,12 @@ stackbeam_cli_test(NAME cli_base_cvode
 stackbeam_cli_test(NAME cli_plot
                    ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
                    EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)
+# --plot on a single leaf without a probe pair (tests/cli_one_leaf.toml): the probe's friction force
+# column is nan, so that figure is left out and the others (and the deformed stack after them) are drawn
+stackbeam_cli_test(NAME cli_plot_one_leaf
+                   ARGS simulate --scenario ${CMAKE_CURRENT_SOURCE_DIR}/cli_one_leaf.toml --quiet
+                        --out ${_cli_out_dir}/cli_plot_one_leaf.csv --plot ${_cli_out_dir}/cli_plot_one_leaf
+                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_one_leaf_stack.png" OUT ${_cli_out_dir}/cli_plot_one_leaf_loop.png)
 # --stack-color stress (issue 43 item 5): the deformed stack's leaves coloured by their stress; the
 # data file has both figures' bands (3 leaves x 2 fibres x 41 nodes x 2 figures = 492 rows, the
 # header and blank lines); a word other than state or stress, and the option without --plot, refused
