@@ -350,6 +350,13 @@ stackbeam_cli_test(NAME cli_windup_map
                    EXPECT_RC 0 EXPECT_TEXT "12 of 12 finished: 12 ok, 0 failed"
                    OUT ${_cli_out_dir}/cli_windup_map/loops/point-0011-windup.csv MIN_LINES 202
                    HEADER_PREFIX "t_s,seat_rotation_rad,seat_moment_n_m")
+# A windup sweep's figures (tests/sweep/windup_loops.toml, decision 076): its loop family is the windup
+# loops, seat moment against seat rotation (the seat held at w = 0 makes no vertical loop, so none drawn)
+stackbeam_cli_test(NAME cli_windup_sweep_plot
+                   ARGS sweep ${PROJECT_SOURCE_DIR}/tests/sweep/windup_loops.toml --out-dir ${_cli_out_dir}/cli_windup_sweep_plot
+                        --restart --jobs 1
+                   EXPECT_RC 0 EXPECT_TEXT "figures/windup_loops_along_loading_seat_rotation_rad_amplitude.png"
+                   OUT ${_cli_out_dir}/cli_windup_sweep_plot/figures/windup_loops_along_loading_seat_rotation_rad_amplitude.png)
 stackbeam_cli_test(NAME cli_pairs_csv
                    ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"
