@@ -350,6 +350,13 @@ stackbeam_cli_test(NAME cli_windup_map
                    EXPECT_RC 0 EXPECT_TEXT "12 of 12 finished: 12 ok, 0 failed"
                    OUT ${_cli_out_dir}/cli_windup_map/loops/point-0011-windup.csv MIN_LINES 202
                    HEADER_PREFIX "t_s,seat_rotation_rad,seat_moment_n_m")
+# A windup sweep's figures (tests/sweep/windup_loops.toml, decision 076): its loop family is the windup
+# loops, seat moment against seat rotation (the seat held at w = 0 makes no vertical loop, so none drawn)
+stackbeam_cli_test(NAME cli_windup_sweep_plot
+                   ARGS sweep ${PROJECT_SOURCE_DIR}/tests/sweep/windup_loops.toml --out-dir ${_cli_out_dir}/cli_windup_sweep_plot
+                        --restart --jobs 1
+                   EXPECT_RC 0 EXPECT_TEXT "figures/windup_loops_along_loading_seat_rotation_rad_amplitude.png"
+                   OUT ${_cli_out_dir}/cli_windup_sweep_plot/figures/windup_loops_along_loading_seat_rotation_rad_amplitude.png)
 stackbeam_cli_test(NAME cli_pairs_csv
                    ARGS simulate --case friction --t-end 0.01 --out ${_cli_out_dir}/cli_p.csv --pairs ${_cli_out_dir}/cli_pairs.csv
                    EXPECT_RC 0 OUT ${_cli_out_dir}/cli_pairs.csv HEADER_PREFIX "t,pair,interface,x,state,p_n,p_t,gap,slip"
@@ -370,6 +377,12 @@ stackbeam_cli_test(NAME cli_base_cvode
 stackbeam_cli_test(NAME cli_plot
                    ARGS simulate --case friction --t-end 0.05 --quiet --out ${_cli_out_dir}/cli_plot.csv --plot ${_cli_out_dir}/cli_plot
                    EXPECT_RC 0 EXPECT_TEXT "cli_plot_loop.png" OUT ${_cli_out_dir}/cli_plot_loop.png)
+# --plot on a single leaf without a probe pair (tests/cli_one_leaf.toml): the probe's friction force
+# column is nan, so that figure is left out and the others (and the deformed stack after them) are drawn
+stackbeam_cli_test(NAME cli_plot_one_leaf
+                   ARGS simulate --scenario ${CMAKE_CURRENT_SOURCE_DIR}/cli_one_leaf.toml --quiet
+                        --out ${_cli_out_dir}/cli_plot_one_leaf.csv --plot ${_cli_out_dir}/cli_plot_one_leaf
+                   EXPECT_RC 0 EXPECT_TEXT "cli_plot_one_leaf_stack.png" OUT ${_cli_out_dir}/cli_plot_one_leaf_loop.png)
 # --stack-color stress (issue 43 item 5): the deformed stack's leaves coloured by their stress; the
 # data file has both figures' bands (3 leaves x 2 fibres x 41 nodes x 2 figures = 492 rows, the
 # header and blank lines); a word other than state or stress, and the option without --plot, refused

@@ -12,6 +12,7 @@
 
 #include "stackbeam/fe/system.hpp"
 #include "stackbeam/time/stepper.hpp"
+#include "test_support.hpp"
 
 namespace tt = boost::test_tools;
 using namespace stackbeam;
@@ -23,27 +24,18 @@ namespace {
 /// leaves' own sections); clamp pairs 10 mm long at +-d1 and +-d2 [m] from mid-span with
 /// preloads 300 and 1500 N; elements of h [m].
 ModelSpec two_clamp_pairs(double d1_m, double d2_m, double h_m) {
-    ModelSpec s;
-    for (int i = 0; i < 2; ++i) {
-        LeafSpec l;
-        l.length_m = i == 0 ? 0.9 : 0.75;
-        l.x_start_m = 0.5 * (0.9 - l.length_m);
-        l.height_m = 0.009;
-        l.width_m = 0.04;
-        l.youngs_modulus_pa = 2.06e11;
-        l.left_support = l.right_support = i == 0 ? SupportKind::pinned : SupportKind::free;
-        s.leaves.push_back(l);
-    }
-    InterfaceSpec f;
-    f.law = InterfaceLaw::coulomb;
-    f.friction_coefficient = 0.3;
-    f.contact = InterfaceContact::elastic;
-    s.interfaces.push_back(f);
+    testing::ClampedPairSpec c;
+    c.top_length_m = 0.9;
+    c.lower_length_m = 0.75;
+    c.thickness_m = 0.009;
+    c.width_m = 0.04;
+    c.friction_coefficient = 0.3;
+    c.contact = InterfaceContact::elastic;
+    c.body_mass_kg = 100.0;
+    c.element_length_m = h_m;
+    ModelSpec s = testing::clamped_pair_stack(c);
     for (const auto& [d, preload] : {std::pair{d1_m, 300.0}, std::pair{d2_m, 1500.0}})
         for (double x : {0.45 - d, 0.45 + d}) s.clamps.push_back({x, preload, 0.01});
-    s.rigid_body.x_m = 0.45;
-    s.rigid_body.mass_kg = 100.0;
-    s.mesh.element_length_m = h_m;
     return s;
 }
 

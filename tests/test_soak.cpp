@@ -30,6 +30,7 @@
 #include "stackbeam/time/run_report.hpp"
 #include "stackbeam/time/stepper.hpp"
 #include "time/stepper_registry.hpp"
+#include "test_support.hpp"
 
 using namespace stackbeam;
 namespace bdata = boost::unit_test::data;
@@ -575,25 +576,8 @@ namespace {
 /// rigid interface, clamps of preload `preload_n` [N] at x = 0.15 and 0.45 m, a 1 kg body at
 /// mid-span, massless leaves.
 ModelSpec clamp_stack(double preload_n) {
-    ModelSpec s;
-    for (int i = 0; i < 2; ++i) {
-        LeafSpec l;
-        l.length_m = i == 0 ? 0.6 : 0.5;
-        l.x_start_m = 0.5 * (0.6 - l.length_m);
-        l.height_m = 0.006;
-        l.width_m = 0.05;
-        l.youngs_modulus_pa = 2.06e11;
-        l.left_support = l.right_support = i == 0 ? SupportKind::pinned : SupportKind::free;
-        s.leaves.push_back(l);
-    }
-    InterfaceSpec f;
-    f.law = InterfaceLaw::coulomb;
-    f.friction_coefficient = 0.2;
-    s.interfaces.push_back(f);
+    ModelSpec s = testing::clamped_pair_stack({});  // its defaults are this stack
     for (double x : {0.15, 0.45}) s.clamps.push_back({x, preload_n, 0.0});
-    s.rigid_body.x_m = 0.3;
-    s.rigid_body.mass_kg = 1.0;
-    s.mesh.element_length_m = 0.025;
     return s;
 }
 }  // namespace

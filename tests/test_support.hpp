@@ -224,6 +224,40 @@ inline ModelSpec two_leaf_spring(double R1_m, double R2_m) {
     return spec;
 }
 
+/// A clamped two-leaf stack (test_close_clamps, test_soak): two massless steel leaves (E = 2.06e11 Pa)
+/// of one thickness and width, the top one `top_length_m` long from x = 0 and pinned at both ends, the
+/// lower one `lower_length_m` long centred under it with free ends; one Coulomb interface (rigid
+/// contact or an elastic layer); the body at mid-span. No clamps: the caller places them. The defaults
+/// are test_soak's clamp_stack.
+struct ClampedPairSpec {
+    double top_length_m = 0.6, lower_length_m = 0.5, thickness_m = 0.006, width_m = 0.05;
+    double friction_coefficient = 0.2;
+    InterfaceContact contact = InterfaceContact::rigid;
+    double body_mass_kg = 1.0, element_length_m = 0.025;
+};
+inline ModelSpec clamped_pair_stack(const ClampedPairSpec& c) {
+    ModelSpec s;
+    for (int i = 0; i < 2; ++i) {
+        LeafSpec l;
+        l.length_m = i == 0 ? c.top_length_m : c.lower_length_m;
+        l.x_start_m = 0.5 * (c.top_length_m - l.length_m);
+        l.height_m = c.thickness_m;
+        l.width_m = c.width_m;
+        l.youngs_modulus_pa = 2.06e11;
+        l.left_support = l.right_support = i == 0 ? SupportKind::pinned : SupportKind::free;
+        s.leaves.push_back(l);
+    }
+    InterfaceSpec f;
+    f.law = InterfaceLaw::coulomb;
+    f.friction_coefficient = c.friction_coefficient;
+    f.contact = c.contact;
+    s.interfaces.push_back(f);
+    s.rigid_body.x_m = 0.5 * c.top_length_m;
+    s.rigid_body.mass_kg = c.body_mass_kg;
+    s.mesh.element_length_m = c.element_length_m;
+    return s;
+}
+
 /// The field named by the InputError that `f` throws, or "" when it throws none.
 template <class F>
 std::string input_error_field(F&& f) {

@@ -12,8 +12,12 @@
 #include <boost/test/unit_test.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
+
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -22,6 +26,7 @@
 #include "stackbeam/run/run.hpp"
 #include "stackbeam/run/summary_json.hpp"
 #include "stackbeam/study/sweep.hpp"
+#include "stackbeam/study/sweep_output.hpp"
 
 using namespace stackbeam;
 namespace tt = boost::test_tools;
@@ -159,11 +164,77 @@ BOOST_AUTO_TEST_CASE(sweep_columns_are_the_windup_figures) {
         BOOST_TEST(std::isnan(r.figures[column("longitudinal_compliance_m_per_n")]));
         BOOST_TEST(r.figures[column("tangent_vertical_rate_n_per_m")] == s.windup->tangent->vertical_rate_n_per_m);
         BOOST_TEST(r.figures[column("windup_stiffness_n_m_per_rad")] == k, tt::tolerance(1e-9));
-        // point_figures, the sweep's figures from the records alone, gives the same
+        // the message says why the empty figures are empty: the seat is held at w = 0, so the vertical
+        // loading has no period and w no loop (not the loop code's "w does not move"); every windup
+        // figure that applies is there (decision 076)
+        BOOST_TEST(r.message == "no vertical loop: the vertical loading is not periodic");
+        // point_figures, the sweep's figures from the records alone, gives the same; the tangent needs
+        // the System and the last contact state, so its cell is empty there and the note says why
         std::string note;
         const auto f = point_figures(s.records, p.scenario.simulation, note);
         BOOST_TEST(f[column("windup_stiffness_n_m_per_rad")] == m.secant_stiffness_n_per_m);
+        BOOST_TEST(std::isnan(f[column("tangent_vertical_rate_n_per_m")]));
+        BOOST_TEST(note.rfind("no tangent vertical rate: from the records alone (point_figures)", 0) == 0, note);
+        BOOST_TEST(note.find("; no vertical loop: the vertical loading is not periodic") != std::string::npos, note);
     }
+}
+
+// A windup sweep point's files and message (sweep_output.hpp, write_point_files; decision 076): the
+// seat held at w = 0 writes its windup loop (t, theta_R, M over the rig's last period: 1 s at dt 10 ms,
+// 101 records) and no vertical loop file (w constant: no loop); the seat stroked +-5 mm by the vertical
+// rig at the windup rig's 1 Hz writes both, and its message has nothing to explain (both loops, the
+// Fancher fit and the tangent there). A ramped seat moment
+// (not periodic) has no windup loop: the message names that first, then the vertical loop's absence.
+BOOST_AUTO_TEST_CASE(sweep_point_files_and_messages_of_windup_runs) {
+    namespace fs = std::filesystem;
+    const std::string dir =
+        (fs::temp_directory_path() / ("stackbeam_test_windup_point_files_" + std::to_string(::getpid()))).string();
+    fs::remove_all(dir);
+    for (const char* kind : {"scenarios", "loops"}) fs::create_directories(fs::path(dir) / kind);  // as SweepDirectory does
+    auto run_and_write = [&](const Scenario& scenario, int index) {
+        SweepPoint point;
+        point.index = index;
+        point.scenario = scenario;
+        point.scenario_text = "# test point\n";
+        return run_point(point, nullptr, [&](const PointResult& r) { write_point_files(dir, point, r, false); });
+    };
+    auto lines = [](const std::string& path) {
+        std::ifstream in(path);
+        int n = 0;
+        for (std::string line; std::getline(in, line);) ++n;
+        return n;
+    };
+    const Scenario held = load_scenario(kWindupFile);
+    const PointResult a = run_and_write(held, 0);
+    BOOST_TEST_REQUIRE((a.status == PointStatus::ok), a.message);
+    BOOST_TEST(a.message == "no vertical loop: the vertical loading is not periodic");
+    BOOST_TEST(lines(point_file(dir, "loops", 0, "csv", "-windup")) == 102);  // the header and 101 records
+    BOOST_TEST(!fs::exists(point_file(dir, "loops", 0, "csv")));
+
+    Scenario stroked = held;
+    TimeFunction& w = stroked.simulation.loading.displacement_m;
+    w.shape = TimeFunction::Shape::triangle;
+    w.amplitude = 0.005;
+    w.frequency_hz = 1.0;
+    const PointResult b = run_and_write(stroked, 1);
+    BOOST_TEST_REQUIRE((b.status == PointStatus::ok), b.message);
+    BOOST_TEST(lines(point_file(dir, "loops", 1, "csv", "-windup")) == 102);
+    BOOST_TEST(lines(point_file(dir, "loops", 1, "csv")) == 102);
+    BOOST_TEST(b.message == "");
+
+    Scenario ramp = held;  // the seat free vertically, a seat moment ramped to 100 N m over the run
+    ramp.simulation.loading = Loading{};
+    TimeFunction M;
+    M.shape = TimeFunction::Shape::table;
+    M.times_s = {0.0, 2.0};
+    M.values = {0.0, 100.0};
+    ramp.simulation.loading.seat_moment_n_m = M;
+    const PointResult c = run_and_write(ramp, 2);
+    BOOST_TEST_REQUIRE((c.status == PointStatus::ok), c.message);
+    BOOST_TEST(c.message == "no windup loop: no periodic windup rig or seat moment: no steady cycle; "
+                            "no vertical loop: the vertical loading is not periodic");
+    BOOST_TEST(!fs::exists(point_file(dir, "loops", 2, "csv", "-windup")));
+    fs::remove_all(dir);
 }
 
 // A windup rig's loop with friction: the two-leaf spring held at w0 = 50 mm by the vertical rig (the

@@ -63,7 +63,7 @@ int run_request(const SimulateRequest& request) {
         if (!request.plot.empty()) {
             std::string note;
             const auto files = plot_run(request.out, request.plot, note, result.summary.loop.fancher_loop,
-                                        result.summary.windup.has_value());
+                                        result.summary.windup.has_value(), model.probe_pair() >= 0);
             for (const auto& f : files) std::printf("figure                     %s\n", f.c_str());
             if (files.empty()) std::printf("figures                    none: %s\n", note.c_str());
             if (!files.empty()) {  // the deformed stack at the extreme deflections (run.hpp kept them)

@@ -41,7 +41,7 @@ std::optional<std::string> plot_terminal(std::string& note) {
 }
 
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
-                                  const std::vector<std::pair<double, double>>& fitted_loop, bool windup) {
+                                  const std::vector<std::pair<double, double>>& fitted_loop, bool windup, bool probe) {
     using namespace stackbeam::gnuplot;
     const auto terminal = plot_terminal(note);
     if (!terminal) return {};
@@ -68,8 +68,9 @@ std::vector<std::string> plot_run(const std::string& csv, const std::string& pre
         f + " using " + std::to_string(t) + ":" + std::to_string(sf) + " with lines lw 2 title 'spring force', " + f +
             " using " + std::to_string(t) + ":" + std::to_string(ef) + " with lines dt 2 title 'external force', " + f +
             " using " + std::to_string(t) + ":" + std::to_string(fm) + " with lines dt 3 title 'm d^2w/dt^2'");
-    fig("friction", "friction force at the probe pair", "t [s]", "[N]",
-        f + " using " + std::to_string(t) + ":" + std::to_string(pf) + " with lines lw 2 title 'p_t'");
+    if (probe)  // a model without a probe pair (one leaf, no clamp) has no friction force to draw (the column is nan)
+        fig("friction", "friction force at the probe pair", "t [s]", "[N]",
+            f + " using " + std::to_string(t) + ":" + std::to_string(pf) + " with lines lw 2 title 'p_t'");
     std::string fitted;
     if (!fitted_loop.empty()) {
         const std::string data = prefix + "_fancher_loop.csv";

@@ -20,9 +20,12 @@ std::optional<std::string> plot_terminal(std::string& note);
 /// `fitted_loop`: Fancher's model fitted to the last cycle, (w [m], F [N]) (summary.hpp's
 /// LoopFigures::fancher_loop), drawn over the loop (written to PREFIX_fancher_loop.csv);
 /// empty: none. `windup` (the loading loads the seat): also the windup loop, seat_moment against
-/// seat_rotation, as PREFIX_windup_loop.png.
+/// seat_rotation, as PREFIX_windup_loop.png. `probe` (the model has a probe pair, Model::probe_pair()
+/// >= 0): the friction force at the probe, PREFIX_friction.png; without one (a single leaf, or no
+/// clamp to put it at) the CSV's probe_friction_force is nan and that figure is left out.
 std::vector<std::string> plot_run(const std::string& csv, const std::string& prefix, std::string& note,
-                                  const std::vector<std::pair<double, double>>& fitted_loop = {}, bool windup = false);
+                                  const std::vector<std::pair<double, double>>& fitted_loop = {}, bool windup = false,
+                                  bool probe = true);
 
 /// The deformed stack at the run's extreme deflections (the records of the largest and the
 /// smallest w, RunResult::stack_at_max / _min; of the seat's rotation theta_R in a windup run, the

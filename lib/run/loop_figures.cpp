@@ -87,11 +87,14 @@ WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loadi
     }
     // the vertical rate where the vertical loading has a period of its own (Loading::period_s falls back
     // to the windup rig's: then w only follows the windup, and its "loop" is no rate)
-    const double vertical_period_s = loading.kind == LoadingKind::applied_force      ? loading.force_n.period_s()
-                                     : loading.kind == LoadingKind::initial_conditions ? 0.0
-                                                                                       : loading.displacement_m.period_s();
-    if (vertical.metrics && vertical_period_s > 0.0) f.vertical_rate_n_per_m = vertical.metrics->secant_stiffness_n_per_m;
+    if (vertical.metrics && vertical_period_s(loading) > 0.0) f.vertical_rate_n_per_m = vertical.metrics->secant_stiffness_n_per_m;
     return f;
+}
+
+double vertical_period_s(const Loading& loading) {
+    return loading.kind == LoadingKind::applied_force        ? loading.force_n.period_s()
+           : loading.kind == LoadingKind::initial_conditions ? 0.0
+                                                             : loading.displacement_m.period_s();
 }
 
 SeatStiffness seat_tangent_stiffness(const System& system, const std::vector<PairRecord>& pairs, double t_s) {

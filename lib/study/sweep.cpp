@@ -600,6 +600,25 @@ void add_windup_figures(const std::optional<WindupFigures>& windup, std::vector<
     if (windup->tangent) f[23] = windup->tangent->vertical_rate_n_per_m;
 }
 
+/// The message of a run that loads the seat (decision 076): why each of its empty figures is empty,
+/// the windup's first (the windup loop; the longitudinal compliance where a longitudinal force acts;
+/// the tangent vertical rate), then the vertical loop's: none where the vertical loading is not
+/// periodic (the seat held at a preload: w makes no loop), else `vertical_note` (figures_of's).
+std::string windup_message(const WindupFigures& windup, const Loading& loading, const LoopFigures& loop,
+                           const std::string& vertical_note) {
+    std::string message;
+    auto add = [&message](const std::string& part) { message += (message.empty() ? "" : "; ") + part; };
+    if (!windup.windup) add("no windup loop: " + windup.windup_note);
+    if (loading.longitudinal_force_n && !windup.longitudinal) add("no longitudinal compliance: " + windup.longitudinal_note);
+    if (!windup.tangent) add("no tangent vertical rate: " + windup.tangent_note);
+    if (!loop.metrics)
+        add("no vertical loop: " +
+            (vertical_period_s(loading) > 0.0 ? loop.note : std::string("the vertical loading is not periodic")));
+    else if (!vertical_note.empty())
+        add(vertical_note);  // the Fancher fit's
+    return message;
+}
+
 /// The stress columns (point_figure_columns 17, 18) from a run's stress figures; NaN where none
 /// (not asked, or no leaf with a material whose endurance limit gives a safety factor).
 void add_stress_figures(const std::optional<RunStresses>& stresses, std::vector<double>& f) {
@@ -623,7 +642,13 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
     for (const StepRecord& r : records) balance = std::max(balance, std::abs(r.energy_balance_error_j));
     const LoopFigures loop = loop_figures(records, options.loading.period_s());
     std::vector<double> f = figures_of(loop, static_cast<long>(records.size()), balance, note);
-    if (loads_the_seat(options.loading)) add_windup_figures(windup_figures(records, options.loading, loop), f);
+    if (loads_the_seat(options.loading)) {
+        WindupFigures windup = windup_figures(records, options.loading, loop);
+        windup.tangent_note = "from the records alone (point_figures): the seat's tangent stiffness needs the "
+                              "System and the last record's contact state (run_point has them)";
+        add_windup_figures(windup, f);
+        note = windup_message(windup, options.loading, loop, note);
+    }
     return f;
 }
 
@@ -650,6 +675,8 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
         add_stress_figures(summary.stresses, result.figures);
         add_windup_figures(summary.windup, result.figures);
+        if (summary.windup)
+            result.message = windup_message(*summary.windup, run.options.loading, summary.loop, result.message);
     } catch (const SolverError& e) {
         result.status = PointStatus::failed;
         result.message = "solver failure at step " + std::to_string(e.step()) + " (t = " + format_value(e.time_s()) +

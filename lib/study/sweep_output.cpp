@@ -614,7 +614,16 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
     }
     if (r.records && r.status == PointStatus::ok) {
         const auto& records = *r.records;
-        const double period = point.scenario.simulation.loading.period_s();
+        const auto& columns = point_figure_columns();
+        auto figure = [&](const char* name) {
+            const auto i = std::find(columns.begin(), columns.end(), name) - columns.begin();
+            return static_cast<std::size_t>(i) < r.figures.size() ? r.figures[static_cast<std::size_t>(i)] : std::nan("");
+        };
+        const Loading& loading = point.scenario.simulation.loading;
+        // a run that loads the seat has a vertical loop file only where its row has the vertical loop
+        // (a seat held at a preload has none: w constant, the file a vertical line in the sweep's figure)
+        const bool vertical_loop = !loads_the_seat(loading) || !std::isnan(figure("secant_stiffness_n_per_m"));
+        const double period = vertical_loop ? loading.period_s() : 0.0;
         if (period > 0.0) {
             try {
                 const auto cycle = last_cycle(records, period);
@@ -631,12 +640,6 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
                 write_whole(point_file(directory, "loops", r.index, "csv"), loop.str());
                 // the fitted Fancher loop along the same path, from the row's parameters: the
                 // model in its periodic state, as fit_fancher_loop's model_force_n
-                const auto& columns = point_figure_columns();
-                auto figure = [&](const char* name) {
-                    const auto i = std::find(columns.begin(), columns.end(), name) - columns.begin();
-                    return static_cast<std::size_t>(i) < r.figures.size() ? r.figures[static_cast<std::size_t>(i)]
-                                                                           : std::nan("");
-                };
                 FancherParameters p;
                 p.upper_rate_n_per_m = figure("fancher_upper_rate_n_per_m");
                 p.upper_offset_n = figure("fancher_upper_offset_n");
@@ -656,7 +659,6 @@ void write_point_files(const std::string& directory, const SweepPoint& point, co
             }
         }
         // a windup run: its windup loop's last cycle (windup_figures' cycle), the moment against the rotation
-        const Loading& loading = point.scenario.simulation.loading;
         const double windup_period = loads_the_seat(loading) ? windup_period_s(loading) : 0.0;
         if (windup_period > 0.0) {
             try {

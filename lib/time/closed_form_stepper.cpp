@@ -10,6 +10,7 @@
 #include "stackbeam/errors.hpp"
 #include "model/mesh_note.hpp"
 #include "time/contact_state.hpp"
+#include "time/held_seat.hpp"
 #include "time/record.hpp"
 #include "time/initial_state.hpp"
 #include "time/static_stages.hpp"
@@ -68,13 +69,13 @@ struct ClosedFormStepper::Impl {
     // (theta_R free: C_h = C', c_h = c, k_h = k, L = B, l = g, v = S). u = [u0; v]: u0 = w(t+dt)
     // where the vertical rig holds R, else R's vertical loading F_v, R static (the windup rig is
     // quasi-static: R's inertia is out of its loop, as newmark's) and eliminated:
-    // w = (F_v - l^T v + c_h^T p) / k_h. The operator's DOFs are the free ones (held_free_).
+    // w = (F_v - l^T v + c_h^T p) / k_h. The operator's DOFs are the free ones (held_dofs_.free).
     bool windup_ = false, held_seat_ = false;
     double seat_a_ = 0.0, seat_kh_ = 0.0;
     Eigen::VectorXd seat_b_, seat_ch_;
     Eigen::MatrixXd seat_L_;
     Eigen::Vector2d seat_l_ = Eigen::Vector2d::Zero();
-    std::vector<int> held_free_;                             // the free DOFs of the held-seat form
+    detail::HeldSeatDofs held_dofs_;                         // the held-seat form's held and free DOFs
     Eigen::Vector2d seat_full_ = Eigen::Vector2d::Zero();    // [M_theta; H] on the seat at t [N m, N]
     double spring_ = 0.0;                                    // R's force on the stack at t [N, meshed part]
     /// The held-seat form's w [m] and seat loads [M_theta; H] for its u and the forces p.
@@ -328,7 +329,7 @@ Eigen::Vector2d ClosedFormStepper::Impl::held_seat_loads(double w, const Eigen::
 
 Eigen::VectorXd ClosedFormStepper::Impl::held_seat_z(const Eigen::VectorXd& zf, const Eigen::VectorXd& u) const {
     Eigen::VectorXd z(w_dof_ + 1);
-    for (std::size_t i = 0; i < held_free_.size(); ++i) z[held_free_[i]] = zf[static_cast<Eigen::Index>(i)];
+    for (std::size_t i = 0; i < held_dofs_.free.size(); ++i) z[held_dofs_.free[i]] = zf[static_cast<Eigen::Index>(i)];
     if (windup_) z[system_.seat_rotation_dof()] = u[1];
     if (rig_) z[w_dof_] = u[0];
     return z;
@@ -354,8 +355,7 @@ StepSystem ClosedFormStepper::Impl::held_seat_system() {
         seat_L_ = sc.B;
         seat_l_ = sc.g;
     }
-    for (int i = 0; i <= w_dof_; ++i)
-        if (!(windup_ && i == theta) && !(rig_ && i == w_dof_)) held_free_.push_back(i);
+    held_dofs_ = detail::held_seat_dofs(system_, windup_, rig_);
     StepSystem sys;
     sys.rows = system_.num_components();
     sys.dense = [this] {
@@ -374,8 +374,8 @@ StepSystem ClosedFormStepper::Impl::held_seat_system() {
         f.displacements = [this](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {  // z_F
             const auto [w, S] = held_seat_state(u, p);
             const Eigen::VectorXd z = system_.reduced_displacements(p, w, S);
-            Eigen::VectorXd zf(static_cast<Eigen::Index>(held_free_.size()));
-            for (std::size_t i = 0; i < held_free_.size(); ++i) zf[static_cast<Eigen::Index>(i)] = z[held_free_[i]];
+            Eigen::VectorXd zf(static_cast<Eigen::Index>(held_dofs_.free.size()));
+            for (std::size_t i = 0; i < held_dofs_.free.size(); ++i) zf[static_cast<Eigen::Index>(i)] = z[held_dofs_.free[i]];
             return zf;
         };
         f.strain_energy_j = [this](const Eigen::VectorXd& u, const Eigen::VectorXd& p) {
@@ -388,9 +388,8 @@ StepSystem ClosedFormStepper::Impl::held_seat_system() {
         // -K_Fh u_h and the offsets by G_h u_h; a free one takes its load (F_v on w, S_0 on theta_R, H on u_R)
         const Eigen::SparseMatrix<double>& K = system_.stiffness_reduced();
         const Eigen::SparseMatrix<double>& G = system_.contact_rows();
-        std::vector<int> index(static_cast<std::size_t>(w_dof_ + 1), -1);
-        for (std::size_t i = 0; i < held_free_.size(); ++i) index[static_cast<std::size_t>(held_free_[i])] = static_cast<int>(i);
-        const int nf = static_cast<int>(held_free_.size());
+        const std::vector<int>& index = held_dofs_.index;
+        const int nf = static_cast<int>(held_dofs_.free.size());
         std::vector<Eigen::Triplet<double>> kt, gt, bt, et;
         const int dofs[3] = {w_dof_, theta, axial};
         for (int col = 0; col < K.outerSize(); ++col)

@@ -9,6 +9,7 @@
 #include "stackbeam/errors.hpp"
 #include "fe/tied_shape.hpp"
 #include "time/contact_state.hpp"
+#include "time/held_seat.hpp"
 #include "time/cvode/cvode_modes.hpp"
 #include "time/reduced_load.hpp"
 #include "time/static_stages.hpp"
@@ -53,15 +54,7 @@ bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd&
     const int theta = sys.seat_rotation_dof(), nz = sys.num_reduced_dofs(), w_dof = nz - 1;
     if (!st.options.loading.windup_rig() || theta < 0) return false;
     const double theta0_rad = st.options.loading.seat_rotation_rad->value(0.0);
-    std::vector<int> index(static_cast<std::size_t>(nz), -1);  // reduced DOF -> free DOF
-    int nf = 0;
-    for (int i = 0; i < nz; ++i)
-        if (i != theta && i != w_dof) index[static_cast<std::size_t>(i)] = nf++;
-    Eigen::SparseMatrix<double> S(nf, nz);  // F <- all
-    std::vector<Eigen::Triplet<double>> sel;
-    for (int i = 0; i < nz; ++i)
-        if (index[static_cast<std::size_t>(i)] >= 0) sel.emplace_back(index[static_cast<std::size_t>(i)], i, 1.0);
-    S.setFromTriplets(sel.begin(), sel.end());
+    const Eigen::SparseMatrix<double> S = held_seat_dofs(sys, true, true).S;  // F <- all
     Eigen::VectorXd zh = Eigen::VectorXd::Zero(nz);  // the held DOFs' values, 0 elsewhere
     zh[theta] = theta0_rad;
     zh[w_dof] = st.w0_m;

@@ -14,6 +14,7 @@
 #include "time/contact_state.hpp"
 #include "time/record.hpp"
 #include "time/reduced_load.hpp"
+#include "time/held_seat.hpp"
 #include "time/rig_reaction.hpp"
 #include "time/stack_properties.hpp"
 #include "time/initial_state.hpp"
@@ -131,23 +132,13 @@ NewmarkStepper::Impl::Impl(const System& system, const detail::InitialState& sta
     const bool windup = options_.loading.windup_rig();
     M_ = system_.mass_reduced(!windup);
     body_mass_on_w_ = windup ? 0.0 : system_.model().spec().rigid_body.mass_kg;
-    const int n = static_cast<int>(K_.rows());
-    if (windup) {
-        prescribed_.push_back(system_.seat_rotation_dof());
-        prescribed_f_.push_back(&*options_.loading.seat_rotation_rad);
-    }
-    if (rig_) {
-        prescribed_.push_back(n - 1);
-        prescribed_f_.push_back(&options_.loading.displacement_m);
-    }
-    std::vector<Eigen::Triplet<double>> sel;
-    for (int i = 0, row = 0; i < n; ++i)
-        if (std::find(prescribed_.begin(), prescribed_.end(), i) == prescribed_.end()) {
-            if (i != row) free_leading_ = false;
-            sel.emplace_back(row++, i, 1.0);
-        }
-    S_.resize(n - static_cast<int>(prescribed_.size()), n);
-    S_.setFromTriplets(sel.begin(), sel.end());
+    // the held DOFs H in held_seat_dofs' order (theta_R, then w), each with its prescribed motion
+    detail::HeldSeatDofs dofs = detail::held_seat_dofs(system_, windup, rig_);
+    prescribed_ = std::move(dofs.held);
+    if (windup) prescribed_f_.push_back(&*options_.loading.seat_rotation_rad);
+    if (rig_) prescribed_f_.push_back(&options_.loading.displacement_m);
+    S_ = std::move(dofs.S);
+    free_leading_ = dofs.free_leading;
     rig_force_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(prescribed_.size()));
     if (options_.damping.active()) {  // structural damping C = alpha M + beta K (massive leaves)
         C_ = options_.damping.rayleigh_alpha_per_s * M_ + options_.damping.rayleigh_beta_s * K_;

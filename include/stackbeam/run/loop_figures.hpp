@@ -94,6 +94,12 @@ bool loads_the_seat(const Loading& loading);
 /// the longitudinal force's where it has a moment (h != 0); 0 when none of them is periodic.
 double windup_period_s(const Loading& loading);
 
+/// The period of the vertical loading itself [s]: the applied force's or the prescribed (or base)
+/// displacement's; 0 for initial conditions or a loading that is not periodic. Loading::period_s()
+/// falls back to the seat's loading where this is 0, so a windup run's vertical "loop" is then w
+/// following the windup (or held), no vertical rate.
+double vertical_period_s(const Loading& loading);
+
 /// The windup figures of `records` under `loading` (loads_the_seat), with the vertical rate from
 /// `vertical` (the same run's loop_figures). Bad data gives notes, never an exception.
 WindupFigures windup_figures(const std::vector<StepRecord>& records, const Loading& loading, const LoopFigures& vertical);

@@ -166,7 +166,10 @@ const std::vector<std::string>& point_figure_columns();
 /// The figures of one finished run, in the order of point_figure_columns(); NaN where a
 /// figure does not exist (no periodic loading: no loop). The place to add a figure: its
 /// name in point_figure_columns(), its value here. `note` says why the loop figures are
-/// missing ("" if they are there).
+/// missing ("" if they are there); in a run that loads the seat, why each missing windup figure
+/// is missing, then the vertical loop's (run_point's message, decision 076). From the records
+/// alone the seat's tangent stiffness cannot be had (it needs the System and the last record's
+/// contact state): tangent_vertical_rate_n_per_m is NaN here, and `note` says so.
 std::vector<double> point_figures(const std::vector<StepRecord>& records, const SimulationOptions& options,
                                   std::string& note);
 
@@ -174,7 +177,7 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
 struct PointResult {
     int index = 0;
     PointStatus status = PointStatus::ok;
-    std::string message;             ///< failure message, or why the loop figures are empty ("" none)
+    std::string message;             ///< failure message, or why the loop (and windup) figures are empty ("" none)
     std::vector<double> figures;     ///< point_figure_columns() order; NaN where none (all NaN when not ok)
     double wall_s = 0.0;             ///< the point's wall time [s]
     /// The point's records (only during the on_point_done call that reports it; empty after

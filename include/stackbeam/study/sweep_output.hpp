@@ -118,6 +118,8 @@ private:
 /// Writes the files of one finished point under `directory`: its scenario (always, over any
 /// older file), its loop (and its series with keep_series) from result.records when it is ok
 /// and has them; an older loop or series file of the point is removed when there is none now.
+/// A run that loads the seat: its windup loop (-windup), and its vertical loop only where the
+/// row has that loop's figures (the seat held at a preload has none).
 /// Used by SweepDirectory::record, and by a process that runs points for another (MPI ranks).
 /// `spec_source` names the spec in the scenario file's first line. Write errors throw
 /// std::runtime_error with the system's reason.
