@@ -117,7 +117,7 @@ public:
     }
 
     /// Slip rows: p_t = sigma mu tau(p_n), written with the same formula as the friction limit.
-    void put_slip_forces(const ContactProblem& pr, Eigen::VectorXd& p) const {
+    void put_slip_forces(const ContactLaws& pr, Eigen::VectorXd& p) const {
         for (int k = 0; k < static_cast<int>(pr.pairs.size()); ++k) {
             const auto& c = pr.pairs[k];
             if (c.row_t >= 0 && (tmode[k] == SLIP_POS || tmode[k] == SLIP_NEG))
