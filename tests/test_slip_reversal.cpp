@@ -2,7 +2,7 @@
 // cvode_massive.cpp; docs/decisions/074-slip-stops-at-the-cone.md): the rate's root is one located
 // event into stick (the stick force stays inside the cone), and the pair slips again, the other
 // way, only where its stick force has crossed the cone: never a loop of reversals. The instants
-// are checked against mode newmark on the same massive model as its step falls.
+// are checked against mode newmark on the same massive model at a small step.
 #define BOOST_TEST_MODULE slip_reversal
 #include <boost/test/unit_test.hpp>
 #include <cmath>
