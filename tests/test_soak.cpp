@@ -308,10 +308,13 @@ bool known_failure(unsigned seed, const char* row) {
 /// it; every run must complete within the step budget and close its balance. `only_row`: that row
 /// alone (the regression cases); else every row but the known failures. `expect_error`: the run
 /// must instead stop with an error saying that, well within its step budget (a named refusal).
-/// `massive_t_end_s`: the whole massive stack's window (its first 0.05 s; a regression case may
-/// take less).
+/// The whole massive stack's window [s] (soak_seed: its first 0.05 s; a regression case may take less).
+struct MassiveWindow {
+    double t_end_s = 0.05;
+};
+/// `massive`: the whole massive stack's window.
 void soak_seed(unsigned seed, const std::string& only_row = "", const std::string& expect_error = "",
-               double massive_t_end_s = 0.05) {
+               MassiveWindow massive = {}) {
     const RandomCase c = random_case(seed);
     BOOST_TEST_MESSAGE("seed " << seed << ": " << c.what);
     const double T = 2.0 * kPi / c.omega_rad_per_s;
@@ -349,7 +352,7 @@ void soak_seed(unsigned seed, const std::string& only_row = "", const std::strin
             if (std::string(row.name) == "cvode-massive") {
                 o.damping.rayleigh_beta_s = 1e-6;
                 o.damping.layer_normal_time_s = 1e-6;
-                o.t_end_s = std::min(o.t_end_s, massive_t_end_s);
+                o.t_end_s = std::min(o.t_end_s, massive.t_end_s);
                 o.dt_s = std::min({o.dt_s, 0.005, o.t_end_s / 10.0});
                 o.cvode.max_steps = 200000;
             }
@@ -527,14 +530,14 @@ BOOST_AUTO_TEST_CASE(one_run, *boost::unit_test::disabled()) {
 // stuck pair's margin covers its forces' round-off (decision 074). Its first 2 ms: 0 slip
 // reversals, every transition a root (stick <-> slip), balance within the bound.
 BOOST_AUTO_TEST_CASE(seed_14_cvode_massive_initial_solve_within_round_off) {
-    soak_seed(14, "cvode-massive", "", 2e-3);
+    soak_seed(14, "cvode-massive", "", MassiveWindow{2e-3});
 }
 // Seed 25 (4 leaves, elastic interfaces, clamps of 1978 N, base motion, gravity): pair 18 slipping
 // at its cone stopped (slip-rate root) with its stick force staying on the cone at second order;
 // the event solve put it on the cone's edge (a slip), its rate at the state (+5e-15 V_ref beyond
 // the margin) reversed it, and it reversed again at each next rate root every ~40 ns: 100 changes
 // within 2.8e-5 s. Now it sticks there (decision 074); its first ms runs through.
-BOOST_AUTO_TEST_CASE(seed_25_cvode_massive_slip_stops_at_its_cone) { soak_seed(25, "cvode-massive", "", 1e-3); }
+BOOST_AUTO_TEST_CASE(seed_25_cvode_massive_slip_stops_at_its_cone) { soak_seed(25, "cvode-massive", "", MassiveWindow{1e-3}); }
 // A run that reaches cvode.max_steps says what the steps went into (decision 065): seed 1's
 // massive stack stopped at 3,000 steps (t = 81 us), well before its chatter is named: the message
 // gives the mean step (2.7e-8 s) and the last against the stack's period (0.31 s), the events
