@@ -20,11 +20,18 @@
 // contact iteration deciding the modes at an event is per pair. Witnesses (positive while the
 // modes hold, decreasing crossings): a closed pair's compression, an open pair's gap, a
 // sticking pair's margin mu tau - |p_t|, a slipping pair's slider rate against its force.
-// A pair at the slip/stick boundary: when a slipping pair's slider rate reaches 0 its stick
-// force equals its slip force and their first derivatives agree, so sticking is decided at
-// second order by the look-ahead (stick if the stick force stays inside the cone); a pair
-// that would leave the cone at once slips on, and the sign of a new slip follows the slider
-// rate (correct_decision). No sliding mode arises: a slip that stops reverses its rate.
+// A pair at the slip/stick boundary (its force at the cone's edge, p_t = sigma mu tau): at
+// fixed z and z' its sigma-slip rate u and its stick force's rate into the cone are one
+// quantity, d(mu tau - sigma p_t)/dt = sigma u / c_t in stick (the layer's compliance c_t): where
+// the slip's rate contradicts the slip (sigma u > 0) the stick force moves inside the cone, where
+// it agrees the stick force leaves it. So exactly one of stick and sigma-slip holds at first
+// order, and neither needs a force jump. The look-ahead decides at second order where u ~ 0;
+// where its decision is a sigma-slip whose rate at the event's state contradicts it, the pair
+// sticks (correct_decision), and slips again only at a root of its stick witness. Only a pair
+// not at that edge of its cone slips with a jump, its sign following its rate. (The old rule
+// reversed every contradicted slip, a force jump of 2 mu tau: a pair that stopped on its cone
+// then reversed at every rate root, soak seeds 14 and 25, decision 074.) A stuck pair's margin
+// covers its forces' round-off (force_round_off_n).
 //
 // Structural damping (SimulationOptions::damping, off by default): C = alpha M + beta K of the
 // leaves and R, its work int v^T C v dt a state of its own (StepRecord::damping_energy_j). The
@@ -104,6 +111,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     bool damped_ = false;     // Cd has an entry
     bool damped() const { return damped_; }
     RowSpMat Grow;            // G, row-major [-]
+    RowSpMat Gabs;            // |G_ij| (force_round_off_n) [-]
     Eigen::VectorXd cL;       // layer compliance per contact row [m/N]
     Eigen::SimplicialLDLT<SpMat> mass;  // M
     std::unique_ptr<ReducedLoad> load;  // q(t) of the loading (none for initial conditions and the rig)
@@ -293,9 +301,22 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         const auto z = y.head(ndof());
         const auto v = y.segment(ndof(), ndof());
         const Eigen::VectorXd& d = anchors();
+        const Vec round_off = force_round_off_n(z);
         witnesses_from(
             forces_z(z), [&](int row) { return Hs.row(row).dot(z) + hs[row] - d[row]; },
-            [&](int row) { return Hs.row(row).dot(v); }, g);
+            [&](int row) { return Hs.row(row).dot(v); }, g, &round_off);
+    }
+
+    /// The round-off of each row's force at z [N]: a held row's p_i = (d_i - G_i z) / c_i is a
+    /// difference of terms G_ij z_j / c_i far larger than p_i on a stiff layer (soak seed 14: sum
+    /// |G_n z| / c_n = 6.3e10 N for p_n = -289 N, so eps times it, 1.4e-5 N, is 1e-8 F_ref), and a
+    /// slipping row's mu p_n carries its normal row's. kRoundOffTerms eps (|G_i| |z| + |d_i|) / c_i
+    /// bounds it: a sum of n terms is rounded to ~sqrt(n) eps sum |terms| (rows of 8-16 terms;
+    /// measured 0.22 eps sum |terms| at seed 14's stick entry). Decision 074.
+    Vec force_round_off_n(const Eigen::Ref<const Eigen::VectorXd>& z) const {
+        constexpr double kRoundOffTerms = 4.0;
+        const Vec sum = Gabs * z.cwiseAbs() + anchors().cwiseAbs();
+        return (kRoundOffTerms * std::numeric_limits<double>::epsilon()) * sum.cwiseQuotient(cL);
     }
 
     /// The look-ahead: the contact points move by ~kLookahead L_ref and the forces by
@@ -341,10 +362,25 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
         wd = y[ndof() + w_dof()];
     }
 
-    /// A slipping pair slips against its slider rate (EventDriver::signs_follow_slip_rates).
+    /// A slipping pair slips against its slider rate (EventDriver::signs_follow_slip_rates); one
+    /// whose force at y is at its cone on the decided slip's side and whose rate contradicts that
+    /// slip sticks (file comment: the pair at the slip/stick boundary).
     void correct_decision(const State& y, const Vec& rel, std::vector<signed char>& nm,
                           std::vector<signed char>& tm) override {
-        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(ndof(), ndof())); });
+        // the forces at y before the event: rel = G z + C_L p (relative_at_event; every row has a layer)
+        const Vec p_cur = (rel - Grow * y.head(ndof())).cwiseQuotient(cL);
+        const Vec round_off = force_round_off_n(y.head(ndof()));
+        std::vector<signed char> side(static_cast<std::size_t>(num_pairs()), 0);
+        for (int kk = 0; kk < num_pairs(); ++kk) {
+            const ContactPair& cp = pairs()[kk];
+            if (cp.row_t < 0 || cp.kind == PairKind::bonded || !(cp.friction_coefficient > 0.0)) continue;
+            const double limit_n = cp.friction_coefficient * friction_normal_force(laws(), kk, p_cur);
+            // at the edge within the stick witness's margin (witnesses_from with the forces' round-off)
+            const double r = cp.row_n >= 0 ? round_off[cp.row_t] + cp.friction_coefficient * round_off[cp.row_n] : round_off[cp.row_t];
+            if (limit_n > 0.0 && std::abs(p_cur[cp.row_t]) >= limit_n - std::max(kForceMargin * scales().F_ref_n, r))
+                side[static_cast<std::size_t>(kk)] = p_cur[cp.row_t] > 0.0 ? 1 : -1;
+        }
+        signs_follow_slip_rates(rel, nm, tm, [&] { return Vec(Hs * y.segment(ndof(), ndof())); }, &side);
     }
 
     /// A force jump at an event (a slip that reverses) releases the layer's energy
@@ -467,6 +503,7 @@ CvodeMassiveStepper::Impl::Impl(const System& system, const InitialState& start)
       M(system.mass_reduced(!start.options.loading.windup_rig())),  // the windup rig: R's inertia out (quasi-static)
       Gt(system.contact_rows().transpose()),
       Grow(system.contact_rows()),
+      Gabs(Grow.cwiseAbs()),
       cL(system.layer_compliance_m_per_n()),
       load(std::make_unique<ReducedLoad>(system, start.options.loading)),
       rig(start.rig) {

@@ -291,7 +291,10 @@ bool EventDriver::apply_slot_transitions(const std::function<bool(std::size_t)>&
 }
 
 void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
-                                          const std::function<Vec()>& rate) {
+                                          const std::function<Vec()>& rate, const std::vector<signed char>* cone_side) {
+    // A contradicted slip reverses (a force jump of 2 mu tau), unless the pair is at the edge of
+    // its cone on that slip's side: there it sticks (cone_side).
+    const auto stops = [&](int kk, int sign) { return cone_side != nullptr && (*cone_side)[kk] == sign; };
     for (int pass = 0; pass < 3; ++pass) {
         bool changed = false;
         in_candidate_modes(rel, nm, tm, true, [&] {
@@ -299,8 +302,13 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
             for (int kk = 0; kk < np_; ++kk) {
                 const int rt = pairs()[kk].row_t;
                 if (rt < 0) continue;
-                if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * scales_.V_ref_m_per_s) { tm[kk] = SLIP_NEG; changed = true; }
-                else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * scales_.V_ref_m_per_s) { tm[kk] = SLIP_POS; changed = true; }
+                if (tm[kk] == SLIP_POS && r[rt] > kMotionMargin * scales_.V_ref_m_per_s) {
+                    tm[kk] = stops(kk, 1) ? STICK : SLIP_NEG;
+                    changed = true;
+                } else if (tm[kk] == SLIP_NEG && r[rt] < -kMotionMargin * scales_.V_ref_m_per_s) {
+                    tm[kk] = stops(kk, -1) ? STICK : SLIP_POS;
+                    changed = true;
+                }
             }
         });
         if (!changed) break;
@@ -308,7 +316,7 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
 }
 
 void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>& s_of,
-                                 const std::function<double(int)>& rate_of, double* g) const {
+                                 const std::function<double(int)>& rate_of, double* g, const Vec* force_round_off) const {
     for (std::size_t i = 0; i < slots_.size(); ++i) {
         const int kk = slots_[i].pair;
         const auto& cp = pairs()[kk];
@@ -330,6 +338,11 @@ void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>&
             switch (modes_.tmode[kk]) {
                 case STICK:
                     val = (cp.friction_coefficient * friction_normal_force(chk_problem_, kk, p) - std::abs(p[rt])) / scales_.F_ref_n;
+                    if (force_round_off != nullptr) {  // the margin no finer than the forces' round-off
+                        double r = (*force_round_off)[rt];
+                        if (cp.row_n >= 0) r += cp.friction_coefficient * (*force_round_off)[cp.row_n];
+                        margin = std::max(margin, r / scales_.F_ref_n);
+                    }
                     break;
                 case SLIP_POS: val = -rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;
                 case SLIP_NEG: val = rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;

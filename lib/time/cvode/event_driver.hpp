@@ -233,15 +233,22 @@ protected:
     /// of a tangential row (`rate_of(row)`): a closed pair's compression, an open pair's gap, a
     /// clamp's release or engagement, a sticking pair's margin to the cone, a slipping pair's
     /// rate against its force; each positive while its modes hold, with its margin.
+    /// `force_round_off` (optional, per row [N]): the round-off of each row's force; a sticking
+    /// pair's margin is then at least that of its force and of mu times its normal force's
+    /// (the massive stack on a stiff layer, decision 074).
     void witnesses_from(const Vec& p, const std::function<double(int)>& s_of, const std::function<double(int)>& rate_of,
-                        double* g) const;
+                        double* g, const Vec* force_round_off = nullptr) const;
     /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
     /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
     /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
     /// rate the look-ahead's motion is too short to resolve), the sign follows the rate.
+    /// `cone_side` (optional, per pair: +1 / -1 where the pair's force at the event's state is
+    /// at the positive / negative edge of its cone, 0 inside): a pair whose contradicted slip
+    /// has the sign of the edge it is at sticks instead (its slip would stop at once, and its
+    /// stick force moves into the cone: the massive stack, decision 074).
     /// At most three passes; the current modes and anchors are left as they were.
     void signs_follow_slip_rates(const Vec& rel, std::vector<signed char>& nm, std::vector<signed char>& tm,
-                                 const std::function<Vec()>& rate);
+                                 const std::function<Vec()>& rate, const std::vector<signed char>* cone_side = nullptr);
     /// Books a force jump at an event (a slip that reverses where sticking is not admissible)
     /// that released `loss` [J, whole spring] of the contact layer's energy: friction work.
     void book_force_jump(const std::string& cause, double loss, const Vec& p_cur, const Vec& p_new);
