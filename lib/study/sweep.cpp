@@ -648,6 +648,8 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         if (summary.interrupted) throw SweepStopped();
         records = std::move(summary.records);
         result.figures = figures_of(summary.loop, summary.stats.records, summary.stats.max_abs_balance_j, result.message);
+        for (const std::string& note : summary.model_adjustments)  // close clamps merged: the point's message says so
+            result.message += (result.message.empty() ? "" : "; ") + note;
         add_stress_figures(summary.stresses, result.figures);
         add_windup_figures(summary.windup, result.figures);
     } catch (const SolverError& e) {
