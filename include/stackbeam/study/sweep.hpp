@@ -174,7 +174,7 @@ std::vector<double> point_figures(const std::vector<StepRecord>& records, const 
 struct PointResult {
     int index = 0;
     PointStatus status = PointStatus::ok;
-    std::string message;             ///< failure message, or why the loop figures are empty, and what the model adjusted (Model::adjustments(); "" none)
+    std::string message;             ///< failure message, or why the loop figures are empty ("" none)
     std::vector<double> figures;     ///< point_figure_columns() order; NaN where none (all NaN when not ok)
     double wall_s = 0.0;             ///< the point's wall time [s]
     /// The point's records (only during the on_point_done call that reports it; empty after
