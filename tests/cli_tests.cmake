@@ -16,7 +16,9 @@ if(CMAKE_SCRIPT_MODE_FILE)
   # [-DOUT=<file that must exist after the run, or must not when EXPECT_RC != 0>]
   # [-DHEADER_PREFIX=<prefix of OUT's first line>] [-DMIN_LINES=<n>]
   # [-DJSON=<a JSON file the run writes> -DJSON_PATH=<keys separated by |> -DJSON_RANGE=<lo|hi>]:
-  #   the number at JSON_PATH in JSON must lie in [lo, hi]
+  #   the number at JSON_PATH in JSON must lie in [lo, hi]; [-DJSON_TEXT=<text>] instead: the string
+  #   at JSON_PATH must contain it; [-DJSON_ABSENT=<key>]: JSON has no top-level key of that name
+  # [-DNOT_TEXT=<text stdout+stderr must not contain>]
   string(REPLACE "|" ";" args "${ARGS}")
   if(DEFINED OUT)
     file(REMOVE "${OUT}" "${OUT}.partial")
@@ -31,6 +33,12 @@ if(CMAKE_SCRIPT_MODE_FILE)
     string(FIND "${out}${err}" "${EXPECT_TEXT}" pos)
     if(pos EQUAL -1)
       message(FATAL_ERROR "the output does not contain '${EXPECT_TEXT}'")
+    endif()
+  endif()
+  if(DEFINED NOT_TEXT)
+    string(FIND "${out}${err}" "${NOT_TEXT}" pos)
+    if(NOT pos EQUAL -1)
+      message(FATAL_ERROR "the output contains '${NOT_TEXT}'")
     endif()
   endif()
   if(DEFINED OUT)
@@ -59,11 +67,27 @@ if(CMAKE_SCRIPT_MODE_FILE)
   endif()
   if(DEFINED JSON)
     file(READ "${JSON}" json_text)
+  endif()
+  if(DEFINED JSON AND DEFINED JSON_ABSENT)
+    string(JSON value ERROR_VARIABLE json_error GET "${json_text}" "${JSON_ABSENT}")
+    if(NOT json_error)
+      message(FATAL_ERROR "${JSON} has the key '${JSON_ABSENT}': ${value}")
+    endif()
+    message(STATUS "${JSON}: no key '${JSON_ABSENT}'")
+  elseif(DEFINED JSON)
     string(REPLACE "|" ";" json_keys "${JSON_PATH}")
     string(JSON value ERROR_VARIABLE json_error GET "${json_text}" ${json_keys})
     if(json_error)
       message(FATAL_ERROR "${JSON}: ${JSON_PATH}: ${json_error}")
     endif()
+  endif()
+  if(DEFINED JSON AND DEFINED JSON_TEXT)
+    string(FIND "${value}" "${JSON_TEXT}" pos)
+    if(pos EQUAL -1)
+      message(FATAL_ERROR "${JSON}: ${JSON_PATH} = '${value}' does not contain '${JSON_TEXT}'")
+    endif()
+    message(STATUS "${JSON_PATH} contains '${JSON_TEXT}'")
+  elseif(DEFINED JSON AND DEFINED JSON_RANGE)
     string(REPLACE "|" ";" range "${JSON_RANGE}")
     list(GET range 0 lo)
     list(GET range 1 hi)
@@ -79,12 +103,13 @@ endif()
 # ---- configure mode: the registrations -------------------------------------------------
 
 # stackbeam_cli_test(NAME <name> ARGS <arg>... EXPECT_RC <n> [EXPECT_TEXT <text>] [OUT <file>]
-#                    [HEADER_PREFIX <prefix>] [MIN_LINES <n>])
+#                    [NOT_TEXT <text>] [HEADER_PREFIX <prefix>] [MIN_LINES <n>]
+#                    [JSON <file> JSON_PATH <keys> (JSON_RANGE <lo|hi> | JSON_TEXT <text>) | JSON_ABSENT <key>])
 function(stackbeam_cli_test)
-  cmake_parse_arguments(T "" "NAME;EXPECT_RC;EXPECT_TEXT;OUT;HEADER_PREFIX;MIN_LINES;JSON;JSON_PATH;JSON_RANGE" "ARGS" ${ARGN})
+  cmake_parse_arguments(T "" "NAME;EXPECT_RC;EXPECT_TEXT;NOT_TEXT;OUT;HEADER_PREFIX;MIN_LINES;JSON;JSON_PATH;JSON_RANGE;JSON_TEXT;JSON_ABSENT" "ARGS" ${ARGN})
   string(REPLACE ";" "|" args "${T_ARGS}")
   set(defs -DCLI=$<TARGET_FILE:stackbeam_cli> "-DARGS=${args}" -DEXPECT_RC=${T_EXPECT_RC})
-  foreach(opt EXPECT_TEXT OUT HEADER_PREFIX MIN_LINES JSON JSON_PATH JSON_RANGE)
+  foreach(opt EXPECT_TEXT NOT_TEXT OUT HEADER_PREFIX MIN_LINES JSON JSON_PATH JSON_RANGE JSON_TEXT JSON_ABSENT)
     if(DEFINED T_${opt})
       list(APPEND defs "-D${opt}=${T_${opt}}")
     endif()
@@ -439,6 +464,28 @@ stackbeam_cli_test(NAME cli_interface_over_scenario_warns
                         --t-end 0.002 --quiet --out ${_cli_out_dir}/cli_el3.csv
                    EXPECT_RC 0 EXPECT_TEXT "note: interface 0 has the elastic law with mu = 0.8"
                    OUT ${_cli_out_dir}/cli_el3.csv)
+
+# Close clamps merged (Model::adjustments(), decision 077): tests/cli_close_clamps.toml's clamps[0]
+# and clamps[1], 0.4 mm apart on 12.5 mm elements, act as one clamp at their midpoint 0.1002 m; the
+# text summary and the JSON summary's "model_adjustments" say so, naming them as written. The
+# paper's friction case has no close clamps: neither the line nor the key.
+stackbeam_cli_test(NAME cli_close_clamps_text
+                   ARGS simulate --scenario ${CMAKE_CURRENT_LIST_DIR}/cli_close_clamps.toml
+                        --out ${_cli_out_dir}/cli_close_clamps_text.csv
+                   EXPECT_RC 0
+                   EXPECT_TEXT "model adjustment           clamps[0] (x = 0.1 m) and clamps[1] (x = 0.1004 m), 0.0004 m apart, act as one clamp at x = 0.1002 m"
+                   OUT ${_cli_out_dir}/cli_close_clamps_text.csv)
+stackbeam_cli_test(NAME cli_close_clamps_summary
+                   ARGS simulate --scenario ${CMAKE_CURRENT_LIST_DIR}/cli_close_clamps.toml
+                        --out ${_cli_out_dir}/cli_close_clamps_summary.csv --summary ${_cli_out_dir}/cli_close_clamps_summary.json
+                   EXPECT_RC 0 OUT ${_cli_out_dir}/cli_close_clamps_summary.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_close_clamps_summary.json JSON_PATH "model_adjustments|0"
+                   JSON_TEXT "clamps[0] (x = 0.1 m) and clamps[1] (x = 0.1004 m), 0.0004 m apart, act as one clamp at x = 0.1002 m")
+stackbeam_cli_test(NAME cli_no_close_clamps_no_note
+                   ARGS simulate --case friction --t-end 0.002
+                        --out ${_cli_out_dir}/cli_no_close_clamps.csv --summary ${_cli_out_dir}/cli_no_close_clamps.json
+                   EXPECT_RC 0 NOT_TEXT "model adjustment" OUT ${_cli_out_dir}/cli_no_close_clamps.json HEADER_PREFIX "{"
+                   JSON ${_cli_out_dir}/cli_no_close_clamps.json JSON_ABSENT "model_adjustments")
 
 # Interruption (apps/cli/run.hpp): SIGTERM / SIGINT once the first rows are on disk; exit
 # status 143 / 130, the .partial files end on whole rows (every line the header's field

@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "stackbeam/fe/system.hpp"
+#include "stackbeam/run/run.hpp"
+#include "stackbeam/run/summary_json.hpp"
+#include "stackbeam/study/sweep.hpp"
 #include "stackbeam/time/stepper.hpp"
 #include "test_support.hpp"
 
@@ -151,4 +154,101 @@ BOOST_AUTO_TEST_CASE(the_merge_moves_the_answer_less_than_the_mesh_does) {
                                                    << " J, merged on h = 50 mm " << d_coarse << " J");
     BOOST_TEST(std::abs(f_merged_fine - f_converged) <= 0.1 * std::abs(f_coarse - f_converged));
     BOOST_TEST(std::abs(d_merged_fine - d_converged) <= 0.1 * std::abs(d_coarse - d_converged));
+}
+
+namespace {
+
+/// A short run of `model` through the run layer (10 steps of rig_cycle's stroke) and its JSON summary.
+std::pair<RunSummary, std::string> short_run(const Model& model) {
+    const System sys(model);
+    RunRequest request;
+    request.options.mode = Mode::closed_form;
+    request.options.loading.kind = LoadingKind::prescribed_displacement;
+    request.options.loading.displacement_m.shape = TimeFunction::Shape::table;
+    request.options.loading.displacement_m.times_s = {0.0, 0.25};
+    request.options.loading.displacement_m.values = {0.0, -0.01};
+    request.options.dt_s = 1e-3;
+    request.options.t_end_s = 0.01;
+    request.options.solver.tolerance_m = 1e-9;
+    RunSummary summary = run_scenario(sys, request);
+    summary.wall_s = 0.0;  // the one figure that differs between two runs of the same model
+    std::string json = summary_json(summary, model);
+    return {std::move(summary), std::move(json)};
+}
+
+}  // namespace
+
+// The merge is told (Model::adjustments(), decision 077): one sentence per merged pair naming the
+// clamps as the user wrote them (their index in clamps and their x), the gap, the merged x and why.
+// The independent values: the spec two_clamp_pairs(0.15, 0.15035, 0.05) writes clamps[0] at 0.45 -
+// 0.15 = 0.3 m and clamps[2] at 0.45 - 0.15035 = 0.29965 m (0.35 mm apart, < 0.1 h = 5 mm), their
+// midpoint 0.299825 m; clamps[1] at 0.6 m and clamps[3] at 0.60035 m, midpoint 0.600175 m. Clamps
+// kept apart (6 mm on h = 50 mm, or rigid ties) give no sentence.
+BOOST_AUTO_TEST_CASE(the_merge_is_told_naming_the_clamps_as_written) {
+    const Model m = Model::build(two_clamp_pairs(0.15, 0.15035, 0.05));
+    const std::vector<std::string>& notes = m.adjustments();
+    BOOST_TEST_REQUIRE(notes.size() == 2u);
+    for (const std::string& n : notes) BOOST_TEST_MESSAGE(n);
+    const auto has = [](const std::string& note, const std::string& part) {
+        BOOST_TEST(note.find(part) != std::string::npos, "'" << part << "' not in: " << note);
+    };
+    has(notes[0], "clamps[0] (x = 0.3 m) and clamps[2] (x = 0.29965 m), 0.00035 m apart, act as one clamp at x = 0.299825 m");
+    has(notes[1], "clamps[1] (x = 0.6 m) and clamps[3] (x = 0.60035 m), 0.00035 m apart, act as one clamp at x = 0.600175 m");
+    for (const std::string& n : notes) {
+        has(n, "their preloads and lengths added");
+        has(n, "closer than a tenth of mesh.element_length_m (0.005 m of 0.05 m)");
+    }
+    // the sentence's merged x is where the model put both clamps
+    BOOST_TEST(m.spec().clamps[0].x_m == 0.299825, tt::tolerance(1e-12));
+    BOOST_TEST(m.spec().clamps[3].x_m == 0.600175, tt::tolerance(1e-12));
+    BOOST_TEST(Model::build(two_clamp_pairs(0.15, 0.156, 0.05)).adjustments().empty());
+    ModelSpec rigid = two_clamp_pairs(0.15, 0.15035, 0.05);
+    rigid.interfaces[0].contact = InterfaceContact::rigid;
+    BOOST_TEST(Model::build(rigid).adjustments().empty());
+}
+
+// Every front-end shows it through the run layer: RunSummary::model_adjustments is the model's, and
+// the JSON summary (the command line's --summary, Python's result.summary) has them under
+// "model_adjustments", which is its only difference from the same summary without them. A model
+// without close clamps has none and its summary no such key: byte for byte what it was before.
+BOOST_AUTO_TEST_CASE(the_run_summary_shows_the_merge_and_only_when_there_is_one) {
+    const Model merged = Model::build(two_clamp_pairs(0.15, 0.15035, 0.05));
+    auto [summary, json] = short_run(merged);
+    BOOST_TEST(summary.model_adjustments == merged.adjustments());
+    const std::string key = "\"model_adjustments\": [";
+    const std::size_t at = json.find(key);
+    BOOST_TEST_REQUIRE(at != std::string::npos);
+    BOOST_TEST(json.find("act as one clamp at x = 0.299825 m") != std::string::npos);
+    // the key's lines taken out, the summary is the one without adjustments
+    const std::size_t line = json.rfind('\n', at), end = json.find("\n  ],", at);
+    BOOST_TEST_REQUIRE(end != std::string::npos);
+    std::string without_key = json;
+    without_key.erase(line, end + 5 - line);
+    summary.model_adjustments.clear();
+    BOOST_TEST(summary_json(summary, merged) == without_key);
+
+    const Model apart = Model::build(two_clamp_pairs(0.15, 0.156, 0.05));
+    const auto [plain, plain_json] = short_run(apart);
+    BOOST_TEST(plain.model_adjustments.empty());
+    BOOST_TEST(plain_json.find("model_adjustments") == std::string::npos);
+}
+
+// A sweep point's message (points.csv's `message` column) carries the sentence too: the point runs
+// through the same run layer (run_point), so its row says which clamps its model merged.
+BOOST_AUTO_TEST_CASE(a_sweep_point_tells_the_merge_in_its_message) {
+    SweepPoint point;
+    point.scenario.model = two_clamp_pairs(0.15, 0.15035, 0.05);
+    point.scenario.simulation.mode = Mode::closed_form;
+    point.scenario.simulation.loading.kind = LoadingKind::prescribed_displacement;
+    point.scenario.simulation.loading.displacement_m.shape = TimeFunction::Shape::table;
+    point.scenario.simulation.loading.displacement_m.times_s = {0.0, 0.25};
+    point.scenario.simulation.loading.displacement_m.values = {0.0, -0.01};
+    point.scenario.simulation.dt_s = 1e-3;
+    point.scenario.simulation.t_end_s = 0.01;
+    const PointResult r = run_point(point);
+    BOOST_TEST((r.status == PointStatus::ok), r.message);
+    BOOST_TEST(r.message.find("clamps[0] (x = 0.3 m) and clamps[2] (x = 0.29965 m)") != std::string::npos, r.message);
+    BOOST_TEST(r.message.find("clamps[1] (x = 0.6 m) and clamps[3] (x = 0.60035 m)") != std::string::npos, r.message);
+    point.scenario.model = two_clamp_pairs(0.15, 0.156, 0.05);
+    BOOST_TEST(run_point(point).message.find("clamps[") == std::string::npos);
 }

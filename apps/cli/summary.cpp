@@ -36,6 +36,8 @@ void print_summary(const SimulateRequest& request, const System& system, const R
                     to_string(summary.contact_path), summary.contact_components);
         std::printf("steps                      %ld\n", steps);
     }
+    for (const std::string& note : summary.model_adjustments)  // Model::adjustments(): close clamps merged
+        std::printf("model adjustment           %s\n", note.c_str());
     const ModelSpec& spec = system.model().spec();
     for (std::size_t i = 0; i < spec.interfaces.size(); ++i)
         if (spec.interfaces[i].contact == InterfaceContact::elastic) {

@@ -223,8 +223,8 @@ constexpr double kNodeMergeFraction = 0.1;
 
 /// Moves the clamps of `spec` by the rule above (the model's spec keeps the moved positions; the
 /// clamps that meet at one point make one pair per interface). tol: the model's position
-/// tolerance [m].
-void merge_close_clamps(ModelSpec& spec, double tol) {
+/// tolerance [m]. Returns one sentence per merge for Model::adjustments() (the user is told).
+std::vector<std::string> merge_close_clamps(ModelSpec& spec, double tol) {
     const double reach = kNodeMergeFraction * spec.mesh.element_length_m;  // [m]
     // whether clamp c ties two leaves rigidly: it crosses an interface that is not bonded, rigid
     // or with c a point clamp (length 0: rigid on an elastic interface too)
@@ -243,15 +243,25 @@ void merge_close_clamps(ModelSpec& spec, double tol) {
     for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return spec.clamps[a].x_m < spec.clamps[b].x_m; });
     const double seat = spec.rigid_body.x_m;
+    std::vector<std::string> notes;
     for (std::size_t k = 0; k + 1 < order.size(); ++k) {
         ClampSpec &a = spec.clamps[order[k]], &b = spec.clamps[order[k + 1]];
         const double gap = b.x_m - a.x_m;
         if (merged[order[k]] || gap <= tol || gap > reach) continue;
         if (a.x_m <= seat + tol && b.x_m >= seat - tol) continue;  // across (or at) the seat: the half model's mirror
         if (rigid_tie(a) || rigid_tie(b)) continue;
+        const std::size_t i = std::min(order[k], order[k + 1]), j = std::max(order[k], order[k + 1]);
+        const double xi = spec.clamps[i].x_m, xj = spec.clamps[j].x_m;
         a.x_m = b.x_m = 0.5 * (a.x_m + b.x_m);
         merged[order[k]] = merged[order[k + 1]] = true;
+        const auto clamp = [](std::size_t c, double x) { return "clamps[" + std::to_string(c) + "] (x = " + format_value(x) + " m)"; };
+        notes.push_back(clamp(i, xi) + " and " + clamp(j, xj) + ", " + format_value(gap) + " m apart, act as one clamp at x = " +
+                        format_value(a.x_m) + " m, their preloads and lengths added: two clamps closer than a tenth of "
+                        "mesh.element_length_m (" + format_value(reach) + " m of " + format_value(spec.mesh.element_length_m) +
+                        " m) share a node, as an element that short would leave a round-off floor in every energy balance "
+                        "(docs/model-and-scenarios.md, \"Mesh\"; a smaller element_length_m keeps them apart)");
     }
+    return notes;
 }
 }  // namespace
 
@@ -689,7 +699,7 @@ Model Model::build(ModelSpec spec) {
     validate_probe(spec, present, x_hi, tol);
 
     // --- the mesh and each leaf's node range -------------------------------------------
-    merge_close_clamps(spec, tol);
+    m.adjustments_ = merge_close_clamps(spec, tol);
     m.nodes_x_ = node_grid(spec, tol, x_hi);
     const int nn = static_cast<int>(m.nodes_x_.size());
     for (const auto& l : leaves) {

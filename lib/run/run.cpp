@@ -106,6 +106,7 @@ RunSummary run_scenario(const System& system, const RunRequest& request) {
     const std::function<bool()>& stop = options.stop_requested;
     summary.contact_path = choose_contact_path(system, options);
     summary.contact_components = system.num_components();
+    summary.model_adjustments = system.model().adjustments();
     RunSink none;
     RunSink& sink = request.sink ? *request.sink : none;
     const RunOutputs& out = request.outputs;

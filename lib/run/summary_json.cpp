@@ -181,6 +181,8 @@ std::string summary_json(const RunSummary& summary, const Model& model, const Su
                                 {"decay_length_m", kappa.decay_length_m},
                                 {"elastic", kappa.elastic}};
     j["interfaces"] = interfaces_json(model);
+    // what Model::build changed in the spec (close clamps merged): only when it changed something
+    if (!summary.model_adjustments.empty()) j["model_adjustments"] = summary.model_adjustments;
     j["loading"] = {{"kind", to_string(options.loading.kind)},
                     {"gravity_m_per_s2", options.loading.gravity_m_per_s2},
                     {"period_s", options.loading.period_s()}};

@@ -659,10 +659,12 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
     result.index = point.index;
     result.figures.assign(point_figure_columns().size(), std::numeric_limits<double>::quiet_NaN());
     std::vector<StepRecord> records;
+    std::vector<std::string> adjustments;  // Model::adjustments() (close clamps merged): told last in the message
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
     try {
         // the library's run, as `stackbeam simulate --scenario` (run/run.hpp): build, system, run
         const Model model = Model::build(point.scenario.model);
+        adjustments = model.adjustments();
         const System system(model);
         RunRequest run;
         run.options = point.scenario.simulation;
@@ -690,6 +692,7 @@ PointResult run_point(const SweepPoint& point, const std::atomic<bool>* stop,
         result.status = PointStatus::failed;
         result.message = e.what();
     }
+    for (const std::string& note : adjustments) result.message += (result.message.empty() ? "" : "; ") + note;
     result.wall_s = elapsed();
     if (with_records) {
         result.records = &records;

@@ -23,7 +23,10 @@ void require_converged(const SolveResult& r) {
 }
 
 /// The contact state with R held at w0 (held_body_system) by `options`' solver on the start's
-/// path: p [N] and z (w last) on exit.
+/// path: p [N] and z (w last) on exit, the pairs that slipped into it re-anchored where they are
+/// (as held_seat_start and every step do): left at their anchors from before the solve, a pair
+/// still slipping at step 1 was measured against the stale anchor and its friction did negative
+/// work (decision 077: -2.8e-5 J at step 1 of a cosine rig stroke from 20 mm, closed-form).
 void held_contact_state(const System& sys, InitialState& st, const SolverOptions& options) {
     const int w_dof = sys.num_reduced_dofs() - 1;
     StepProblem held;
@@ -38,6 +41,7 @@ void held_contact_state(const System& sys, InitialState& st, const SolverOptions
     if (st.z.size() != w_dof + 1) st.z = Eigen::VectorXd::Zero(w_dof + 1);
     st.z.head(w_dof) = zr;
     st.z[w_dof] = st.w0_m;
+    reanchor(st.laws, st.p, relative_positions(sys, st.z, st.p), st.d);
 }
 
 /// The windup rig holds theta_R from the start (loading.seat_rotation_rad, theta_R(0) = 0 by
@@ -93,7 +97,7 @@ bool held_seat_start(const System& sys, InitialState& st, const Eigen::VectorXd&
 }
 
 /// The massless stack: the assembly and R's weight -m g as static steps with R free (one solver
-/// over both, on the start's path), then the contact state with R held at w0 (no re-anchoring).
+/// over both, on the start's path), then the contact state with R held at w0 (re-anchored).
 void start_massless(const System& sys, InitialState& st, const SolverOptions& options) {
     const int n = sys.num_components();
     const Loading& L = st.options.loading;

@@ -275,6 +275,13 @@ public:
     double whole_spring_factor() const noexcept { return spec_.symmetry == Symmetry::half ? 2.0 : 1.0; }
     /// Tolerance used to decide that two x positions coincide [m].
     double x_tolerance_m() const noexcept { return x_tol_; }
+    /// What build() changed in the spec it was given, one sentence each naming the keys as the
+    /// user wrote them (empty: nothing). So far the close clamps it merged (docs/model-and-scenarios.md,
+    /// "Mesh"; decision 071): "clamps[0] (x = 0.29965 m) and clamps[2] (x = 0.3 m), 0.00035 m apart,
+    /// act as one clamp at x = 0.299825 m, ...". Every front-end shows them with the run's answers
+    /// (RunSummary::model_adjustments: the JSON summary's "model_adjustments", the text summary, a
+    /// sweep point's message).
+    const std::vector<std::string>& adjustments() const noexcept { return adjustments_; }
 
 private:
     ModelSpec spec_;
@@ -286,6 +293,7 @@ private:
     int attach_node_ = 0;
     int probe_pair_ = -1;
     double x_tol_ = 0.0;
+    std::vector<std::string> adjustments_;
 };
 
 /// The curvature of a leaf's free shape [1/m]: 1/free_radius_m, or 8 free_camber_m / L^2 (0: flat).

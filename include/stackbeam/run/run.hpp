@@ -149,6 +149,9 @@ struct RunSummary {
     /// RunOutputs::stresses: the stress figures (none when not asked; when interrupted: stresses_note says)
     std::optional<RunStresses> stresses;
     std::string stresses_note;
+    /// What Model::build changed in the user's spec (Model::adjustments(): close clamps merged),
+    /// one sentence each; every front-end shows them with the answers (empty: nothing, no key)
+    std::vector<std::string> model_adjustments;
     bool interrupted = false;        ///< the stop check ended the run
     double t_reached_s = 0.0;        ///< the last record's time [s]
     double wall_s = 0.0;             ///< wall time of the run [s] (the set-up of the stepper and the steps)
