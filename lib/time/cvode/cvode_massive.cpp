@@ -392,6 +392,8 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
 
     /// At fixed z only the diagonal layer is instantaneous: the state decides every pair.
     bool settle_at_state() const override { return true; }
+    /// Every contact row has its own layer (p_i = (d_i - G_i z) / c_i on a held row).
+    double own_layer_compliance_m_per_n(int row) const override { return cL[row]; }
 
     // ---- CVODE ------------------------------------------------------------------
 

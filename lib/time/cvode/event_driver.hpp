@@ -117,6 +117,10 @@ public:
     /// True when the state y alone decides every pair's modes (no instantaneous coupling but
     /// the diagonal layer): decide_modes then makes every witness hold at y (default false).
     virtual bool settle_at_state() const;
+    /// The compliance c_i [m/N] of contact row i's own layer where the stepper's forces of held rows
+    /// are p_i = (d_i - G_i z) / c_i (a diagonal layer: settle_at_state), else 0 (default): a pair
+    /// that sticks at an event with its force past its cone then sticks at the cone (decide_modes).
+    virtual double own_layer_compliance_m_per_n(int row) const;
     /// The new modes entered with forces p_new (p_cur before): the stepper's bookkeeping of the jump.
     virtual void after_event(const std::string& cause, const Vec& p_cur, const Vec& p_new) = 0;
 };
@@ -343,6 +347,9 @@ private:
     void start_cvode(const EventStart& s);
     void decide_initial_modes(const InitialState& stage, const EventStart& s);
     void rebuild();
+    /// Moves the anchors of the stuck pairs whose force p_cur lies past their cone so that it sits
+    /// on it (a diagonal layer only); true when one moved.
+    bool stick_at_cones(const Vec& p_cur, const std::vector<signed char>& tm);
     void enter(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm);
     void in_candidate_modes(const Vec& rel, const std::vector<signed char>& nm, const std::vector<signed char>& tm,
                             bool build, const std::function<void()>& body);
