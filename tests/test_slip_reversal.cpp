@@ -68,6 +68,20 @@ Instants newmark_instants(const System& sys, double dt_s) {
     });
     return in;
 }
+/// The whole massive stack under cvode, records every dt_s [s], beta as newmark's; the layer's
+/// normal dashpots (tau_L = 1e-5 s, decision 071) keep its contact points from bouncing on the
+/// layer while the end pairs close.
+SimulationOptions massive_options(double dt_s) {
+    SimulationOptions so;
+    so.mode = Mode::cvode;
+    so.cvode.leaf_inertia = LeafInertia::massive;
+    so.dt_s = dt_s;
+    so.t_end_s = kEnd_s;
+    so.solver.tolerance_m = 1e-9;
+    so.damping.rayleigh_beta_s = kBeta_s;
+    so.damping.layer_normal_time_s = 1e-5;
+    return so;
+}
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(slip_stops_at_a_located_root_and_sticks) {
@@ -78,14 +92,7 @@ BOOST_AUTO_TEST_CASE(slip_stops_at_a_located_root_and_sticks) {
     // rate witness), stick -> slip+ at 8.85195 ms (its stick force across the cone), 32 events
     // in all, no slip reversal.
     const System sys(Model::build(rising_stack()));
-    SimulationOptions so;
-    so.mode = Mode::cvode;
-    so.cvode.leaf_inertia = LeafInertia::massive;
-    so.dt_s = 5e-4;
-    so.t_end_s = kEnd_s;
-    so.solver.tolerance_m = 1e-9;
-    so.damping.rayleigh_beta_s = kBeta_s;
-    so.damping.layer_normal_time_s = 1e-5;
+    const SimulationOptions so = massive_options(5e-4);
     RunReport rep;
     const auto r = simulate(sys, so, {}, &rep);
     BOOST_TEST(r.back().t_s == kEnd_s, boost::test_tools::tolerance(1e-12));
@@ -141,14 +148,7 @@ BOOST_AUTO_TEST_CASE(slip_stops_at_a_located_root_and_sticks) {
 // missed event (the per-step check's) changes a pair.
 BOOST_AUTO_TEST_CASE(a_slipping_pairs_force_is_on_its_cone) {
     const System sys(Model::build(rising_stack()));
-    SimulationOptions so;
-    so.mode = Mode::cvode;
-    so.cvode.leaf_inertia = LeafInertia::massive;
-    so.dt_s = 1e-4;
-    so.t_end_s = kEnd_s;
-    so.solver.tolerance_m = 1e-9;
-    so.damping.rayleigh_beta_s = kBeta_s;
-    so.damping.layer_normal_time_s = 1e-5;
+    const SimulationOptions so = massive_options(1e-4);
     RunReport rep;
     int slipping = 0;
     double worst = 0.0;
