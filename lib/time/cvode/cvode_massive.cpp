@@ -238,7 +238,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
     /// roundings left a slipping pair's force ~1e-9 (relative) inside its own cone. The per-step
     /// check then read it as sticking, its slip since the last step as the incremental problem's
     /// error, and stopped the run at a "missed event" that kept every mode (4,033 restarts of
-    /// soak seed 23's 4,377 events; decision 074).
+    /// soak seed 23's 4,377 events; decision 078).
     Vec forces_z(const Eigen::Ref<const Eigen::VectorXd>& z) const {
         Vec p = P * z + p0;
         modes().put_slip_forces(laws(), p);
@@ -376,7 +376,7 @@ struct CvodeMassiveStepper::Impl final : EventDriver, ContactEventHooks {
             if (cp.row_t < 0 || cp.kind == PairKind::bonded || !(cp.friction_coefficient > 0.0)) continue;
             const double limit_n = cp.friction_coefficient * friction_normal_force(laws(), kk, p_cur);
             // at the edge within the stick witness's margin (witnesses_from with the forces' round-off)
-            const double r = cp.row_n >= 0 ? round_off[cp.row_t] + cp.friction_coefficient * round_off[cp.row_n] : round_off[cp.row_t];
+            const double r = stick_round_off_n(kk, round_off);
             if (limit_n > 0.0 && std::abs(p_cur[cp.row_t]) >= limit_n - std::max(kForceMargin * scales().F_ref_n, r))
                 side[static_cast<std::size_t>(kk)] = p_cur[cp.row_t] > 0.0 ? 1 : -1;
         }

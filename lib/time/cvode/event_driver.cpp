@@ -342,6 +342,13 @@ void EventDriver::signs_follow_slip_rates(const Vec& rel, std::vector<signed cha
     }
 }
 
+double EventDriver::stick_round_off_n(int kk, const Vec& force_round_off) const {
+    const auto& cp = pairs()[kk];
+    double r = force_round_off[cp.row_t];
+    if (cp.row_n >= 0) r += cp.friction_coefficient * force_round_off[cp.row_n];
+    return r;
+}
+
 void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>& s_of,
                                  const std::function<double(int)>& rate_of, double* g, const Vec* force_round_off) const {
     for (std::size_t i = 0; i < slots_.size(); ++i) {
@@ -365,11 +372,8 @@ void EventDriver::witnesses_from(const Vec& p, const std::function<double(int)>&
             switch (modes_.tmode[kk]) {
                 case STICK:
                     val = (cp.friction_coefficient * friction_normal_force(chk_problem_, kk, p) - std::abs(p[rt])) / scales_.F_ref_n;
-                    if (force_round_off != nullptr) {  // the margin no finer than the forces' round-off
-                        double r = (*force_round_off)[rt];
-                        if (cp.row_n >= 0) r += cp.friction_coefficient * (*force_round_off)[cp.row_n];
-                        margin = std::max(margin, r / scales_.F_ref_n);
-                    }
+                    if (force_round_off != nullptr)  // the margin no finer than the forces' round-off
+                        margin = std::max(margin, stick_round_off_n(kk, *force_round_off) / scales_.F_ref_n);
                     break;
                 case SLIP_POS: val = -rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;
                 case SLIP_NEG: val = rate_of(rt) / scales_.V_ref_m_per_s; margin = kMotionMargin; break;

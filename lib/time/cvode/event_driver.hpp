@@ -242,6 +242,9 @@ protected:
     /// (the massive stack on a stiff layer, decision 074).
     void witnesses_from(const Vec& p, const std::function<double(int)>& s_of, const std::function<double(int)>& rate_of,
                         double* g, const Vec* force_round_off = nullptr) const;
+    /// The round-off [N] of pair kk's stick margin mu tau - |p_t| from each row's force round-off
+    /// `force_round_off` [N]: its tangential row's, plus mu times its normal row's.
+    double stick_round_off_n(int kk, const Vec& force_round_off) const;
     /// For correct_decision of the steppers with slipping pairs of their own rate: a slipping
     /// pair slips against its slider rate; where the new modes' rate (`rate`, evaluated on the
     /// candidate modes after build_mode) contradicts the decided sign beyond the margin (a
