@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -145,7 +146,8 @@ BOOST_AUTO_TEST_CASE(slip_stops_at_a_located_root_and_sticks) {
 // last step as the contact problem's error, and stopped at a "missed" event that kept every mode
 // (4,033 of seed 23's 4,377 events). Here every record's slipping pair has |p_t| = mu |p_n| to the
 // rounding of the records' scaling (4 eps), and no event is a missed one that kept its modes: each
-// missed event (the per-step check's) changes a pair.
+// missed event (the per-step check's) changes a pair. Measured with the old forces (P z + p0): the
+// slipping forces 1.5e-9 inside their cone, 84 missed events of which none changed a pair.
 BOOST_AUTO_TEST_CASE(a_slipping_pairs_force_is_on_its_cone) {
     const System sys(Model::build(rising_stack()));
     const SimulationOptions so = massive_options(1e-4);
@@ -162,7 +164,10 @@ BOOST_AUTO_TEST_CASE(a_slipping_pairs_force_is_on_its_cone) {
     BOOST_TEST_MESSAGE(slipping << " slipping pair records, largest |p_t| / (mu |p_n|) - 1: " << worst);
     BOOST_TEST(slipping > 0);
     BOOST_TEST(worst <= 4.0 * std::numeric_limits<double>::epsilon());
-    long checks = 0;
-    for (const ContactEvent& e : rep.events) checks += e.cause == "check";
-    BOOST_TEST(rep.cvode.missed_events <= checks);  // every missed event logged a transition
+    // every missed event changed a pair: as many distinct instants of "check" transitions as missed events
+    std::set<double> check_times;
+    for (const ContactEvent& e : rep.events)
+        if (e.cause == "check") check_times.insert(e.t_s);
+    BOOST_TEST_MESSAGE(rep.cvode.missed_events << " missed events, " << check_times.size() << " with a transition");
+    BOOST_TEST(rep.cvode.missed_events == static_cast<long>(check_times.size()));
 }

@@ -318,15 +318,16 @@ void massive_window(SimulationOptions& o, double t_end_s) {
     o.cvode.max_steps = 1000000;
 }
 
+/// The whole massive stack's window [s] (soak_seed: its first 0.05 s; a regression case may take less).
+struct MassiveWindow {
+    double t_end_s = 0.05;
+};
+
 /// Runs seed `seed` (massless, then with steel leaves) under every registered stepper that takes
 /// it; every run must complete within the step budget and close its balance. `only_row`: that row
 /// alone (the regression cases); else every row but the known failures. `expect_error`: the run
 /// must instead stop with an error saying that, well within its step budget (a named refusal).
 /// `steps` > 0: the runs stop after that many steps (fixed-step rows: a regression case's start).
-/// The whole massive stack's window [s] (soak_seed: its first 0.05 s; a regression case may take less).
-struct MassiveWindow {
-    double t_end_s = 0.05;
-};
 /// `massive`: the whole massive stack's window.
 void soak_seed(unsigned seed, const std::string& only_row = "", const std::string& expect_error = "", long steps = 0,
                MassiveWindow massive = {}) {
@@ -535,7 +536,7 @@ BOOST_AUTO_TEST_CASE(seed_14_cvode_massive_initial_solve_within_round_off) {
 // at the event's state itself: each next step's check failed at once and the run crept by 5e-17 s
 // a restart, 200 events within 1e-10 s (the named one-instant chatter). A pair that leaves an
 // event stuck past its cone now sticks on it (EventDriver::stick_at_cones, decision 078): the
-// first 1 ms runs (the full window reaches the step limit at 9.6 ms: kKnownFailures).
+// first 1 ms runs here (the whole 0.05 s window, 444,607 steps, in the slow tier).
 BOOST_AUTO_TEST_CASE(seed_18_cvode_massive_sticks_on_its_cone) { soak_seed(18, "cvode-massive", "", 0, MassiveWindow{1e-3}); }
 BOOST_AUTO_TEST_CASE(seed_25_cvode_massive_slip_stops_at_its_cone) { soak_seed(25, "cvode-massive", "", 0, MassiveWindow{1e-3}); }
 // A run that reaches cvode.max_steps says what the steps went into (decision 065): seed 1's
